@@ -1,0 +1,318 @@
+/* perilin: implicit static and modal peridynamics on PETSc.
+ *
+ * The flow of one run (see docs/design.md):
+ *   scene (YAML + options) -> particles -> partition + neighbours (bonds) -> corrections
+ *   -> model calibration -> assembly of K -> analysis -> output.
+ * PeriProblem owns every stage; the executable and the tests drive it through this header. */
+#pragma once
+
+#include <petscksp.h>
+
+#if PETSC_VERSION_LT(3, 19, 0)
+  #define PETSC_SUCCESS 0
+#endif
+
+#define PERI_MAX_DOF     3
+#define PERI_MAX_MODES   6
+#define PERI_NAME_LEN    64
+#define PERI_MAX_MEASURE 3
+
+/* ------------------------------------------------------------------ scene (src/scene.c) */
+typedef enum {
+  PERI_NODE_MAP,
+  PERI_NODE_SEQ,
+  PERI_NODE_SCALAR
+} PeriNodeKind;
+
+typedef struct _PeriNode *PeriNode;
+struct _PeriNode {
+  PeriNodeKind kind;
+  char        *key;   /* key in the parent mapping, or the index for sequence items */
+  char        *path;  /* dotted path from the root, e.g. "material.nu", "bc.0.region" */
+  char        *value; /* scalars only */
+  int          line;  /* 1-based line in the scene file; 0 when set from the options database */
+  PetscInt     n;
+  PeriNode    *child;
+};
+
+typedef struct _p_PeriScene *PeriScene;
+struct _p_PeriScene {
+  char     file[PETSC_MAX_PATH_LEN];
+  char     dir[PETSC_MAX_PATH_LEN]; /* directory of the scene file, for relative paths */
+  PeriNode root;
+};
+
+PETSC_EXTERN PetscErrorCode PeriSceneCreateFromFile(const char[], PeriScene *);
+PETSC_EXTERN PetscErrorCode PeriSceneDestroy(PeriScene *);
+PETSC_EXTERN PetscErrorCode PeriSceneHelp(MPI_Comm);
+PETSC_EXTERN PetscErrorCode PeriSceneWhere(PeriScene, PeriNode, const char[], char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriSceneGetNode(PeriNode, const char[], PeriNode *);
+PETSC_EXTERN PetscErrorCode PeriSceneGetMap(PeriScene, PeriNode, const char[], PetscBool, PeriNode *);
+PETSC_EXTERN PetscErrorCode PeriSceneCheckKeys(PeriScene, PeriNode, const char *const[]);
+PETSC_EXTERN PetscErrorCode PeriSceneGetReal(PeriScene, PeriNode, const char[], PetscBool, PetscReal *, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneGetInt(PeriScene, PeriNode, const char[], PetscBool, PetscInt *, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneGetBool(PeriScene, PeriNode, const char[], PetscBool *, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneGetString(PeriScene, PeriNode, const char[], PetscBool, char[], size_t, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneGetChoice(PeriScene, PeriNode, const char[], const char *const[], PetscInt *, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneGetRealArray(PeriScene, PeriNode, const char[], PetscBool, PetscInt, PetscInt, PetscReal[], PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriSceneParseReal(PeriScene, PeriNode, PetscReal *);
+PETSC_EXTERN PetscErrorCode PeriSceneParseBool(PeriScene, PeriNode, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneParseRealArray(PeriScene, PeriNode, PetscInt, PetscInt, PetscReal[], PetscInt *);
+
+/* A user-input error that names the file, the line and the key. */
+#define PeriInputCheck(cond, scene, node, key, fmt, ...) \
+  do { \
+    if (PetscUnlikely(!(cond))) { \
+      char peri_where_[2 * PETSC_MAX_PATH_LEN]; \
+      PetscCall(PeriSceneWhere((scene), (node), (key), peri_where_, sizeof(peri_where_))); \
+      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: " fmt, peri_where_, ##__VA_ARGS__); \
+    } \
+  } while (0)
+
+/* ------------------------------------------------------------------ particles (src/particles.c) */
+typedef struct {
+  PetscInt   dim;
+  PetscInt   n;           /* global number of particles; every rank holds all coordinates */
+  PetscReal *x;           /* 3 per particle (z = 0 in 2D) */
+  PetscReal *volume;      /* includes the thickness in 2D */
+  PetscReal *spacing;     /* the particle's own grid spacing, for partial volumes */
+  PetscInt  *source_line; /* line in the CSV file (0 for grid particles), for messages */
+  PetscReal  thickness;   /* 2D only */
+  PetscReal  lower[3], upper[3];
+  PetscBool  periodic[3];
+  PetscReal  mean_spacing;
+} PeriParticles;
+
+PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
+PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
+
+/* ------------------------------------------------------------------ regions (src/regions.c) */
+typedef enum {
+  PERI_REGION_ALL,
+  PERI_REGION_BOX,
+  PERI_REGION_LAYER
+} PeriRegionKind;
+
+typedef struct {
+  char           name[PERI_NAME_LEN];
+  PeriRegionKind kind;
+  PetscReal      lower[3], upper[3]; /* the box, or the layer's slab */
+  PetscInt       axis, side;         /* layers: axis 0..2, side -1 (lower face) or +1 (upper face) */
+  PetscReal      depth;              /* layers */
+  PetscReal      face_area;          /* layers: area of the body's face the layer lies on */
+  PetscInt       count;              /* particles inside */
+  PetscReal      volume;             /* their total volume */
+  PeriNode       node;
+} PeriRegion;
+
+PETSC_EXTERN PetscErrorCode PeriRegionsCreateFromScene(PeriScene, const PeriParticles *, PetscReal, PetscInt *, PeriRegion **);
+PETSC_EXTERN PetscErrorCode PeriRegionFind(PeriScene, PeriNode, const char[], PetscInt, PeriRegion *, PeriRegion **);
+PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscReal[]);
+
+/* ------------------------------------------------------------------ bonds (src/neighbors.c, src/corrections.c) */
+typedef enum {
+  PERI_PARTIAL_VOLUME_NONE,
+  PERI_PARTIAL_VOLUME_LINEAR,
+  PERI_PARTIAL_VOLUME_LINEAR_CONTINUED
+} PeriPartialVolume;
+PETSC_EXTERN const char *const PeriPartialVolumes[];
+
+typedef enum {
+  PERI_SURFACE_NONE,
+  PERI_SURFACE_VOLUME
+} PeriSurfaceCorrection;
+PETSC_EXTERN const char *const PeriSurfaceCorrections[];
+
+/* Bonds are stored once per pair, in the row of the smaller global index (CSR over owned particles). */
+typedef struct {
+  PetscInt       rstart, rend; /* owned particles */
+  PetscInt      *offset;       /* rend - rstart + 1 */
+  PetscInt      *j;            /* the other particle (global index, j >= i; j == i only for periodic self-images) */
+  PetscReal     *xi;           /* 3 per bond: X_j - X_i, minimum image on periodic axes */
+  PetscReal     *length;
+  PetscReal     *alpha;        /* partial-volume factor */
+  PetscReal     *lambda;       /* surface correction factor */
+  unsigned char *live;         /* 1 intact, 0 broken */
+  PetscInt       nbonds;       /* local */
+} PeriBonds;
+
+PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriBondsDestroy(PeriBonds *);
+PETSC_EXTERN PetscReal      PeriPartialVolumeFactor(PeriPartialVolume, PetscReal, PetscReal, PetscReal);
+PETSC_EXTERN PetscReal      PeriSearchRadius(PeriPartialVolume, PetscReal, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm, const PeriParticles *, const PeriBonds *, PetscReal[], PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PeriPartialVolume, PetscInt *, PetscInt **, PetscInt **);
+
+/* ------------------------------------------------------------------ models (src/model.c, models/) */
+typedef struct {
+  PetscReal E, nu, K, G; /* Young's modulus, Poisson ratio, 3D bulk and shear moduli */
+  PetscReal rho;         /* density (0 when the scene gives none) */
+  PetscReal thickness;   /* 2D */
+} PeriMaterial;
+
+/* One bond as the kernels see it: plain data, no PETSc objects. */
+typedef struct {
+  PetscInt  i, j;
+  PetscReal xi[3], length;
+  PetscReal Vi, Vj;
+  PetscReal weight; /* alpha * lambda */
+} PeriBondGeometry;
+
+/* What calibration may use besides the material: the discrete family volumes sum_j alpha_ij V_j. */
+typedef struct {
+  PetscInt         n;
+  const PetscReal *family_volume;
+} PeriCalibrationData;
+
+typedef struct _p_PeriModel *PeriModel;
+typedef struct {
+  /* Reads the model's own scene keys (model.*); may be NULL. */
+  PetscErrorCode (*setfromscene)(PeriModel, PeriScene, PeriNode);
+  /* Admissible Poisson ratio range for this dimension / plane kind. */
+  void (*nu_range)(PeriModel, PetscReal *, PetscReal *);
+  PetscErrorCode (*calibrate)(PeriModel, const PeriCalibrationData *);
+  /* The (2 dofs)^2 linearized stiffness block of one bond, row-major, DOFs of i then of j. */
+  void (*bond_stiffness)(PeriModel, const PeriBondGeometry *, PetscReal[]);
+  /* The bond's strain measures (stretch, sliding, ...) from the two particles' DOFs. */
+  void (*bond_measures)(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
+  /* Values of the rigid-body (zero-energy) modes at a point, nmodes x dofs; returns nmodes. */
+  PetscInt (*rigid_modes)(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
+  PetscErrorCode (*destroy)(PeriModel);
+} PeriModelOps;
+
+struct _p_PeriModel {
+  char               type[PERI_NAME_LEN];
+  PeriModelOps       ops;
+  PetscInt           dim;
+  PetscBool          plane_strain;
+  PetscInt           dofs;
+  const char *const *components;     /* dofs names, e.g. "ux", "uy" */
+  PetscInt           nmeasures;
+  const char *const *measure_names;
+  PetscBool          allows_surface_correction;
+  PeriMaterial       material;
+  PetscReal          delta;
+  void              *data;
+};
+
+PETSC_EXTERN PetscErrorCode PeriModelRegister(const char[], PetscErrorCode (*)(PeriModel));
+PETSC_EXTERN PetscErrorCode PeriModelRegisterAll(void);
+PETSC_EXTERN PetscErrorCode PeriModelCreate(const char[], PetscInt, PetscBool, PeriModel *);
+PETSC_EXTERN PetscErrorCode PeriModelSetFromScene(PeriModel, PeriScene, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriModelListTypes(char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriModelTypeRegistered(const char[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriModelDestroy(PeriModel *);
+PETSC_EXTERN PetscReal      PeriModelIsotropicEnergy(PeriModel);
+PETSC_EXTERN PetscReal      PeriModelHorizonMoment(PeriModel, PetscInt);
+PETSC_EXTERN void           PeriCentralBondBlock(PeriModel, const PeriBondGeometry *, PetscReal, PetscReal[]);
+PETSC_EXTERN void           PeriBondStretch(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
+PETSC_EXTERN void           PeriBondBasedNuRange(PeriModel, PetscReal *, PetscReal *);
+PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
+PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
+
+PETSC_EXTERN PetscErrorCode PeriModelCreate_PMB(PeriModel);
+PETSC_EXTERN PetscErrorCode PeriModelCreate_NPMB(PeriModel);
+
+/* ------------------------------------------------------------------ the problem (src/problem.c) */
+typedef struct {
+  char      name[PERI_NAME_LEN];
+  PetscReal x[3];
+  PetscInt  particle; /* nearest particle (global index) */
+  PetscReal u[PERI_MAX_DOF];
+  PetscReal W;
+} PeriProbe;
+
+typedef struct {
+  PetscReal neighbors_s, assembly_s, solve_s, total_s;
+  PetscReal memory_mb, memory_mb_max_rank;
+  char      ksp_type[64], pc_type[64], converged_reason[64];
+  PetscInt  iterations;
+  PetscReal residual_norm;
+  PetscReal strain_energy;
+  PetscReal max_abs_u[PERI_MAX_DOF];
+  PetscInt  nbonds_total;
+} PeriResults;
+
+typedef struct _p_PeriProblem *PeriProblem;
+struct _p_PeriProblem {
+  MPI_Comm              comm;
+  PetscMPIInt           rank, size;
+  PeriScene             scene;
+  PeriParticles         particles;
+  PetscInt              nregions;
+  PeriRegion           *regions;
+  PetscReal             delta;
+  PeriPartialVolume     partial_volume;
+  PeriSurfaceCorrection surface;
+  PeriBonds             bonds;
+  PetscReal            *family_volume;   /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
+  PetscInt             *neighbor_count;  /* per particle (all ranks) */
+  PetscInt             *owner;           /* rank owning each particle (all ranks) */
+  PeriModel             model;
+  Mat                   K;               /* stiffness */
+  char                  mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
+  Vec                   u, f;
+  PetscInt              nconstrained;    /* owned constrained DOFs */
+  PetscInt             *constrained;     /* their global rows */
+  PetscReal            *constrained_value;
+  PetscInt              nprobes;
+  PeriProbe            *probes;
+  char                  analysis[PERI_NAME_LEN];
+  char                  output_dir[PETSC_MAX_PATH_LEN];
+  PetscBool             vtk;
+  PetscReal            *W;               /* strain energy density per particle (rank 0, after the solve) */
+  PetscReal            *u_all;           /* displacements of all particles (rank 0, after the solve) */
+  PeriResults           results;
+  PetscLogDouble        t_start;
+};
+
+PETSC_EXTERN PetscErrorCode PeriProblemCreate(MPI_Comm, PeriProblem *);
+PETSC_EXTERN PetscErrorCode PeriProblemLoad(PeriProblem, const char[]);
+PETSC_EXTERN PetscErrorCode PeriProblemSetUp(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriProblemAssemble(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriProblemRun(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriProblemWriteOutput(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriProblemDestroy(PeriProblem *);
+PETSC_EXTERN PetscErrorCode PeriProblemCreateVec(PeriProblem, Vec *);
+PETSC_EXTERN PetscErrorCode PeriProblemBondGeometry(PeriProblem, PetscInt, PetscInt, PeriBondGeometry *);
+PETSC_EXTERN PetscErrorCode PeriProblemEvaluateEnergy(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriProblemFindProbe(PeriProblem, const char[], PeriProbe **);
+
+/* assembly (src/assembly.c) */
+PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriProblem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriProblem, PetscInt *, Vec[]);
+PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriProblem, Mat);
+
+/* boundary conditions and loads (src/boundary.c) */
+PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriLoadsAssemble(PeriProblem, Vec);
+PETSC_EXTERN PetscErrorCode PeriCheckRigidMotion(PeriProblem);
+
+/* analyses (src/analysis/) */
+PETSC_EXTERN PetscErrorCode PeriAnalysisRegister(const char[], PetscErrorCode (*)(PeriProblem));
+PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
+PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Static(PeriProblem);
+
+/* output (src/output/) */
+typedef struct _PeriJSON *PeriJSON;
+PETSC_EXTERN PetscErrorCode PeriJSONOpen(const char[], PeriJSON *);
+PETSC_EXTERN PetscErrorCode PeriJSONClose(PeriJSON *, PetscBool);
+PETSC_EXTERN PetscErrorCode PeriJSONBeginObject(PeriJSON, const char[]);
+PETSC_EXTERN PetscErrorCode PeriJSONEndObject(PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriJSONBeginArray(PeriJSON, const char[]);
+PETSC_EXTERN PetscErrorCode PeriJSONEndArray(PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriJSONString(PeriJSON, const char[], const char[]);
+PETSC_EXTERN PetscErrorCode PeriJSONReal(PeriJSON, const char[], PetscReal);
+PETSC_EXTERN PetscErrorCode PeriJSONInt(PeriJSON, const char[], PetscInt);
+PETSC_EXTERN PetscErrorCode PeriJSONRealArray(PeriJSON, const char[], PetscInt, const PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
+PETSC_EXTERN PetscErrorCode PeriWriteVTU(PeriProblem, const char[]);
+PETSC_EXTERN PetscErrorCode PeriOutputDirCreate(const char[]);
+PETSC_EXTERN PetscErrorCode PeriFileCommit(const char[], const char[]);
+
+/* log events */
+PETSC_EXTERN PetscLogEvent PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;
+PETSC_EXTERN PetscLogStage PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
+PETSC_EXTERN PetscErrorCode PeriInitializePackage(void);

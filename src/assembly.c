@@ -1,0 +1,178 @@
+/* Assembly of the linearized stiffness K from the model's bond blocks into a block matrix (BAIJ by
+ * default, block size = DOFs per particle) with exact preallocation, and the rigid-body modes
+ * that serve as AMG's near-null space and as the check for unconstrained motion. */
+#include "perilin.h"
+
+/* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
+static PetscInt RowPartners(const PeriBonds *b, PetscInt i, PetscInt buf[])
+{
+  PetscInt n = 0, m = 0;
+  for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+    if (b->live[k] && b->j[k] != i) buf[n++] = b->j[k];
+  PetscSortInt(n, buf);
+  for (PetscInt k = 0; k < n; k++)
+    if (!m || buf[k] != buf[m - 1]) buf[m++] = buf[k];
+  return m;
+}
+
+/* Block counts per owned row: diagonal/off-diagonal part, and their upper-triangular share for
+ * SBAIJ. Row i sees its stored partners (j > i, upper) and the particles that store a bond to i
+ * (lower), which may live on other ranks: counts for those are summed with MPI_Reduce_scatter. */
+static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **onz, PetscInt **dnzu, PetscInt **onzu)
+{
+  const PeriBonds *b = &p->bonds;
+  const PetscInt   n = p->particles.n, nloc = b->rend - b->rstart;
+  PetscInt        *cnt, *buf, maxrow = 0;
+  PetscMPIInt     *recv;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(2 * n, &cnt)); /* [diag | offdiag] counts of every global row */
+  PetscCall(PetscMalloc4(nloc, dnz, nloc, onz, nloc, dnzu, nloc, onzu));
+  for (PetscInt i = b->rstart; i < b->rend; i++) maxrow = PetscMax(maxrow, b->offset[i - b->rstart + 1] - b->offset[i - b->rstart]);
+  PetscCall(PetscMalloc1(maxrow + 1, &buf));
+  for (PetscInt i = b->rstart; i < b->rend; i++) {
+    PetscInt m = RowPartners(b, i, buf), du = 1, ou = 0;
+    for (PetscInt k = 0; k < m; k++) {
+      PetscInt  j    = buf[k];
+      PetscBool same = (PetscBool)(p->owner[j] == p->rank);
+      if (same) du++;
+      else ou++;
+      cnt[(same ? 0 : n) + j]++; /* row j, column i */
+    }
+    (*dnzu)[i - b->rstart] = du;
+    (*onzu)[i - b->rstart] = ou;
+    cnt[i] += du;
+    cnt[n + i] += ou;
+  }
+  PetscCall(PetscFree(buf));
+  /* owners hold contiguous ranges, so the rows in global order are already grouped by rank */
+  PetscCall(PetscCalloc1(p->size, &recv));
+  for (PetscInt i = 0; i < n; i++) recv[p->owner[i]] += 2;
+  {
+    PetscInt *mine, *sendbuf;
+    PetscCall(PetscMalloc2(2 * nloc, &mine, 2 * n, &sendbuf));
+    for (PetscInt i = 0; i < n; i++) {
+      sendbuf[2 * i]     = cnt[i];
+      sendbuf[2 * i + 1] = cnt[n + i];
+    }
+    PetscCallMPI(MPI_Reduce_scatter(sendbuf, mine, recv, MPIU_INT, MPI_SUM, p->comm));
+    for (PetscInt i = 0; i < nloc; i++) {
+      (*dnz)[i] = mine[2 * i];
+      (*onz)[i] = mine[2 * i + 1];
+    }
+    PetscCall(PetscFree2(mine, sendbuf));
+  }
+  PetscCall(PetscFree(recv));
+  PetscCall(PetscFree(cnt));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAssembleStiffness - assembles K = sum over live bonds of the model's bond blocks. The type is
+  p->mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
+  only). Collective.
+@*/
+PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
+{
+  const PeriBonds *b    = &p->bonds;
+  PeriModel        m    = p->model;
+  const PetscInt   bs   = m->dofs, nloc = b->rend - b->rstart;
+  PetscInt        *dnz, *onz, *dnzu, *onzu;
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PetscBool        sym;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
+  PetscCall(Preallocation(p, &dnz, &onz, &dnzu, &onzu));
+  PetscCall(MatCreate(p->comm, K));
+  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, p->particles.n * bs, p->particles.n * bs));
+  PetscCall(MatSetBlockSize(*K, bs));
+  PetscCall(MatSetType(*K, p->mat_type[0] ? p->mat_type : MATBAIJ));
+  PetscCall(MatSetFromOptions(*K));
+  PetscCall(MatXAIJSetPreallocation(*K, bs, dnz, onz, dnzu, onzu));
+  PetscCall(PetscFree4(dnz, onz, dnzu, onzu));
+  PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)*K, &sym, MATSBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  if (sym) PetscCall(MatSetOption(*K, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PeriBondGeometry g;
+      PetscInt         idx[2];
+      /* a self-image bond moves both ends alike: its blocks cancel */
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+      m->ops.bond_stiffness(m, &g, Ke);
+      idx[0] = i;
+      idx[1] = g.j;
+      PetscCall(MatSetValuesBlocked(*K, 2, idx, 2, idx, Ke, ADD_VALUES));
+    }
+  PetscCall(MatAssemblyBegin(*K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatSetOption(*K, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(*K, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriRigidModes - the model's rigid-body modes as vectors (coordinates relative to the body's
+  centre, so translations and rotations are nearly orthogonal), each scaled to unit norm.
+  Collective; modes[] must hold PERI_MAX_MODES vectors, created here.
+@*/
+PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[])
+{
+  const PeriParticles *pt = &p->particles;
+  PeriModel            m  = p->model;
+  PetscReal            centre[3], vals[PERI_MAX_MODES][PERI_MAX_DOF], X[3];
+  PetscScalar         *a[PERI_MAX_MODES];
+  PetscInt             nm = 0, rstart = p->bonds.rstart;
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
+  X[0] = X[1] = X[2] = 0;
+  nm = m->ops.rigid_modes(m, X, vals);
+  for (PetscInt k = 0; k < nm; k++) {
+    PetscCall(PeriProblemCreateVec(p, &modes[k]));
+    PetscCall(VecGetArray(modes[k], &a[k]));
+  }
+  for (PetscInt i = rstart; i < p->bonds.rend; i++) {
+    for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
+    m->ops.rigid_modes(m, X, vals);
+    for (PetscInt k = 0; k < nm; k++)
+      for (PetscInt c = 0; c < m->dofs; c++) a[k][(i - rstart) * m->dofs + c] = vals[k][c];
+  }
+  for (PetscInt k = 0; k < nm; k++) {
+    PetscCall(VecRestoreArray(modes[k], &a[k]));
+    PetscCall(VecNormalize(modes[k], NULL));
+  }
+  *nmodes = nm;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSetNearNullSpace - gives A the orthonormalized rigid-body modes, for algebraic multigrid.
+  Collective.
+@*/
+PetscErrorCode PeriSetNearNullSpace(PeriProblem p, Mat A)
+{
+  Vec          modes[PERI_MAX_MODES];
+  PetscInt     nm;
+  MatNullSpace nsp;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriRigidModes(p, &nm, modes));
+  /* Gram-Schmidt: MatNullSpaceCreate wants an orthonormal set */
+  for (PetscInt k = 0; k < nm; k++) {
+    for (PetscInt l = 0; l < k; l++) {
+      PetscScalar dot;
+      PetscCall(VecDot(modes[k], modes[l], &dot));
+      PetscCall(VecAXPY(modes[k], -dot, modes[l]));
+    }
+    PetscCall(VecNormalize(modes[k], NULL));
+  }
+  PetscCall(MatNullSpaceCreate(p->comm, PETSC_FALSE, nm, modes, &nsp));
+  PetscCall(MatSetNearNullSpace(A, nsp));
+  PetscCall(MatNullSpaceDestroy(&nsp));
+  for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

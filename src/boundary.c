@@ -1,0 +1,270 @@
+/* Boundary conditions (prescribed DOFs), loads, and the check that the constraints leave no
+ * rigid-body motion free. */
+#include "perilin.h"
+
+/* Translational component of axis a (ux, uy, uz), or -1 when the model has none. */
+static PetscErrorCode AxisComponent(PeriModel m, PetscInt a, PetscInt *c)
+{
+  static const char *const names[] = {"ux", "uy", "uz"};
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriModelComponentIndex(m, names[a], c));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ComponentList(PeriModel m, char buf[], size_t len)
+{
+  PetscFunctionBeginUser;
+  buf[0] = 0;
+  for (PetscInt c = 0; c < m->dofs; c++) {
+    PetscCall(PetscStrlcat(buf, c ? ", " : "", len));
+    PetscCall(PetscStrlcat(buf, m->components[c], len));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ComponentFromNode(PeriProblem p, PeriNode node, const char name[], PetscInt *c)
+{
+  char list[128];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriModelComponentIndex(p->model, name, c));
+  PetscCall(ComponentList(p->model, list, sizeof(list)));
+  PeriInputCheck(*c >= 0, p->scene, node, NULL, "'%s' is not a component of model %s; its components are: %s", name, p->model->type, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* value[] and set[] over the owned DOFs; later conditions override earlier ones. */
+static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal value[], PetscBool set[])
+{
+  static const char *const keys[] = {"region", "fix", "value", "affine", NULL};
+  PeriScene                s       = p->scene;
+  PeriModel                m       = p->model;
+  const PetscInt           bs      = m->dofs, dim = p->particles.dim;
+  PeriRegion              *r;
+  PeriNode                 fix, val, aff;
+  PetscReal                v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
+  PetscBool                use[PERI_MAX_DOF] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
+  PetscInt                 axis_comp[3] = {-1, -1, -1};
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a boundary condition is a mapping {region: name, fix: [..] | value: {..} | affine: {..}}");
+  PetscCall(PeriSceneCheckKeys(s, item, keys));
+  PetscCall(PeriRegionFind(s, item, "region", p->nregions, p->regions, &r));
+  PetscCall(PeriSceneGetNode(item, "fix", &fix));
+  PetscCall(PeriSceneGetNode(item, "value", &val));
+  PetscCall(PeriSceneGetNode(item, "affine", &aff));
+  PeriInputCheck((fix ? 1 : 0) + (val ? 1 : 0) + (aff ? 1 : 0) == 1, s, item, NULL, "give exactly one of fix, value, affine");
+  if (fix) {
+    PeriInputCheck(fix->kind == PERI_NODE_SEQ && fix->n > 0, s, fix, NULL, "must be a list of components, e.g. [ux, uy]");
+    for (PetscInt k = 0; k < fix->n; k++) {
+      PetscInt c;
+      PeriInputCheck(fix->child[k]->kind == PERI_NODE_SCALAR, s, fix->child[k], NULL, "must be a component name");
+      PetscCall(ComponentFromNode(p, fix->child[k], fix->child[k]->value, &c));
+      use[c] = PETSC_TRUE;
+      v[c]   = 0;
+    }
+  } else if (val) {
+    PeriInputCheck(val->kind == PERI_NODE_MAP && val->n > 0, s, val, NULL, "must map components to values, e.g. {ux: 0.001}");
+    for (PetscInt k = 0; k < val->n; k++) {
+      PetscInt c;
+      PetscCall(ComponentFromNode(p, val->child[k], val->child[k]->key, &c));
+      PetscCall(PeriSceneGetReal(s, val, val->child[k]->key, PETSC_TRUE, &v[c], NULL));
+      use[c] = PETSC_TRUE;
+    }
+  } else {
+    static const char *const akeys[] = {"A", "b", NULL};
+    PeriNode                 Anode;
+    PetscInt                 n;
+    PeriInputCheck(aff->kind == PERI_NODE_MAP, s, aff, NULL, "must be {A: [[..], ..], b: [..]}");
+    PetscCall(PeriSceneCheckKeys(s, aff, akeys));
+    PetscCall(PeriSceneGetNode(aff, "A", &Anode));
+    PeriInputCheck(Anode && Anode->kind == PERI_NODE_SEQ && Anode->n == dim, s, Anode ? Anode : aff, Anode ? NULL : "A", "must be a list of %" PetscInt_FMT " rows of %" PetscInt_FMT " numbers (u = A X + b)", dim, dim);
+    for (PetscInt a = 0; a < dim; a++) PetscCall(PeriSceneParseRealArray(s, Anode->child[a], dim, dim, A[a], &n));
+    PetscCall(PeriSceneGetRealArray(s, aff, "b", PETSC_FALSE, dim, dim, b0, &n));
+    for (PetscInt a = 0; a < dim; a++) {
+      PetscCall(AxisComponent(m, a, &axis_comp[a]));
+      PeriInputCheck(axis_comp[a] >= 0, s, aff, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + a));
+      use[axis_comp[a]] = PETSC_TRUE;
+    }
+  }
+  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
+    const PetscReal *X = &p->particles.x[3 * i];
+    if (!PeriRegionContains(r, X)) continue;
+    if (aff)
+      for (PetscInt a = 0; a < dim; a++) {
+        v[axis_comp[a]] = b0[a];
+        for (PetscInt d = 0; d < dim; d++) v[axis_comp[a]] += A[a][d] * X[d];
+      }
+    for (PetscInt c = 0; c < bs; c++)
+      if (use[c]) {
+        value[(i - p->bonds.rstart) * bs + c] = v[c];
+        set[(i - p->bonds.rstart) * bs + c]   = PETSC_TRUE;
+      }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriBoundarySetUp - reads bc: the owned constrained DOFs (global rows) and their values. Collective.
+@*/
+PetscErrorCode PeriBoundarySetUp(PeriProblem p)
+{
+  PeriScene      s  = p->scene;
+  const PetscInt bs = p->model->dofs, nloc = (p->bonds.rend - p->bonds.rstart) * bs;
+  PeriNode       bc;
+  PetscReal     *value;
+  PetscBool     *set;
+  PetscInt       n = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(s->root, "bc", &bc));
+  PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
+  PetscCall(PetscCalloc2(nloc, &value, nloc, &set));
+  for (PetscInt k = 0; bc && k < bc->n; k++) PetscCall(ApplyCondition(p, bc->child[k], value, set));
+  for (PetscInt k = 0; k < nloc; k++) n += set[k] ? 1 : 0;
+  p->nconstrained = n;
+  PetscCall(PetscMalloc1(n, &p->constrained));
+  PetscCall(PetscMalloc1(n, &p->constrained_value));
+  n = 0;
+  for (PetscInt k = 0; k < nloc; k++)
+    if (set[k]) {
+      p->constrained[n]       = p->bonds.rstart * bs + k;
+      p->constrained_value[n] = value[k];
+      n++;
+    }
+  PetscCall(PetscFree2(value, set));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriLoadsAssemble - the load vector from loads: total forces and tractions spread over a
+  region's particles in proportion to their volume, and body forces. Collective.
+@*/
+PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
+{
+  static const char *const keys[] = {"region", "force", "traction", "body_force", NULL};
+  PeriScene                s       = p->scene;
+  PeriModel                m       = p->model;
+  const PetscInt           bs = m->dofs, dim = p->particles.dim;
+  PeriNode                 loads;
+  PetscScalar             *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(f, 0));
+  PetscCall(PeriSceneGetNode(s->root, "loads", &loads));
+  if (!loads) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(loads->kind == PERI_NODE_SEQ, s, loads, NULL, "must be a list of loads, each {region: .., force: [..]}");
+  PetscCall(VecGetArray(f, &a));
+  for (PetscInt k = 0; k < loads->n; k++) {
+    PeriNode    item = loads->child[k], force, traction, body;
+    PeriRegion *r;
+    PetscReal   F[3] = {0, 0, 0}, scale;
+    PetscInt    n, comp[3];
+    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force: [..]}");
+    PetscCall(PeriSceneCheckKeys(s, item, keys));
+    PetscCall(PeriRegionFind(s, item, "region", p->nregions, p->regions, &r));
+    PetscCall(PeriSceneGetNode(item, "force", &force));
+    PetscCall(PeriSceneGetNode(item, "traction", &traction));
+    PetscCall(PeriSceneGetNode(item, "body_force", &body));
+    PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force");
+    PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction" : "body_force", PETSC_TRUE, dim, dim, F, &n));
+    PeriInputCheck(!traction || r->kind == PERI_REGION_LAYER, s, item, "traction", "needs a layer region (side: ..), whose face area converts traction to force; region '%s' is not one", r->name);
+    /* per particle: F * scale * V_i */
+    scale = body ? 1.0 : (traction ? r->face_area : 1.0) / r->volume;
+    for (PetscInt d = 0; d < dim; d++) {
+      PetscCall(AxisComponent(m, d, &comp[d]));
+      PeriInputCheck(comp[d] >= 0 || F[d] == 0, s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
+    }
+    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
+      if (!PeriRegionContains(r, &p->particles.x[3 * i])) continue;
+      for (PetscInt d = 0; d < dim; d++)
+        if (comp[d] >= 0) a[(i - p->bonds.rstart) * bs + comp[d]] += F[d] * scale * p->particles.volume[i];
+    }
+  }
+  PetscCall(VecRestoreArray(f, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Eigen-decomposition of a small symmetric matrix by cyclic Jacobi rotations. */
+static void SymmetricEigen(PetscInt n, PetscReal A[PERI_MAX_MODES][PERI_MAX_MODES], PetscReal w[], PetscReal V[PERI_MAX_MODES][PERI_MAX_MODES])
+{
+  for (PetscInt a = 0; a < n; a++)
+    for (PetscInt b = 0; b < n; b++) V[a][b] = a == b;
+  for (PetscInt sweep = 0; sweep < 100; sweep++) {
+    PetscReal off = 0;
+    for (PetscInt a = 0; a < n; a++)
+      for (PetscInt b = a + 1; b < n; b++) off += A[a][b] * A[a][b];
+    if (off < 1e-30) break;
+    for (PetscInt a = 0; a < n; a++)
+      for (PetscInt b = a + 1; b < n; b++) {
+        PetscReal theta, t, c, s;
+        if (PetscAbsReal(A[a][b]) < 1e-300) continue;
+        theta = (A[b][b] - A[a][a]) / (2 * A[a][b]);
+        t     = (theta >= 0 ? 1 : -1) / (PetscAbsReal(theta) + PetscSqrtReal(theta * theta + 1));
+        c     = 1 / PetscSqrtReal(t * t + 1);
+        s     = t * c;
+        for (PetscInt k = 0; k < n; k++) {
+          PetscReal akp = A[k][a], akq = A[k][b];
+          A[k][a] = c * akp - s * akq;
+          A[k][b] = s * akp + c * akq;
+        }
+        for (PetscInt k = 0; k < n; k++) {
+          PetscReal apk = A[a][k], aqk = A[b][k];
+          A[a][k] = c * apk - s * aqk;
+          A[b][k] = s * apk + c * aqk;
+        }
+        for (PetscInt k = 0; k < n; k++) {
+          PetscReal vkp = V[k][a], vkq = V[k][b];
+          V[k][a] = c * vkp - s * vkq;
+          V[k][b] = s * vkp + c * vkq;
+        }
+      }
+  }
+  for (PetscInt a = 0; a < n; a++) w[a] = A[a][a];
+}
+
+/*@C
+  PeriCheckRigidMotion - errors when the constrained DOFs leave a combination of the rigid-body
+  modes free (K would be singular), naming the motion. Collective.
+@*/
+PetscErrorCode PeriCheckRigidMotion(PeriProblem p)
+{
+  static const char *const names2[] = {"translation along x", "translation along y", "rotation about z"};
+  static const char *const names3[] = {"translation along x", "translation along y", "translation along z", "rotation about x", "rotation about y", "rotation about z"};
+  Vec                      modes[PERI_MAX_MODES];
+  PetscInt                 nm;
+  PetscReal                G[PERI_MAX_MODES][PERI_MAX_MODES] = {{0}}, V[PERI_MAX_MODES][PERI_MAX_MODES], w[PERI_MAX_MODES];
+  const PetscScalar       *a[PERI_MAX_MODES];
+  PetscInt                 rstart;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriRigidModes(p, &nm, modes));
+  PetscCall(VecGetOwnershipRange(modes[0], &rstart, NULL));
+  for (PetscInt k = 0; k < nm; k++) PetscCall(VecGetArrayRead(modes[k], &a[k]));
+  for (PetscInt c = 0; c < p->nconstrained; c++) {
+    PetscInt row = p->constrained[c] - rstart;
+    for (PetscInt k = 0; k < nm; k++)
+      for (PetscInt l = 0; l < nm; l++) G[k][l] += PetscRealPart(a[k][row] * a[l][row]);
+  }
+  for (PetscInt k = 0; k < nm; k++) PetscCall(VecRestoreArrayRead(modes[k], &a[k]));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, G, PERI_MAX_MODES * PERI_MAX_MODES, MPIU_REAL, MPI_SUM, p->comm));
+  /* G holds sums of squares of unit vectors' entries: a free motion gives an eigenvalue of about
+   * round-off; one constrained particle already gives ~1/N */
+  SymmetricEigen(nm, G, w, V);
+  for (PetscInt k = 0; k < nm; k++) {
+    if (w[k] > 1e-12 / p->particles.n) continue;
+    {
+      char     msg[512] = "";
+      PetscInt best     = 0;
+      for (PetscInt l = 0; l < nm; l++)
+        if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
+      if (nm == 3 || nm == 6) PetscCall(PetscSNPrintf(msg, sizeof(msg), "%s", (nm == 3 ? names2 : names3)[best]));
+      else PetscCall(PetscSNPrintf(msg, sizeof(msg), "rigid mode %" PetscInt_FMT, best));
+      for (PetscInt l = 0; l < nm; l++) PetscCall(VecDestroy(&modes[l]));
+      SETERRQ(p->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular. Constrain it in bc (e.g. fix the component on a small region)", p->scene->file, msg);
+    }
+  }
+  for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

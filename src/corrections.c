@@ -1,0 +1,48 @@
+/* Corrections of the discrete horizon: family volumes (for calibration and for the surface
+ * correction) and the volume-method surface correction factor of Diana & Casolo eq. (16). */
+#include "perilin.h"
+
+const char *const PeriSurfaceCorrections[] = {"none", "volume", NULL};
+
+/*@C
+  PeriNeighborhoodVolumes - family volume sum_j alpha_ij V_j (the particle itself excluded) and
+  neighbour count of every particle, summed over the ranks' bonds. Collective.
+@*/
+PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm comm, const PeriParticles *p, const PeriBonds *b, PetscReal family[], PetscInt count[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscArrayzero(family, p->n));
+  PetscCall(PetscArrayzero(count, p->n));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscInt j = b->j[k];
+      if (!b->live[k]) continue;
+      /* a stored self-image stands for the pair of images +shift and -shift */
+      family[i] += b->alpha[k] * p->volume[j];
+      family[j] += b->alpha[k] * p->volume[i];
+      count[i]++;
+      count[j]++;
+    }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, family, (PetscMPIInt)p->n, MPIU_REAL, MPI_SUM, comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, count, (PetscMPIInt)p->n, MPIU_INT, MPI_SUM, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSurfaceCorrectionApply - sets each bond's lambda. The volume method: lambda = 2 V0 /
+  (V(H_i) + V(H_j)), V0 the volume of a full continuous horizon (pi delta^2 t in 2D, 4/3 pi
+  delta^3 in 3D) and V(H) the discrete volume of the body inside the horizon, the particle's own
+  cell included. Not collective.
+@*/
+PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection sc, const PeriParticles *p, PetscReal delta, const PetscReal family[], PeriBonds *b)
+{
+  PetscReal V0 = p->dim == 2 ? PETSC_PI * delta * delta * p->thickness : 4.0 / 3.0 * PETSC_PI * delta * delta * delta;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscInt j = b->j[k];
+      b->lambda[k] = sc == PERI_SURFACE_VOLUME ? 2 * V0 / (family[i] + p->volume[i] + family[j] + p->volume[j]) : 1.0;
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,228 @@
+/* Neighbour search with cell lists: O(N), periodic axes by explicit images (a short periodic
+ * axis gives several bonds to images of the same particle, as the continuum would). */
+#include "perilin.h"
+
+const char *const PeriPartialVolumes[] = {"none", "linear", "linear_continued", NULL};
+
+/* Bonds of length within this relative slack of delta are inside the horizon: m = 3 gives
+ * |xi| = 3 dx in floating point that must count whatever the rounding. */
+#define PERI_HORIZON_SLACK 1e-10
+
+/* The partial-volume factor of a bond of length r for horizon delta and spacing h: the share of
+ * the neighbour's cell inside the horizon, a linear ramp that is 1/2 at delta (Diana & Casolo
+ * eq. 9 with its sign corrected, see docs/theory.md). "linear" cuts the ramp at delta;
+ * "linear_continued" lets it reach zero at delta + h/2. */
+PetscReal PeriPartialVolumeFactor(PeriPartialVolume pv, PetscReal r, PetscReal delta, PetscReal h)
+{
+  const PetscReal rin = delta * (1 + PERI_HORIZON_SLACK);
+  switch (pv) {
+  case PERI_PARTIAL_VOLUME_NONE:
+    return r <= rin ? 1.0 : 0.0;
+  case PERI_PARTIAL_VOLUME_LINEAR:
+    if (r > rin) return 0.0;
+    break;
+  case PERI_PARTIAL_VOLUME_LINEAR_CONTINUED:
+    if (r >= delta + h / 2) return 0.0;
+    break;
+  }
+  if (r <= delta - h / 2) return 1.0;
+  return PetscMin(1.0, (delta + h / 2 - r) / h);
+}
+
+PetscReal PeriSearchRadius(PeriPartialVolume pv, PetscReal delta, PetscReal hmax)
+{
+  return pv == PERI_PARTIAL_VOLUME_LINEAR_CONTINUED ? delta + hmax / 2 : delta * (1 + PERI_HORIZON_SLACK);
+}
+
+typedef struct {
+  PetscInt  ncell[3], reach[3];
+  PetscReal size[3], length[3];
+  PetscInt *start; /* ncells + 1 */
+  PetscInt *item;  /* particles sorted by cell */
+} CellList;
+
+static PetscInt CellOf(const CellList *cl, const PeriParticles *p, PetscInt k, PetscInt d)
+{
+  PetscInt c = (PetscInt)PetscFloorReal((p->x[3 * k + d] - p->lower[d]) / cl->size[d]);
+  return PetscMin(PetscMax(c, 0), cl->ncell[d] - 1);
+}
+
+static PetscInt CellIndex(const CellList *cl, const PetscInt c[3])
+{
+  return (c[2] * cl->ncell[1] + c[1]) * cl->ncell[0] + c[0];
+}
+
+static PetscErrorCode CellListCreate(const PeriParticles *p, PetscReal r, CellList *cl)
+{
+  PetscInt ncells = 1, *cellof;
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) {
+    cl->length[d] = d < p->dim ? p->upper[d] - p->lower[d] : 0;
+    cl->ncell[d]  = d < p->dim ? PetscMax(1, (PetscInt)PetscFloorReal(cl->length[d] / r)) : 1;
+    /* cap the cell count so a huge box with few particles cannot exhaust memory */
+    while (d < p->dim && cl->ncell[d] > 1 && (PetscReal)ncells * cl->ncell[d] > 8.0 * p->n + 64) cl->ncell[d] = (cl->ncell[d] + 1) / 2;
+    cl->size[d]  = d < p->dim ? cl->length[d] / cl->ncell[d] : 1;
+    cl->reach[d] = d < p->dim ? (PetscInt)PetscCeilReal(r / cl->size[d]) : 0;
+    ncells *= cl->ncell[d];
+  }
+  PetscCall(PetscCalloc1(ncells + 1, &cl->start));
+  PetscCall(PetscMalloc1(p->n, &cl->item));
+  PetscCall(PetscMalloc1(p->n, &cellof));
+  for (PetscInt k = 0; k < p->n; k++) {
+    PetscInt c[3];
+    for (PetscInt d = 0; d < 3; d++) c[d] = d < p->dim ? CellOf(cl, p, k, d) : 0;
+    cellof[k] = CellIndex(cl, c);
+    cl->start[cellof[k] + 1]++;
+  }
+  for (PetscInt c = 0; c < ncells; c++) cl->start[c + 1] += cl->start[c];
+  {
+    PetscInt *fill;
+    PetscCall(PetscMalloc1(ncells, &fill));
+    PetscCall(PetscArraycpy(fill, cl->start, ncells));
+    for (PetscInt k = 0; k < p->n; k++) cl->item[fill[cellof[k]]++] = k;
+    PetscCall(PetscFree(fill));
+  }
+  PetscCall(PetscFree(cellof));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode CellListDestroy(CellList *cl)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(cl->start));
+  PetscCall(PetscFree(cl->item));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Growable bond storage. */
+static PetscErrorCode BondsReserve(PeriBonds *b, PetscInt need, PetscInt *cap)
+{
+  PetscFunctionBeginUser;
+  if (need <= *cap) PetscFunctionReturn(PETSC_SUCCESS);
+  {
+    PetscInt       nc = PetscMax(2 * *cap, need + 1024);
+    PetscInt      *j;
+    PetscReal     *xi, *len, *alpha;
+    unsigned char *live;
+    PetscCall(PetscMalloc1(nc, &j));
+    PetscCall(PetscMalloc1(3 * nc, &xi));
+    PetscCall(PetscMalloc1(nc, &len));
+    PetscCall(PetscMalloc1(nc, &alpha));
+    PetscCall(PetscMalloc1(nc, &live));
+    PetscCall(PetscArraycpy(j, b->j, b->nbonds));
+    PetscCall(PetscArraycpy(xi, b->xi, 3 * b->nbonds));
+    PetscCall(PetscArraycpy(len, b->length, b->nbonds));
+    PetscCall(PetscArraycpy(alpha, b->alpha, b->nbonds));
+    PetscCall(PetscArraycpy(live, b->live, b->nbonds));
+    PetscCall(PetscFree(b->j));
+    PetscCall(PetscFree(b->xi));
+    PetscCall(PetscFree(b->length));
+    PetscCall(PetscFree(b->alpha));
+    PetscCall(PetscFree(b->live));
+    b->j      = j;
+    b->xi     = xi;
+    b->length = len;
+    b->alpha  = alpha;
+    b->live   = live;
+    *cap      = nc;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Is the image shift positive in lexicographic order? Of the two images of a particle's
+ * self-bond (+shift, -shift) only one is stored. */
+static PetscBool ShiftPositive(const PetscInt w[3])
+{
+  for (PetscInt d = 0; d < 3; d++)
+    if (w[d]) return w[d] > 0 ? PETSC_TRUE : PETSC_FALSE;
+  return PETSC_FALSE;
+}
+
+/*@C
+  PeriNeighborSearch - finds the bonds of particles rstart..rend-1 with cell lists. With half,
+  each pair is stored once, in the row of its smaller index; otherwise every neighbour is listed
+  (the graph for partitioning). Not collective. Errors on coincident particles.
+@*/
+PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
+{
+  CellList  cl;
+  PetscReal hmax = 0, r;
+  PetscInt  cap  = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(b, sizeof(*b)));
+  for (PetscInt k = 0; k < p->n; k++) hmax = PetscMax(hmax, p->spacing[k]);
+  r = PeriSearchRadius(pv, delta, hmax);
+  PetscCall(CellListCreate(p, r, &cl));
+  b->rstart = rstart;
+  b->rend   = rend;
+  PetscCall(PetscMalloc1(rend - rstart + 1, &b->offset));
+  b->offset[0] = 0;
+  for (PetscInt i = rstart; i < rend; i++) {
+    const PetscReal *xi = &p->x[3 * i];
+    PetscInt         ci[3], o[3];
+    for (PetscInt d = 0; d < 3; d++) ci[d] = d < p->dim ? CellOf(&cl, p, i, d) : 0;
+    for (o[2] = -cl.reach[2]; o[2] <= cl.reach[2]; o[2]++)
+      for (o[1] = -cl.reach[1]; o[1] <= cl.reach[1]; o[1]++)
+        for (o[0] = -cl.reach[0]; o[0] <= cl.reach[0]; o[0]++) {
+          PetscInt  c[3], wrap[3] = {0, 0, 0}, cell;
+          PetscBool skip = PETSC_FALSE;
+          for (PetscInt d = 0; d < 3; d++) {
+            c[d] = ci[d] + o[d];
+            if (c[d] < 0 || c[d] >= cl.ncell[d]) {
+              if (!p->periodic[d]) skip = PETSC_TRUE;
+              else {
+                wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl.ncell[d]);
+                c[d] -= wrap[d] * cl.ncell[d];
+              }
+            }
+          }
+          if (skip) continue;
+          cell = CellIndex(&cl, c);
+          for (PetscInt s = cl.start[cell]; s < cl.start[cell + 1]; s++) {
+            PetscInt  j = cl.item[s], self = (j == i);
+            PetscReal x[3], len2 = 0, len, h, alpha;
+            if (half && (j < i || (self && !ShiftPositive(wrap)))) continue;
+            if (self && !wrap[0] && !wrap[1] && !wrap[2]) continue;
+            if (!half && self) continue;
+            for (PetscInt d = 0; d < 3; d++) {
+              x[d] = p->x[3 * j + d] + wrap[d] * cl.length[d] - xi[d];
+              len2 += x[d] * x[d];
+            }
+            if (len2 > r * r) continue;
+            len = PetscSqrtReal(len2);
+            h   = 0.5 * (p->spacing[i] + p->spacing[j]);
+            PetscCheck(len > 1e-8 * h, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "particles %" PetscInt_FMT " and %" PetscInt_FMT " coincide at (%g, %g, %g)%s (distance %g, spacing %g)", p->source_line[i] ? p->source_line[i] : i, p->source_line[j] ? p->source_line[j] : j, (double)xi[0], (double)xi[1], (double)xi[2], p->source_line[i] ? " (the numbers are lines of particles.file)" : "", (double)len, (double)h);
+            alpha = PeriPartialVolumeFactor(pv, len, delta, h);
+            if (alpha <= 0) continue;
+            PetscCall(BondsReserve(b, b->nbonds + 1, &cap));
+            b->j[b->nbonds] = j;
+            for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
+            b->length[b->nbonds] = len;
+            b->alpha[b->nbonds]  = alpha;
+            b->live[b->nbonds]   = 1;
+            b->nbonds++;
+          }
+        }
+    b->offset[i - rstart + 1] = b->nbonds;
+  }
+  PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
+  for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
+  PetscCall(CellListDestroy(&cl));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriBondsDestroy(PeriBonds *b)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(b->offset));
+  PetscCall(PetscFree(b->j));
+  PetscCall(PetscFree(b->xi));
+  PetscCall(PetscFree(b->length));
+  PetscCall(PetscFree(b->alpha));
+  PetscCall(PetscFree(b->lambda));
+  PetscCall(PetscFree(b->live));
+  b->nbonds = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,77 @@
+/* summary.json: what the run was, what it cost, and its results (docs/summary.md lists the keys). */
+#include "perilin.h"
+
+static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
+{
+  PeriResults   *r  = &p->results;
+  const PetscInt bs = p->model->dofs;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriJSONString(j, "scene", p->scene->file));
+  PetscCall(PeriJSONString(j, "model", p->model->type));
+  PetscCall(PeriJSONInt(j, "dim", p->particles.dim));
+  if (p->particles.dim == 2) PetscCall(PeriJSONString(j, "plane", p->model->plane_strain ? "strain" : "stress"));
+  PetscCall(PeriJSONString(j, "analysis", p->analysis));
+  PetscCall(PeriJSONInt(j, "particles", p->particles.n));
+  PetscCall(PeriJSONInt(j, "bonds", r->nbonds_total));
+  PetscCall(PeriJSONInt(j, "dofs", p->particles.n * bs));
+  PetscCall(PeriJSONInt(j, "ranks", p->size));
+  PetscCall(PeriJSONReal(j, "horizon", p->delta));
+  PetscCall(PeriJSONString(j, "partial_volume", PeriPartialVolumes[p->partial_volume]));
+  PetscCall(PeriJSONString(j, "surface_correction", PeriSurfaceCorrections[p->surface]));
+  PetscCall(PeriJSONBeginObject(j, "material"));
+  PetscCall(PeriJSONReal(j, "E", p->model->material.E));
+  PetscCall(PeriJSONReal(j, "nu", p->model->material.nu));
+  PetscCall(PeriJSONReal(j, "K", p->model->material.K));
+  PetscCall(PeriJSONReal(j, "G", p->model->material.G));
+  PetscCall(PeriJSONEndObject(j));
+  PetscCall(PeriJSONBeginObject(j, "timing"));
+  PetscCall(PeriJSONReal(j, "neighbors_s", r->neighbors_s));
+  PetscCall(PeriJSONReal(j, "assembly_s", r->assembly_s));
+  PetscCall(PeriJSONReal(j, "solve_s", r->solve_s));
+  PetscCall(PeriJSONReal(j, "total_s", r->total_s));
+  PetscCall(PeriJSONEndObject(j));
+  PetscCall(PeriJSONReal(j, "memory_mb", r->memory_mb));
+  PetscCall(PeriJSONReal(j, "memory_mb_max_rank", r->memory_mb_max_rank));
+  PetscCall(PeriJSONBeginObject(j, "solver"));
+  PetscCall(PeriJSONString(j, "ksp_type", r->ksp_type));
+  PetscCall(PeriJSONString(j, "pc_type", r->pc_type));
+  PetscCall(PeriJSONInt(j, "iterations", r->iterations));
+  PetscCall(PeriJSONString(j, "converged_reason", r->converged_reason));
+  PetscCall(PeriJSONReal(j, "residual_norm", r->residual_norm));
+  PetscCall(PeriJSONEndObject(j));
+  PetscCall(PeriJSONReal(j, "strain_energy", r->strain_energy));
+  PetscCall(PeriJSONBeginObject(j, "max_abs_u"));
+  for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, p->model->components[c], r->max_abs_u[c]));
+  PetscCall(PeriJSONEndObject(j));
+  PetscCall(PeriJSONBeginObject(j, "probes"));
+  for (PetscInt k = 0; k < p->nprobes; k++) {
+    PeriProbe *pr = &p->probes[k];
+    PetscCall(PeriJSONBeginObject(j, pr->name));
+    PetscCall(PeriJSONRealArray(j, "x", p->particles.dim, pr->x));
+    PetscCall(PeriJSONRealArray(j, "particle_x", p->particles.dim, &p->particles.x[3 * pr->particle]));
+    PetscCall(PeriJSONString(j, "sampling", "nearest particle"));
+    PetscCall(PeriJSONRealArray(j, "u", bs, pr->u));
+    PetscCall(PeriJSONReal(j, "W", pr->W));
+    PetscCall(PeriJSONEndObject(j));
+  }
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteSummary - writes summary.json on rank 0 (temporary name, then rename). Collective.
+@*/
+PetscErrorCode PeriWriteSummary(PeriProblem p, const char path[])
+{
+  PeriJSON       j = NULL;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  if (p->rank) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriJSONOpen(path, &j));
+  ierr = WriteSummary(p, j);
+  PetscCall(PeriJSONClose(&j, ierr ? PETSC_FALSE : PETSC_TRUE));
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,119 @@
+/* Named regions: boxes, and boundary layers of a given depth along a face of the body. */
+#include "perilin.h"
+
+static const char *const sides[] = {"x-", "x+", "y-", "y+", "z-", "z+", NULL};
+
+/* Points on a region's boundary belong to it: tolerance relative to the body size. */
+static PetscReal Tolerance(const PeriParticles *p)
+{
+  PetscReal L = 0;
+  for (PetscInt d = 0; d < p->dim; d++) L = PetscMax(L, p->upper[d] - p->lower[d]);
+  return 1e-9 * L;
+}
+
+PetscBool PeriRegionContains(const PeriRegion *r, const PetscReal x[])
+{
+  if (r->kind == PERI_REGION_ALL) return PETSC_TRUE;
+  for (PetscInt d = 0; d < 3; d++)
+    if (x[d] < r->lower[d] || x[d] > r->upper[d]) return PETSC_FALSE;
+  return PETSC_TRUE;
+}
+
+static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const PeriParticles *p, PetscReal delta, PeriRegion *r)
+{
+  static const char *const keys[] = {"lower", "upper", "side", "depth", NULL};
+  PetscReal                tol = Tolerance(p);
+  PetscInt                 n, dim = p->dim, side = -1;
+  PeriNode                 lower, sidenode;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(node->kind == PERI_NODE_MAP, scene, node, NULL, "a region is a box {lower: [..], upper: [..]} or a layer {side: x-, depth: d}");
+  PetscCall(PeriSceneCheckKeys(scene, node, keys));
+  PetscCall(PetscStrncpy(r->name, node->key, sizeof(r->name)));
+  r->node = node;
+  PetscCall(PeriSceneGetNode(node, "lower", &lower));
+  PetscCall(PeriSceneGetNode(node, "side", &sidenode));
+  PeriInputCheck(lower || sidenode, scene, node, NULL, "give lower and upper (a box) or side (a boundary layer)");
+  PeriInputCheck(!(lower && sidenode), scene, node, NULL, "give either lower/upper (a box) or side (a layer), not both");
+  for (PetscInt d = 0; d < 3; d++) {
+    r->lower[d] = d < dim ? p->lower[d] - tol : -PETSC_MAX_REAL;
+    r->upper[d] = d < dim ? p->upper[d] + tol : PETSC_MAX_REAL;
+  }
+  if (lower) {
+    PetscReal lo[3], hi[3];
+    r->kind = PERI_REGION_BOX;
+    PetscCall(PeriSceneGetRealArray(scene, node, "lower", PETSC_TRUE, dim, dim, lo, &n));
+    PetscCall(PeriSceneGetRealArray(scene, node, "upper", PETSC_TRUE, dim, dim, hi, &n));
+    for (PetscInt d = 0; d < dim; d++) {
+      PeriInputCheck(hi[d] >= lo[d], scene, node, "upper", "must not be below lower (axis %" PetscInt_FMT ")", d);
+      r->lower[d] = lo[d] - tol;
+      r->upper[d] = hi[d] + tol;
+    }
+  } else {
+    r->kind  = PERI_REGION_LAYER;
+    r->depth = delta;
+    PetscCall(PeriSceneGetChoice(scene, node, "side", sides, &side, NULL));
+    PetscCall(PeriSceneGetReal(scene, node, "depth", PETSC_FALSE, &r->depth, NULL));
+    PeriInputCheck(r->depth > 0, scene, node, "depth", "must be positive");
+    r->axis = side / 2;
+    r->side = side % 2 ? 1 : -1;
+    PeriInputCheck(r->axis < dim, scene, node, "side", "axis %c does not exist in %" PetscInt_FMT "D", (char)('x' + r->axis), dim);
+    if (r->side < 0) r->upper[r->axis] = p->lower[r->axis] + r->depth + tol;
+    else r->lower[r->axis] = p->upper[r->axis] - r->depth - tol;
+    r->face_area = dim == 2 ? p->thickness : 1;
+    for (PetscInt d = 0; d < dim; d++)
+      if (d != r->axis) r->face_area *= p->upper[d] - p->lower[d];
+  }
+  for (PetscInt k = 0; k < p->n; k++)
+    if (PeriRegionContains(r, &p->x[3 * k])) {
+      r->count++;
+      r->volume += p->volume[k];
+    }
+  PeriInputCheck(r->count > 0, scene, node, NULL, "the region holds no particle");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriRegionsCreateFromScene - reads the regions map; region "all" always exists. Not collective.
+@*/
+PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *p, PetscReal delta, PetscInt *nregions, PeriRegion **regions)
+{
+  PeriNode    map;
+  PetscInt    n;
+  PeriRegion *r;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(scene, scene->root, "regions", PETSC_FALSE, &map));
+  n = 1 + (map ? map->n : 0);
+  PetscCall(PetscCalloc1(n, &r));
+  PetscCall(PetscStrncpy(r[0].name, "all", sizeof(r[0].name)));
+  r[0].kind  = PERI_REGION_ALL;
+  r[0].count = p->n;
+  for (PetscInt k = 0; k < p->n; k++) r[0].volume += p->volume[k];
+  for (PetscInt k = 1; k < n; k++) {
+    PeriInputCheck(strcmp(map->child[k - 1]->key, "all"), scene, map->child[k - 1], NULL, "'all' is reserved: it always names every particle");
+    PetscCall(RegionFromScene(scene, map->child[k - 1], p, delta, &r[k]));
+  }
+  *nregions = n;
+  *regions  = r;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The region named by the scalar key of map (e.g. bc.0.region). */
+PetscErrorCode PeriRegionFind(PeriScene scene, PeriNode map, const char key[], PetscInt nregions, PeriRegion *regions, PeriRegion **region)
+{
+  char name[PERI_NAME_LEN], list[512] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetString(scene, map, key, PETSC_TRUE, name, sizeof(name), NULL));
+  for (PetscInt k = 0; k < nregions; k++) {
+    if (!strcmp(regions[k].name, name)) {
+      *region = &regions[k];
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    PetscCall(PetscStrlcat(list, k ? ", " : "", sizeof(list)));
+    PetscCall(PetscStrlcat(list, regions[k].name, sizeof(list)));
+  }
+  PeriInputCheck(PETSC_FALSE, scene, map, key, "no region named '%s'; the regions are: %s", name, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

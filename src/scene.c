@@ -1,0 +1,521 @@
+/* Scene files: YAML -> a tree of nodes with line numbers, every scalar overridable from the
+ * PETSc options database by its path joined with '_' (-material_nu 0.1). Readers validate
+ * as they go and report errors as "file:line: key 'a.b' ..." (PeriInputCheck). */
+#include "perilin.h"
+#include <yaml.h>
+#include <ctype.h>
+#include <errno.h>
+#include <libgen.h>
+
+/* The documented scalar keys: `perilin -help` lists them, and an option naming one that the
+ * file lacks adds it (so -horizon_m 4 works on a scene that gives horizon.delta). */
+typedef struct {
+  const char *path, *meaning;
+} PeriSceneKey;
+
+static const PeriSceneKey scene_keys[] = {
+  {"dim",                         "2 or 3"                                                                              },
+  {"model.type",                  "bond model: pmb | npmb (see docs/models)"                                            },
+  {"model.plane",                 "2D only: stress | strain"                                                            },
+  {"material.E",                  "Young's modulus [stress]"                                                            },
+  {"material.nu",                 "Poisson ratio (bond-based pmb/npmb: 1/3 plane stress, 1/4 plane strain and 3D)"      },
+  {"material.K",                  "3D bulk modulus [stress], instead of E"                                              },
+  {"material.rho",                "density [mass/volume]"                                                               },
+  {"material.thickness",          "2D thickness [length]; default 1"                                                    },
+  {"grid.spacing",                "particle spacing dx [length]"                                                        },
+  {"grid.lower",                  "box lower corner [length], a list of dim numbers"                                    },
+  {"grid.upper",                  "box upper corner [length], a list of dim numbers"                                    },
+  {"grid.periodic",               "list of dim booleans: periodic axes (minimum image)"                                 },
+  {"particles.file",              "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid"},
+  {"horizon.m",                   "horizon as a multiple of the spacing, delta = m dx"                                  },
+  {"horizon.delta",               "horizon radius [length], instead of m"                                               },
+  {"corrections.partial_volume",  "none | linear (alpha ramp cut at delta) | linear_continued (ramp to delta + dx/2)"    },
+  {"corrections.surface",         "none | volume (lambda = 2 V0 / (V(H_i) + V(H_j)))"                                   },
+  {"regions.<name>.lower/upper",  "a box region"                                                                        },
+  {"regions.<name>.side",         "a boundary layer: x- | x+ | y- | y+ | z- | z+, with .depth [length] (default delta)" },
+  {"bc.<k>.region",               "region the condition applies to (all = every particle)"                              },
+  {"bc.<k>.fix",                  "list of components held at zero, e.g. [ux, uy]"                                      },
+  {"bc.<k>.value",                "map component -> prescribed value, e.g. {ux: 0.001}"                                 },
+  {"bc.<k>.affine",               "prescribed linear field u = A X + b: {A: [[..],..], b: [..]}"                        },
+  {"loads.<k>.region",            "region the load applies to"                                                          },
+  {"loads.<k>.force",             "total force [force], spread over the region's particles by volume"                   },
+  {"loads.<k>.traction",          "traction [stress] on the face of a layer region (force = traction x face area)"      },
+  {"loads.<k>.body_force",        "force per unit volume [force/volume]"                                                },
+  {"probes.<name>",               "a point [x, y(, z)]: displacement and energy density of the nearest particle"        },
+  {"analysis.type",               "static"                                                                              },
+  {"output.dir",                  "output directory; default <scene name>-out"                                          },
+  {"output.vtk",                  "true | false: write particles.vtu (default true)"                                    },
+};
+
+static PetscErrorCode NodeCreate(PeriNodeKind kind, const char key[], const char parent_path[], int line, PeriNode *node)
+{
+  PeriNode n;
+  size_t   len;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&n));
+  n->kind = kind;
+  n->line = line;
+  PetscCall(PetscStrallocpy(key, &n->key));
+  if (parent_path && parent_path[0]) {
+    len = strlen(parent_path) + strlen(key) + 2;
+    PetscCall(PetscMalloc1(len, &n->path));
+    PetscCall(PetscSNPrintf(n->path, len, "%s.%s", parent_path, key));
+  } else PetscCall(PetscStrallocpy(key ? key : "", &n->path));
+  *node = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode NodeAppend(PeriNode parent, PeriNode child)
+{
+  PeriNode *c;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(parent->n + 1, &c));
+  for (PetscInt k = 0; k < parent->n; k++) c[k] = parent->child[k];
+  c[parent->n] = child;
+  PetscCall(PetscFree(parent->child));
+  parent->child = c;
+  parent->n++;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode NodeDestroy(PeriNode *node)
+{
+  PetscFunctionBeginUser;
+  if (!*node) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < (*node)->n; k++) PetscCall(NodeDestroy(&(*node)->child[k]));
+  PetscCall(PetscFree((*node)->child));
+  PetscCall(PetscFree((*node)->key));
+  PetscCall(PetscFree((*node)->path));
+  PetscCall(PetscFree((*node)->value));
+  PetscCall(PetscFree(*node));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+typedef struct {
+  yaml_parser_t parser;
+  const char   *file;
+} Reader;
+
+static PetscErrorCode ReaderNext(Reader *r, yaml_event_t *ev)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(yaml_parser_parse(&r->parser, ev), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: invalid YAML: %s", r->file, (int)r->parser.problem_mark.line + 1, r->parser.problem ? r->parser.problem : "syntax error");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Builds the node for the event ev (already read) and everything below it. */
+static PetscErrorCode ParseNode(Reader *r, yaml_event_t *ev, const char key[], const char parent_path[], PeriNode *node)
+{
+  int line = (int)ev->start_mark.line + 1;
+
+  PetscFunctionBeginUser;
+  switch (ev->type) {
+  case YAML_SCALAR_EVENT:
+    PetscCall(NodeCreate(PERI_NODE_SCALAR, key, parent_path, line, node));
+    PetscCall(PetscStrallocpy((const char *)ev->data.scalar.value, &(*node)->value));
+    yaml_event_delete(ev);
+    break;
+  case YAML_SEQUENCE_START_EVENT: {
+    PetscInt k = 0;
+    yaml_event_delete(ev);
+    PetscCall(NodeCreate(PERI_NODE_SEQ, key, parent_path, line, node));
+    while (PETSC_TRUE) {
+      yaml_event_t item;
+      PeriNode     child;
+      char         idx[32];
+      PetscCall(ReaderNext(r, &item));
+      if (item.type == YAML_SEQUENCE_END_EVENT) {
+        yaml_event_delete(&item);
+        break;
+      }
+      PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, k++));
+      PetscCall(ParseNode(r, &item, idx, (*node)->path, &child));
+      PetscCall(NodeAppend(*node, child));
+    }
+  } break;
+  case YAML_MAPPING_START_EVENT:
+    yaml_event_delete(ev);
+    PetscCall(NodeCreate(PERI_NODE_MAP, key, parent_path, line, node));
+    while (PETSC_TRUE) {
+      yaml_event_t kev, vev;
+      PeriNode     child, dup;
+      char        *k;
+      PetscCall(ReaderNext(r, &kev));
+      if (kev.type == YAML_MAPPING_END_EVENT) {
+        yaml_event_delete(&kev);
+        break;
+      }
+      PetscCheck(kev.type == YAML_SCALAR_EVENT, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: mapping keys must be plain words", r->file, (int)kev.start_mark.line + 1);
+      PetscCall(PetscStrallocpy((const char *)kev.data.scalar.value, &k));
+      line = (int)kev.start_mark.line + 1;
+      yaml_event_delete(&kev);
+      PetscCall(PeriSceneGetNode(*node, k, &dup));
+      if (dup) {
+        PetscCall(PetscFree(k));
+        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: key '%s' appears twice in '%s'", r->file, line, dup->path, (*node)->path[0] ? (*node)->path : "the scene");
+      }
+      PetscCall(ReaderNext(r, &vev));
+      PetscCall(ParseNode(r, &vev, k, (*node)->path, &child));
+      PetscCall(PetscFree(k));
+      PetscCall(NodeAppend(*node, child));
+    }
+    break;
+  case YAML_ALIAS_EVENT:
+    yaml_event_delete(ev);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: YAML aliases are not supported in scene files", r->file, line);
+  default:
+    yaml_event_delete(ev);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: unexpected YAML content", r->file, line);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static void OptionName(const char path[], char opt[], size_t len)
+{
+  size_t k = 0;
+  opt[k++] = '-';
+  for (const char *c = path; *c && k + 1 < len; c++) opt[k++] = (*c == '.') ? '_' : *c;
+  opt[k] = 0;
+}
+
+/* Every scalar whose option -path_joined_by_underscores is set takes the option's value. */
+static PetscErrorCode ApplyOptions(PeriNode node)
+{
+  PetscFunctionBeginUser;
+  if (node->kind == PERI_NODE_SCALAR) {
+    char      opt[512], val[PETSC_MAX_PATH_LEN];
+    PetscBool set;
+    OptionName(node->path, opt, sizeof(opt));
+    PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
+    if (set) {
+      PetscCall(PetscFree(node->value));
+      PetscCall(PetscStrallocpy(val, &node->value));
+      node->line = 0;
+    }
+  }
+  for (PetscInt k = 0; k < node->n; k++) PetscCall(ApplyOptions(node->child[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A documented key missing from the file is added when its option is given. */
+static PetscErrorCode AddOptionKeys(PeriNode root)
+{
+  PetscFunctionBeginUser;
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) {
+    const char *path = scene_keys[k].path;
+    char        opt[512], val[PETSC_MAX_PATH_LEN], parent[256], leaf[128];
+    const char *dot;
+    PetscBool   set;
+    PeriNode    map = root, child;
+
+    if (strchr(path, '<')) continue;
+    OptionName(path, opt, sizeof(opt));
+    PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
+    if (!set) continue;
+    dot = strrchr(path, '.');
+    if (dot) {
+      PetscCall(PetscStrncpy(parent, path, PetscMin((size_t)(dot - path + 1), sizeof(parent))));
+      PetscCall(PetscStrncpy(leaf, dot + 1, sizeof(leaf)));
+      PetscCall(PeriSceneGetNode(root, parent, &map));
+      if (!map) {
+        PetscCall(NodeCreate(PERI_NODE_MAP, parent, "", 0, &map));
+        PetscCall(NodeAppend(root, map));
+      }
+      if (map->kind != PERI_NODE_MAP) continue; /* the reader reports the wrong type */
+    } else PetscCall(PetscStrncpy(leaf, path, sizeof(leaf)));
+    PetscCall(PeriSceneGetNode(map, leaf, &child));
+    if (child) continue; /* ApplyOptions already set it */
+    PetscCall(NodeCreate(PERI_NODE_SCALAR, leaf, map->path, 0, &child));
+    PetscCall(PetscStrallocpy(val, &child->value));
+    PetscCall(NodeAppend(map, child));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSceneCreateFromFile - reads a YAML scene file and applies option overrides. Not collective:
+  every rank reads the file.
+@*/
+PetscErrorCode PeriSceneCreateFromFile(const char file[], PeriScene *scene)
+{
+  PeriScene    s;
+  FILE        *fp;
+  Reader       r;
+  yaml_event_t ev;
+  char         tmp[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&s));
+  PetscCall(PetscStrncpy(s->file, file, sizeof(s->file)));
+  PetscCall(PetscStrncpy(tmp, file, sizeof(tmp)));
+  PetscCall(PetscStrncpy(s->dir, dirname(tmp), sizeof(s->dir)));
+  fp = fopen(file, "r");
+  if (!fp) {
+    int err = errno;
+    PetscCall(PetscFree(s));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "cannot open scene file %s: %s", file, strerror(err));
+  }
+  r.file = s->file;
+  PetscCheck(yaml_parser_initialize(&r.parser), PETSC_COMM_SELF, PETSC_ERR_LIB, "libyaml could not initialize");
+  yaml_parser_set_input_file(&r.parser, fp);
+  *scene = s;
+  /* stream start, document start, then the root mapping */
+  PetscCall(ReaderNext(&r, &ev));
+  yaml_event_delete(&ev);
+  PetscCall(ReaderNext(&r, &ev));
+  if (ev.type == YAML_STREAM_END_EVENT) {
+    yaml_event_delete(&ev);
+    yaml_parser_delete(&r.parser);
+    fclose(fp);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the scene file is empty", file);
+  }
+  yaml_event_delete(&ev);
+  PetscCall(ReaderNext(&r, &ev));
+  PetscCheck(ev.type == YAML_MAPPING_START_EVENT, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: a scene is a mapping of keys (dim, model, material, ...)", file, (int)ev.start_mark.line + 1);
+  PetscCall(ParseNode(&r, &ev, "", "", &s->root));
+  yaml_parser_delete(&r.parser);
+  fclose(fp);
+  PetscCall(ApplyOptions(s->root));
+  PetscCall(AddOptionKeys(s->root));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneDestroy(PeriScene *scene)
+{
+  PetscFunctionBeginUser;
+  if (!*scene) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(NodeDestroy(&(*scene)->root));
+  PetscCall(PetscFree(*scene));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSceneHelp - prints the documented scene keys and their options. Collective.
+@*/
+PetscErrorCode PeriSceneHelp(MPI_Comm comm)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(comm, "Scene keys (YAML; every scalar key is also an option: its path joined with '_', e.g. -material_nu 0.1):\n"));
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) PetscCall(PetscPrintf(comm, "  %-30s %s\n", scene_keys[k].path, scene_keys[k].meaning));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* "file:line: key 'material.nu' (option -material_nu)" for node (or its child key when given). */
+PetscErrorCode PeriSceneWhere(PeriScene scene, PeriNode node, const char key[], char buf[], size_t len)
+{
+  char        path[512], opt[512];
+  const char *p = node ? node->path : "";
+
+  PetscFunctionBeginUser;
+  if (key && key[0]) PetscCall(PetscSNPrintf(path, sizeof(path), "%s%s%s", p, p[0] ? "." : "", key));
+  else PetscCall(PetscStrncpy(path, p, sizeof(path)));
+  OptionName(path, opt, sizeof(opt));
+  if (node && node->line > 0) {
+    PeriNode child = NULL;
+    int      line  = node->line;
+    if (key && key[0]) PetscCall(PeriSceneGetNode(node, key, &child));
+    if (child && child->line > 0) line = child->line;
+    PetscCall(PetscSNPrintf(buf, len, "%s:%d: key '%s'", scene->file, line, path));
+  } else if (node) PetscCall(PetscSNPrintf(buf, len, "%s: key '%s' (set by option %s)", scene->file, path, opt));
+  else PetscCall(PetscSNPrintf(buf, len, "%s: key '%s'", scene->file, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The child of map named key; the key may be dotted ("material.nu"). NULL when absent. */
+PetscErrorCode PeriSceneGetNode(PeriNode map, const char key[], PeriNode *child)
+{
+  const char *dot;
+  size_t      len;
+
+  PetscFunctionBeginUser;
+  *child = NULL;
+  if (!map || map->kind != PERI_NODE_MAP) PetscFunctionReturn(PETSC_SUCCESS);
+  dot = strchr(key, '.');
+  len = dot ? (size_t)(dot - key) : strlen(key);
+  for (PetscInt k = 0; k < map->n; k++) {
+    if (strlen(map->child[k]->key) == len && !strncmp(map->child[k]->key, key, len)) {
+      if (dot) PetscCall(PeriSceneGetNode(map->child[k], dot + 1, child));
+      else *child = map->child[k];
+      break;
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneGetMap(PeriScene scene, PeriNode map, const char key[], PetscBool required, PeriNode *child)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(map, key, child));
+  PeriInputCheck(*child || !required, scene, map, key, "is required");
+  PeriInputCheck(!*child || (*child)->kind == PERI_NODE_MAP, scene, *child, NULL, "must be a mapping of keys");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneCheckKeys(PeriScene scene, PeriNode map, const char *const allowed[])
+{
+  PetscFunctionBeginUser;
+  if (!map) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < map->n; k++) {
+    PetscBool ok = PETSC_FALSE;
+    for (PetscInt a = 0; allowed[a]; a++)
+      if (!strcmp(map->child[k]->key, allowed[a])) ok = PETSC_TRUE;
+    if (!ok) {
+      char list[512] = "";
+      for (PetscInt a = 0; allowed[a]; a++) {
+        PetscCall(PetscStrlcat(list, a ? ", " : "", sizeof(list)));
+        PetscCall(PetscStrlcat(list, allowed[a], sizeof(list)));
+      }
+      PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s", list);
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode GetScalar(PeriScene scene, PeriNode map, const char key[], PetscBool required, PeriNode *node)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(map, key, node));
+  PeriInputCheck(*node || !required, scene, map, key, "is required");
+  PeriInputCheck(!*node || (*node)->kind == PERI_NODE_SCALAR, scene, *node, NULL, "must be a single value, not a list or mapping");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Numbers, and simple fractions such as 1/3 (exact Poisson ratios). */
+PetscErrorCode PeriSceneParseReal(PeriScene scene, PeriNode node, PetscReal *v)
+{
+  char  *end;
+  double a, b = 1;
+
+  PetscFunctionBeginUser;
+  errno = 0;
+  a     = strtod(node->value, &end);
+  PeriInputCheck(end != node->value, scene, node, NULL, "expected a number, got '%s'", node->value);
+  if (*end == '/') {
+    const char *s = end + 1;
+    b             = strtod(s, &end);
+    PeriInputCheck(end != s && b != 0, scene, node, NULL, "expected a number or a fraction a/b, got '%s'", node->value);
+  }
+  while (isspace((unsigned char)*end)) end++;
+  PeriInputCheck(!*end && errno != ERANGE, scene, node, NULL, "expected a number, got '%s'", node->value);
+  *v = (PetscReal)(a / b);
+  PeriInputCheck(PetscIsNormalReal(*v) || *v == 0, scene, node, NULL, "expected a finite number, got '%s'", node->value);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneGetReal(PeriScene scene, PeriNode map, const char key[], PetscBool required, PetscReal *v, PetscBool *found)
+{
+  PeriNode node;
+
+  PetscFunctionBeginUser;
+  PetscCall(GetScalar(scene, map, key, required, &node));
+  if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
+  if (node) PetscCall(PeriSceneParseReal(scene, node, v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneGetInt(PeriScene scene, PeriNode map, const char key[], PetscBool required, PetscInt *v, PetscBool *found)
+{
+  PeriNode node;
+  char    *end;
+  long     l;
+
+  PetscFunctionBeginUser;
+  PetscCall(GetScalar(scene, map, key, required, &node));
+  if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
+  if (!node) PetscFunctionReturn(PETSC_SUCCESS);
+  l = strtol(node->value, &end, 10);
+  PeriInputCheck(end != node->value && !*end, scene, node, NULL, "expected a whole number, got '%s'", node->value);
+  *v = (PetscInt)l;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneParseBool(PeriScene scene, PeriNode node, PetscBool *v)
+{
+  static const char *const yes[] = {"true", "yes", "on", "1"}, *const no[] = {"false", "no", "off", "0"};
+  PetscBool                match = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(node->kind == PERI_NODE_SCALAR, scene, node, NULL, "expected true or false");
+  for (int k = 0; k < 4; k++) {
+    PetscBool y, n;
+    PetscCall(PetscStrcasecmp(node->value, yes[k], &y));
+    PetscCall(PetscStrcasecmp(node->value, no[k], &n));
+    if (y) *v = PETSC_TRUE;
+    if (n) *v = PETSC_FALSE;
+    match = (PetscBool)(match || y || n);
+  }
+  PeriInputCheck(match, scene, node, NULL, "expected true or false, got '%s'", node->value);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneGetBool(PeriScene scene, PeriNode map, const char key[], PetscBool *v, PetscBool *found)
+{
+  PeriNode node;
+
+  PetscFunctionBeginUser;
+  PetscCall(GetScalar(scene, map, key, PETSC_FALSE, &node));
+  if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
+  if (node) PetscCall(PeriSceneParseBool(scene, node, v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneGetString(PeriScene scene, PeriNode map, const char key[], PetscBool required, char buf[], size_t len, PetscBool *found)
+{
+  PeriNode node;
+
+  PetscFunctionBeginUser;
+  PetscCall(GetScalar(scene, map, key, required, &node));
+  if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
+  if (node) PetscCall(PetscStrncpy(buf, node->value, len));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* choices is NULL-terminated; *idx is left alone when the key is absent. */
+PetscErrorCode PeriSceneGetChoice(PeriScene scene, PeriNode map, const char key[], const char *const choices[], PetscInt *idx, PetscBool *found)
+{
+  PeriNode node;
+  char     list[512] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(GetScalar(scene, map, key, PETSC_FALSE, &node));
+  if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
+  if (!node) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; choices[k]; k++) {
+    if (!strcmp(node->value, choices[k])) {
+      *idx = k;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    PetscCall(PetscStrlcat(list, k ? ", " : "", sizeof(list)));
+    PetscCall(PetscStrlcat(list, choices[k], sizeof(list)));
+  }
+  PeriInputCheck(PETSC_FALSE, scene, node, NULL, "'%s' is not allowed; choose one of: %s", node->value, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A list of nmin..nmax numbers. */
+PetscErrorCode PeriSceneParseRealArray(PeriScene scene, PeriNode node, PetscInt nmin, PetscInt nmax, PetscReal v[], PetscInt *n)
+{
+  PetscFunctionBeginUser;
+  PeriInputCheck(node->kind == PERI_NODE_SEQ, scene, node, NULL, "must be a list of %" PetscInt_FMT " numbers, e.g. [0, 1]", nmax);
+  PeriInputCheck(node->n >= nmin && node->n <= nmax, scene, node, NULL, "must have %" PetscInt_FMT " to %" PetscInt_FMT " entries, got %" PetscInt_FMT, nmin, nmax, node->n);
+  for (PetscInt k = 0; k < node->n; k++) {
+    PeriInputCheck(node->child[k]->kind == PERI_NODE_SCALAR, scene, node->child[k], NULL, "must be a number");
+    PetscCall(PeriSceneParseReal(scene, node->child[k], &v[k]));
+  }
+  *n = node->n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSceneGetRealArray(PeriScene scene, PeriNode map, const char key[], PetscBool required, PetscInt nmin, PetscInt nmax, PetscReal v[], PetscInt *n)
+{
+  PeriNode node;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  PetscCall(PeriSceneGetNode(map, key, &node));
+  PeriInputCheck(node || !required, scene, map, key, "is required");
+  if (node) PetscCall(PeriSceneParseRealArray(scene, node, nmin, nmax, v, n));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
