@@ -17,8 +17,7 @@ static PetscErrorCode ComponentList(PeriModel m, char buf[], size_t len)
   PetscFunctionBeginUser;
   buf[0] = 0;
   for (PetscInt c = 0; c < m->dofs; c++) {
-    PetscCall(PetscStrlcat(buf, c ? ", " : "", len));
-    PetscCall(PetscStrlcat(buf, m->components[c], len));
+    PeriListAppend(buf, len, m->components[c]);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

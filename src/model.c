@@ -33,8 +33,7 @@ PetscErrorCode PeriModelListTypes(char buf[], size_t len)
   PetscCall(PetscFunctionListGet(PeriModelList, &names, &n));
   buf[0] = 0;
   for (int k = 0; k < n; k++) {
-    PetscCall(PetscStrlcat(buf, k ? ", " : "", len));
-    PetscCall(PetscStrlcat(buf, names[k], len));
+    PeriListAppend(buf, len, names[k]);
   }
   PetscCall(PetscFree(names));
   PetscFunctionReturn(PETSC_SUCCESS);

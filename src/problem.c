@@ -81,7 +81,7 @@ static PetscErrorCode ReadCorrections(PeriProblem p)
   static const char *const keys[] = {"partial_volume", "surface", NULL};
   PeriScene                s       = p->scene;
   PeriNode                 c;
-  PetscInt                 pv = PERI_PARTIAL_VOLUME_LINEAR, sc = PERI_SURFACE_NONE;
+  PetscInt                 pv = PERI_PARTIAL_VOLUME_LINEAR_CONTINUED, sc = PERI_SURFACE_NONE;
   PetscBool                found;
 
   PetscFunctionBeginUser;

@@ -111,8 +111,7 @@ PetscErrorCode PeriRegionFind(PeriScene scene, PeriNode map, const char key[], P
       *region = &regions[k];
       PetscFunctionReturn(PETSC_SUCCESS);
     }
-    PetscCall(PetscStrlcat(list, k ? ", " : "", sizeof(list)));
-    PetscCall(PetscStrlcat(list, regions[k].name, sizeof(list)));
+    PeriListAppend(list, sizeof(list), regions[k].name);
   }
   PeriInputCheck(PETSC_FALSE, scene, map, key, "no region named '%s'; the regions are: %s", name, list);
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -172,6 +172,14 @@ static PetscErrorCode ParseNode(Reader *r, yaml_event_t *ev, const char key[], c
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Appends ", item" (or "item" to an empty list), truncating: PetscStrlcat in PETSc 3.18 can
+ * write past the end of the buffer. */
+void PeriListAppend(char buf[], size_t len, const char item[])
+{
+  size_t used = strlen(buf);
+  if (used + 1 < len) snprintf(buf + used, len - used, "%s%s", used ? ", " : "", item);
+}
+
 static void OptionName(const char path[], char opt[], size_t len)
 {
   size_t k = 0;
@@ -364,8 +372,7 @@ PetscErrorCode PeriSceneCheckKeys(PeriScene scene, PeriNode map, const char *con
     if (!ok) {
       char list[512] = "";
       for (PetscInt a = 0; allowed[a]; a++) {
-        PetscCall(PetscStrlcat(list, a ? ", " : "", sizeof(list)));
-        PetscCall(PetscStrlcat(list, allowed[a], sizeof(list)));
+        PeriListAppend(list, sizeof(list), allowed[a]);
       }
       PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s", list);
     }
@@ -487,8 +494,7 @@ PetscErrorCode PeriSceneGetChoice(PeriScene scene, PeriNode map, const char key[
       *idx = k;
       PetscFunctionReturn(PETSC_SUCCESS);
     }
-    PetscCall(PetscStrlcat(list, k ? ", " : "", sizeof(list)));
-    PetscCall(PetscStrlcat(list, choices[k], sizeof(list)));
+    PeriListAppend(list, sizeof(list), choices[k]);
   }
   PeriInputCheck(PETSC_FALSE, scene, node, NULL, "'%s' is not allowed; choose one of: %s", node->value, list);
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -71,6 +71,20 @@ static PetscErrorCode JSONCheckUsable(PeriJSON j)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Bounded append that truncates. Not PetscStrlcat(): in PETSc 3.18 it writes past the end of the
+   buffer when the result does not fit. */
+static PetscErrorCode JSONAppend(char dst[], const char src[], size_t size)
+{
+  size_t len = strlen(dst), add = strlen(src);
+
+  PetscFunctionBeginUser;
+  if (len + 1 >= size) PetscFunctionReturn(PETSC_SUCCESS);
+  if (add > size - 1 - len) add = size - 1 - len;
+  memcpy(dst + len, src, add);
+  dst[len + add] = '\0';
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Dotted path of the value about to be written ("results.max_abs_u[2]"), for error messages. */
 static PetscErrorCode JSONPath(PeriJSON j, const char key[], char path[], size_t len)
 {
@@ -80,12 +94,12 @@ static PetscErrorCode JSONPath(PeriJSON j, const char key[], char path[], size_t
   PetscFunctionBeginUser;
   path[0] = '\0';
   for (d = 1; d <= j->depth; d++) {
-    if (j->label[d][0] != '[' && path[0]) PetscCall(PetscStrlcat(path, ".", len));
-    PetscCall(PetscStrlcat(path, j->label[d], len));
+    if (j->label[d][0] != '[' && path[0]) PetscCall(JSONAppend(path, ".", len));
+    PetscCall(JSONAppend(path, j->label[d], len));
   }
   if (j->kind[j->depth] == '[') PetscCall(PetscSNPrintf(last, sizeof(last), "[%" PetscInt_FMT "]", j->count[j->depth]));
   else PetscCall(PetscSNPrintf(last, sizeof(last), "%s%s", path[0] ? "." : "", key ? key : "(null)"));
-  PetscCall(PetscStrlcat(path, last, len));
+  PetscCall(JSONAppend(path, last, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -302,7 +316,7 @@ static PetscErrorCode JSONCheckFinite(PeriJSON j, const char key[], PetscInt n, 
       char index[32];
 
       PetscCall(PetscSNPrintf(index, sizeof(index), "[%" PetscInt_FMT "]", i));
-      PetscCall(PetscStrlcat(path, index, sizeof(path)));
+      PetscCall(JSONAppend(path, index, sizeof(path)));
     }
     PetscCall(JSONAbandon(j));
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FP, "summary value %s is not finite (NaN or Inf): refusing to write it", path);

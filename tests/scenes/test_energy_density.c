@@ -1,0 +1,64 @@
+/* Ganzenmueller et al. sec. 3.1.1 (Fig. 3): energy density of u = s X at the centre of a cubic
+ * lattice for m = 2..6. npmb must give 9 K s^2 / 2 to round-off; pmb's error must equal the
+ * lattice sum sum_j |xi_j| V_j / (pi delta^4) - 1, computed here independently by brute force.
+ * The paper's neighbour counts (32 at m = 2, 924 at m = 6) are checked too. */
+#include "testing.h"
+
+/* sum over lattice points 0 < |xi| <= m of |xi|^p, and their number */
+static void LatticeSum(PetscInt m, PetscInt p, PetscReal *sum, PetscInt *count)
+{
+  *sum   = 0;
+  *count = 0;
+  for (PetscInt i = -m; i <= m; i++)
+    for (PetscInt j = -m; j <= m; j++)
+      for (PetscInt k = -m; k <= m; k++) {
+        PetscInt r2 = i * i + j * j + k * k;
+        if (r2 == 0 || r2 > m * m) continue;
+        *sum += PetscPowReal(PetscSqrtReal((PetscReal)r2), (PetscReal)p);
+        (*count)++;
+      }
+}
+
+int main(int argc, char **argv)
+{
+  const PetscReal K = 1e9, s = 0.01, Wexact = 4.5 * K * s * s;
+
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_energy_density examples/pmb/energy_density.yaml");
+  for (PetscInt m = 2; m <= 6; m++) {
+    char        val[8], what[128];
+    PetscReal   sum1;
+    PetscInt    count;
+    PeriProblem p;
+    PeriProbe  *c;
+
+    LatticeSum(m, 1, &sum1, &count);
+    PetscCall(PetscSNPrintf(val, sizeof(val), "%" PetscInt_FMT, m));
+    PetscCall(PeriTestSetOption("-horizon_m", val));
+
+    PetscCall(PeriTestSetOption("-model_type", "npmb"));
+    PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
+    if (p->rank == 0) {
+      PetscCall(PeriProblemFindProbe(p, "center", &c));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "npmb m=%" PetscInt_FMT ": centre W / (9 K s^2/2)", m));
+      PeriTestClose(what, c->W / Wexact, 1.0, 1e-10);
+      PetscCall(PetscSNPrintf(what, sizeof(what), "m=%" PetscInt_FMT ": neighbours of the centre (lattice count)", m));
+      PeriTestClose(what, (PetscReal)p->neighbor_count[c->particle], (PetscReal)count, 0);
+      if (m == 2) PeriTestClose("m=2: neighbours of the centre (paper: 32)", (PetscReal)count, 32, 0);
+      if (m == 6) PeriTestClose("m=6: neighbours of the centre (paper: 924)", (PetscReal)count, 924, 0);
+    }
+    PetscCall(PeriProblemDestroy(&p));
+
+    PetscCall(PeriTestSetOption("-model_type", "pmb"));
+    PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
+    if (p->rank == 0) {
+      PetscReal predicted = sum1 / (PETSC_PI * PetscPowReal((PetscReal)m, 4));
+      PetscCall(PeriProblemFindProbe(p, "center", &c));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "pmb m=%" PetscInt_FMT ": centre W / (9 K s^2/2), error %+.2f %%", m, (double)(100 * (c->W / Wexact - 1))));
+      PeriTestClose(what, c->W / Wexact, predicted, 1e-10 * predicted);
+    }
+    PetscCall(PeriProblemDestroy(&p));
+  }
+  PetscCall(PetscFinalize());
+  return 0;
+}

@@ -1,0 +1,71 @@
+/* An affine displacement u = A X + b produces zero internal force K u on every particle whose
+ * horizon (and its neighbours' horizons, on which npmb's c_ij and the surface factors depend) lies
+ * inside the body. Run with a scene and -model_type. */
+#include "testing.h"
+
+static PetscErrorCode CheckAffine(const char file[])
+{
+  PeriProblem p;
+  Vec         u, f;
+  PetscScalar *a;
+  const PetscScalar *fa;
+  PetscReal   A[3][3] = {{1e-3, 4e-4, -2e-4}, {-3e-4, 2e-3, 5e-4}, {1e-4, -6e-4, -1e-3}}, b[3] = {0.1, -0.2, 0.3};
+  PetscReal   fmax = 0, scale = 0, reach;
+  PetscInt    checked = 0, total;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
+  PetscCall(PeriProblemLoad(p, file));
+  PetscCall(PeriProblemSetUp(p));
+  PetscCall(PeriProblemAssemble(p));
+  PetscCall(MatCreateVecs(p->K, &u, &f));
+  PetscCall(VecGetArray(u, &a));
+  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
+    for (PetscInt c = 0; c < p->particles.dim; c++) {
+      PetscReal v = b[c];
+      for (PetscInt d = 0; d < p->particles.dim; d++) v += A[c][d] * p->particles.x[3 * i + d];
+      a[(i - p->bonds.rstart) * p->model->dofs + c] = v;
+    }
+  PetscCall(VecRestoreArray(u, &a));
+  PetscCall(MatMult(p->K, u, f));
+  /* the scale of the force from the strain alone: the diagonal block times the strain times dx */
+  {
+    Vec dg;
+    PetscCall(MatCreateVecs(p->K, &dg, NULL));
+    PetscCall(MatGetDiagonal(p->K, dg));
+    PetscCall(VecNorm(dg, NORM_INFINITY, &scale));
+    PetscCall(VecDestroy(&dg));
+    scale *= 2e-3 * p->particles.mean_spacing;
+  }
+  reach = 2 * PeriSearchRadius(p->partial_volume, p->delta, p->particles.mean_spacing);
+  PetscCall(VecGetArrayRead(f, &fa));
+  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
+    PetscBool inner = PETSC_TRUE;
+    for (PetscInt d = 0; d < p->particles.dim; d++) {
+      PetscReal x = p->particles.x[3 * i + d];
+      if (!p->particles.periodic[d] && (x - p->particles.lower[d] < reach || p->particles.upper[d] - x < reach)) inner = PETSC_FALSE;
+    }
+    if (!inner) continue;
+    checked++;
+    for (PetscInt c = 0; c < p->model->dofs; c++) fmax = PetscMax(fmax, PetscAbsReal(PetscRealPart(fa[(i - p->bonds.rstart) * p->model->dofs + c])));
+  }
+  PetscCall(VecRestoreArrayRead(f, &fa));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &fmax, 1, MPIU_REAL, MPI_MAX, p->comm));
+  PetscCallMPI(MPI_Allreduce(&checked, &total, 1, MPIU_INT, MPI_SUM, p->comm));
+  PetscCheck(total > 0, p->comm, PETSC_ERR_PLIB, "no particle with a full horizon: enlarge the scene");
+  PetscCall(PetscPrintf(p->comm, "%s, model %s: %" PetscInt_FMT " interior particles, max |K u| / force scale = %g\n", file, p->model->type, total, (double)(fmax / scale)));
+  PeriTestClose("interior residual force of an affine field (relative)", fmax / scale, 0.0, 1e-11);
+  PetscCall(VecDestroy(&u));
+  PetscCall(VecDestroy(&f));
+  PetscCall(PeriProblemDestroy(&p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+int main(int argc, char **argv)
+{
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_affine SCENE.yaml [options]");
+  PetscCall(CheckAffine(argv[1]));
+  PetscCall(PetscFinalize());
+  return 0;
+}
