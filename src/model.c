@@ -32,9 +32,8 @@ PetscErrorCode PeriModelListTypes(char buf[], size_t len)
   PetscCall(PeriModelRegisterAll());
   PetscCall(PetscFunctionListGet(PeriModelList, &names, &n));
   buf[0] = 0;
-  for (int k = 0; k < n; k++) {
-    PeriListAppend(buf, len, names[k]);
-  }
+  for (int k = 0; k < n; k++)
+    if (names[k]) PeriListAppend(buf, len, names[k]);
   PetscCall(PetscFree(names));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
