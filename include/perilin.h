@@ -9,7 +9,7 @@
 #include <petscksp.h>
 
 #if PETSC_VERSION_LT(3, 19, 0)
-  #define PETSC_SUCCESS 0
+#  define PETSC_SUCCESS 0
 #endif
 
 #define PERI_MAX_DOF     3
@@ -61,13 +61,13 @@ PETSC_EXTERN PetscErrorCode PeriSceneParseBool(PeriScene, PeriNode, PetscBool *)
 PETSC_EXTERN PetscErrorCode PeriSceneParseRealArray(PeriScene, PeriNode, PetscInt, PetscInt, PetscReal[], PetscInt *);
 
 /* A user-input error that names the file, the line and the key. */
-#define PeriInputCheck(cond, scene, node, key, fmt, ...) \
-  do { \
-    if (PetscUnlikely(!(cond))) { \
-      char peri_where_[2 * PETSC_MAX_PATH_LEN]; \
-      PetscCall(PeriSceneWhere((scene), (node), (key), peri_where_, sizeof(peri_where_))); \
+#define PeriInputCheck(cond, scene, node, key, fmt, ...)                                      \
+  do {                                                                                        \
+    if (PetscUnlikely(!(cond))) {                                                             \
+      char peri_where_[2 * PETSC_MAX_PATH_LEN];                                               \
+      PetscCall(PeriSceneWhere((scene), (node), (key), peri_where_, sizeof(peri_where_)));    \
       SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: " fmt, peri_where_, ##__VA_ARGS__); \
-    } \
+    }                                                                                         \
   } while (0)
 
 /* ------------------------------------------------------------------ particles (src/particles.c) */
@@ -132,10 +132,10 @@ typedef struct {
   PetscInt      *j;            /* the other particle (global index, j >= i; j == i only for periodic self-images) */
   PetscReal     *xi;           /* 3 per bond: X_j - X_i, minimum image on periodic axes */
   PetscReal     *length;
-  PetscReal     *alpha;        /* partial-volume factor */
-  PetscReal     *lambda;       /* surface correction factor */
-  unsigned char *live;         /* 1 intact, 0 broken */
-  PetscInt       nbonds;       /* local */
+  PetscReal     *alpha;  /* partial-volume factor */
+  PetscReal     *lambda; /* surface correction factor */
+  unsigned char *live;   /* 1 intact, 0 broken */
+  PetscInt       nbonds; /* local */
 } PeriBonds;
 
 PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
@@ -189,7 +189,7 @@ struct _p_PeriModel {
   PetscInt           dim;
   PetscBool          plane_strain;
   PetscInt           dofs;
-  const char *const *components;     /* dofs names, e.g. "ux", "uy" */
+  const char *const *components; /* dofs names, e.g. "ux", "uy" */
   PetscInt           nmeasures;
   const char *const *measure_names;
   PetscBool          allows_surface_correction;
@@ -248,23 +248,23 @@ struct _p_PeriProblem {
   PeriPartialVolume     partial_volume;
   PeriSurfaceCorrection surface;
   PeriBonds             bonds;
-  PetscReal            *family_volume;   /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
-  PetscInt             *neighbor_count;  /* per particle (all ranks) */
-  PetscInt             *owner;           /* rank owning each particle (all ranks) */
+  PetscReal            *family_volume;  /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
+  PetscInt             *neighbor_count; /* per particle (all ranks) */
+  PetscInt             *owner;          /* rank owning each particle (all ranks) */
   PeriModel             model;
-  Mat                   K;               /* stiffness */
+  Mat                   K;                       /* stiffness */
   char                  mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
   Vec                   u, f;
-  PetscInt              nconstrained;    /* owned constrained DOFs */
-  PetscInt             *constrained;     /* their global rows */
+  PetscInt              nconstrained; /* owned constrained DOFs */
+  PetscInt             *constrained;  /* their global rows */
   PetscReal            *constrained_value;
   PetscInt              nprobes;
   PeriProbe            *probes;
   char                  analysis[PERI_NAME_LEN];
   char                  output_dir[PETSC_MAX_PATH_LEN];
   PetscBool             vtk;
-  PetscReal            *W;               /* strain energy density per particle (rank 0, after the solve) */
-  PetscReal            *u_all;           /* displacements of all particles (rank 0, after the solve) */
+  PetscReal            *W;     /* strain energy density per particle (rank 0, after the solve) */
+  PetscReal            *u_all; /* displacements of all particles (rank 0, after the solve) */
   PeriResults           results;
   PetscLogDouble        t_start;
 };
@@ -297,7 +297,7 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Static(PeriProblem);
 
 /* output (src/output/) */
-typedef struct _PeriJSON *PeriJSON;
+typedef struct _PeriJSON   *PeriJSON;
 PETSC_EXTERN PetscErrorCode PeriJSONOpen(const char[], PeriJSON *);
 PETSC_EXTERN PetscErrorCode PeriJSONClose(PeriJSON *, PetscBool);
 PETSC_EXTERN PetscErrorCode PeriJSONBeginObject(PeriJSON, const char[]);
@@ -314,6 +314,6 @@ PETSC_EXTERN PetscErrorCode PeriOutputDirCreate(const char[]);
 PETSC_EXTERN PetscErrorCode PeriFileCommit(const char[], const char[]);
 
 /* log events */
-PETSC_EXTERN PetscLogEvent PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;
-PETSC_EXTERN PetscLogStage PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
+PETSC_EXTERN PetscLogEvent  PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;
+PETSC_EXTERN PetscLogStage  PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
 PETSC_EXTERN PetscErrorCode PeriInitializePackage(void);

@@ -11,7 +11,7 @@ typedef struct {
 } NPMB;
 
 static const char *const components2[] = {"ux", "uy"}, *const components3[] = {"ux", "uy", "uz"};
-static const char *const measures[]    = {"stretch"};
+static const char *const measures[] = {"stretch"};
 
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {
@@ -53,11 +53,11 @@ PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&np));
-  m->data                      = np;
-  m->dofs                      = m->dim;
-  m->components                = m->dim == 2 ? components2 : components3;
-  m->nmeasures                 = 1;
-  m->measure_names             = measures;
+  m->data          = np;
+  m->dofs          = m->dim;
+  m->components    = m->dim == 2 ? components2 : components3;
+  m->nmeasures     = 1;
+  m->measure_names = measures;
   /* the per-particle normalization already corrects surfaces; the volume method would count twice */
   m->allows_surface_correction = PETSC_FALSE;
   m->ops.nu_range              = PeriBondBasedNuRange;

@@ -9,7 +9,7 @@ typedef struct {
 } PMB;
 
 static const char *const components2[] = {"ux", "uy"}, *const components3[] = {"ux", "uy", "uz"};
-static const char *const measures[]    = {"stretch"};
+static const char *const measures[] = {"stretch"};
 
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {

@@ -35,8 +35,10 @@ static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **on
     for (PetscInt k = 0; k < m; k++) {
       PetscInt  j    = buf[k];
       PetscBool same = (PetscBool)(p->owner[j] == p->rank);
-      if (same) du++;
-      else ou++;
+      if (same)
+        du++;
+      else
+        ou++;
       cnt[(same ? 0 : n) + j]++; /* row j, column i */
     }
     (*dnzu)[i - b->rstart] = du;
@@ -74,9 +76,9 @@ static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **on
 @*/
 PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
 {
-  const PeriBonds *b    = &p->bonds;
-  PeriModel        m    = p->model;
-  const PetscInt   bs   = m->dofs, nloc = b->rend - b->rstart;
+  const PeriBonds *b  = &p->bonds;
+  PeriModel        m  = p->model;
+  const PetscInt   bs = m->dofs, nloc = b->rend - b->rstart;
   PetscInt        *dnz, *onz, *dnzu, *onzu;
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
   PetscBool        sym;
@@ -130,7 +132,7 @@ PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[])
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
   X[0] = X[1] = X[2] = 0;
-  nm = m->ops.rigid_modes(m, X, vals);
+  nm                 = m->ops.rigid_modes(m, X, vals);
   for (PetscInt k = 0; k < nm; k++) {
     PetscCall(PeriProblemCreateVec(p, &modes[k]));
     PetscCall(VecGetArray(modes[k], &a[k]));

@@ -37,14 +37,14 @@ static PetscErrorCode ComponentFromNode(PeriProblem p, PeriNode node, const char
 static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal value[], PetscBool set[])
 {
   static const char *const keys[] = {"region", "fix", "value", "affine", NULL};
-  PeriScene                s       = p->scene;
-  PeriModel                m       = p->model;
-  const PetscInt           bs      = m->dofs, dim = p->particles.dim;
+  PeriScene                s      = p->scene;
+  PeriModel                m      = p->model;
+  const PetscInt           bs = m->dofs, dim = p->particles.dim;
   PeriRegion              *r;
   PeriNode                 fix, val, aff;
   PetscReal                v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
   PetscBool                use[PERI_MAX_DOF] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
-  PetscInt                 axis_comp[3] = {-1, -1, -1};
+  PetscInt                 axis_comp[3]      = {-1, -1, -1};
 
   PetscFunctionBeginUser;
   PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a boundary condition is a mapping {region: name, fix: [..] | value: {..} | affine: {..}}");
@@ -143,8 +143,8 @@ PetscErrorCode PeriBoundarySetUp(PeriProblem p)
 PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
 {
   static const char *const keys[] = {"region", "force", "traction", "body_force", NULL};
-  PeriScene                s       = p->scene;
-  PeriModel                m       = p->model;
+  PeriScene                s      = p->scene;
+  PeriModel                m      = p->model;
   const PetscInt           bs = m->dofs, dim = p->particles.dim;
   PeriNode                 loads;
   PetscScalar             *a;
@@ -167,7 +167,9 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
     PetscCall(PeriSceneGetNode(item, "traction", &traction));
     PetscCall(PeriSceneGetNode(item, "body_force", &body));
     PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force");
-    PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction" : "body_force", PETSC_TRUE, dim, dim, F, &n));
+    PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
+                                                                        : "body_force",
+                                    PETSC_TRUE, dim, dim, F, &n));
     PeriInputCheck(!traction || r->kind == PERI_REGION_LAYER, s, item, "traction", "needs a layer region (side: ..), whose face area converts traction to force; region '%s' is not one", r->name);
     /* per particle: F * scale * V_i */
     scale = body ? 1.0 : (traction ? r->face_area : 1.0) / r->volume;
@@ -258,8 +260,10 @@ PetscErrorCode PeriCheckRigidMotion(PeriProblem p)
       PetscInt best     = 0;
       for (PetscInt l = 0; l < nm; l++)
         if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
-      if (nm == 3 || nm == 6) PetscCall(PetscSNPrintf(msg, sizeof(msg), "%s", (nm == 3 ? names2 : names3)[best]));
-      else PetscCall(PetscSNPrintf(msg, sizeof(msg), "rigid mode %" PetscInt_FMT, best));
+      if (nm == 3 || nm == 6)
+        PetscCall(PetscSNPrintf(msg, sizeof(msg), "%s", (nm == 3 ? names2 : names3)[best]));
+      else
+        PetscCall(PetscSNPrintf(msg, sizeof(msg), "rigid mode %" PetscInt_FMT, best));
       for (PetscInt l = 0; l < nm; l++) PetscCall(VecDestroy(&modes[l]));
       SETERRQ(p->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular. Constrain it in bc (e.g. fix the component on a small region)", p->scene->file, msg);
     }

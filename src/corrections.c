@@ -41,7 +41,7 @@ PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection sc, const PeriPa
   PetscFunctionBeginUser;
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscInt j = b->j[k];
+      PetscInt j   = b->j[k];
       b->lambda[k] = sc == PERI_SURFACE_VOLUME ? 2 * V0 / (family[i] + p->volume[i] + family[j] + p->volume[j]) : 1.0;
     }
   PetscFunctionReturn(PETSC_SUCCESS);

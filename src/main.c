@@ -12,8 +12,10 @@ static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, con
   (void)comm;
   (void)ctx;
   if (p == PETSC_ERROR_INITIAL && !first_error[0]) {
-    if (n == PETSC_ERR_USER_INPUT) PetscSNPrintf(first_error, sizeof(first_error), "%s", mess ? mess : "invalid input");
-    else PetscSNPrintf(first_error, sizeof(first_error), "%s (PETSc error %d in %s() at %s:%d)", mess ? mess : "error", (int)n, fun, file, line);
+    if (n == PETSC_ERR_USER_INPUT)
+      PetscSNPrintf(first_error, sizeof(first_error), "%s", mess ? mess : "invalid input");
+    else
+      PetscSNPrintf(first_error, sizeof(first_error), "%s (PETSc error %d in %s() at %s:%d)", mess ? mess : "error", (int)n, fun, file, line);
   }
   return n;
 }

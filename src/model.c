@@ -95,7 +95,8 @@ PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal del
     /* 0.333 means 1/3: bond-based models have one Poisson ratio, accept it to 3 digits */
     PeriInputCheck(PetscAbsReal(nu - lo) < 1e-3, scene, mat, "nu", "model %s in this setting has the fixed Poisson ratio %g; got %g (use a model with shear bonds for other values)", m->type, (double)lo, (double)nu);
     nu = lo;
-  } else PeriInputCheck(nu >= lo && nu <= hi, scene, mat, "nu", "must lie in [%g, %g] for model %s, got %g", (double)lo, (double)hi, m->type, (double)nu);
+  } else
+    PeriInputCheck(nu >= lo && nu <= hi, scene, mat, "nu", "must lie in [%g, %g] for model %s, got %g", (double)lo, (double)hi, m->type, (double)nu);
   PeriInputCheck(nu > -1 && nu < 0.5, scene, mat, "nu", "must lie in (-1, 1/2), got %g", (double)nu);
   if (hasK) E = 3 * K * (1 - 2 * nu);
   m->material.E   = E;
@@ -158,7 +159,7 @@ void PeriCentralBondBlock(PeriModel m, const PeriBondGeometry *b, PetscReal k, P
   for (PetscInt a = 0; a < n * n; a++) Ke[a] = 0;
   for (PetscInt a = 0; a < m->dim; a++)
     for (PetscInt c = 0; c < m->dim; c++) {
-      PetscReal v = k * b->xi[a] * b->xi[c] / (b->length * b->length);
+      PetscReal v                   = k * b->xi[a] * b->xi[c] / (b->length * b->length);
       Ke[a * n + c]                 = v;
       Ke[(a + dofs) * n + c + dofs] = v;
       Ke[a * n + c + dofs]          = -v;

@@ -171,7 +171,8 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
           for (PetscInt d = 0; d < 3; d++) {
             c[d] = ci[d] + o[d];
             if (c[d] < 0 || c[d] >= cl.ncell[d]) {
-              if (!p->periodic[d]) skip = PETSC_TRUE;
+              if (!p->periodic[d])
+                skip = PETSC_TRUE;
               else {
                 wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl.ncell[d]);
                 c[d] -= wrap[d] * cl.ncell[d];
@@ -182,7 +183,7 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
           cell = CellIndex(&cl, c);
           for (PetscInt s = cl.start[cell]; s < cl.start[cell + 1]; s++) {
             PetscInt  j = cl.item[s], self = (j == i);
-            PetscReal x[3], len2 = 0, len, h, alpha;
+            PetscReal x[3], len2           = 0, len, h, alpha;
             if (half && (j < i || (self && !ShiftPositive(wrap)))) continue;
             if (self && !wrap[0] && !wrap[1] && !wrap[2]) continue;
             if (!half && self) continue;

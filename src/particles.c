@@ -13,7 +13,7 @@ static PetscErrorCode ParticlesAllocate(PeriParticles *p, PetscInt n)
 
 static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, PeriParticles *p)
 {
-  static const char *const keys[] = {"lower", "upper", "spacing", "periodic", NULL};
+  static const char *const keys[]   = {"lower", "upper", "spacing", "periodic", NULL};
   PetscReal                lower[3] = {0, 0, 0}, upper[3] = {0, 0, 0}, h, cellvol;
   PetscInt                 nl, nu, cells[3] = {1, 1, 1}, n = 1, k = 0;
   PeriNode                 per;
@@ -32,7 +32,7 @@ static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, P
   for (PetscInt d = 0; d < dim; d++) {
     PetscReal L = upper[d] - lower[d], c;
     PeriInputCheck(L > 0, scene, grid, "upper", "must exceed grid.lower in every axis (axis %" PetscInt_FMT ": %g <= %g)", d, (double)upper[d], (double)lower[d]);
-    c = L / h;
+    c        = L / h;
     cells[d] = (PetscInt)PetscFloorReal(c + 0.5);
     PeriInputCheck(cells[d] >= 1 && PetscAbsReal(c - cells[d]) < 1e-6 * PetscMax(c, 1), scene, grid, "spacing", "the box length %g along axis %" PetscInt_FMT " is not a whole number of spacings %g", (double)L, d, (double)h);
     PeriInputCheck(cells[d] <= 100000000 / n, scene, grid, "spacing", "gives too many particles");
@@ -62,21 +62,23 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
   char                     name[PETSC_MAX_PATH_LEN], path[PETSC_MAX_PATH_LEN], line[1024];
   FILE                    *fp;
   PetscInt                 cap = 1024, n = 0, lineno = 0;
-  PetscReal               *x, *vol, sum = 0;
+  PetscReal               *x, *vol, sum              = 0;
   PetscInt                *src;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckKeys(scene, node, keys));
   PetscCall(PeriSceneGetString(scene, node, "file", PETSC_TRUE, name, sizeof(name), NULL));
-  if (name[0] == '/') PetscCall(PetscStrncpy(path, name, sizeof(path)));
-  else PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", scene->dir, name));
+  if (name[0] == '/')
+    PetscCall(PetscStrncpy(path, name, sizeof(path)));
+  else
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", scene->dir, name));
   fp = fopen(path, "r");
   PeriInputCheck(fp, scene, node, "file", "cannot open %s: %s", path, strerror(errno));
   PetscCall(PetscMalloc3(3 * cap, &x, cap, &vol, cap, &src));
   while (fgets(line, sizeof(line), fp)) {
-    double      v[5];
-    int         nf = 0;
-    char       *s  = line, *end;
+    double         v[5];
+    int            nf   = 0;
+    char          *s    = line, *end;
     PetscErrorCode ierr = PETSC_SUCCESS;
 
     lineno++;
@@ -92,8 +94,10 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
     }
     while (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') s++;
     if (nf == 0 && n == 0 && lineno == 1) continue; /* header */
-    if (nf < dim + 1 || nf > dim + 2 || *s) ierr = PETSC_ERR_USER_INPUT;
-    else if (!(v[dim] > 0)) ierr = PETSC_ERR_USER_INPUT + 1;
+    if (nf < dim + 1 || nf > dim + 2 || *s)
+      ierr = PETSC_ERR_USER_INPUT;
+    else if (!(v[dim] > 0))
+      ierr = PETSC_ERR_USER_INPUT + 1;
     if (ierr) {
       fclose(fp);
       PetscCall(PetscFree3(x, vol, src));
@@ -159,8 +163,10 @@ PetscErrorCode PeriParticlesCreateFromScene(PeriScene scene, PetscInt dim, Petsc
   PetscCall(PeriSceneGetMap(scene, scene->root, "particles", PETSC_FALSE, &csv));
   PeriInputCheck(grid || csv, scene, scene->root, "grid", "is required (or give particles.file)");
   PeriInputCheck(!(grid && csv), scene, csv, NULL, "give either grid or particles, not both");
-  if (grid) PetscCall(GridCreate(scene, grid, dim, p));
-  else PetscCall(CSVCreate(scene, csv, dim, p));
+  if (grid)
+    PetscCall(GridCreate(scene, grid, dim, p));
+  else
+    PetscCall(CSVCreate(scene, csv, dim, p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -30,7 +30,7 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal delta, Pe
   PetscCall(PeriBondsDestroy(&g));
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_SEED] = 1;
-  status = METIS_PartGraphKway(&nv, &ncon, xadj, adjncy, NULL, NULL, NULL, &np, NULL, NULL, options, &objval, where);
+  status                     = METIS_PartGraphKway(&nv, &ncon, xadj, adjncy, NULL, NULL, NULL, &np, NULL, NULL, options, &objval, where);
   PetscCheck(status == METIS_OK, PETSC_COMM_SELF, PETSC_ERR_LIB, "METIS_PartGraphKway failed with status %d on %" PetscInt_FMT " particles and %d parts", status, p->n, (int)nparts);
   for (PetscInt i = 0; i < p->n; i++) part[i] = (PetscInt)where[i];
   *edgecut = (PetscInt)objval;

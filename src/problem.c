@@ -55,7 +55,7 @@ PetscErrorCode PeriProblemLoad(PeriProblem p, const char file[])
 static PetscErrorCode ReadHorizon(PeriProblem p)
 {
   static const char *const keys[] = {"m", "delta", NULL};
-  PeriScene                s       = p->scene;
+  PeriScene                s      = p->scene;
   PeriNode                 h;
   PetscReal                m = 0, hmax = 0;
   PetscBool                hasm, hasd;
@@ -79,7 +79,7 @@ static PetscErrorCode ReadHorizon(PeriProblem p)
 static PetscErrorCode ReadCorrections(PeriProblem p)
 {
   static const char *const keys[] = {"partial_volume", "surface", NULL};
-  PeriScene                s       = p->scene;
+  PeriScene                s      = p->scene;
   PeriNode                 c;
   PetscInt                 pv = PERI_PARTIAL_VOLUME_LINEAR_CONTINUED, sc = PERI_SURFACE_NONE;
   PetscBool                found;
@@ -107,7 +107,7 @@ static PetscErrorCode ReadProbes(PeriProblem p)
   p->nprobes = map->n;
   PetscCall(PetscCalloc1(map->n, &p->probes));
   for (PetscInt k = 0; k < map->n; k++) {
-    PeriProbe *pr = &p->probes[k];
+    PeriProbe *pr   = &p->probes[k];
     PetscReal  best = PETSC_MAX_REAL;
     PetscInt   n;
     PetscCall(PetscStrncpy(pr->name, map->child[k]->key, sizeof(pr->name)));
@@ -116,7 +116,7 @@ static PetscErrorCode ReadProbes(PeriProblem p)
       PetscReal d2 = 0;
       for (PetscInt d = 0; d < pt->dim; d++) d2 += PetscSqr(pt->x[3 * i + d] - pr->x[d]);
       if (d2 < best) {
-        best        = d2;
+        best         = d2;
         pr->particle = i;
       }
     }
@@ -129,7 +129,7 @@ static PetscErrorCode ReadProbes(PeriProblem p)
 static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
 {
   static const char *const keys[] = {"dir", "vtk", NULL};
-  PeriScene                s       = p->scene;
+  PeriScene                s      = p->scene;
   PeriNode                 o;
   char                     base[PETSC_MAX_PATH_LEN], *slash, *dot;
   static const char *const akeys[] = {"type", NULL};
@@ -154,11 +154,11 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
 static PetscErrorCode CreateModel(PeriProblem p)
 {
   static const char *const keys[] = {"type", "plane", NULL}, *const planes[] = {"stress", "strain", NULL};
-  PeriScene                s = p->scene;
-  PeriNode                 m;
-  PetscInt                 dim = 0, plane = 0;
-  char                     type[PERI_NAME_LEN];
-  PetscBool                found;
+  PeriScene s = p->scene;
+  PeriNode  m;
+  PetscInt  dim = 0, plane = 0;
+  char      type[PERI_NAME_LEN];
+  PetscBool found;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetInt(s, s->root, "dim", PETSC_TRUE, &dim, NULL));
@@ -193,7 +193,7 @@ static PetscErrorCode CheckRootKeys(PeriScene s)
 @*/
 PetscErrorCode PeriProblemSetUp(PeriProblem p)
 {
-  PeriScene           s = p->scene;
+  PeriScene           s         = p->scene;
   PetscReal           thickness = 1;
   PetscInt           *perm, *range, edgecut;
   PeriNode            mat;
@@ -390,7 +390,8 @@ PetscErrorCode PeriProblemEvaluateEnergy(PeriProblem p)
       for (PetscInt c = 0; c < bs; c++) pr->u[c] = p->u_all[pr->particle * bs + c];
       pr->W = W[pr->particle];
     }
-  } else PetscCall(PetscFree(W));
+  } else
+    PetscCall(PetscFree(W));
   PetscCall(VecRestoreArrayRead(all, &u));
   for (PetscInt c = 0; c < bs; c++) PetscCall(VecStrideNorm(p->u, c, NORM_INFINITY, &p->results.max_abs_u[c]));
   PetscCall(VecDestroy(&all));

@@ -22,7 +22,7 @@ PetscBool PeriRegionContains(const PeriRegion *r, const PetscReal x[])
 static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const PeriParticles *p, PetscReal delta, PeriRegion *r)
 {
   static const char *const keys[] = {"lower", "upper", "side", "depth", NULL};
-  PetscReal                tol = Tolerance(p);
+  PetscReal                tol    = Tolerance(p);
   PetscInt                 n, dim = p->dim, side = -1;
   PeriNode                 lower, sidenode;
 
@@ -58,8 +58,10 @@ static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const Peri
     r->axis = side / 2;
     r->side = side % 2 ? 1 : -1;
     PeriInputCheck(r->axis < dim, scene, node, "side", "axis %c does not exist in %" PetscInt_FMT "D", (char)('x' + r->axis), dim);
-    if (r->side < 0) r->upper[r->axis] = p->lower[r->axis] + r->depth + tol;
-    else r->lower[r->axis] = p->upper[r->axis] - r->depth - tol;
+    if (r->side < 0)
+      r->upper[r->axis] = p->lower[r->axis] + r->depth + tol;
+    else
+      r->lower[r->axis] = p->upper[r->axis] - r->depth - tol;
     r->face_area = dim == 2 ? p->thickness : 1;
     for (PetscInt d = 0; d < dim; d++)
       if (d != r->axis) r->face_area *= p->upper[d] - p->lower[d];

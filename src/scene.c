@@ -14,37 +14,37 @@ typedef struct {
 } PeriSceneKey;
 
 static const PeriSceneKey scene_keys[] = {
-  {"dim",                         "2 or 3"                                                                              },
-  {"model.type",                  "bond model: pmb | npmb (see docs/models)"                                            },
-  {"model.plane",                 "2D only: stress | strain"                                                            },
-  {"material.E",                  "Young's modulus [stress]"                                                            },
-  {"material.nu",                 "Poisson ratio (bond-based pmb/npmb: 1/3 plane stress, 1/4 plane strain and 3D)"      },
-  {"material.K",                  "3D bulk modulus [stress], instead of E"                                              },
-  {"material.rho",                "density [mass/volume]"                                                               },
-  {"material.thickness",          "2D thickness [length]; default 1"                                                    },
-  {"grid.spacing",                "particle spacing dx [length]"                                                        },
-  {"grid.lower",                  "box lower corner [length], a list of dim numbers"                                    },
-  {"grid.upper",                  "box upper corner [length], a list of dim numbers"                                    },
-  {"grid.periodic",               "list of dim booleans: periodic axes (minimum image)"                                 },
-  {"particles.file",              "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid"},
-  {"horizon.m",                   "horizon as a multiple of the spacing, delta = m dx"                                  },
-  {"horizon.delta",               "horizon radius [length], instead of m"                                               },
-  {"corrections.partial_volume",  "none | linear (alpha ramp cut at delta) | linear_continued (ramp to delta + dx/2)"    },
-  {"corrections.surface",         "none | volume (lambda = 2 V0 / (V(H_i) + V(H_j)))"                                   },
-  {"regions.<name>.lower/upper",  "a box region"                                                                        },
-  {"regions.<name>.side",         "a boundary layer: x- | x+ | y- | y+ | z- | z+, with .depth [length] (default delta)" },
-  {"bc.<k>.region",               "region the condition applies to (all = every particle)"                              },
-  {"bc.<k>.fix",                  "list of components held at zero, e.g. [ux, uy]"                                      },
-  {"bc.<k>.value",                "map component -> prescribed value, e.g. {ux: 0.001}"                                 },
-  {"bc.<k>.affine",               "prescribed linear field u = A X + b: {A: [[..],..], b: [..]}"                        },
-  {"loads.<k>.region",            "region the load applies to"                                                          },
-  {"loads.<k>.force",             "total force [force], spread over the region's particles by volume"                   },
-  {"loads.<k>.traction",          "traction [stress] on the face of a layer region (force = traction x face area)"      },
-  {"loads.<k>.body_force",        "force per unit volume [force/volume]"                                                },
-  {"probes.<name>",               "a point [x, y(, z)]: displacement and energy density of the nearest particle"        },
-  {"analysis.type",               "static"                                                                              },
-  {"output.dir",                  "output directory; default <scene name>-out"                                          },
-  {"output.vtk",                  "true | false: write particles.vtu (default true)"                                    },
+    {"dim", "2 or 3"},
+    {"model.type", "bond model: pmb | npmb (see docs/models)"},
+    {"model.plane", "2D only: stress | strain"},
+    {"material.E", "Young's modulus [stress]"},
+    {"material.nu", "Poisson ratio (bond-based pmb/npmb: 1/3 plane stress, 1/4 plane strain and 3D)"},
+    {"material.K", "3D bulk modulus [stress], instead of E"},
+    {"material.rho", "density [mass/volume]"},
+    {"material.thickness", "2D thickness [length]; default 1"},
+    {"grid.spacing", "particle spacing dx [length]"},
+    {"grid.lower", "box lower corner [length], a list of dim numbers"},
+    {"grid.upper", "box upper corner [length], a list of dim numbers"},
+    {"grid.periodic", "list of dim booleans: periodic axes (minimum image)"},
+    {"particles.file", "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid"},
+    {"horizon.m", "horizon as a multiple of the spacing, delta = m dx"},
+    {"horizon.delta", "horizon radius [length], instead of m"},
+    {"corrections.partial_volume", "none | linear (alpha ramp cut at delta) | linear_continued (ramp to delta + dx/2)"},
+    {"corrections.surface", "none | volume (lambda = 2 V0 / (V(H_i) + V(H_j)))"},
+    {"regions.<name>.lower/upper", "a box region"},
+    {"regions.<name>.side", "a boundary layer: x- | x+ | y- | y+ | z- | z+, with .depth [length] (default delta)"},
+    {"bc.<k>.region", "region the condition applies to (all = every particle)"},
+    {"bc.<k>.fix", "list of components held at zero, e.g. [ux, uy]"},
+    {"bc.<k>.value", "map component -> prescribed value, e.g. {ux: 0.001}"},
+    {"bc.<k>.affine", "prescribed linear field u = A X + b: {A: [[..],..], b: [..]}"},
+    {"loads.<k>.region", "region the load applies to"},
+    {"loads.<k>.force", "total force [force], spread over the region's particles by volume"},
+    {"loads.<k>.traction", "traction [stress] on the face of a layer region (force = traction x face area)"},
+    {"loads.<k>.body_force", "force per unit volume [force/volume]"},
+    {"probes.<name>", "a point [x, y(, z)]: displacement and energy density of the nearest particle"},
+    {"analysis.type", "static"},
+    {"output.dir", "output directory; default <scene name>-out"},
+    {"output.vtk", "true | false: write particles.vtu (default true)"},
 };
 
 static PetscErrorCode NodeCreate(PeriNodeKind kind, const char key[], const char parent_path[], int line, PeriNode *node)
@@ -61,7 +61,8 @@ static PetscErrorCode NodeCreate(PeriNodeKind kind, const char key[], const char
     len = strlen(parent_path) + strlen(key) + 2;
     PetscCall(PetscMalloc1(len, &n->path));
     PetscCall(PetscSNPrintf(n->path, len, "%s.%s", parent_path, key));
-  } else PetscCall(PetscStrallocpy(key ? key : "", &n->path));
+  } else
+    PetscCall(PetscStrallocpy(key ? key : "", &n->path));
   *node = n;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -232,7 +233,8 @@ static PetscErrorCode AddOptionKeys(PeriNode root)
         PetscCall(NodeAppend(root, map));
       }
       if (map->kind != PERI_NODE_MAP) continue; /* the reader reports the wrong type */
-    } else PetscCall(PetscStrncpy(leaf, path, sizeof(leaf)));
+    } else
+      PetscCall(PetscStrncpy(leaf, path, sizeof(leaf)));
     PetscCall(PeriSceneGetNode(map, leaf, &child));
     if (child) continue; /* ApplyOptions already set it */
     PetscCall(NodeCreate(PERI_NODE_SCALAR, leaf, map->path, 0, &child));
@@ -317,8 +319,10 @@ PetscErrorCode PeriSceneWhere(PeriScene scene, PeriNode node, const char key[], 
   const char *p = node ? node->path : "";
 
   PetscFunctionBeginUser;
-  if (key && key[0]) PetscCall(PetscSNPrintf(path, sizeof(path), "%s%s%s", p, p[0] ? "." : "", key));
-  else PetscCall(PetscStrncpy(path, p, sizeof(path)));
+  if (key && key[0])
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s%s%s", p, p[0] ? "." : "", key));
+  else
+    PetscCall(PetscStrncpy(path, p, sizeof(path)));
   OptionName(path, opt, sizeof(opt));
   if (node && node->line > 0) {
     PeriNode child = NULL;
@@ -326,8 +330,10 @@ PetscErrorCode PeriSceneWhere(PeriScene scene, PeriNode node, const char key[], 
     if (key && key[0]) PetscCall(PeriSceneGetNode(node, key, &child));
     if (child && child->line > 0) line = child->line;
     PetscCall(PetscSNPrintf(buf, len, "%s:%d: key '%s'", scene->file, line, path));
-  } else if (node) PetscCall(PetscSNPrintf(buf, len, "%s: key '%s' (set by option %s)", scene->file, path, opt));
-  else PetscCall(PetscSNPrintf(buf, len, "%s: key '%s'", scene->file, path));
+  } else if (node)
+    PetscCall(PetscSNPrintf(buf, len, "%s: key '%s' (set by option %s)", scene->file, path, opt));
+  else
+    PetscCall(PetscSNPrintf(buf, len, "%s: key '%s'", scene->file, path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -344,8 +350,10 @@ PetscErrorCode PeriSceneGetNode(PeriNode map, const char key[], PeriNode *child)
   len = dot ? (size_t)(dot - key) : strlen(key);
   for (PetscInt k = 0; k < map->n; k++) {
     if (strlen(map->child[k]->key) == len && !strncmp(map->child[k]->key, key, len)) {
-      if (dot) PetscCall(PeriSceneGetNode(map->child[k], dot + 1, child));
-      else *child = map->child[k];
+      if (dot)
+        PetscCall(PeriSceneGetNode(map->child[k], dot + 1, child));
+      else
+        *child = map->child[k];
       break;
     }
   }
@@ -441,7 +449,7 @@ PetscErrorCode PeriSceneGetInt(PeriScene scene, PeriNode map, const char key[], 
 PetscErrorCode PeriSceneParseBool(PeriScene scene, PeriNode node, PetscBool *v)
 {
   static const char *const yes[] = {"true", "yes", "on", "1"}, *const no[] = {"false", "no", "off", "0"};
-  PetscBool                match = PETSC_FALSE;
+  PetscBool match = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PeriInputCheck(node->kind == PERI_NODE_SCALAR, scene, node, NULL, "expected true or false");

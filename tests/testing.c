@@ -15,7 +15,9 @@ PetscErrorCode PeriTestRunScene(MPI_Comm comm, const char file[], PeriProblem *p
 PetscErrorCode PeriTestSetOption(const char name[], const char value[])
 {
   PetscFunctionBeginUser;
-  if (value) PetscCall(PetscOptionsSetValue(NULL, name, value));
-  else PetscCall(PetscOptionsClearValue(NULL, name));
+  if (value)
+    PetscCall(PetscOptionsSetValue(NULL, name, value));
+  else
+    PetscCall(PetscOptionsClearValue(NULL, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -3,11 +3,11 @@
 #include "perilin.h"
 
 /* Fails the test with the expected value, the tolerance and what was measured. */
-#define PeriTestClose(what, got, expected, tol) \
-  do { \
-    PetscReal got_ = (got), exp_ = (expected), tol_ = (tol); \
+#define PeriTestClose(what, got, expected, tol)                                                                                                                                                                                   \
+  do {                                                                                                                                                                                                                            \
+    PetscReal got_ = (got), exp_ = (expected), tol_ = (tol);                                                                                                                                                                      \
     PetscCheck(PetscAbsReal(got_ - exp_) <= tol_, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s: got %.12g, expected %.12g within %.3g (off by %.3g)", what, (double)got_, (double)exp_, (double)tol_, (double)PetscAbsReal(got_ - exp_)); \
-    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s = %.10g (expected %.10g, tolerance %.2g)\n", what, (double)got_, (double)exp_, (double)tol_)); \
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s = %.10g (expected %.10g, tolerance %.2g)\n", what, (double)got_, (double)exp_, (double)tol_));                                                                                \
   } while (0)
 
 PetscErrorCode PeriTestRunScene(MPI_Comm, const char[], PeriProblem *);

@@ -36,12 +36,12 @@ static PetscErrorCode JSONAbandon(PeriJSON j)
 
 /* Abandon the file, then raise the error. The message arguments are evaluated after the abandon,
    so never pass strerror(errno) here: save errno first. */
-#define JSONCheck(j, cond, code, ...) \
-  do { \
-    if (PetscUnlikely(!(cond))) { \
-      PetscCall(JSONAbandon(j)); \
+#define JSONCheck(j, cond, code, ...)              \
+  do {                                             \
+    if (PetscUnlikely(!(cond))) {                  \
+      PetscCall(JSONAbandon(j));                   \
       SETERRQ(PETSC_COMM_SELF, code, __VA_ARGS__); \
-    } \
+    }                                              \
   } while (0)
 
 static PetscErrorCode JSONPrintf(PeriJSON j, const char fmt[], ...) PETSC_ATTRIBUTE_FORMAT(2, 3);
@@ -97,8 +97,10 @@ static PetscErrorCode JSONPath(PeriJSON j, const char key[], char path[], size_t
     if (j->label[d][0] != '[' && path[0]) PetscCall(JSONAppend(path, ".", len));
     PetscCall(JSONAppend(path, j->label[d], len));
   }
-  if (j->kind[j->depth] == '[') PetscCall(PetscSNPrintf(last, sizeof(last), "[%" PetscInt_FMT "]", j->count[j->depth]));
-  else PetscCall(PetscSNPrintf(last, sizeof(last), "%s%s", path[0] ? "." : "", key ? key : "(null)"));
+  if (j->kind[j->depth] == '[')
+    PetscCall(PetscSNPrintf(last, sizeof(last), "[%" PetscInt_FMT "]", j->count[j->depth]));
+  else
+    PetscCall(PetscSNPrintf(last, sizeof(last), "%s%s", path[0] ? "." : "", key ? key : "(null)"));
   PetscCall(JSONAppend(path, last, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -133,8 +135,10 @@ static PetscErrorCode JSONWriteString(PeriJSON j, const char s[])
       PetscCall(JSONPrintf(j, "\\f"));
       break;
     default:
-      if (*c < 0x20) PetscCall(JSONPrintf(j, "\\u%04x", (unsigned)*c));
-      else PetscCall(JSONPrintf(j, "%c", *c));
+      if (*c < 0x20)
+        PetscCall(JSONPrintf(j, "\\u%04x", (unsigned)*c));
+      else
+        PetscCall(JSONPrintf(j, "%c", *c));
     }
   }
   PetscCall(JSONPrintf(j, "\""));
@@ -165,8 +169,10 @@ static PetscErrorCode JSONBegin(PeriJSON j, const char key[], char kind)
   PetscCall(JSONCheckUsable(j));
   JSONCheck(j, j->depth + 1 < PERI_JSON_MAX_DEPTH, PETSC_ERR_ARG_OUTOFRANGE, "JSON file %s: nesting deeper than %d levels", j->final, PERI_JSON_MAX_DEPTH - 1);
   /* The label must be taken before JSONBeginValue() counts this member. */
-  if (j->kind[j->depth] == '[') PetscCall(PetscSNPrintf(label, sizeof(label), "[%" PetscInt_FMT "]", j->count[j->depth]));
-  else PetscCall(PetscStrncpy(label, key ? key : "", sizeof(label)));
+  if (j->kind[j->depth] == '[')
+    PetscCall(PetscSNPrintf(label, sizeof(label), "[%" PetscInt_FMT "]", j->count[j->depth]));
+  else
+    PetscCall(PetscStrncpy(label, key ? key : "", sizeof(label)));
   PetscCall(JSONBeginValue(j, key));
   PetscCall(JSONPrintf(j, "%c", kind));
   j->depth++;
@@ -185,8 +191,10 @@ static PetscErrorCode JSONEnd(PeriJSON j, char kind)
   PetscCall(JSONCheckUsable(j));
   JSONCheck(j, j->kind[j->depth] == kind, PETSC_ERR_ARG_WRONGSTATE, "JSON file %s: '%c' does not close %s, which was opened with '%c'", j->final, close, j->depth ? j->label[j->depth] : "the root", j->kind[j->depth]);
   /* Empty containers stay on one line: {} and []. */
-  if (j->count[j->depth]) PetscCall(JSONPrintf(j, "\n%*s%c", 2 * j->depth, "", close));
-  else PetscCall(JSONPrintf(j, "%c", close));
+  if (j->count[j->depth])
+    PetscCall(JSONPrintf(j, "\n%*s%c", 2 * j->depth, "", close));
+  else
+    PetscCall(JSONPrintf(j, "%c", close));
   j->depth--;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -255,8 +263,10 @@ PetscErrorCode PeriJSONClose(PeriJSON *j, PetscBool commit)
   if (!j || !*j) PetscFunctionReturn(PETSC_SUCCESS);
   J  = *j;
   *j = NULL;
-  if (commit) ierr = JSONFinish(J); /* propagated only after J is freed */
-  else PetscCall(JSONAbandon(J));
+  if (commit)
+    ierr = JSONFinish(J); /* propagated only after J is freed */
+  else
+    PetscCall(JSONAbandon(J));
   PetscCall(PetscFree(J));
   PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -297,8 +307,10 @@ PetscErrorCode PeriJSONString(PeriJSON j, const char key[], const char value[])
 {
   PetscFunctionBeginUser;
   PetscCall(JSONBeginValue(j, key));
-  if (value) PetscCall(JSONWriteString(j, value));
-  else PetscCall(JSONPrintf(j, "null"));
+  if (value)
+    PetscCall(JSONWriteString(j, value));
+  else
+    PetscCall(JSONPrintf(j, "null"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -86,7 +86,7 @@ static PetscErrorCode VTUAddInt(VTUArray a[], PetscInt *na, VTUSection section, 
    missing field fails without creating anything. */
 static PetscErrorCode VTUDescribe(PeriProblem p, VTUArray a[], PetscInt *na)
 {
-  PeriModel model = p->model;
+  PeriModel model  = p->model;
   PetscInt  map[3] = {-1, -1, -1}, c, axis, ntrans = 0;
 
   PetscFunctionBeginUser;
@@ -98,9 +98,12 @@ static PetscErrorCode VTUDescribe(PeriProblem p, VTUArray a[], PetscInt *na)
       const char *name = model->components[c];
 
       axis = -1;
-      if (!strcmp(name, "ux")) axis = 0;
-      else if (!strcmp(name, "uy")) axis = 1;
-      else if (!strcmp(name, "uz")) axis = 2;
+      if (!strcmp(name, "ux"))
+        axis = 0;
+      else if (!strcmp(name, "uy"))
+        axis = 1;
+      else if (!strcmp(name, "uz"))
+        axis = 2;
       if (axis < 0) continue;
       PetscCheck(map[axis] < 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Model %s names component %s twice", model->type, name);
       map[axis] = c;
@@ -182,8 +185,8 @@ static PetscErrorCode VTUWriteFile(FILE *fp, const char file[], PetscInt n, Pets
 {
   static const char *const opentag[]  = {"<PointData>", "<Points>", "<Cells>"};
   static const char *const closetag[] = {"</PointData>", "</Points>", "</Cells>"};
-  const uint16_t           one     = 1;
-  const char *const        order   = *(const unsigned char *)&one ? "LittleEndian" : "BigEndian";
+  const uint16_t           one        = 1;
+  const char *const        order      = *(const unsigned char *)&one ? "LittleEndian" : "BigEndian";
   PetscInt                 s, k;
 
   PetscFunctionBeginUser;

@@ -18,7 +18,7 @@ static PetscReal Alpha(PetscReal r, PetscReal m)
 static void LatticeUniaxial(PetscReal m, PetscReal *exx, PetscReal *nu)
 {
   PetscReal c11 = 0, c12 = 0, c22 = 0, c = 9 / (PETSC_PI * m * m * m), det;
-  PetscInt  R   = (PetscInt)m + 2;
+  PetscInt  R = (PetscInt)m + 2;
   for (PetscInt i = -R; i <= R; i++)
     for (PetscInt j = -R; j <= R; j++) {
       PetscReal r = PetscSqrtReal((PetscReal)(i * i + j * j)), a, ex, ey;

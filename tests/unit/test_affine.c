@@ -5,13 +5,13 @@
 
 static PetscErrorCode CheckAffine(const char file[])
 {
-  PeriProblem p;
-  Vec         u, f;
-  PetscScalar *a;
+  PeriProblem        p;
+  Vec                u, f;
+  PetscScalar       *a;
   const PetscScalar *fa;
-  PetscReal   A[3][3] = {{1e-3, 4e-4, -2e-4}, {-3e-4, 2e-3, 5e-4}, {1e-4, -6e-4, -1e-3}}, b[3] = {0.1, -0.2, 0.3};
-  PetscReal   fmax = 0, scale = 0, reach;
-  PetscInt    checked = 0, total;
+  PetscReal          A[3][3] = {{1e-3, 4e-4, -2e-4}, {-3e-4, 2e-3, 5e-4}, {1e-4, -6e-4, -1e-3}}, b[3] = {0.1, -0.2, 0.3};
+  PetscReal          fmax = 0, scale = 0, reach;
+  PetscInt           checked = 0, total;
 
   PetscFunctionBeginUser;
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
