@@ -69,23 +69,42 @@ static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **on
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Adds the bs x bs block B (row stride ld) to the row's block for column j. */
+static void RowAdd(PetscInt bs, PetscInt j, const PetscReal *B, PetscInt ld, PetscInt slot[], PetscInt col[], PetscReal blocks[], PetscInt *ncol)
+{
+  PetscReal *dst;
+  if (slot[j] < 0) {
+    slot[j]      = (*ncol)++;
+    col[slot[j]] = j;
+    for (PetscInt a = 0; a < bs * bs; a++) blocks[slot[j] * bs * bs + a] = 0;
+  }
+  dst = &blocks[slot[j] * bs * bs];
+  for (PetscInt a = 0; a < bs; a++)
+    for (PetscInt c = 0; c < bs; c++) dst[a * bs + c] += B[a * ld + c];
+}
+
 /*@C
   PeriAssembleStiffness - assembles K = sum over live bonds of the model's bond blocks. The type is
   p->mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
   only). Collective.
+
+  Each owned block row is gathered in full (its stored bonds and the bonds other owned particles
+  store towards it) and inserted with one call: inserting bond by bond costs a search per entry.
+  Only rows owned by other ranks receive bond blocks through the stash.
 @*/
 PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
 {
   const PeriBonds *b  = &p->bonds;
   PeriModel        m  = p->model;
-  const PetscInt   bs = m->dofs, nloc = b->rend - b->rstart;
-  PetscInt        *dnz, *onz, *dnzu, *onzu;
-  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  const PetscInt   bs = m->dofs, nb = 2 * bs, nloc = b->rend - b->rstart, rstart = b->rstart;
+  PetscInt        *dnz, *onz, *dnzu, *onzu, *tptr, *tbond, *trow, *slot, *col, *perm, maxcol = 1;
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], *blocks, *row;
   PetscBool        sym;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
   PetscCall(Preallocation(p, &dnz, &onz, &dnzu, &onzu));
+  for (PetscInt i = 0; i < nloc; i++) maxcol = PetscMax(maxcol, dnz[i] + onz[i]);
   PetscCall(MatCreate(p->comm, K));
   PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, p->particles.n * bs, p->particles.n * bs));
   PetscCall(MatSetBlockSize(*K, bs));
@@ -96,18 +115,71 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
   PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)*K, &sym, MATSBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
   if (sym) PetscCall(MatSetOption(*K, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PeriBondGeometry g;
-      PetscInt         idx[2];
+
+  /* incoming bonds: stored at owned row r towards owned particle j > r, listed under j */
+  PetscCall(PetscCalloc1(nloc + 1, &tptr));
+  for (PetscInt k = 0; k < b->nbonds; k++) {
+    PetscInt j = b->j[k];
+    if (b->live[k] && j >= rstart && j < b->rend) tptr[j - rstart + 1]++;
+  }
+  for (PetscInt i = 0; i < nloc; i++) tptr[i + 1] += tptr[i];
+  PetscCall(PetscMalloc2(tptr[nloc], &tbond, tptr[nloc], &trow));
+  {
+    PetscInt *fill;
+    PetscCall(PetscMalloc1(nloc, &fill));
+    PetscCall(PetscArraycpy(fill, tptr, nloc));
+    for (PetscInt r = rstart; r < b->rend; r++)
+      for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++) {
+        PetscInt j = b->j[k];
+        if (!b->live[k] || j == r || j < rstart || j >= b->rend) continue;
+        tbond[fill[j - rstart]]  = k;
+        trow[fill[j - rstart]++] = r;
+      }
+    PetscCall(PetscFree(fill));
+  }
+
+  PetscCall(PetscMalloc1(p->particles.n, &slot));
+  for (PetscInt i = 0; i < p->particles.n; i++) slot[i] = -1;
+  PetscCall(PetscMalloc4(maxcol, &col, maxcol, &perm, maxcol * bs * bs, &blocks, maxcol * bs * bs, &row));
+  for (PetscInt i = rstart; i < b->rend; i++) {
+    PetscInt         ncol = 0;
+    PeriBondGeometry g;
+    slot[i] = ncol++; /* the diagonal block is always there */
+    col[0]  = i;
+    for (PetscInt a = 0; a < bs * bs; a++) blocks[a] = 0;
+    for (PetscInt k = b->offset[i - rstart]; k < b->offset[i - rstart + 1]; k++) {
+      PetscInt j = b->j[k];
       /* a self-image bond moves both ends alike: its blocks cancel */
-      if (!b->live[k] || b->j[k] == i) continue;
+      if (!b->live[k] || j == i) continue;
       PetscCall(PeriProblemBondGeometry(p, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
-      idx[0] = i;
-      idx[1] = g.j;
-      PetscCall(MatSetValuesBlocked(*K, 2, idx, 2, idx, Ke, ADD_VALUES));
+      RowAdd(bs, i, &Ke[0], nb, slot, col, blocks, &ncol);
+      RowAdd(bs, j, &Ke[bs], nb, slot, col, blocks, &ncol);
+      if (p->owner[j] != p->rank) {
+        PetscInt idx[2] = {i, j};
+        PetscCall(MatSetValuesBlocked(*K, 1, &j, 2, idx, &Ke[bs * nb], ADD_VALUES));
+      }
     }
+    for (PetscInt t = tptr[i - rstart]; t < tptr[i - rstart + 1]; t++) {
+      PetscCall(PeriProblemBondGeometry(p, trow[t], tbond[t], &g));
+      m->ops.bond_stiffness(m, &g, Ke);
+      RowAdd(bs, i, &Ke[bs * nb + bs], nb, slot, col, blocks, &ncol);
+      RowAdd(bs, trow[t], &Ke[bs * nb], nb, slot, col, blocks, &ncol);
+    }
+    /* sorted columns make the insertion a merge */
+    for (PetscInt c = 0; c < ncol; c++) perm[c] = c;
+    PetscCall(PetscSortIntWithArray(ncol, col, perm));
+    for (PetscInt c = 0; c < ncol; c++) {
+      slot[col[c]] = -1;
+      for (PetscInt a = 0; a < bs; a++)
+        for (PetscInt e = 0; e < bs; e++) row[a * ncol * bs + c * bs + e] = blocks[perm[c] * bs * bs + a * bs + e];
+    }
+    PetscCall(MatSetValuesBlocked(*K, 1, &i, ncol, col, row, ADD_VALUES));
+  }
+  PetscCall(PetscFree4(col, perm, blocks, row));
+  PetscCall(PetscFree(slot));
+  PetscCall(PetscFree2(tbond, trow));
+  PetscCall(PetscFree(tptr));
   PetscCall(MatAssemblyBegin(*K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(*K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatSetOption(*K, MAT_SYMMETRIC, PETSC_TRUE));
