@@ -21,6 +21,23 @@ static const char *Advice(KSPConvergedReason reason)
   }
 }
 
+/* The block format (BAIJ) unless the preconditioner cannot take it: in PETSc 3.18 GAMG builds its
+ * graph from AIJ only, and MUMPS factors BAIJ by LU only. -mat_type overrides this. */
+static PetscErrorCode DefaultMatType(char type[], size_t len)
+{
+  char      pc[64] = PCGAMG, solver[64] = "";
+  PetscBool gamg, cholesky, mumps;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_factor_mat_solver_type", solver, sizeof(solver), NULL));
+  PetscCall(PetscStrcmp(pc, PCGAMG, &gamg));
+  PetscCall(PetscStrcmp(pc, PCCHOLESKY, &cholesky));
+  PetscCall(PetscStrcmp(solver, MATSOLVERMUMPS, &mumps));
+  PetscCall(PetscStrncpy(type, gamg || (cholesky && mumps) ? MATAIJ : MATBAIJ, len));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAnalysisRun_Static - solves the linear static problem and evaluates energies and probes.
   Options: every KSP/PC option (-ksp_type, -pc_type, -ksp_rtol, ...). Collective.
@@ -51,15 +68,7 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(PeriCheckRigidMotion(p));
-  {
-    /* GAMG (the default) builds its graph from AIJ only in PETSc 3.18; other preconditioners get
-     * the block format */
-    char      pctype[64] = PCGAMG;
-    PetscBool gamg;
-    PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pctype, sizeof(pctype), NULL));
-    PetscCall(PetscStrcmp(pctype, PCGAMG, &gamg));
-    PetscCall(PetscStrncpy(p->mat_type, gamg ? MATAIJ : MATBAIJ, sizeof(p->mat_type)));
-  }
+  PetscCall(DefaultMatType(p->mat_type, sizeof(p->mat_type)));
   if (!p->K) PetscCall(PeriProblemAssemble(p));
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
@@ -77,6 +86,11 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscCall(VecNorm(r, NORM_1, &diag));
   PetscCall(VecGetSize(r, &N));
   diag /= N;
+  {
+    PetscBool mpisbaij;
+    PetscCall(PetscObjectTypeCompare((PetscObject)p->K, MATMPISBAIJ, &mpisbaij));
+    PetscCheck(!mpisbaij, p->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
+  }
   PetscCall(MatZeroRowsColumns(p->K, p->nconstrained, p->constrained, diag, p->u, p->f));
 
   PetscCall(KSPCreate(p->comm, &ksp));
@@ -85,7 +99,6 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCGAMG));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
-  PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
   PetscCall(KSPSetFromOptions(ksp));
   PetscCall(KSPSolve(ksp, p->f, p->u));
   PetscCall(KSPGetConvergedReason(ksp, &reason));
