@@ -193,6 +193,9 @@ struct _p_PeriModel {
   PetscInt           nmeasures;
   const char *const *measure_names;
   PetscBool          allows_surface_correction;
+  const char *const *keys;                   /* the model's own scene keys besides model.type and model.plane, or NULL */
+  PetscBool          inactive[PERI_MAX_DOF]; /* components without stiffness after calibration: held at 0 */
+  char               warning[256];           /* set by calibration; printed once by the problem */
   PeriMaterial       material;
   PetscReal          delta;
   void              *data;
@@ -208,6 +211,9 @@ PETSC_EXTERN PetscErrorCode PeriModelDestroy(PeriModel *);
 PETSC_EXTERN PetscReal      PeriModelIsotropicEnergy(PeriModel);
 PETSC_EXTERN PetscReal      PeriModelHorizonMoment(PeriModel, PetscInt);
 PETSC_EXTERN void           PeriCentralBondBlock(PeriModel, const PeriBondGeometry *, PetscReal, PetscReal[]);
+PETSC_EXTERN void           PeriAddSpring(PetscInt, const PetscReal[], PetscReal, PetscReal[]);
+PETSC_EXTERN void           PeriPlaneMicromoduli(PeriModel, PetscReal *, PetscReal *);
+PETSC_EXTERN void           PeriShearBondNuRange(PeriModel, PetscReal *, PetscReal *);
 PETSC_EXTERN void           PeriBondStretch(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
 PETSC_EXTERN void           PeriBondBasedNuRange(PeriModel, PetscReal *, PetscReal *);
 PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
@@ -215,6 +221,9 @@ PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], Pet
 
 PETSC_EXTERN PetscErrorCode PeriModelCreate_PMB(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriModelCreate_NPMB(PeriModel);
+PETSC_EXTERN PetscErrorCode PeriModelCreate_PDS(PeriModel);
+PETSC_EXTERN PetscErrorCode PeriModelCreate_MPPD(PeriModel);
+PETSC_EXTERN PetscErrorCode PeriModelCreate_Gerstle(PeriModel);
 
 /* ------------------------------------------------------------------ the problem (src/problem.c) */
 typedef struct {
@@ -234,7 +243,28 @@ typedef struct {
   PetscReal strain_energy;
   PetscReal max_abs_u[PERI_MAX_DOF];
   PetscInt  nbonds_total;
+  /* against the scene's reference field (src/reference.c) */
+  PetscBool has_reference;
+  PetscInt  interior_particles;
+  PetscReal interior_strain[3];                     /* e_xx, e_yy, gamma_xy */
+  PetscReal effective_E, effective_nu, effective_G; /* 0 where the stress state does not define it */
+  PetscReal error_l2_rel, error_max_rel;
 } PeriResults;
+
+typedef enum {
+  PERI_REFERENCE_NONE,
+  PERI_REFERENCE_UNIAXIAL,
+  PERI_REFERENCE_SHEAR,
+  PERI_REFERENCE_BENDING
+} PeriReferenceType;
+PETSC_EXTERN const char *const PeriReferenceTypes[];
+
+typedef struct {
+  PeriReferenceType type;
+  PetscReal         stress; /* sigma (uniaxial), tau (shear), the extreme fibre stress (bending) */
+  PetscInt          axis;   /* uniaxial: the loaded axis */
+  PetscReal         center[3];
+} PeriReference;
 
 typedef struct _p_PeriProblem *PeriProblem;
 struct _p_PeriProblem {
@@ -266,6 +296,7 @@ struct _p_PeriProblem {
   PetscReal            *W;     /* strain energy density per particle (rank 0, after the solve) */
   PetscReal            *u_all; /* displacements of all particles (rank 0, after the solve) */
   PeriResults           results;
+  PeriReference         reference;
   PetscLogDouble        t_start;
 };
 
@@ -290,6 +321,11 @@ PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriProblem, Mat);
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriLoadsAssemble(PeriProblem, Vec);
 PETSC_EXTERN PetscErrorCode PeriCheckRigidMotion(PeriProblem);
+
+/* reference solutions (src/reference.c) */
+PETSC_EXTERN PetscErrorCode PeriReferenceSetUp(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriReferenceEvaluate(PeriProblem);
+PETSC_EXTERN void           PeriReferenceDisplacement(PeriProblem, const PetscReal[], PetscReal[]);
 
 /* analyses (src/analysis/) */
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegister(const char[], PetscErrorCode (*)(PeriProblem));

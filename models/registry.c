@@ -10,5 +10,8 @@ PetscErrorCode PeriModelRegisterAll(void)
   done = PETSC_TRUE;
   PetscCall(PeriModelRegister("pmb", PeriModelCreate_PMB));
   PetscCall(PeriModelRegister("npmb", PeriModelCreate_NPMB));
+  PetscCall(PeriModelRegister("pds", PeriModelCreate_PDS));
+  PetscCall(PeriModelRegister("mppd", PeriModelCreate_MPPD));
+  PetscCall(PeriModelRegister("gerstle", PeriModelCreate_Gerstle));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

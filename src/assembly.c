@@ -118,10 +118,11 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
 
   /* incoming bonds: stored at owned row r towards owned particle j > r, listed under j */
   PetscCall(PetscCalloc1(nloc + 1, &tptr));
-  for (PetscInt k = 0; k < b->nbonds; k++) {
-    PetscInt j = b->j[k];
-    if (b->live[k] && j >= rstart && j < b->rend) tptr[j - rstart + 1]++;
-  }
+  for (PetscInt r = rstart; r < b->rend; r++)
+    for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++) {
+      PetscInt j = b->j[k];
+      if (b->live[k] && j != r && j >= rstart && j < b->rend) tptr[j - rstart + 1]++;
+    }
   for (PetscInt i = 0; i < nloc; i++) tptr[i + 1] += tptr[i];
   PetscCall(PetscMalloc2(tptr[nloc], &tbond, tptr[nloc], &trow));
   {
@@ -213,7 +214,7 @@ PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[])
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
     m->ops.rigid_modes(m, X, vals);
     for (PetscInt k = 0; k < nm; k++)
-      for (PetscInt c = 0; c < m->dofs; c++) a[k][(i - rstart) * m->dofs + c] = vals[k][c];
+      for (PetscInt c = 0; c < m->dofs; c++) a[k][(i - rstart) * m->dofs + c] = m->inactive[c] ? 0 : vals[k][c];
   }
   for (PetscInt k = 0; k < nm; k++) {
     PetscCall(VecRestoreArray(modes[k], &a[k]));

@@ -33,10 +33,29 @@ static PetscErrorCode ComponentFromNode(PeriProblem p, PeriNode node, const char
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* {A: [[..], ..], b: [..]}: a field A X + b with dim rows (b optional). */
+static PetscErrorCode ParseAffine(PeriProblem p, PeriNode node, PetscReal A[3][3], PetscReal b[3])
+{
+  static const char *const keys[] = {"A", "b", NULL};
+  PeriScene                s      = p->scene;
+  const PetscInt           dim    = p->particles.dim;
+  PeriNode                 Anode;
+  PetscInt                 n;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(node->kind == PERI_NODE_MAP, s, node, NULL, "must be {A: [[..], ..], b: [..]}");
+  PetscCall(PeriSceneCheckKeys(s, node, keys));
+  PetscCall(PeriSceneGetNode(node, "A", &Anode));
+  PeriInputCheck(Anode && Anode->kind == PERI_NODE_SEQ && Anode->n == dim, s, Anode ? Anode : node, Anode ? NULL : "A", "must be a list of %" PetscInt_FMT " rows of %" PetscInt_FMT " numbers (A X + b)", dim, dim);
+  for (PetscInt a = 0; a < dim; a++) PetscCall(PeriSceneParseRealArray(s, Anode->child[a], dim, dim, A[a], &n));
+  PetscCall(PeriSceneGetRealArray(s, node, "b", PETSC_FALSE, dim, dim, b, &n));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* value[] and set[] over the owned DOFs; later conditions override earlier ones. */
 static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal value[], PetscBool set[])
 {
-  static const char *const keys[] = {"region", "fix", "value", "affine", NULL};
+  static const char *const keys[] = {"region", "fix", "value", "affine", "optional", NULL};
   PeriScene                s      = p->scene;
   PeriModel                m      = p->model;
   const PetscInt           bs = m->dofs, dim = p->particles.dim;
@@ -45,11 +64,13 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
   PetscReal                v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
   PetscBool                use[PERI_MAX_DOF] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
   PetscInt                 axis_comp[3]      = {-1, -1, -1};
+  PetscBool                optional          = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a boundary condition is a mapping {region: name, fix: [..] | value: {..} | affine: {..}}");
   PetscCall(PeriSceneCheckKeys(s, item, keys));
   PetscCall(PeriRegionFind(s, item, "region", p->nregions, p->regions, &r));
+  PetscCall(PeriSceneGetBool(s, item, "optional", &optional, NULL));
   PetscCall(PeriSceneGetNode(item, "fix", &fix));
   PetscCall(PeriSceneGetNode(item, "value", &val));
   PetscCall(PeriSceneGetNode(item, "affine", &aff));
@@ -59,6 +80,8 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
     for (PetscInt k = 0; k < fix->n; k++) {
       PetscInt c;
       PeriInputCheck(fix->child[k]->kind == PERI_NODE_SCALAR, s, fix->child[k], NULL, "must be a component name");
+      PetscCall(PeriModelComponentIndex(m, fix->child[k]->value, &c));
+      if (c < 0 && optional) continue;
       PetscCall(ComponentFromNode(p, fix->child[k], fix->child[k]->value, &c));
       use[c] = PETSC_TRUE;
       v[c]   = 0;
@@ -67,20 +90,14 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
     PeriInputCheck(val->kind == PERI_NODE_MAP && val->n > 0, s, val, NULL, "must map components to values, e.g. {ux: 0.001}");
     for (PetscInt k = 0; k < val->n; k++) {
       PetscInt c;
+      PetscCall(PeriModelComponentIndex(m, val->child[k]->key, &c));
+      if (c < 0 && optional) continue;
       PetscCall(ComponentFromNode(p, val->child[k], val->child[k]->key, &c));
       PetscCall(PeriSceneGetReal(s, val, val->child[k]->key, PETSC_TRUE, &v[c], NULL));
       use[c] = PETSC_TRUE;
     }
   } else {
-    static const char *const akeys[] = {"A", "b", NULL};
-    PeriNode                 Anode;
-    PetscInt                 n;
-    PeriInputCheck(aff->kind == PERI_NODE_MAP, s, aff, NULL, "must be {A: [[..], ..], b: [..]}");
-    PetscCall(PeriSceneCheckKeys(s, aff, akeys));
-    PetscCall(PeriSceneGetNode(aff, "A", &Anode));
-    PeriInputCheck(Anode && Anode->kind == PERI_NODE_SEQ && Anode->n == dim, s, Anode ? Anode : aff, Anode ? NULL : "A", "must be a list of %" PetscInt_FMT " rows of %" PetscInt_FMT " numbers (u = A X + b)", dim, dim);
-    for (PetscInt a = 0; a < dim; a++) PetscCall(PeriSceneParseRealArray(s, Anode->child[a], dim, dim, A[a], &n));
-    PetscCall(PeriSceneGetRealArray(s, aff, "b", PETSC_FALSE, dim, dim, b0, &n));
+    PetscCall(ParseAffine(p, aff, A, b0));
     for (PetscInt a = 0; a < dim; a++) {
       PetscCall(AxisComponent(m, a, &axis_comp[a]));
       PeriInputCheck(axis_comp[a] >= 0, s, aff, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + a));
@@ -121,6 +138,14 @@ PetscErrorCode PeriBoundarySetUp(PeriProblem p)
   PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
   PetscCall(PetscCalloc2(nloc, &value, nloc, &set));
   for (PetscInt k = 0; bc && k < bc->n; k++) PetscCall(ApplyCondition(p, bc->child[k], value, set));
+  for (PetscInt c = 0; c < bs; c++) {
+    if (!p->model->inactive[c]) continue;
+    PetscCall(PetscPrintf(p->comm, "perilin: note: %s has no stiffness in model %s at nu = %g (no shear springs): it is held at 0\n", p->model->components[c], p->model->type, (double)p->model->material.nu));
+    for (PetscInt i = 0; i < nloc / bs; i++) {
+      value[i * bs + c] = 0;
+      set[i * bs + c]   = PETSC_TRUE;
+    }
+  }
   for (PetscInt k = 0; k < nloc; k++) n += set[k] ? 1 : 0;
   p->nconstrained = n;
   PetscCall(PetscMalloc1(n, &p->constrained));
@@ -142,7 +167,7 @@ PetscErrorCode PeriBoundarySetUp(PeriProblem p)
 @*/
 PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
 {
-  static const char *const keys[] = {"region", "force", "traction", "body_force", NULL};
+  static const char *const keys[] = {"region", "force", "traction", "body_force", "traction_field", NULL};
   PeriScene                s      = p->scene;
   PeriModel                m      = p->model;
   const PetscInt           bs = m->dofs, dim = p->particles.dim;
@@ -156,31 +181,39 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
   PeriInputCheck(loads->kind == PERI_NODE_SEQ, s, loads, NULL, "must be a list of loads, each {region: .., force: [..]}");
   PetscCall(VecGetArray(f, &a));
   for (PetscInt k = 0; k < loads->n; k++) {
-    PeriNode    item = loads->child[k], force, traction, body;
+    PeriNode    item = loads->child[k], force, traction, body, field;
     PeriRegion *r;
-    PetscReal   F[3] = {0, 0, 0}, scale;
+    PetscReal   A[3][3] = {{0}}, F[3] = {0, 0, 0}, scale;
     PetscInt    n, comp[3];
-    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force: [..]}");
+    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force | traction_field: ..}");
     PetscCall(PeriSceneCheckKeys(s, item, keys));
     PetscCall(PeriRegionFind(s, item, "region", p->nregions, p->regions, &r));
     PetscCall(PeriSceneGetNode(item, "force", &force));
     PetscCall(PeriSceneGetNode(item, "traction", &traction));
     PetscCall(PeriSceneGetNode(item, "body_force", &body));
-    PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force");
-    PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
-                                                                        : "body_force",
-                                    PETSC_TRUE, dim, dim, F, &n));
-    PeriInputCheck(!traction || r->kind == PERI_REGION_LAYER, s, item, "traction", "needs a layer region (side: ..), whose face area converts traction to force; region '%s' is not one", r->name);
-    /* per particle: F * scale * V_i */
-    scale = body ? 1.0 : (traction ? r->face_area : 1.0) / r->volume;
+    PetscCall(PeriSceneGetNode(item, "traction_field", &field));
+    PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) + (field ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force, traction_field");
+    if (field)
+      PetscCall(ParseAffine(p, field, A, F));
+    else
+      PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
+                                                                          : "body_force",
+                                      PETSC_TRUE, dim, dim, F, &n));
+    PeriInputCheck(!(traction || field) || r->kind == PERI_REGION_LAYER, s, item, traction ? "traction" : "traction_field", "needs a layer region (side: ..), whose face area converts traction to force; region '%s' is not one", r->name);
+    /* particle i receives (A X_i + F) scale V_i */
+    scale = body ? 1.0 : (traction || field ? r->face_area : 1.0) / r->volume;
     for (PetscInt d = 0; d < dim; d++) {
       PetscCall(AxisComponent(m, d, &comp[d]));
-      PeriInputCheck(comp[d] >= 0 || F[d] == 0, s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
+      PeriInputCheck(comp[d] >= 0 || (F[d] == 0 && A[d][0] == 0 && A[d][1] == 0 && A[d][2] == 0), s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
     }
     for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
-      if (!PeriRegionContains(r, &p->particles.x[3 * i])) continue;
-      for (PetscInt d = 0; d < dim; d++)
-        if (comp[d] >= 0) a[(i - p->bonds.rstart) * bs + comp[d]] += F[d] * scale * p->particles.volume[i];
+      const PetscReal *X = &p->particles.x[3 * i];
+      if (!PeriRegionContains(r, X)) continue;
+      for (PetscInt d = 0; d < dim; d++) {
+        PetscReal v = F[d];
+        for (PetscInt e = 0; e < dim; e++) v += A[d][e] * X[e];
+        if (comp[d] >= 0) a[(i - p->bonds.rstart) * bs + comp[d]] += v * scale * p->particles.volume[i];
+      }
     }
   }
   PetscCall(VecRestoreArray(f, &a));

@@ -167,6 +167,38 @@ void PeriCentralBondBlock(PeriModel m, const PeriBondGeometry *b, PetscReal k, P
     }
 }
 
+/* K += k b b^T for a deformation measure h = b . u_e over the bond's 2 dofs DOFs. */
+void PeriAddSpring(PetscInt n, const PetscReal b[], PetscReal k, PetscReal Ke[])
+{
+  for (PetscInt a = 0; a < n; a++)
+    for (PetscInt c = 0; c < n; c++) Ke[a * n + c] += k * b[a] * b[c];
+}
+
+/* The 2D micromoduli of a bond with normal and shear springs, calibrated on an isotropic
+ * expansion and a pure shear (Diana & Casolo eqs. 7 and 21): c = k_n, g = k_t. g = 0 at the
+ * bond-based Poisson ratio, g < 0 above it. */
+void PeriPlaneMicromoduli(PeriModel m, PetscReal *c, PetscReal *g)
+{
+  const PetscReal E = m->material.E, nu = m->material.nu, d3 = PetscPowReal(m->delta, 3), t = m->material.thickness;
+  if (m->plane_strain) {
+    *c = 6 * E / (PETSC_PI * t * d3 * (1 - 2 * nu) * (1 + nu));
+    *g = 6 * E * (1 - 4 * nu) / (PETSC_PI * t * d3 * (1 - 2 * nu) * (1 + nu));
+  } else {
+    *c = 6 * E / (PETSC_PI * t * d3 * (1 - nu));
+    *g = 6 * E * (1 - 3 * nu) / (PETSC_PI * t * d3 * (1 - nu * nu));
+  }
+  if (*g < 0) PetscSNPrintf(m->warning, sizeof(m->warning), "nu = %g is above the bond-based value %s: the shear springs are negative and the stiffness may be indefinite; if CG fails use -ksp_type preonly -pc_type lu", (double)nu, m->plane_strain ? "1/4" : "1/3");
+}
+
+/* Admissible Poisson ratios of 2D shear-bond models: where the plane elasticity they calibrate to
+ * is positive definite. */
+void PeriShearBondNuRange(PeriModel m, PetscReal *lo, PetscReal *hi)
+{
+  (void)m;
+  *lo = -1 + 1e-6;
+  *hi = 0.5 - 1e-6;
+}
+
 /* Linearized stretch s = e . (u_j - u_i) / |xi|. */
 void PeriBondStretch(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[], const PetscReal uj[], PetscReal s[])
 {

@@ -164,7 +164,6 @@ static PetscErrorCode CreateModel(PeriProblem p)
   PetscCall(PeriSceneGetInt(s, s->root, "dim", PETSC_TRUE, &dim, NULL));
   PeriInputCheck(dim == 2 || dim == 3, s, s->root, "dim", "must be 2 or 3, got %" PetscInt_FMT, dim);
   PetscCall(PeriSceneGetMap(s, s->root, "model", PETSC_TRUE, &m));
-  PetscCall(PeriSceneCheckKeys(s, m, keys));
   PetscCall(PeriSceneGetString(s, m, "type", PETSC_TRUE, type, sizeof(type), NULL));
   PetscCall(PeriSceneGetChoice(s, m, "plane", planes, &plane, &found));
   PeriInputCheck(!found || dim == 2, s, m, "plane", "applies to 2D scenes only");
@@ -175,12 +174,20 @@ static PetscErrorCode CreateModel(PeriProblem p)
     PeriInputCheck(PETSC_FALSE, s, m, "type", "unknown model '%s'; registered models: %s", type, list);
   }
   PetscCall(PeriModelCreate(type, dim, plane == 1 ? PETSC_TRUE : PETSC_FALSE, &p->model));
+  {
+    const char *allowed[16];
+    PetscInt    n = 0;
+    for (PetscInt k = 0; keys[k]; k++) allowed[n++] = keys[k];
+    for (PetscInt k = 0; p->model->keys && p->model->keys[k] && n < 15; k++) allowed[n++] = p->model->keys[k];
+    allowed[n] = NULL;
+    PetscCall(PeriSceneCheckKeys(s, m, allowed));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode CheckRootKeys(PeriScene s)
 {
-  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", NULL};
+  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", NULL};
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckKeys(s, s->root, keys));
@@ -240,9 +247,11 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   cal.n             = p->particles.n;
   cal.family_volume = p->family_volume;
   PetscCall(p->model->ops.calibrate(p->model, &cal));
+  if (p->model->warning[0]) PetscCall(PetscPrintf(p->comm, "perilin: warning: %s\n", p->model->warning));
 
   PetscCall(PeriRegionsCreateFromScene(s, &p->particles, p->delta, &p->nregions, &p->regions));
   PetscCall(ReadProbes(p));
+  PetscCall(PeriReferenceSetUp(p));
   PetscCall(PeriBoundarySetUp(p));
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -326,7 +335,14 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   if (!run) {
     PeriNode a;
     PetscCall(PeriSceneGetNode(p->scene->root, "analysis", &a));
-    PeriInputCheck(PETSC_FALSE, p->scene, a, "type", "unknown analysis '%s'; available: static", p->analysis);
+    const char **names;
+    char         list[256] = "";
+    int          n;
+    PetscCall(PetscFunctionListGet(PeriAnalysisList, &names, &n));
+    for (int k = 0; k < n; k++)
+      if (names[k]) PeriListAppend(list, sizeof(list), names[k]);
+    PetscCall(PetscFree(names));
+    PeriInputCheck(PETSC_FALSE, p->scene, a, "type", "unknown analysis '%s'; available: %s", p->analysis, list);
   }
   PetscCall(PetscLogStagePush(PERI_STAGE_Solve));
   PetscCall((*run)(p));

@@ -65,6 +65,7 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
     PetscCall(PetscStrncpy(p->results.pc_type, "none", sizeof(p->results.pc_type)));
     PetscCall(PetscStrncpy(p->results.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(p->results.converged_reason)));
     PetscCall(PeriProblemEvaluateEnergy(p));
+    PetscCall(PeriReferenceEvaluate(p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(PeriCheckRigidMotion(p));
@@ -126,5 +127,6 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscCall(PetscTime(&t1));
   p->results.solve_s = t1 - t0;
   PetscCall(PeriProblemEvaluateEnergy(p));
+  PetscCall(PeriReferenceEvaluate(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -44,6 +44,23 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONBeginObject(j, "max_abs_u"));
   for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, p->model->components[c], r->max_abs_u[c]));
   PetscCall(PeriJSONEndObject(j));
+  if (r->has_reference) {
+    PetscCall(PeriJSONBeginObject(j, "reference"));
+    PetscCall(PeriJSONString(j, "type", PeriReferenceTypes[p->reference.type]));
+    PetscCall(PeriJSONReal(j, "stress", p->reference.stress));
+    PetscCall(PeriJSONEndObject(j));
+    PetscCall(PeriJSONInt(j, "interior_particles", r->interior_particles));
+    PetscCall(PeriJSONRealArray(j, "interior_strain", 3, r->interior_strain));
+    PetscCall(PeriJSONBeginObject(j, "effective"));
+    if (r->effective_E != 0) PetscCall(PeriJSONReal(j, "E", r->effective_E));
+    if (r->effective_E != 0) PetscCall(PeriJSONReal(j, "nu", r->effective_nu));
+    if (r->effective_G != 0) PetscCall(PeriJSONReal(j, "G", r->effective_G));
+    PetscCall(PeriJSONEndObject(j));
+    PetscCall(PeriJSONBeginObject(j, "error"));
+    PetscCall(PeriJSONReal(j, "l2_rel", r->error_l2_rel));
+    PetscCall(PeriJSONReal(j, "max_rel", r->error_max_rel));
+    PetscCall(PeriJSONEndObject(j));
+  }
   PetscCall(PeriJSONBeginObject(j, "probes"));
   for (PetscInt k = 0; k < p->nprobes; k++) {
     PeriProbe *pr = &p->probes[k];

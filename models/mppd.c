@@ -1,0 +1,167 @@
+/* mppd and gerstle: 2D micropolar bonds (Diana & Casolo sec. 2.2), 3 DOFs per particle
+ * (ux, uy, theta). Deformation measures of a bond (eqs. 26-28, kappa = 0):
+ *   s     = e.(u_j - u_i) / |xi|                       stretch
+ *   gamma = t.(u_j - u_i) / |xi| - (theta_i + theta_j)/2  sliding (chord rotation minus the
+ *                                                        particles' mean rotation)
+ *   vartheta = theta_j - theta_i                         relative rotation
+ * with e = xi/|xi|, t = e rotated by +90 degrees, theta counter-clockwise. The pair energy is
+ * alpha lambda V_i V_j (k_n s^2 |xi| + k_t gamma^2 |xi| + k_theta vartheta^2) / 2 (eq. 32); a rigid
+ * rotation u = w x X, theta = w leaves every measure zero. Eqs. (30) and (33) print the theta
+ * terms of the sliding with the opposite sign, which is the clockwise convention; with it a rigid
+ * rotation would slide the bonds (docs/models/mppd.md).
+ *   mppd:    k_n = c, k_t = g (eqs. 7, 21), k_theta = f c delta^2 / (36 |xi|), f = model.k_theta_factor
+ *            (default 1: Gerstle's rotational spring at nu = 0), or k_theta = model.k_theta.
+ *   gerstle: k_n = c, k_t = 12 d / |xi|^2, k_theta = d / |xi| (eqs. 42-43), d = g delta^2 / 36. */
+#include "perilin.h"
+
+typedef struct {
+  PetscBool gerstle;
+  PetscReal c, g, d;
+  PetscReal k_theta, k_theta_factor; /* mppd: absolute value when >= 0, else the factor applies */
+} MPPD;
+
+static const char *const components[] = {"ux", "uy", "theta"};
+static const char *const measures[]   = {"stretch", "sliding", "relative_rotation"};
+static const char *const mppd_keys[]  = {"k_theta", "k_theta_factor", NULL};
+
+static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
+{
+  MPPD     *mp = (MPPD *)m->data;
+  PetscBool has_k, has_f;
+
+  PetscFunctionBeginUser;
+  mp->k_theta        = -1;
+  mp->k_theta_factor = 1;
+  PetscCall(PeriSceneGetReal(scene, node, "k_theta", PETSC_FALSE, &mp->k_theta, &has_k));
+  PetscCall(PeriSceneGetReal(scene, node, "k_theta_factor", PETSC_FALSE, &mp->k_theta_factor, &has_f));
+  PeriInputCheck(!(has_k && has_f), scene, node, "k_theta_factor", "give model.k_theta or model.k_theta_factor, not both");
+  PeriInputCheck(!has_k || mp->k_theta >= 0, scene, node, "k_theta", "must not be negative");
+  PeriInputCheck(mp->k_theta_factor >= 0, scene, node, "k_theta_factor", "must not be negative");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
+{
+  MPPD *mp = (MPPD *)m->data;
+
+  PetscFunctionBeginUser;
+  (void)data;
+  PeriPlaneMicromoduli(m, &mp->c, &mp->g);
+  mp->d = mp->g * m->delta * m->delta / 36;
+  /* at the bond-based Poisson ratio the shear springs vanish and theta no longer acts on the
+   * displacements: it is held at 0 rather than left singular */
+  m->inactive[2] = (PetscBool)(PetscAbsReal(mp->g) <= 1e-12 * mp->c);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static void Springs(const MPPD *mp, PetscReal delta, PetscReal L, PetscReal *kn, PetscReal *kt, PetscReal *kth)
+{
+  *kn = mp->c;
+  if (mp->gerstle) {
+    *kt  = 12 * mp->d / (L * L);
+    *kth = mp->d / L;
+  } else {
+    *kt  = mp->g;
+    *kth = mp->k_theta >= 0 ? mp->k_theta : mp->k_theta_factor * mp->c * delta * delta / (36 * L);
+  }
+}
+
+/* measure vectors over (ux_i, uy_i, theta_i, ux_j, uy_j, theta_j) */
+static void Vectors(const PeriBondGeometry *b, PetscReal bs[6], PetscReal bg[6], PetscReal bt[6])
+{
+  const PetscReal L = b->length, ex = b->xi[0] / L, ey = b->xi[1] / L;
+  const PetscReal s[6] = {-ex / L, -ey / L, 0, ex / L, ey / L, 0};
+  const PetscReal g[6] = {ey / L, -ex / L, -0.5, -ey / L, ex / L, -0.5};
+  const PetscReal t[6] = {0, 0, -1, 0, 0, 1};
+  for (PetscInt a = 0; a < 6; a++) {
+    bs[a] = s[a];
+    bg[a] = g[a];
+    bt[a] = t[a];
+  }
+}
+
+static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[])
+{
+  const MPPD *mp = (const MPPD *)m->data;
+  PetscReal   bs[6], bg[6], bt[6], kn, kt, kth, w = b->Vi * b->Vj * b->weight;
+  Vectors(b, bs, bg, bt);
+  Springs(mp, m->delta, b->length, &kn, &kt, &kth);
+  for (PetscInt a = 0; a < 36; a++) Ke[a] = 0;
+  PeriAddSpring(6, bs, w * kn * b->length, Ke);
+  PeriAddSpring(6, bg, w * kt * b->length, Ke);
+  PeriAddSpring(6, bt, w * kth, Ke);
+}
+
+static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[], const PetscReal uj[], PetscReal h[])
+{
+  PetscReal bs[6], bg[6], bt[6], u[6] = {ui[0], ui[1], ui[2], uj[0], uj[1], uj[2]};
+  (void)m;
+  Vectors(b, bs, bg, bt);
+  h[0] = h[1] = h[2] = 0;
+  for (PetscInt a = 0; a < 6; a++) {
+    h[0] += bs[a] * u[a];
+    h[1] += bg[a] * u[a];
+    h[2] += bt[a] * u[a];
+  }
+}
+
+/* translations, and the rigid rotation u = w x X with theta = w */
+static PetscInt RigidModes(PeriModel m, const PetscReal X[], PetscReal modes[][PERI_MAX_DOF])
+{
+  (void)m;
+  for (PetscInt k = 0; k < PERI_MAX_MODES; k++)
+    for (PetscInt c = 0; c < PERI_MAX_DOF; c++) modes[k][c] = 0;
+  modes[0][0] = 1;
+  modes[1][1] = 1;
+  modes[2][0] = -X[1];
+  modes[2][1] = X[0];
+  modes[2][2] = 1;
+  return 3;
+}
+
+static PetscErrorCode Destroy(PeriModel m)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(m->data));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
+{
+  MPPD *mp;
+
+  PetscFunctionBeginUser;
+  PetscCheck(m->dim == 2, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "model %s is two-dimensional (plane stress or plane strain); use dim: 2", m->type);
+  PetscCall(PetscNew(&mp));
+  mp->gerstle           = gerstle;
+  mp->k_theta           = -1;
+  mp->k_theta_factor    = 1;
+  m->data               = mp;
+  m->dofs               = 3;
+  m->components         = components;
+  m->nmeasures          = 3;
+  m->measure_names      = measures;
+  m->keys               = gerstle ? NULL : mppd_keys;
+  m->ops.setfromscene   = gerstle ? NULL : SetFromScene;
+  m->ops.nu_range       = PeriShearBondNuRange;
+  m->ops.calibrate      = Calibrate;
+  m->ops.bond_stiffness = BondStiffness;
+  m->ops.bond_measures  = BondMeasures;
+  m->ops.rigid_modes    = RigidModes;
+  m->ops.destroy        = Destroy;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriModelCreate_MPPD(PeriModel m)
+{
+  PetscFunctionBeginUser;
+  PetscCall(Create(m, PETSC_FALSE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriModelCreate_Gerstle(PeriModel m)
+{
+  PetscFunctionBeginUser;
+  PetscCall(Create(m, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
