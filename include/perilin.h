@@ -264,6 +264,7 @@ typedef struct {
   PetscReal         stress; /* sigma (uniaxial), tau (shear), the extreme fibre stress (bending) */
   PetscInt          axis;   /* uniaxial: the loaded axis */
   PetscReal         center[3];
+  PetscReal         E, nu; /* elastic constants of the reference; default the material's */
 } PeriReference;
 
 typedef struct _p_PeriProblem *PeriProblem;

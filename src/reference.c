@@ -7,7 +7,7 @@ const char *const PeriReferenceTypes[] = {"none", "uniaxial", "shear", "bending"
 
 PetscErrorCode PeriReferenceSetUp(PeriProblem p)
 {
-  static const char *const keys[] = {"type", "stress", "axis", "center", NULL}, *const axes[] = {"x", "y", NULL};
+  static const char *const keys[] = {"type", "stress", "axis", "center", "E", "nu", NULL}, *const axes[] = {"x", "y", NULL};
   PeriScene      s = p->scene;
   PeriReference *r = &p->reference;
   PeriNode       node;
@@ -27,15 +27,21 @@ PetscErrorCode PeriReferenceSetUp(PeriProblem p)
   PetscCall(PeriSceneGetChoice(s, node, "axis", axes, &r->axis, NULL));
   for (PetscInt d = 0; d < 3; d++) r->center[d] = 0.5 * (p->particles.lower[d] + p->particles.upper[d]);
   PetscCall(PeriSceneGetRealArray(s, node, "center", PETSC_FALSE, 2, 2, r->center, &n));
+  r->E  = p->model->material.E;
+  r->nu = p->model->material.nu;
+  PetscCall(PeriSceneGetReal(s, node, "E", PETSC_FALSE, &r->E, NULL));
+  PetscCall(PeriSceneGetReal(s, node, "nu", PETSC_FALSE, &r->nu, NULL));
+  PeriInputCheck(r->E > 0, s, node, "E", "must be positive");
+  PeriInputCheck(r->nu > -1 && r->nu < 0.5, s, node, "nu", "must lie in (-1, 1/2)");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Plane strain is plane stress with E' = E/(1-nu^2), nu' = nu/(1-nu). */
 static void PlaneConstants(PeriProblem p, PetscReal *E, PetscReal *nu)
 {
-  const PeriMaterial *m = &p->model->material;
-  *E                    = p->model->plane_strain ? m->E / (1 - m->nu * m->nu) : m->E;
-  *nu                   = p->model->plane_strain ? m->nu / (1 - m->nu) : m->nu;
+  const PeriReference *r = &p->reference;
+  *E                     = p->model->plane_strain ? r->E / (1 - r->nu * r->nu) : r->E;
+  *nu                    = p->model->plane_strain ? r->nu / (1 - r->nu) : r->nu;
 }
 
 /* The exact displacement at X (up to a rigid motion):

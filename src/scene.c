@@ -48,6 +48,8 @@ static const PeriSceneKey scene_keys[] = {
     {"reference.type", "exact plane field to compare with: uniaxial | shear | bending"},
     {"reference.stress", "its stress: sigma (uniaxial), tau (shear), extreme fibre stress (bending) [stress]"},
     {"reference.axis", "uniaxial: the loaded axis, x | y"},
+    {"reference.E", "Young's modulus of the reference solution [stress]; default material.E"},
+    {"reference.nu", "Poisson ratio of the reference solution; default material.nu"},
     {"reference.center", "the point where the reference field has no displacement; default the body centre"},
     {"probes.<name>", "a point [x, y(, z)]: displacement and energy density of the nearest particle"},
     {"analysis.type", "static"},

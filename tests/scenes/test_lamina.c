@@ -1,0 +1,142 @@
+/* Diana & Casolo sec. 3: the square lamina under traction, pure shear and pure bending with the
+ * shear-bond (pds) and micropolar (mppd, gerstle) models, plane stress, nu in {-0.5, 0, 0.1, 0.25}.
+ *
+ * References, all computed here independently of perilin's assembly:
+ *  - the homogenized stiffness of the infinite m = 3 lattice for each model (normal springs c,
+ *    shear springs g or 12 d/|xi|^2 with the continuum calibration of eqs. 7, 21, 43, theta = 0 in
+ *    homogeneous states): the effective nu, E (traction) and G (shear) the plate should approach;
+ *  - the same for pmb at nu = 1/3 on the same plate, whose distance to its own lattice value is
+ *    what a finite 61 x 61 plate measured over its 2-delta interior costs (boundary layers);
+ *  - exact plane elasticity for bending (summary error.l2_rel).
+ * Asserted: traction nu and E within 0.02 / 3 % of the lattice values; shear G within the pmb
+ * plate's own distance to its lattice value + 2 %; bending within the issue's 5 % of exact
+ * elasticity for mppd, and for gerstle within 5 % of the elastic solution with its lattice's
+ * constants (its 1/|xi|^2 shear springs homogenize to nu_eff = 0.08 at nu = 0 on this lattice,
+ * docs/models/mppd.md); pds off by more than 30 % (the paper: 51-200 %). */
+#include "testing.h"
+
+typedef enum {
+  LATTICE_PMB,
+  LATTICE_PDS_MPPD,
+  LATTICE_GERSTLE
+} LatticeModel;
+
+static PetscReal Alpha(PetscReal r, PetscReal m)
+{
+  if (r >= m + 0.5) return 0;
+  if (r <= m - 0.5) return 1;
+  return m + 0.5 - r;
+}
+
+/* plane stress, unit E, t, spacing: effective nu, E, G of the lattice */
+static void Lattice(LatticeModel model, PetscReal nu, PetscReal m, PetscReal *nu_eff, PetscReal *E_eff, PetscReal *G_eff)
+{
+  const PetscReal d3 = m * m * m, c = 6 / (PETSC_PI * d3 * (1 - nu)), g = 6 * (1 - 3 * nu) / (PETSC_PI * d3 * (1 - nu * nu)), d = g * m * m / 36;
+  PetscReal       C[3][3] = {{0}}, det;
+  PetscInt        R       = (PetscInt)m + 2;
+  for (PetscInt i = -R; i <= R; i++)
+    for (PetscInt j = -R; j <= R; j++) {
+      PetscReal L = PetscSqrtReal((PetscReal)(i * i + j * j)), a, ex, ey, tx, ty, kt, bs[3], bg[3];
+      if (!i && !j) continue;
+      a = Alpha(L, m);
+      if (a <= 0) continue;
+      ex = i / L, ey = j / L, tx = -ey, ty = ex;
+      kt    = model == LATTICE_PMB ? 0 : (model == LATTICE_GERSTLE ? 12 * d / (L * L) : g);
+      bs[0] = ex * ex, bs[1] = ey * ey, bs[2] = ex * ey;
+      bg[0] = tx * ex, bg[1] = ty * ey, bg[2] = 0.5 * (tx * ey + ty * ex);
+      for (PetscInt p = 0; p < 3; p++)
+        for (PetscInt q = 0; q < 3; q++) C[p][q] += 0.5 * a * (c * L * bs[p] * bs[q] + kt * L * bg[p] * bg[q]);
+    }
+  det     = C[0][0] * C[1][1] - C[0][1] * C[1][0];
+  *nu_eff = C[0][1] / C[0][0];
+  *E_eff  = det / C[0][0]; /* 1 / e_yy for unit sigma_yy */
+  *G_eff  = C[2][2];
+}
+
+static PetscErrorCode Run(const char dir[], const char scene[], const char model[], const char nu[], PeriProblem *p)
+{
+  char file[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriTestSetOption("-reference_E", NULL));
+  PetscCall(PeriTestSetOption("-reference_nu", NULL));
+  PetscCall(PetscSNPrintf(file, sizeof(file), "%s/%s.yaml", dir, scene));
+  PetscCall(PeriTestSetOption("-model_type", model));
+  PetscCall(PeriTestSetOption("-material_nu", nu));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, file, p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+int main(int argc, char **argv)
+{
+  const char *const nus[]    = {"-0.5", "0", "0.1", "0.25"};
+  const char *const models[] = {"pds", "mppd", "gerstle"};
+  const PetscReal   E = 7e10, sigma = 1e7;
+  PetscReal         lnu, lE, lG, shear_allow;
+  PeriProblem       p;
+  PetscMPIInt       rank;
+  char              what[160];
+
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_lamina examples/lamina");
+  PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+
+  /* what the finite plate costs: pmb (= pds at nu = 1/3) against its own lattice */
+  Lattice(LATTICE_PMB, 1.0 / 3, 3, &lnu, &lE, &lG);
+  PetscCall(Run(argv[1], "shear", "pds", "1/3", &p));
+  shear_allow = PetscAbsReal(p->results.effective_G / (E * lG) - 1) + 0.02;
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "pmb plate: G_eff / G_lattice - 1 = %+.4f: shear tolerance %.4f\n", (double)(p->results.effective_G / (E * lG) - 1), (double)shear_allow));
+  PetscCall(PeriProblemDestroy(&p));
+
+  for (int k = 0; k < 4; k++) {
+    PetscReal nu = (PetscReal)atof(nus[k]), G = E / (2 * (1 + nu));
+    for (int mo = 0; mo < 3; mo++) {
+      LatticeModel lm = mo == 2 ? LATTICE_GERSTLE : LATTICE_PDS_MPPD;
+      Lattice(lm, nu, 3, &lnu, &lE, &lG);
+
+      PetscCall(Run(argv[1], "traction", models[mo], nus[k], &p));
+      if (!rank) {
+        PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s traction: nu_eff vs lattice", models[mo], nus[k]));
+        PeriTestClose(what, p->results.effective_nu, lnu, 0.02);
+        PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s traction: E_eff / E_lattice", models[mo], nus[k]));
+        PeriTestClose(what, p->results.effective_E / (E * lE), 1.0, 0.03);
+      }
+      PetscCall(PeriProblemDestroy(&p));
+
+      PetscCall(Run(argv[1], "shear", models[mo], nus[k], &p));
+      if (!rank) {
+        PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s shear: G_eff / G_lattice (exact G ratio %.4f)", models[mo], nus[k], (double)(p->results.effective_G / G)));
+        PeriTestClose(what, p->results.effective_G / (E * lG), 1.0, shear_allow);
+      }
+      PetscCall(PeriProblemDestroy(&p));
+
+      PetscCall(Run(argv[1], "bending", models[mo], nus[k], &p));
+      if (mo == 2) {
+        /* gerstle: against the elastic solution of its own lattice constants */
+        char Es[64], nus_l[64];
+        PetscCall(PeriProblemDestroy(&p));
+        PetscCall(PetscSNPrintf(Es, sizeof(Es), "%.10g", (double)(E * lE)));
+        PetscCall(PetscSNPrintf(nus_l, sizeof(nus_l), "%.10g", (double)lnu));
+        PetscCall(PetscSNPrintf(what, sizeof(what), "%s/bending.yaml", argv[1]));
+        PetscCall(PeriTestSetOption("-model_type", models[mo]));
+        PetscCall(PeriTestSetOption("-material_nu", nus[k]));
+        PetscCall(PeriTestSetOption("-reference_E", Es));
+        PetscCall(PeriTestSetOption("-reference_nu", nus_l));
+        PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, what, &p));
+      }
+      if (!rank) {
+        PetscReal err = p->results.error_l2_rel;
+        PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s bending: interior l2 error vs elasticity%s", models[mo], nus[k], mo == 2 ? " with the lattice's E, nu" : ""));
+        if (mo == 0) {
+          PetscCheck(err > 0.3, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s: %g, but pds should miss bending by tens of percent (Table 3)", what, (double)err);
+          PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s = %.4f > 0.3 (pds misses bending)\n", what, (double)err));
+        } else
+          PeriTestClose(what, err, 0.0, 0.05);
+      }
+      PetscCall(PeriProblemDestroy(&p));
+    }
+  }
+  (void)sigma;
+  PetscCall(PetscFinalize());
+  return 0;
+}
