@@ -29,9 +29,11 @@ static PetscReal Alpha(PetscReal r, PetscReal m)
 }
 
 /* plane stress, unit E, t, spacing: effective nu, E, G of the lattice */
-static void Lattice(LatticeModel model, PetscReal nu, PetscReal m, PetscReal *nu_eff, PetscReal *E_eff, PetscReal *G_eff)
+static void LatticePlane(LatticeModel model, PetscBool strain, PetscReal nu, PetscReal m, PetscReal *nu_eff, PetscReal *E_eff, PetscReal *G_eff)
 {
-  const PetscReal d3 = m * m * m, c = 6 / (PETSC_PI * d3 * (1 - nu)), g = 6 * (1 - 3 * nu) / (PETSC_PI * d3 * (1 - nu * nu)), d = g * m * m / 36;
+  const PetscReal d3 = m * m * m;
+  const PetscReal c  = strain ? 6 / (PETSC_PI * d3 * (1 - 2 * nu) * (1 + nu)) : 6 / (PETSC_PI * d3 * (1 - nu));
+  const PetscReal g = strain ? 6 * (1 - 4 * nu) / (PETSC_PI * d3 * (1 - 2 * nu) * (1 + nu)) : 6 * (1 - 3 * nu) / (PETSC_PI * d3 * (1 - nu * nu)), d = g * m * m / 36;
   PetscReal       C[3][3] = {{0}}, det;
   PetscInt        R       = (PetscInt)m + 2;
   for (PetscInt i = -R; i <= R; i++)
@@ -51,6 +53,101 @@ static void Lattice(LatticeModel model, PetscReal nu, PetscReal m, PetscReal *nu
   *nu_eff = C[0][1] / C[0][0];
   *E_eff  = det / C[0][0]; /* 1 / e_yy for unit sigma_yy */
   *G_eff  = C[2][2];
+}
+
+static void Lattice(LatticeModel model, PetscReal nu, PetscReal m, PetscReal *nu_eff, PetscReal *E_eff, PetscReal *G_eff)
+{
+  LatticePlane(model, PETSC_FALSE, nu, m, nu_eff, E_eff, G_eff);
+}
+
+static PetscErrorCode Run(const char[], const char[], const char[], const char[], PeriProblem *);
+
+/* Runs a scene that may legitimately fail to converge: returns the PETSc error code. */
+static PetscErrorCode TryRun(const char file[], PeriProblem *p, PetscErrorCode *ierr)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  *ierr = PeriTestRunScene(PETSC_COMM_WORLD, file, p);
+  PetscCall(PetscPopErrorHandler());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Stability at the extremes (issue 3): nu -> -1, nu above the bond-based value (negative shear
+ * springs), plane strain nu -> 1/2, and m from 1.5 to 6. Each gives the lattice's answer, or, for CG
+ * on an indefinite operator, the not-converged error that names the reason. */
+static PetscErrorCode Extremes(const char dir[])
+{
+  const char *const models[] = {"pds", "mppd", "gerstle"};
+  char              file[PETSC_MAX_PATH_LEN], what[200];
+  PetscReal         lnu, lE, lG;
+  PeriProblem       p = NULL;
+  PetscMPIInt       rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+  PetscCall(PetscSNPrintf(file, sizeof(file), "%s/traction.yaml", dir));
+  for (int mo = 0; mo < 3; mo++) {
+    LatticeModel lm = mo == 2 ? LATTICE_GERSTLE : LATTICE_PDS_MPPD;
+    /* nu -> -1: the auxetic limit; CG still converges, more slowly */
+    Lattice(lm, -0.99, 3, &lnu, &lE, &lG);
+    PetscCall(Run(dir, "traction", models[mo], "-0.99", &p));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=-0.99 traction: nu_eff vs lattice", models[mo]));
+    if (!rank) PeriTestClose(what, p->results.effective_nu, lnu, 0.03);
+    PetscCall(PeriProblemDestroy(&p));
+    /* nu = 0.34 > 1/3: negative shear springs. The direct solver always answers; CG either converges
+     * or stops with a reason */
+    Lattice(lm, 0.34, 3, &lnu, &lE, &lG);
+    for (int direct = 0; direct < 2; direct++) {
+      PetscErrorCode ierr;
+      PetscCall(PeriTestSetOption("-ksp_type", direct ? "preonly" : NULL));
+      PetscCall(PeriTestSetOption("-pc_type", direct ? "lu" : NULL));
+      PetscCall(PeriTestSetOption("-model_type", models[mo]));
+      PetscCall(PeriTestSetOption("-material_nu", "0.34"));
+      PetscCall(TryRun(file, &p, &ierr));
+      if (ierr) {
+        PetscCheck(!direct && ierr == PETSC_ERR_NOT_CONVERGED, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s nu=0.34 (%s): unexpected error %d", models[mo], direct ? "lu" : "cg", (int)ierr);
+        PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s nu=0.34 with CG: stops with 'did not converge' (indefinite), as documented\n", models[mo]));
+      } else {
+        PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=0.34 (%s) traction: nu_eff vs lattice", models[mo], direct ? "lu" : "cg"));
+        if (!rank) PeriTestClose(what, p->results.effective_nu, lnu, 0.02);
+      }
+      PetscCall(PeriProblemDestroy(&p));
+      PetscCall(PeriTestSetOption("-ksp_type", NULL));
+      PetscCall(PeriTestSetOption("-pc_type", NULL));
+    }
+  }
+  /* plane strain towards incompressibility, direct solver: the in-plane Poisson ratio nu/(1-nu) of
+   * the lattice; at 0.499 the lattice locks (nu'_eff 0.93 where elasticity has 0.996, docs/models) */
+  {
+    const char *const nus[] = {"0.3", "0.45", "0.499"};
+    PetscCall(PeriTestSetOption("-model_plane", "strain"));
+    PetscCall(PeriTestSetOption("-ksp_type", "preonly"));
+    PetscCall(PeriTestSetOption("-pc_type", "lu"));
+    for (int k = 0; k < 3; k++) {
+      LatticePlane(LATTICE_PDS_MPPD, PETSC_TRUE, (PetscReal)atof(nus[k]), 3, &lnu, &lE, &lG);
+      PetscCall(Run(dir, "traction", "mppd", nus[k], &p));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "mppd plane strain nu=%s (lu): in-plane nu_eff vs lattice", nus[k]));
+      if (!rank) PeriTestClose(what, p->results.effective_nu, lnu, 0.035);
+      PetscCall(PeriProblemDestroy(&p));
+    }
+    PetscCall(PeriTestSetOption("-model_plane", NULL));
+    PetscCall(PeriTestSetOption("-ksp_type", NULL));
+    PetscCall(PeriTestSetOption("-pc_type", NULL));
+  }
+  /* the horizon from 1.5 to 6 spacings */
+  {
+    const char *const ms[] = {"1.5", "2", "3", "4", "6"};
+    for (int k = 0; k < 5; k++) {
+      Lattice(LATTICE_PDS_MPPD, 0.25, (PetscReal)atof(ms[k]), &lnu, &lE, &lG);
+      PetscCall(PeriTestSetOption("-horizon_m", ms[k]));
+      PetscCall(Run(dir, "traction", "mppd", "0.25", &p));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "mppd nu=0.25 m=%s traction: nu_eff vs lattice", ms[k]));
+      if (!rank) PeriTestClose(what, p->results.effective_nu, lnu, 0.02);
+      PetscCall(PeriProblemDestroy(&p));
+    }
+    PetscCall(PeriTestSetOption("-horizon_m", NULL));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode Run(const char dir[], const char scene[], const char model[], const char nu[], PeriProblem *p)
@@ -137,6 +234,7 @@ int main(int argc, char **argv)
     }
   }
   (void)sigma;
+  PetscCall(Extremes(argv[1]));
   PetscCall(PetscFinalize());
   return 0;
 }

@@ -1,0 +1,26 @@
+/* A scene solved on all ranks of the communicator must give what each rank gets alone: the
+ * strain energy and the largest displacement of every component, to the solver tolerance. */
+#include "testing.h"
+
+int main(int argc, char **argv)
+{
+  PeriProblem p, q;
+  PetscMPIInt size;
+  char        what[128];
+
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_ranks SCENE.yaml [options]");
+  PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
+  PetscCall(PeriTestRunScene(PETSC_COMM_SELF, argv[1], &q));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %d ranks vs 1", p->model->type, size));
+  PeriTestClose(what, p->results.strain_energy, q->results.strain_energy, 1e-8 * q->results.strain_energy);
+  for (PetscInt c = 0; c < p->model->dofs; c++) {
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s| on %d ranks vs 1", p->model->type, p->model->components[c], size));
+    PeriTestClose(what, p->results.max_abs_u[c], q->results.max_abs_u[c], 1e-7 * q->results.max_abs_u[c] + 1e-300);
+  }
+  PetscCall(PeriProblemDestroy(&p));
+  PetscCall(PeriProblemDestroy(&q));
+  PetscCall(PetscFinalize());
+  return 0;
+}
