@@ -193,9 +193,10 @@ struct _p_PeriModel {
   PetscInt           nmeasures;
   const char *const *measure_names;
   PetscBool          allows_surface_correction;
-  const char *const *keys;                   /* the model's own scene keys besides model.type and model.plane, or NULL */
-  PetscBool          inactive[PERI_MAX_DOF]; /* components without stiffness after calibration: held at 0 */
-  char               warning[256];           /* set by calibration; printed once by the problem */
+  const char *const *keys;                     /* the model's own scene keys besides model.type and model.plane, or NULL */
+  PetscBool          inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
+  PetscBool          rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
+  char               warning[256];             /* set by calibration; printed once by the problem */
   PeriMaterial       material;
   PetscReal          delta;
   void              *data;
@@ -267,6 +268,27 @@ typedef struct {
   PetscReal         E, nu; /* elastic constants of the reference; default the material's */
 } PeriReference;
 
+#define PERI_MAX_VTU_MODES 12
+
+/* One natural mode: frequency, accuracy, and what moves. */
+typedef struct {
+  PetscReal f_hz, omega2, residual;
+  PetscReal energy_share[PERI_MAX_DOF]; /* kinetic energy share per component */
+  PetscReal effective_mass[3];          /* per direction, as a fraction of the total mass */
+  char      kind[32];
+} PeriMode;
+
+typedef struct {
+  PetscInt   nmodes, nrigid, nfree_dofs;
+  PeriMode  *modes;
+  PetscReal  total_mass, target_hz;
+  PetscReal  longitudinal_speed, theory_speed; /* free bars only; 0 otherwise */
+  PetscInt   axis;                             /* the structure's main axis */
+  PetscReal *shapes;                           /* rank 0: min(nmodes, PERI_MAX_VTU_MODES) x n x dofs, each scaled to max |u| = 1 */
+  PetscInt   nshapes;
+  PetscReal  factor_s, solve_s;
+} PeriModal;
+
 typedef struct _p_PeriProblem *PeriProblem;
 struct _p_PeriProblem {
   MPI_Comm              comm;
@@ -298,6 +320,7 @@ struct _p_PeriProblem {
   PetscReal            *u_all; /* displacements of all particles (rank 0, after the solve) */
   PeriResults           results;
   PeriReference         reference;
+  PeriModal            *modal; /* modal analysis results, when the scene asks for modes */
   PetscLogDouble        t_start;
 };
 
@@ -332,6 +355,10 @@ PETSC_EXTERN void           PeriReferenceDisplacement(PeriProblem, const PetscRe
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegister(const char[], PetscErrorCode (*)(PeriProblem));
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Static(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Modal(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriAssembleMass(PeriProblem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriWriteModesCSV(PeriProblem, const char[]);
 
 /* output (src/output/) */
 typedef struct _PeriJSON   *PeriJSON;

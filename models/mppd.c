@@ -142,6 +142,7 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->nmeasures          = 3;
   m->measure_names      = measures;
   m->keys               = gerstle ? NULL : mppd_keys;
+  m->rotational[2]      = PETSC_TRUE;
   m->ops.setfromscene   = gerstle ? NULL : SetFromScene;
   m->ops.nu_range       = PeriShearBondNuRange;
   m->ops.calibrate      = Calibrate;

@@ -259,10 +259,10 @@ static void SymmetricEigen(PetscInt n, PetscReal A[PERI_MAX_MODES][PERI_MAX_MODE
 }
 
 /*@C
-  PeriCheckRigidMotion - errors when the constrained DOFs leave a combination of the rigid-body
-  modes free (K would be singular), naming the motion. Collective.
+  PeriRigidMotionFree - how many combinations of the rigid-body modes the constrained DOFs leave
+  free (K is singular when any is), and the main motion of the first, named. Collective.
 @*/
-PetscErrorCode PeriCheckRigidMotion(PeriProblem p)
+PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], size_t len)
 {
   static const char *const names2[] = {"translation along x", "translation along y", "rotation about z"};
   static const char *const names3[] = {"translation along x", "translation along y", "translation along z", "rotation about x", "rotation about y", "rotation about z"};
@@ -282,25 +282,38 @@ PetscErrorCode PeriCheckRigidMotion(PeriProblem p)
       for (PetscInt l = 0; l < nm; l++) G[k][l] += PetscRealPart(a[k][row] * a[l][row]);
   }
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecRestoreArrayRead(modes[k], &a[k]));
+  for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, G, PERI_MAX_MODES * PERI_MAX_MODES, MPIU_REAL, MPI_SUM, p->comm));
   /* G holds sums of squares of unit vectors' entries: a free motion gives an eigenvalue of about
    * round-off; one constrained particle already gives ~1/N */
   SymmetricEigen(nm, G, w, V);
+  *nfree = 0;
+  if (what) what[0] = 0;
   for (PetscInt k = 0; k < nm; k++) {
+    PetscInt best = 0;
     if (w[k] > 1e-12 / p->particles.n) continue;
-    {
-      char     msg[512] = "";
-      PetscInt best     = 0;
-      for (PetscInt l = 0; l < nm; l++)
-        if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
-      if (nm == 3 || nm == 6)
-        PetscCall(PetscSNPrintf(msg, sizeof(msg), "%s", (nm == 3 ? names2 : names3)[best]));
-      else
-        PetscCall(PetscSNPrintf(msg, sizeof(msg), "rigid mode %" PetscInt_FMT, best));
-      for (PetscInt l = 0; l < nm; l++) PetscCall(VecDestroy(&modes[l]));
-      SETERRQ(p->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular. Constrain it in bc (e.g. fix the component on a small region)", p->scene->file, msg);
-    }
+    if ((*nfree)++ || !what) continue;
+    for (PetscInt l = 0; l < nm; l++)
+      if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
+    if (nm == 3 || nm == 6)
+      PetscCall(PetscSNPrintf(what, len, "%s", (nm == 3 ? names2 : names3)[best]));
+    else
+      PetscCall(PetscSNPrintf(what, len, "rigid mode %" PetscInt_FMT, best));
   }
-  for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriCheckRigidMotion - errors when the constrained DOFs leave a rigid-body motion free (K would
+  be singular), naming the motion. Collective.
+@*/
+PetscErrorCode PeriCheckRigidMotion(PeriProblem p)
+{
+  PetscInt nfree;
+  char     what[128];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what)));
+  PetscCheck(!nfree, p->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular. Constrain it in bc (e.g. fix the component on a small region)", p->scene->file, what);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -132,7 +132,7 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PeriScene                s      = p->scene;
   PeriNode                 o;
   char                     base[PETSC_MAX_PATH_LEN], *slash, *dot;
-  static const char *const akeys[] = {"type", NULL};
+  static const char *const akeys[] = {"type", "nev", "target_hz", NULL};
   PeriNode                 a;
 
   PetscFunctionBeginUser;
@@ -317,6 +317,7 @@ PetscErrorCode PeriAnalysisRegisterAll(void)
   if (done) PetscFunctionReturn(PETSC_SUCCESS);
   done = PETSC_TRUE;
   PetscCall(PeriAnalysisRegister("static", PeriAnalysisRun_Static));
+  PetscCall(PeriAnalysisRegister("modal", PeriAnalysisRun_Modal));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -440,6 +441,10 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.vtu", p->output_dir));
     PetscCall(PeriWriteVTU(p, path));
   }
+  if (p->modal) {
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", p->output_dir));
+    PetscCall(PeriWriteModesCSV(p, path));
+  }
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/summary.json", p->output_dir));
   PetscCall(PeriWriteSummary(p, path));
   PetscCall(PetscLogStagePop());
@@ -466,6 +471,11 @@ PetscErrorCode PeriProblemDestroy(PeriProblem *problem)
   PetscCall(PetscFree(p->constrained_value));
   PetscCall(PetscFree(p->W));
   PetscCall(PetscFree(p->u_all));
+  if (p->modal) {
+    PetscCall(PetscFree(p->modal->modes));
+    PetscCall(PetscFree(p->modal->shapes));
+    PetscCall(PetscFree(p->modal));
+  }
   PetscCall(PeriSceneDestroy(&p->scene));
   PetscCall(PetscFree(p));
   *problem = NULL;

@@ -52,7 +52,9 @@ static const PeriSceneKey scene_keys[] = {
     {"reference.nu", "Poisson ratio of the reference solution; default material.nu"},
     {"reference.center", "the point where the reference field has no displacement; default the body centre"},
     {"probes.<name>", "a point [x, y(, z)]: displacement and energy density of the nearest particle"},
-    {"analysis.type", "static"},
+    {"analysis.type", "static | modal"},
+    {"analysis.nev", "modal: number of modes (default 6)"},
+    {"analysis.target_hz", "modal: the modes nearest above this frequency [1/time] (default 0: the lowest)"},
     {"output.dir", "output directory; default <scene name>-out"},
     {"output.vtk", "true | false: write particles.vtu (default true)"},
 };

@@ -40,10 +40,12 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONString(j, "converged_reason", r->converged_reason));
   PetscCall(PeriJSONReal(j, "residual_norm", r->residual_norm));
   PetscCall(PeriJSONEndObject(j));
-  PetscCall(PeriJSONReal(j, "strain_energy", r->strain_energy));
-  PetscCall(PeriJSONBeginObject(j, "max_abs_u"));
-  for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, p->model->components[c], r->max_abs_u[c]));
-  PetscCall(PeriJSONEndObject(j));
+  if (p->u_all) {
+    PetscCall(PeriJSONReal(j, "strain_energy", r->strain_energy));
+    PetscCall(PeriJSONBeginObject(j, "max_abs_u"));
+    for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, p->model->components[c], r->max_abs_u[c]));
+    PetscCall(PeriJSONEndObject(j));
+  }
   if (r->has_reference) {
     PetscCall(PeriJSONBeginObject(j, "reference"));
     PetscCall(PeriJSONString(j, "type", PeriReferenceTypes[p->reference.type]));
@@ -61,8 +63,38 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
     PetscCall(PeriJSONReal(j, "max_rel", r->error_max_rel));
     PetscCall(PeriJSONEndObject(j));
   }
+  if (p->modal) {
+    const PeriModal *md = p->modal;
+    PetscReal        f[256];
+    PetscCall(PeriJSONBeginObject(j, "modal"));
+    for (PetscInt k = 0; k < PetscMin(md->nmodes, 256); k++) f[k] = md->modes[k].f_hz;
+    PetscCall(PeriJSONRealArray(j, "frequencies_hz", PetscMin(md->nmodes, 256), f));
+    PetscCall(PeriJSONInt(j, "rigid_modes", md->nrigid));
+    PetscCall(PeriJSONInt(j, "free_dofs", md->nfree_dofs));
+    PetscCall(PeriJSONReal(j, "total_mass", md->total_mass));
+    PetscCall(PeriJSONString(j, "axis", (const char *[]){"x", "y", "z"}[md->axis]));
+    PetscCall(PeriJSONReal(j, "factorization_s", md->factor_s));
+    PetscCall(PeriJSONReal(j, "eigensolve_s", md->solve_s));
+    if (md->longitudinal_speed > 0) PetscCall(PeriJSONReal(j, "longitudinal_speed", md->longitudinal_speed));
+    if (md->theory_speed > 0) PetscCall(PeriJSONReal(j, "theory_speed", md->theory_speed));
+    PetscCall(PeriJSONBeginArray(j, "modes"));
+    for (PetscInt k = 0; k < md->nmodes; k++) {
+      const PeriMode *m = &md->modes[k];
+      PetscCall(PeriJSONBeginObject(j, NULL));
+      PetscCall(PeriJSONReal(j, "f_hz", m->f_hz));
+      PetscCall(PeriJSONReal(j, "residual", m->residual));
+      PetscCall(PeriJSONString(j, "kind", m->kind));
+      PetscCall(PeriJSONBeginObject(j, "energy_share"));
+      for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, p->model->components[c], m->energy_share[c]));
+      PetscCall(PeriJSONEndObject(j));
+      PetscCall(PeriJSONRealArray(j, "effective_mass", p->particles.dim, m->effective_mass));
+      PetscCall(PeriJSONEndObject(j));
+    }
+    PetscCall(PeriJSONEndArray(j));
+    PetscCall(PeriJSONEndObject(j));
+  }
   PetscCall(PeriJSONBeginObject(j, "probes"));
-  for (PetscInt k = 0; k < p->nprobes; k++) {
+  for (PetscInt k = 0; p->u_all && k < p->nprobes; k++) {
     PeriProbe *pr = &p->probes[k];
     PetscCall(PeriJSONBeginObject(j, pr->name));
     PetscCall(PeriJSONRealArray(j, "x", p->particles.dim, pr->x));

@@ -12,7 +12,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#define VTU_MAX_ARRAYS (8 + PERI_MAX_DOF)
+#define VTU_MAX_ARRAYS (8 + PERI_MAX_DOF * (1 + PERI_MAX_VTU_MODES))
 #define VTK_VERTEX     1
 
 typedef enum {
@@ -114,6 +114,30 @@ static PetscErrorCode VTUDescribe(PeriProblem p, VTUArray a[], PetscInt *na)
     for (c = 0; c < model->dofs; c++) {
       if (c == map[0] || c == map[1] || c == map[2]) continue;
       PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, model->components[c], 1, p->u_all, model->dofs, &c));
+    }
+  }
+  if (p->modal) {
+    /* one array per mode: its displacement vector, and each other component on its own */
+    static char    names[PERI_MAX_VTU_MODES][PERI_MAX_DOF][PERI_NAME_LEN + 16];
+    const PetscInt nd = p->particles.n * model->dofs;
+    for (c = 0; c < model->dofs; c++) {
+      axis = -1;
+      if (!strcmp(model->components[c], "ux"))
+        axis = 0;
+      else if (!strcmp(model->components[c], "uy"))
+        axis = 1;
+      else if (!strcmp(model->components[c], "uz"))
+        axis = 2;
+      if (axis >= 0) map[axis] = c;
+    }
+    for (PetscInt k = 0; k < p->modal->nshapes; k++) {
+      PetscCall(PetscSNPrintf(names[k][0], sizeof(names[k][0]), "mode_%" PetscInt_FMT, k + 1));
+      PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, names[k][0], 3, &p->modal->shapes[k * nd], model->dofs, map));
+      for (c = 0; c < model->dofs; c++) {
+        if (c == map[0] || c == map[1] || c == map[2]) continue;
+        PetscCall(PetscSNPrintf(names[k][c], sizeof(names[k][c]), "mode_%" PetscInt_FMT "_%s", k + 1, model->components[c]));
+        PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, names[k][c], 1, &p->modal->shapes[k * nd], model->dofs, &c));
+      }
     }
   }
   PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "volume", 1, p->particles.volume, 1, NULL));
