@@ -1,5 +1,6 @@
 /* A scene solved on all ranks of the communicator must give what each rank gets alone: the
- * strain energy and the largest displacement of every component, to the solver tolerance. */
+ * strain energy and the largest displacement of every component (static), or the frequencies
+ * (modal), to the solver tolerance. */
 #include "testing.h"
 
 int main(int argc, char **argv)
@@ -13,6 +14,17 @@ int main(int argc, char **argv)
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   PetscCall(PeriTestRunScene(PETSC_COMM_SELF, argv[1], &q));
+  if (p->modal) {
+    /* modes: the frequencies, which the eigensolver converges to 1e-10 */
+    for (PetscInt k = 0; k < p->modal->nmodes; k++) {
+      PetscCall(PetscSNPrintf(what, sizeof(what), "%s: mode %" PetscInt_FMT " frequency on %d ranks vs 1", p->model->type, k + 1, size));
+      PeriTestClose(what, p->modal->modes[k].f_hz, q->modal->modes[k].f_hz, 1e-7 * q->modal->modes[k].f_hz);
+    }
+    PetscCall(PeriProblemDestroy(&p));
+    PetscCall(PeriProblemDestroy(&q));
+    PetscCall(PetscFinalize());
+    return 0;
+  }
   PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %d ranks vs 1", p->model->type, size));
   PeriTestClose(what, p->results.strain_energy, q->results.strain_energy, 1e-8 * q->results.strain_energy);
   for (PetscInt c = 0; c < p->model->dofs; c++) {
