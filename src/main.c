@@ -1,7 +1,7 @@
 /* perilin SCENE.yaml [PETSc options]: run a scene, write summary.json and particles.vtu. */
 #include "perilin.h"
 
-static const char help[] = "perilin: implicit static peridynamics.\n"
+static const char help[] = "perilin: implicit static and modal peridynamics.\n"
                            "Usage: perilin SCENE.yaml [-material_nu 0.25 -model_type npmb ... PETSc options]\n";
 
 /* The first error's message, printed once by main instead of PETSc's traceback. */
@@ -39,7 +39,12 @@ static PetscErrorCode Run(int argc, char **argv)
   PetscCall(PeriProblemWriteOutput(p));
   PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis, p->model->type, p->particles.n, p->results.nbonds_total, p->particles.n * p->model->dofs, p->size));
   PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s), peak memory %.1f MB\n", p->results.neighbors_s, p->results.assembly_s, p->results.solve_s, p->results.ksp_type, p->results.pc_type, p->results.iterations, p->results.converged_reason, p->results.memory_mb));
-  PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", p->results.strain_energy, p->output_dir));
+  if (p->modal) {
+    PetscCall(PetscPrintf(p->comm, "perilin: %" PetscInt_FMT " modes (Hz):", p->modal->nmodes));
+    for (PetscInt k = 0; k < p->modal->nmodes; k++) PetscCall(PetscPrintf(p->comm, " %.6g (%s)", (double)p->modal->modes[k].f_hz, p->modal->modes[k].kind));
+    PetscCall(PetscPrintf(p->comm, "; results in %s/\n", p->output_dir));
+  } else
+    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", p->results.strain_energy, p->output_dir));
   PetscCall(PeriProblemDestroy(&p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -54,7 +54,7 @@ static const PeriSceneKey scene_keys[] = {
     {"probes.<name>", "a point [x, y(, z)]: displacement and energy density of the nearest particle"},
     {"analysis.type", "static | modal"},
     {"analysis.nev", "modal: number of modes (default 6)"},
-    {"analysis.target_hz", "modal: the modes nearest above this frequency [1/time] (default 0: the lowest)"},
+    {"analysis.target_hz", "modal: compute the modes nearest this frequency [1/time] (default 0: the lowest)"},
     {"output.dir", "output directory; default <scene name>-out"},
     {"output.vtk", "true | false: write particles.vtu (default true)"},
 };

@@ -114,12 +114,57 @@ static PetscErrorCode Bar(const char file[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Stability at the extremes: a lamina held by a single particle row, nu -> -1, more modes asked
+ * than there are free DOFs, and a target inside the spectrum. */
+static PetscErrorCode Extremes(const char lamina[], const char tiny[])
+{
+  PeriProblem p, q;
+  char        what[160];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriTestSetOption("-model_type", "mppd"));
+  PetscCall(PeriTestSetOption("-material_nu", "0"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &q));
+  PetscCall(PeriTestSetOption("-regions_base_depth", "0.01"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &p));
+  PetscCall(PeriTestSetOption("-regions_base_depth", NULL));
+  for (int m = 0; m < 3; m++) PetscCheck(p->modal->modes[m].residual < 1e-8, PETSC_COMM_SELF, PETSC_ERR_PLIB, "single-row clamp: mode %d residual %g", m, (double)p->modal->modes[m].residual);
+  PetscCheck(p->modal->modes[0].f_hz < q->modal->modes[0].f_hz && !strcmp(p->modal->modes[0].kind, "flexural"), PETSC_COMM_SELF, PETSC_ERR_PLIB, "a one-row clamp must be softer than a three-row one");
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: one-row clamp: f1 = %.1f Hz < %.1f Hz (three rows), residuals < 1e-8\n", (double)p->modal->modes[0].f_hz, (double)q->modal->modes[0].f_hz));
+  PetscCall(PeriProblemDestroy(&p));
+
+  PetscCall(PeriTestSetOption("-analysis_target_hz", "2330"));
+  PetscCall(PeriTestSetOption("-analysis_nev", "3"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &p));
+  PetscCall(PeriTestSetOption("-analysis_target_hz", NULL));
+  PetscCall(PeriTestSetOption("-analysis_nev", NULL));
+  PetscCheck(p->modal->nmodes == 3, PETSC_COMM_SELF, PETSC_ERR_PLIB, "target 2330 Hz: %" PetscInt_FMT " modes", p->modal->nmodes);
+  PeriTestClose("target 2330 Hz: the axial mode nearest it, vs the run from 0", p->modal->modes[1].f_hz / q->modal->modes[1].f_hz, 1.0, 1e-8);
+  PetscCall(PeriProblemDestroy(&p));
+  PetscCall(PeriProblemDestroy(&q));
+
+  PetscCall(PeriTestSetOption("-material_nu", "-0.99"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &p));
+  for (int m = 0; m < 3; m++) PetscCheck(p->modal->modes[m].residual < 1e-8 && p->modal->modes[m].f_hz > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "nu = -0.99: mode %d residual %g", m, (double)p->modal->modes[m].residual);
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: nu = -0.99: modes at %.1f, %.1f, %.1f Hz with residuals < 1e-8\n", (double)p->modal->modes[0].f_hz, (double)p->modal->modes[1].f_hz, (double)p->modal->modes[2].f_hz));
+  PetscCall(PeriProblemDestroy(&p));
+
+  PetscCall(PeriTestSetOption("-model_type", NULL));
+  PetscCall(PeriTestSetOption("-material_nu", NULL));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, tiny, &p));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "nev 50 on %" PetscInt_FMT " free DOFs: modes returned", p->modal->nfree_dofs));
+  PeriTestClose(what, (PetscReal)p->modal->nmodes, (PetscReal)p->modal->nfree_dofs, 0);
+  PetscCall(PeriProblemDestroy(&p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 int main(int argc, char **argv)
 {
   PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
-  PetscCheck(argc >= 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_modal examples/lamina/modal.yaml examples/pmb/bar_modes.yaml");
+  PetscCheck(argc >= 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_modal examples/lamina/modal.yaml examples/pmb/bar_modes.yaml tests/scenes/tiny_modal.yaml");
   PetscCall(Lamina(argv[1]));
   PetscCall(Bar(argv[2]));
+  PetscCall(Extremes(argv[1], argv[3]));
   PetscCall(PetscFinalize());
   return 0;
 }
