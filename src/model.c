@@ -71,7 +71,7 @@ PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_
 @*/
 PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal delta)
 {
-  static const char *const keys[] = {"E", "nu", "K", "rho", "thickness", NULL};
+  static const char *const keys[] = {"E", "nu", "K", "rho", "rho_by_region", "thickness", NULL};
   PeriNode                 mat, node;
   PetscReal                lo, hi, E = 0, nu = 0, K = 0;
   PetscBool                hasE, hasnu, hasK;

@@ -107,7 +107,10 @@ PetscErrorCode PeriRegionFind(PeriScene scene, PeriNode map, const char key[], P
   char name[PERI_NAME_LEN], list[512] = "";
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetString(scene, map, key, PETSC_TRUE, name, sizeof(name), NULL));
+  if (key)
+    PetscCall(PeriSceneGetString(scene, map, key, PETSC_TRUE, name, sizeof(name), NULL));
+  else
+    PetscCall(PetscStrncpy(name, map->key, sizeof(name))); /* a map entry keyed by the region's name */
   for (PetscInt k = 0; k < nregions; k++) {
     if (!strcmp(regions[k].name, name)) {
       *region = &regions[k];

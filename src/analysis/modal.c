@@ -5,15 +5,40 @@
 #include "perilin.h"
 #include <slepceps.h>
 
+/* The density of each owned particle: material.rho, or material.rho_by_region {region: rho}
+ * (later regions win where they overlap). */
+static PetscErrorCode Densities(PeriProblem p, PetscReal **rho)
+{
+  PeriScene      s    = p->scene;
+  const PetscInt nloc = p->bonds.rend - p->bonds.rstart;
+  PeriNode       mat, map;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(nloc, rho));
+  for (PetscInt i = 0; i < nloc; i++) (*rho)[i] = p->model->material.rho;
+  PetscCall(PeriSceneGetNode(s->root, "material", &mat));
+  PetscCall(PeriSceneGetMap(s, mat, "rho_by_region", PETSC_FALSE, &map));
+  for (PetscInt k = 0; map && k < map->n; k++) {
+    PeriRegion *r;
+    PetscReal   v;
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, p->nregions, p->regions, &r));
+    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &v, NULL));
+    PeriInputCheck(v > 0, s, map, map->child[k]->key, "must be positive");
+    for (PetscInt i = 0; i < nloc; i++)
+      if (PeriRegionContains(r, &p->particles.x[3 * (p->bonds.rstart + i)])) (*rho)[i] = v;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAssembleMass - the lumped mass matrix, diagonal, in the layout of K. Collective.
 @*/
 PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
 {
-  const PetscInt  bs = p->model->dofs, nloc = p->bonds.rend - p->bonds.rstart;
-  const PetscReal rho = p->model->material.rho;
-  Vec             d;
-  PetscScalar    *a;
+  const PetscInt bs = p->model->dofs, nloc = p->bonds.rend - p->bonds.rstart;
+  PetscReal     *rho;
+  Vec            d;
+  PetscScalar   *a;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreate(p->comm, M));
@@ -24,12 +49,14 @@ PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
   PetscCall(MatSeqAIJSetPreallocation(*M, 1, NULL));
   PetscCall(MatMPIAIJSetPreallocation(*M, 1, NULL, 0, NULL));
   PetscCall(PeriProblemCreateVec(p, &d));
+  PetscCall(Densities(p, &rho));
   PetscCall(VecGetArray(d, &a));
   for (PetscInt i = 0; i < nloc; i++) {
     PetscReal V = p->particles.volume[p->bonds.rstart + i], h = p->particles.spacing[p->bonds.rstart + i];
-    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = p->model->rotational[c] ? rho * V * (h * h + h * h) / 12 : rho * V;
+    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = p->model->rotational[c] ? rho[i] * V * (h * h + h * h) / 12 : rho[i] * V;
   }
   PetscCall(VecRestoreArray(d, &a));
+  PetscCall(PetscFree(rho));
   PetscCall(MatDiagonalSet(*M, d, INSERT_VALUES));
   PetscCall(MatAssemblyBegin(*M, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(*M, MAT_FINAL_ASSEMBLY));
@@ -208,7 +235,12 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
   PetscCall(PetscNew(&md));
   p->modal = md;
   /* rotations carry inertia, not mass: the total mass is that of the particles */
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) md->total_mass += p->model->material.rho * p->particles.volume[i];
+  {
+    PetscReal *rho;
+    PetscCall(Densities(p, &rho));
+    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) md->total_mass += rho[i - p->bonds.rstart] * p->particles.volume[i];
+    PetscCall(PetscFree(rho));
+  }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, p->comm));
   md->target_hz = target_hz;
   md->axis      = MainAxis(p);
