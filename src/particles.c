@@ -64,6 +64,7 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
   PetscInt                 cap = 1024, n = 0, lineno = 0;
   PetscReal               *x, *vol, sum              = 0;
   PetscInt                *src;
+  PetscBool                header = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckKeys(scene, node, keys));
@@ -93,15 +94,20 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
       if (*s == ',') s++;
     }
     while (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') s++;
-    if (nf == 0 && n == 0 && lineno == 1) continue; /* header */
+    if (nf == 0 && n == 0 && !header) { /* a header line before the first particle */
+      header = PETSC_TRUE;
+      continue;
+    }
     if (nf < dim + 1 || nf > dim + 2 || *s)
       ierr = PETSC_ERR_USER_INPUT;
     else if (!(v[dim] > 0))
       ierr = PETSC_ERR_USER_INPUT + 1;
+    for (int k = 0; k < nf; k++)
+      if (!PetscIsNormalReal((PetscReal)v[k]) && v[k] != 0) ierr = PETSC_ERR_USER_INPUT + 2;
     if (ierr) {
       fclose(fp);
       PetscCall(PetscFree3(x, vol, src));
-      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%" PetscInt_FMT ": %s (particles.file, referenced from %s)", path, lineno, ierr == PETSC_ERR_USER_INPUT ? (dim == 2 ? "expected x, y, volume[, material]" : "expected x, y, z, volume[, material]") : "the volume must be positive", scene->file);
+      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%" PetscInt_FMT ": %s (particles.file, referenced from %s)", path, lineno, ierr == PETSC_ERR_USER_INPUT ? (dim == 2 ? "expected x, y, volume[, material]" : "expected x, y, z, volume[, material]") : (ierr == PETSC_ERR_USER_INPUT + 1 ? "the volume must be positive" : "every value must be a finite number"), scene->file);
     }
     if (n == cap) {
       PetscReal *x2, *v2;

@@ -141,14 +141,14 @@ analysis's rigid-motion check, `PeriRigidMotionFree`), K_ff is singular. perilin
 `nev` + `nfree` modes and, when the target is 0, shifts to σ = −1e-8 ‖K_ff‖₁/‖M_ff‖₁, just below
 the zero eigenvalues, so the factorization exists. Of the converged eigenvalues in ascending
 order, the lowest ones with |ω²| < 1e-6 ‖K_ff‖₁/‖M_ff‖₁ are counted as rigid (at most `nfree`)
-and skipped: `modal.rigid_modes` says how many. The periodic bar of the table above has 3 (its
-translations: the rotations of a body periodic in y and z are not zero-energy motions). For a
+and skipped: `modal.rigid_modes` says how many (the periodic bar above: its 3 translations; the
+rotations of a body periodic in y and z are not zero-energy motions and are not skipped). For a
 free body, `modal.longitudinal_speed` = 2 L f of the lowest axial/longitudinal mode (L the extent
 along the main axis: half a wave over the length), and in 3D `modal.theory_speed` =
 √((K + 4G/3)/ρ), the uniaxial-strain (P-wave) speed.
 
-**Residual.** For every mode, `residual` = ‖K_ff x − ω² M_ff x‖₂ / (‖K_ff‖₁ ‖x‖₂). The runs above
-give 1e-17 to 1e-14. A mode with ω² ≤ 0 (other than the rigid ones) stops the run: the stiffness
+**Residual.** For every mode, `residual` = ‖K_ff x − ω² M_ff x‖₂ / (‖K_ff‖₁ ‖x‖₂), with x the
+eigenvector on the free DOFs as SLEPc returns it. A mode with ω² ≤ 0 (other than the rigid ones) stops the run: the stiffness
 is indefinite (a Poisson ratio above the bond-based value, where the shear springs are negative).
 
 **Kinds.** Each mode is labelled from the mass it moves. The effective mass along direction d is
@@ -165,9 +165,7 @@ per component.
 
 For a structure symmetric about its axis the effective masses separate the symmetric
 ("axial") and antisymmetric ("flexural") families exactly; the energy-share fallback does not
-follow that split (in the gerstle ν = 0 lamina, mode 4 at 3945 Hz has effective masses 1e-31
-across and 4e-6 along the axis, a symmetric mode, and is labelled flexural). The tables above only
-use modes with large effective masses.
+follow that split (see the notes under the tables for an example).
 
 **Main axis** (`modal.axis`). With constraints: for every prescribed DOF take its particle's
 offset from the centre of the bounding box; average per axis; divide by the body's extent along
@@ -269,13 +267,41 @@ def generate(tmp):
       "and is labelled `axial`, so the `flexural` rule picks the next antisymmetric mode instead."
       % (pdsm[0]["f_hz"], third["f_hz"], third["effective_mass"][1], 100 * third["energy_share"]["ux"]))
     w("- **pds** reproduces the paper's failure: its flexural modes are far too stiff for ν ≠ 1/3, "
-      "because its shear springs resist rigid rotations of the bonds.")
-    w("- **mppd** (default k_θ factor 1) is within 2.5 % of FEM for f_I and f_II at every ν.")
-    w("- **gerstle** is mppd with Gerstle's shear and rotational springs (k_t = 12 d/|ξ|², "
-      "k_θ = d/|ξ|, d = g δ²/36). Its discrete lattice is softer in shear than the continuum "
-      "calibration below ν = 0.25, so its frequencies are lower there (see docs/models/).")
+      "because its shear springs also resist rigid rotations of the bonds.")
+    for m in ["mppd", "gerstle"]:
+        worst = {}
+        for key, _, _, kind, idx in TABLES:
+            for nu in NUS:
+                mode = pick(res[m, nu], kind, idx)
+                if mode is not None:
+                    e = 100 * (mode["f_hz"] / float(PAPER[key][nu][0]) - 1)
+                    if key not in worst or abs(e) > abs(worst[key][0]):
+                        worst[key] = (e, nu)
+        w("- **%s**: the largest deviations from FEM are %s." % (m, ", ".join(
+            "%+.1f %% (f_%s, ν = %s)" % (worst[k][0], k, worst[k][1]) for k in ["I", "II", "III"] if k in worst)))
+    w("- **gerstle** is the micropolar bond with Gerstle's springs (k_t = 12 d/|ξ|², k_θ = d/|ξ|, "
+      "d = g δ²/36) instead of mppd's (k_t = g, k_θ = c δ²/(36 |ξ|)); below ν = 0.25 its "
+      "frequencies fall below mppd's and the FEM column (docs/models/).")
     w("- **ν = 1/3**: the shear springs vanish, θ is held at 0 (mppd, gerstle) and the three models "
       "are the same central-force lattice: identical frequencies.")
+    # a mode that moves (almost) no net mass is labelled by its energy shares: an example
+    for m in MODELS:
+        for nu in NUS:
+            for k, mode in enumerate(res[m, nu]):
+                em = mode["effective_mass"]
+                if max(em) < 1e-3 and em[1] > 100 * em[0]:
+                    w("- **Labels of modes that move little net mass.** %s, ν = %s, mode %d (%.1f Hz): "
+                      "effective mass %.1e along the axis and %.1e across it, so it is symmetric about the "
+                      "axis like the axial modes; both are below 1e-3, so the energy-share rule labels it "
+                      "`%s` (%.0f %% of its kinetic energy in uy)."
+                      % (m, nu, k + 1, mode["f_hz"], em[1], em[0], mode["kind"], 100 * mode["energy_share"]["uy"]))
+                    break
+            else:
+                continue
+            break
+        else:
+            continue
+        break
     w("")
     w("## The free bar: longitudinal sound speed (Ganzenmueller et al. sec. 3.1.2)")
     w("")
