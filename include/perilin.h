@@ -180,7 +180,7 @@ typedef struct {
   void (*bond_measures)(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
   /* Values of the rigid-body (zero-energy) modes at a point, nmodes x dofs; returns nmodes. */
   PetscInt (*rigid_modes)(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
-  PetscErrorCode (*destroy)(PeriModel);
+  PetscErrorCode (*destroy)(PeriModel); /* frees what data points to; data itself is freed after; may be NULL */
 } PeriModelOps;
 
 struct _p_PeriModel {
@@ -217,6 +217,7 @@ PETSC_EXTERN void           PeriPlaneMicromoduli(PeriModel, PetscReal *, PetscRe
 PETSC_EXTERN void           PeriShearBondNuRange(PeriModel, PetscReal *, PetscReal *);
 PETSC_EXTERN void           PeriBondStretch(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
 PETSC_EXTERN void           PeriBondBasedNuRange(PeriModel, PetscReal *, PetscReal *);
+PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);
 PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
 PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
 

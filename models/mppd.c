@@ -119,13 +119,6 @@ static PetscInt RigidModes(PeriModel m, const PetscReal X[], PetscReal modes[][P
   return 3;
 }
 
-static PetscErrorCode Destroy(PeriModel m)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFree(m->data));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
 {
   MPPD *mp;
@@ -149,7 +142,6 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->ops.bond_stiffness = BondStiffness;
   m->ops.bond_measures  = BondMeasures;
   m->ops.rigid_modes    = RigidModes;
-  m->ops.destroy        = Destroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -10,9 +10,6 @@ typedef struct {
   PetscReal *c; /* per particle (global index) */
 } NPMB;
 
-static const char *const components2[] = {"ux", "uy"}, *const components3[] = {"ux", "uy", "uz"};
-static const char *const measures[] = {"stretch"};
-
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {
   NPMB     *np = (NPMB *)m->data;
@@ -39,11 +36,8 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 
 static PetscErrorCode Destroy(PeriModel m)
 {
-  NPMB *np = (NPMB *)m->data;
-
   PetscFunctionBeginUser;
-  PetscCall(PetscFree(np->c));
-  PetscCall(PetscFree(m->data));
+  PetscCall(PetscFree(((NPMB *)m->data)->c));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -53,18 +47,12 @@ PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&np));
-  m->data          = np;
-  m->dofs          = m->dim;
-  m->components    = m->dim == 2 ? components2 : components3;
-  m->nmeasures     = 1;
-  m->measure_names = measures;
+  m->data = np;
+  PeriModelSetCentralForce(m);
   /* the per-particle normalization already corrects surfaces; the volume method would count twice */
   m->allows_surface_correction = PETSC_FALSE;
-  m->ops.nu_range              = PeriBondBasedNuRange;
   m->ops.calibrate             = Calibrate;
   m->ops.bond_stiffness        = BondStiffness;
-  m->ops.bond_measures         = PeriBondStretch;
-  m->ops.rigid_modes           = PeriTranslationalRigidModes;
   m->ops.destroy               = Destroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

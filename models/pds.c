@@ -59,13 +59,6 @@ static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal
   }
 }
 
-static PetscErrorCode Destroy(PeriModel m)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFree(m->data));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 PetscErrorCode PeriModelCreate_PDS(PeriModel m)
 {
   PDS *pds;
@@ -84,6 +77,5 @@ PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   m->ops.bond_measures  = BondMeasures;
   /* the rotation is not a zero-energy mode for g != 0, but it is the near-null space AMG wants */
   m->ops.rigid_modes = PeriTranslationalRigidModes;
-  m->ops.destroy     = Destroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -8,9 +8,6 @@ typedef struct {
   PetscReal c;
 } PMB;
 
-static const char *const components2[] = {"ux", "uy"}, *const components3[] = {"ux", "uy", "uz"};
-static const char *const measures[] = {"stretch"};
-
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {
   PMB *pmb = (PMB *)m->data;
@@ -28,29 +25,15 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
   PeriCentralBondBlock(m, b, pmb->c * b->Vi * b->Vj * b->weight / b->length, Ke);
 }
 
-static PetscErrorCode Destroy(PeriModel m)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFree(m->data));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 PetscErrorCode PeriModelCreate_PMB(PeriModel m)
 {
   PMB *pmb;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&pmb));
-  m->data               = pmb;
-  m->dofs               = m->dim;
-  m->components         = m->dim == 2 ? components2 : components3;
-  m->nmeasures          = 1;
-  m->measure_names      = measures;
-  m->ops.nu_range       = PeriBondBasedNuRange;
+  m->data = pmb;
+  PeriModelSetCentralForce(m);
   m->ops.calibrate      = Calibrate;
   m->ops.bond_stiffness = BondStiffness;
-  m->ops.bond_measures  = PeriBondStretch;
-  m->ops.rigid_modes    = PeriTranslationalRigidModes;
-  m->ops.destroy        = Destroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

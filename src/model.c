@@ -119,6 +119,7 @@ PetscErrorCode PeriModelDestroy(PeriModel *m)
   PetscFunctionBeginUser;
   if (!*m) PetscFunctionReturn(PETSC_SUCCESS);
   if ((*m)->ops.destroy) PetscCall((*m)->ops.destroy(*m));
+  PetscCall(PetscFree((*m)->data));
   PetscCall(PetscFree(*m));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -211,6 +212,21 @@ void PeriBondStretch(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[
 void PeriBondBasedNuRange(PeriModel m, PetscReal *lo, PetscReal *hi)
 {
   *lo = *hi = (m->dim == 2 && !m->plane_strain) ? 1.0 / 3.0 : 0.25;
+}
+
+/* The common part of central-force (bond-based) models: the dim displacements as DOFs, the
+ * stretch as measure, the one bond-based Poisson ratio, translations and rotations as rigid modes. */
+void PeriModelSetCentralForce(PeriModel m)
+{
+  static const char *const components2[] = {"ux", "uy"}, *const components3[] = {"ux", "uy", "uz"};
+  static const char *const measures[] = {"stretch"};
+  m->dofs                             = m->dim;
+  m->components                       = m->dim == 2 ? components2 : components3;
+  m->nmeasures                        = 1;
+  m->measure_names                    = measures;
+  m->ops.nu_range                     = PeriBondBasedNuRange;
+  m->ops.bond_measures                = PeriBondStretch;
+  m->ops.rigid_modes                  = PeriTranslationalRigidModes;
 }
 
 /* Translations, and rotations u = w x X, of models whose DOFs are the dim displacements. */

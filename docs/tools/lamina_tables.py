@@ -295,10 +295,14 @@ def main():
     if len(sys.argv) > 1:
         dest = os.path.abspath(sys.argv[1])
         fd, part = tempfile.mkstemp(prefix=".lamina_tables_", suffix=".md", dir=os.path.dirname(dest))
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.chmod(part, 0o644)
-        os.replace(part, dest)
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write(text)
+            os.chmod(part, 0o644)
+            os.replace(part, dest)
+        except BaseException:
+            os.unlink(part)
+            raise
     else:
         sys.stdout.write(text)
 

@@ -117,7 +117,7 @@ static PetscErrorCode Extremes(const char dir[])
     }
   }
   /* plane strain towards incompressibility, direct solver: the in-plane Poisson ratio nu/(1-nu) of
-   * the lattice; at 0.499 the lattice locks (nu'_eff 0.93 where elasticity has 0.996, docs/models) */
+   * the lattice; at 0.499 the lattice locks (its nu' is 0.93 where elasticity has 0.996; the plate gives 0.89) */
   {
     const char *const nus[] = {"0.3", "0.45", "0.499"};
     PetscCall(PeriTestSetOption("-model_plane", "strain"));

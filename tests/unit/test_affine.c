@@ -1,6 +1,7 @@
-/* An affine displacement u = A X + b produces zero internal force K u on every particle whose
- * horizon (and its neighbours' horizons, on which npmb's c_ij and the surface factors depend) lies
- * inside the body. Run with a scene and -model_type. */
+/* An affine displacement u = A X + b (with the microrotation theta = the field's rotation for
+ * micropolar models) produces zero internal force K u on every particle whose horizon (and its
+ * neighbours' horizons, on which npmb's c_ij and the surface factors depend) lies inside the body.
+ * Run with a scene and -model_type. */
 #include "testing.h"
 
 static PetscErrorCode CheckAffine(const char file[])
@@ -25,6 +26,8 @@ static PetscErrorCode CheckAffine(const char file[])
       PetscReal v = b[c];
       for (PetscInt d = 0; d < p->particles.dim; d++) v += A[c][d] * p->particles.x[3 * i + d];
       a[(i - p->bonds.rstart) * p->model->dofs + c] = v;
+      /* micropolar models: the particles turn with the field's rotation */
+      if (p->model->dofs == 3 && p->particles.dim == 2) a[(i - p->bonds.rstart) * 3 + 2] = 0.5 * (A[1][0] - A[0][1]);
     }
   PetscCall(VecRestoreArray(u, &a));
   PetscCall(MatMult(p->K, u, f));
