@@ -245,6 +245,7 @@ typedef struct {
   PetscReal strain_energy;
   PetscReal max_abs_u[PERI_MAX_DOF];
   PetscInt  nbonds_total;
+  PetscInt  edge_cut; /* bonds between particles of different ranks */
   /* against the scene's reference field (src/reference.c) */
   PetscBool has_reference;
   PetscInt  interior_particles;

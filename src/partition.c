@@ -1,9 +1,12 @@
-/* Partitioning: METIS k-way on the bond graph, on rank 0, broadcast; particles are then renumbered
- * so that each rank owns a contiguous range (PETSc's row ownership). */
+/* Partitioning: METIS k-way on rank 0, broadcast; particles are then renumbered so that each rank
+ * owns a contiguous range (PETSc's row ownership). METIS sees the nearest-neighbour graph (bonds up
+ * to 1.5 spacings): a horizon of m spacings only adds edges between particles that graph already
+ * links through short paths, so it gives the same parts for a fraction of the graph size and search
+ * time (docs/performance.md measures both). */
 #include "perilin.h"
 #include <metis.h>
 
-static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PetscMPIInt nparts, PetscInt part[], PetscInt *edgecut)
+static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, PetscMPIInt nparts, PetscInt part[], PetscInt *edgecut)
 {
   PeriBonds g;
   idx_t    *xadj, *adjncy, *where, nv = (idx_t)p->n, ncon = 1, np = nparts, objval = 0, options[METIS_NOPTIONS];
@@ -11,7 +14,7 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal delta, Pe
   int       status;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriNeighborSearch(p, delta, pv, 0, p->n, PETSC_FALSE, &g));
+  PetscCall(PeriNeighborSearch(p, radius, PERI_PARTIAL_VOLUME_NONE, 0, p->n, PETSC_FALSE, &g));
   PetscCall(PetscMalloc3(p->n + 1, &xadj, g.nbonds, &adjncy, p->n, &where));
   /* METIS wants each edge once per direction: drop repeated periodic images of a pair */
   xadj[0] = 0;
@@ -56,7 +59,10 @@ PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal de
   *edgecut = 0;
   if (size > 1) {
     PetscCheck(p->n >= size, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " particles cannot be shared by %d ranks", p->n, size);
-    if (rank == 0) PetscCall(MetisPartition(p, delta, pv, size, part, edgecut));
+    PetscReal hmax = 0;
+    for (PetscInt i = 0; i < p->n; i++) hmax = PetscMax(hmax, p->spacing[i]);
+    (void)pv;
+    if (rank == 0) PetscCall(MetisPartition(p, PetscMin(delta, 1.5 * hmax), size, part, edgecut));
     PetscCallMPI(MPI_Bcast(part, (PetscMPIInt)p->n, MPIU_INT, 0, comm));
     PetscCallMPI(MPI_Bcast(edgecut, 1, MPIU_INT, 0, comm));
   }

@@ -238,6 +238,11 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PetscTime(&t1));
   p->results.neighbors_s = t1 - t0;
   PetscCallMPI(MPI_Allreduce(&p->bonds.nbonds, &p->results.nbonds_total, 1, MPIU_INT, MPI_SUM, p->comm));
+  {
+    PetscInt cut = 0;
+    for (PetscInt k = 0; k < p->bonds.nbonds; k++) cut += p->owner[p->bonds.j[k]] != p->rank;
+    PetscCallMPI(MPI_Allreduce(&cut, &p->results.edge_cut, 1, MPIU_INT, MPI_SUM, p->comm));
+  }
   PetscCall(PetscFree(perm));
   PetscCall(PetscFree(range));
   (void)edgecut;

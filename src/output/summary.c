@@ -16,6 +16,7 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONInt(j, "bonds", r->nbonds_total));
   PetscCall(PeriJSONInt(j, "dofs", p->particles.n * bs));
   PetscCall(PeriJSONInt(j, "ranks", p->size));
+  PetscCall(PeriJSONInt(j, "edge_cut", r->edge_cut));
   PetscCall(PeriJSONReal(j, "horizon", p->delta));
   PetscCall(PeriJSONString(j, "partial_volume", PeriPartialVolumes[p->partial_volume]));
   PetscCall(PeriJSONString(j, "surface_correction", PeriSurfaceCorrections[p->surface]));
