@@ -95,6 +95,13 @@ static PetscErrorCode ReadCorrections(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscBool LexLess(const PetscReal a[], const PetscReal b[])
+{
+  for (PetscInt d = 0; d < 3; d++)
+    if (a[d] != b[d]) return a[d] < b[d] ? PETSC_TRUE : PETSC_FALSE;
+  return PETSC_FALSE;
+}
+
 static PetscErrorCode ReadProbes(PeriProblem p)
 {
   PeriScene            s = p->scene;
@@ -115,7 +122,8 @@ static PetscErrorCode ReadProbes(PeriProblem p)
     for (PetscInt i = 0; i < pt->n; i++) {
       PetscReal d2 = 0;
       for (PetscInt d = 0; d < pt->dim; d++) d2 += PetscSqr(pt->x[3 * i + d] - pr->x[d]);
-      if (d2 < best) {
+      /* ties go to the lexicographically smallest position, whatever the numbering (ranks) */
+      if (d2 < best || (d2 == best && LexLess(&pt->x[3 * i], &pt->x[3 * pr->particle]))) {
         best         = d2;
         pr->particle = i;
       }
@@ -258,6 +266,9 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(ReadProbes(p));
   PetscCall(PeriReferenceSetUp(p));
   PetscCall(PeriBoundarySetUp(p));
+  /* the loads too, so that a bad load is reported before any solve */
+  PetscCall(PeriProblemCreateVec(p, &p->f));
+  PetscCall(PeriLoadsAssemble(p, p->f));
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -8,7 +8,7 @@
 #include <libgen.h>
 
 /* The documented scalar keys: `perilin -help` lists them, and an option naming one that the
- * file lacks adds it (so -horizon_m 4 works on a scene that gives horizon.delta). */
+ * file lacks adds it (so -model_plane strain works on a scene that does not name the plane). */
 typedef struct {
   const char *path, *meaning;
 } PeriSceneKey;
@@ -202,10 +202,31 @@ static void OptionName(const char path[], char opt[], size_t len)
   opt[k] = 0;
 }
 
-/* Every scalar whose option -path_joined_by_underscores is set takes the option's value. */
+/* Every scalar whose option -path_joined_by_underscores is set takes the option's value; a list of
+ * scalars takes a comma-separated one (-grid_upper 1,0.5). */
 static PetscErrorCode ApplyOptions(PeriNode node)
 {
   PetscFunctionBeginUser;
+  if (node->kind == PERI_NODE_SEQ && node->n > 0 && node->child[0]->kind == PERI_NODE_SCALAR) {
+    char      opt[512], val[PETSC_MAX_PATH_LEN], *tok, *save;
+    PetscBool set;
+    OptionName(node->path, opt, sizeof(opt));
+    PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
+    if (set) {
+      for (PetscInt k = 0; k < node->n; k++) PetscCall(NodeDestroy(&node->child[k]));
+      node->n = 0;
+      for (tok = strtok_r(val, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
+        PeriNode item;
+        char     idx[32];
+        PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, node->n));
+        PetscCall(NodeCreate(PERI_NODE_SCALAR, idx, node->path, 0, &item));
+        PetscCall(PetscStrallocpy(tok, &item->value));
+        PetscCall(NodeAppend(node, item));
+      }
+      node->line = 0;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+  }
   if (node->kind == PERI_NODE_SCALAR) {
     char      opt[512], val[PETSC_MAX_PATH_LEN];
     PetscBool set;
@@ -526,7 +547,7 @@ PetscErrorCode PeriSceneParseRealArray(PeriScene scene, PeriNode node, PetscInt 
 {
   PetscFunctionBeginUser;
   PeriInputCheck(node->kind == PERI_NODE_SEQ, scene, node, NULL, "must be a list of %" PetscInt_FMT " numbers, e.g. [0, 1]", nmax);
-  PeriInputCheck(node->n >= nmin && node->n <= nmax, scene, node, NULL, "must have %" PetscInt_FMT " to %" PetscInt_FMT " entries, got %" PetscInt_FMT, nmin, nmax, node->n);
+  PeriInputCheck(node->n >= nmin && node->n <= nmax, scene, node, NULL, "must have %" PetscInt_FMT "%s entries, got %" PetscInt_FMT, nmax, nmin == nmax ? "" : " or fewer", node->n);
   for (PetscInt k = 0; k < node->n; k++) {
     PeriInputCheck(node->child[k]->kind == PERI_NODE_SCALAR, scene, node->child[k], NULL, "must be a number");
     PetscCall(PeriSceneParseReal(scene, node->child[k], &v[k]));

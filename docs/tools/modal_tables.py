@@ -121,9 +121,9 @@ f = ω / 2π.
 so the rotational inertia is ρ Vᵢ hᵢ²/6. Vᵢ includes the thickness in 2D. This is Diana &
 Casolo's J = M r² with r² = (Δx² + Δy²)/12, the radius of gyration of a square cell about its
 centre: the paper prints `r_i = 1/12(Δx² + Δy²)`, which is r², not r. The model says which
-components are rotations (`rotational[]` in `PeriModel`). `material.rho` is required (> 0). M is
-assembled only by the modal analysis. `modal.total_mass` = Σ ρ Vᵢ (the rotations carry inertia,
-not mass).
+components are rotations (`rotational[]` in `PeriModel`). ρ is `material.rho` (required, > 0),
+or on the particles of a region the value `material.rho_by_region` gives it. M is assembled only
+by the modal analysis. `modal.total_mass` = Σ ρᵢ Vᵢ (the rotations carry inertia, not mass).
 
 **Constrained DOFs are removed.** The prescribed DOFs (bc, and a θ held at 0, see below) are
 dropped: the eigenproblem is posed on the free-DOF submatrices K_ff and M_ff

@@ -74,9 +74,7 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(VecDestroy(&p->u));
-  PetscCall(VecDestroy(&p->f));
-  PetscCall(MatCreateVecs(p->K, &p->u, &p->f));
-  PetscCall(PeriLoadsAssemble(p, p->f));
+  PetscCall(MatCreateVecs(p->K, &p->u, NULL));
   PetscCall(PeriSetNearNullSpace(p, p->K));
   PetscCall(VecSetValues(p->u, p->nconstrained, p->constrained, p->constrained_value, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(p->u));
