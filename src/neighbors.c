@@ -155,6 +155,12 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
   for (PetscInt k = 0; k < p->n; k++) hmax = PetscMax(hmax, p->spacing[k]);
   r = PeriSearchRadius(pv, delta, hmax);
   PetscCall(CellListCreate(p, r, &cl));
+  {
+    /* reserve what a full horizon holds, so the arrays are rarely copied while they grow */
+    PetscReal vmean = 0, ball = p->dim == 2 ? PETSC_PI * r * r * p->thickness : 4.0 / 3.0 * PETSC_PI * r * r * r;
+    for (PetscInt k = 0; k < p->n; k++) vmean += p->volume[k] / p->n;
+    PetscCall(BondsReserve(b, (PetscInt)(1.05 * (rend - rstart) * ball / vmean / (half ? 2 : 1)) + 16, &cap));
+  }
   b->rstart = rstart;
   b->rend   = rend;
   PetscCall(PetscMalloc1(rend - rstart + 1, &b->offset));
