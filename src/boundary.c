@@ -140,7 +140,7 @@ PetscErrorCode PeriBoundarySetUp(PeriProblem p)
   for (PetscInt k = 0; bc && k < bc->n; k++) PetscCall(ApplyCondition(p, bc->child[k], value, set));
   for (PetscInt c = 0; c < bs; c++) {
     if (!p->model->inactive[c]) continue;
-    PetscCall(PetscPrintf(p->comm, "perilin: note: %s has no stiffness in model %s at nu = %g (no shear springs): it is held at 0\n", p->model->components[c], p->model->type, (double)p->model->material.nu));
+    PetscCall(PetscPrintf(p->comm, "perilin: note: in model %s at nu = %g the shear springs vanish and %s no longer acts on the displacements: it is held at 0\n", p->model->type, (double)p->model->material.nu, p->model->components[c]));
     for (PetscInt i = 0; i < nloc / bs; i++) {
       value[i * bs + c] = 0;
       set[i * bs + c]   = PETSC_TRUE;

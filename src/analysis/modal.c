@@ -65,26 +65,29 @@ PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
 }
 
 /* The structure's main axis: away from its constraints (a cantilever's length), or, for a free
- * body, its longest extent. */
-static PetscInt MainAxis(PeriProblem p)
+ * body, its longest extent. Components held at 0 because they are inactive do not count. */
+static PetscErrorCode MainAxis(PeriProblem p, PetscInt *axis)
 {
   const PeriParticles *pt   = &p->particles;
-  PetscReal            s[3] = {0, 0, 0}, best = -1, cnt = p->nconstrained, tmp[4];
-  PetscInt             axis = 0;
+  PetscReal            s[4] = {0, 0, 0, 0}, best = -1;
+
+  PetscFunctionBeginUser;
   for (PetscInt k = 0; k < p->nconstrained; k++) {
     PetscInt i = p->constrained[k] / p->model->dofs;
+    if (p->model->inactive[p->constrained[k] % p->model->dofs]) continue;
     for (PetscInt d = 0; d < pt->dim; d++) s[d] += pt->x[3 * i + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
+    s[3] += 1;
   }
-  tmp[0] = s[0], tmp[1] = s[1], tmp[2] = s[2], tmp[3] = cnt;
-  MPI_Allreduce(MPI_IN_PLACE, tmp, 4, MPIU_REAL, MPI_SUM, p->comm);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, s, 4, MPIU_REAL, MPI_SUM, p->comm));
+  *axis = 0;
   for (PetscInt d = 0; d < pt->dim; d++) {
-    PetscReal v = tmp[3] > 0 ? PetscAbsReal(tmp[d] / tmp[3]) / (pt->upper[d] - pt->lower[d]) : pt->upper[d] - pt->lower[d];
+    PetscReal v = s[3] > 0 ? PetscAbsReal(s[d] / s[3]) / (pt->upper[d] - pt->lower[d]) : pt->upper[d] - pt->lower[d];
     if (v > best) {
-      best = v;
-      axis = d;
+      best  = v;
+      *axis = d;
     }
   }
-  return axis;
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode ReadSettings(PeriProblem p, PetscInt *nev, PetscReal *target_hz)
@@ -192,8 +195,12 @@ static PetscErrorCode StoreShape(PeriProblem p, Vec full, PetscInt k)
   PetscCall(VecScatterEnd(sc, full, all, INSERT_VALUES, SCATTER_FORWARD));
   if (p->rank == 0) {
     PetscReal amax = 0, *s = &p->modal->shapes[k * nd];
+    PetscBool trans = PETSC_FALSE;
+    for (PetscInt c = 0; c < p->model->dofs; c++) trans = (PetscBool)(trans || !p->model->rotational[c]);
     PetscCall(VecGetArrayRead(all, &a));
-    for (PetscInt i = 0; i < nd; i++) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
+    /* the largest displacement is 1 (rotations, in radians, do not set the scale) */
+    for (PetscInt i = 0; i < nd; i++)
+      if (!trans || !p->model->rotational[i % p->model->dofs]) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
     for (PetscInt i = 0; i < nd; i++) s[i] = PetscRealPart(a[i]) / (amax > 0 ? amax : 1);
     PetscCall(VecRestoreArrayRead(all, &a));
   }
@@ -243,7 +250,7 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, p->comm));
   md->target_hz = target_hz;
-  md->axis      = MainAxis(p);
+  PetscCall(MainAxis(p, &md->axis));
 
   PetscCall(FreeDOFs(p, &isfree));
   PetscCall(ISGetSize(isfree, &md->nfree_dofs));
@@ -354,9 +361,12 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
     PetscCall(PCGetType(pc, &pt));
     PetscCall(PetscStrncpy(p->results.ksp_type, kt, sizeof(p->results.ksp_type)));
     PetscCall(PetscStrncpy(p->results.pc_type, pt, sizeof(p->results.pc_type)));
-    PetscCall(PetscStrncpy(p->results.converged_reason, nconv >= nreq ? "EPS_CONVERGED" : "EPS_PARTIAL", sizeof(p->results.converged_reason)));
+    PetscInt asked;
+    PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
+    PetscCall(PetscStrncpy(p->results.converged_reason, nconv >= asked ? "EPS_CONVERGED" : "EPS_PARTIAL", sizeof(p->results.converged_reason)));
     PetscCall(EPSGetIterationNumber(eps, &p->results.iterations));
   }
+  md->nshapes = PetscMin(md->nmodes, md->nshapes); /* only converged modes go to particles.vtu */
   PetscCheck(md->nmodes > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", p->scene->file, md->nrigid);
   if (md->nmodes < nev) PetscCall(PetscPrintf(p->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
   PetscCall(PetscFree2(lam, order));
