@@ -170,30 +170,33 @@ follow that split (see the notes under the tables for an example).
 **Main axis** (`modal.axis`). With constraints: for every prescribed DOF take its particle's
 offset from the centre of the bounding box; average per axis; divide by the body's extent along
 the axis; the axis with the largest |mean offset|/extent is the main axis (a cantilever clamped
-at y− gets y). Without constraints: the axis of the largest extent.
+at y− gets y). Without prescribed DOFs: the axis of the largest extent. Components held at 0
+because they are inactive (θ at the bond-based ν) do not count as prescribed.
 
 **θ held at 0.** At the bond-based Poisson ratio (1/3 plane stress, 1/4 plane strain) mppd and
 gerstle have no shear springs and θ no longer acts on the displacements; perilin then prescribes
-θ = 0 everywhere and prints `perilin: note: theta has no stiffness in model M at nu = ...: it is
-held at 0`. Those θ DOFs are removed like any prescribed DOF, which is why the three models
+θ = 0 everywhere and prints `perilin: note: in model mppd at nu = 0.333333 the shear springs vanish
+and theta no longer acts on the displacements: it is held at 0`. Those θ DOFs are removed like any prescribed DOF, which is why the three models
 coincide at ν = 1/3 in the tables.
 
 **Output.** `summary.json` gets a `modal` section ([summary.md](summary.md)), `modes.csv` one row
 per mode (`mode, f_hz, omega2, residual, kind, share_<component>..., meff_x, meff_y, meff_z`),
-and `particles.vtu` the shapes of the first min(nev, 12) modes: `mode_K` (the translations, 3
+and `particles.vtu` the shapes of the first min(converged modes, 12) modes: `mode_K` (the translations, 3
 components) and `mode_K_<component>` for each other component (`mode_K_theta`). Each shape is
-scaled so that its largest entry over all components, θ included, is 1 in absolute value.
+scaled so that its largest displacement component is 1 in absolute value (θ does not set the scale).
 
 **Options that matter.** Every `-eps_*` and `-st_*` option is applied after perilin's defaults
 (`EPSSetFromOptions`):
 - `-eps_tol` (default here 1e-10), `-eps_ncv` (subspace size; raise it when few modes converge),
-  `-eps_max_it`; the number of modes is `analysis.nev` (`-analysis_nev`), not `-eps_nev`
-  (which `-eps_*` processing would also honour, but then the summary reports at most
-  `analysis.nev` modes);
+  `-eps_max_it`. The number of modes is `analysis.nev` (`-analysis_nev`). `-eps_nev` replaces
+  the number of pairs perilin asks SLEPc for (`nev` + the rigid-body modes) but not the number
+  reported: `-eps_nev 2` on the lamina returns 3 of the 6 modes, with a warning and
+  `EPS_PARTIAL`; a larger `-eps_nev` only costs time;
+- `-st_pc_factor_mat_solver_type petsc` (PETSc's own Cholesky) works on one rank only; on
+  several ranks SLEPc stops with "in parallel runs you need to select an external package";
 - `-st_type` (default `sinvert`);
 - `-st_ksp_type` (default `preonly`), `-st_pc_type` (default `cholesky`),
-  `-st_pc_factor_mat_solver_type` (default `mumps` when available; `petsc` is serial only).
-  An iterative inner solve (`-st_ksp_type cg -st_pc_type gamg -st_ksp_rtol 1e-12`) is possible
+  `-st_pc_factor_mat_solver_type` (default `mumps` when available). An iterative inner solve (`-st_ksp_type cg -st_pc_type gamg -st_ksp_rtol 1e-12`) is possible
   but must be far more accurate than the eigenvalue tolerance; see the performance section.
 - `-eps_view` prints what was used.
 """
@@ -231,7 +234,7 @@ def generate(tmp):
     w("")
     w("Our modes are taken from `modal.modes` of `summary.json` in ascending frequency: f_I is the "
       "first mode of kind `flexural`, f_II the first `axial`, f_III the second `flexural`. "
-      "Errors are ours vs the paper's FEM column, signed, in %; the paper prints their magnitude. "
+      "Errors are ours vs the paper's FEM column, signed, in %%; the paper prints their magnitude. "
       "The paper's PDS and MPPD columns are its own peridynamic results. The largest residual of "
       "the %d modes computed in these runs is %.1e." % (6 * len(res), maxres))
     w("")
@@ -253,7 +256,8 @@ def generate(tmp):
         w("")
     pds0 = res["pds", "0"]
     pdsm = res["pds", "-0.5"]
-    third = pdsm[2]
+    third = min(pdsm, key=lambda x: abs(x["f_hz"] - 5770.3))
+    rule = pick(pdsm, "flexural", 1)
     w("Notes")
     w("")
     w("- **pds at ν = 0** has c = g: its lattice responds alike to stretch and sliding, and the first "
@@ -261,11 +265,13 @@ def generate(tmp):
       "2294.9 for both). So are the next pairs. Within a degenerate pair the eigensolver returns "
       "an arbitrary basis, so which one is labelled `flexural` and which `axial` is not meaningful "
       "there; the frequencies are." % (pds0[0]["f_hz"], pds0[1]["f_hz"]))
-    w("- **pds at ν = −0.5**: the axial mode is the lowest (%.1f Hz), as the paper says. The "
-      "paper's f_III = 5770.3 Hz is its third mode; ours, %.1f Hz, is a mode symmetric about the "
-      "axis (effective mass %.3f along it, none across) with %.0f %% of its kinetic energy in ux, "
-      "and is labelled `axial`, so the `flexural` rule picks the next antisymmetric mode instead."
-      % (pdsm[0]["f_hz"], third["f_hz"], third["effective_mass"][1], 100 * third["energy_share"]["ux"]))
+    w("- **pds at ν = −0.5**: the lowest mode is `%s` (%.1f Hz); the paper too finds the axial mode "
+      "first. The paper's f_III = 5770.3 Hz is its third mode. Our nearest is mode %d, %.1f Hz, "
+      "labelled `%s`: effective mass %.3g along the axis and %.1e across it, %.0f %% of its "
+      "kinetic energy in ux. The rule \"second flexural\" picks %s instead."
+      % (pdsm[0]["kind"], pdsm[0]["f_hz"], pdsm.index(third) + 1, third["f_hz"], third["kind"],
+         third["effective_mass"][1], third["effective_mass"][0], 100 * third["energy_share"]["ux"],
+         "%.1f Hz" % rule["f_hz"] if rule else "nothing (no second flexural mode among the six)"))
     w("- **pds** reproduces the paper's failure: its flexural modes are far too stiff for ν ≠ 1/3, "
       "because its shear springs also resist rigid rotations of the bonds.")
     for m in ["mppd", "gerstle"]:
@@ -280,8 +286,10 @@ def generate(tmp):
         w("- **%s**: the largest deviations from FEM are %s." % (m, ", ".join(
             "%+.1f %% (f_%s, ν = %s)" % (worst[k][0], k, worst[k][1]) for k in ["I", "II", "III"] if k in worst)))
     w("- **gerstle** is the micropolar bond with Gerstle's springs (k_t = 12 d/|ξ|², k_θ = d/|ξ|, "
-      "d = g δ²/36) instead of mppd's (k_t = g, k_θ = c δ²/(36 |ξ|)); below ν = 0.25 its "
-      "frequencies fall below mppd's and the FEM column (docs/models/).")
+      "d = g δ²/36) instead of mppd's (k_t = g, k_θ = c δ²/(36 |ξ|)). Its frequencies are below "
+      "mppd's for every ν < 1/3, most at ν = −0.5: its m = 3 lattice is softer than the elastic "
+      "constants it is calibrated to ([lamina.md](lamina.md) Tables 1–2, "
+      "[models/mppd.md](models/mppd.md)).")
     w("- **ν = 1/3**: the shear springs vanish, θ is held at 0 (mppd, gerstle) and the three models "
       "are the same central-force lattice: identical frequencies.")
     # a mode that moves (almost) no net mass is labelled by its energy shares: an example
@@ -289,11 +297,11 @@ def generate(tmp):
         for nu in NUS:
             for k, mode in enumerate(res[m, nu]):
                 em = mode["effective_mass"]
-                if max(em) < 1e-3 and em[1] > 100 * em[0]:
+                if max(em) < 1e-3 and em[1] > 100 * em[0] and mode["kind"] == "flexural":
                     w("- **Labels of modes that move little net mass.** %s, ν = %s, mode %d (%.1f Hz): "
                       "effective mass %.1e along the axis and %.1e across it, so it is symmetric about the "
-                      "axis like the axial modes; both are below 1e-3, so the energy-share rule labels it "
-                      "`%s` (%.0f %% of its kinetic energy in uy)."
+                      "axis like the axial modes; both are below 1e-3, so the energy-share rule decides, and "
+                      "labels it `%s` (%.0f %% of its kinetic energy in uy, not more than half)."
                       % (m, nu, k + 1, mode["f_hz"], em[1], em[0], mode["kind"], 100 * mode["energy_share"]["uy"]))
                     break
             else:
@@ -324,9 +332,10 @@ def generate(tmp):
     w("The exact discrete value is set by the simple cubic lattice's anisotropy, not by the "
       "continuum: a wave along a lattice axis sees C11 of the lattice sum, not K + 4G/3. For npmb, "
       "C11 = 9K Σ e_x⁴ / N over the N = 80 neighbours within δ = 2.5 (no partial volumes), "
-      "+1.02 % in speed; for pmb, C11 = 9K Σ |ξ| e_x⁴ / (π δ⁴) with the analytic micromodulus, "
-      "+14.8 %. `tests/scenes/test_modal.c` checks both to 0.2 %. The paper's < 1 % (npmb) and "
-      "+13 % (pmb) come from timing a pulse in an explicit simulation of a 500 × 4 × 4 bar.")
+      "%+.2f %% in speed; for pmb, C11 = 9K Σ |ξ| e_x⁴ / (π δ⁴) with the analytic micromodulus, "
+      "%+.1f %%. `tests/scenes/test_modal.c` checks both to 0.2 %%. The paper's < 1 %% (npmb) and "
+      "+13 %% (pmb) come from timing a pulse in an explicit simulation of a 500 × 4 × 4 bar."
+      % (100 * (lattice_speed_ratio(True) - 1), 100 * (lattice_speed_ratio(False) - 1)))
     w("")
     w(EXPLANATION.strip("\n"))
     w("")
@@ -353,7 +362,7 @@ def main():
     fd, name = tempfile.mkstemp(prefix=".modal_", dir=os.path.dirname(os.path.abspath(path)))
     try:
         with os.fdopen(fd, "w") as f:
-            f.write(text + tail.lstrip("\n") if not tail else text + tail)
+            f.write(text + ("\n" + tail.lstrip("\n") if tail else ""))
         os.replace(name, path)
     except BaseException:
         os.unlink(name)
