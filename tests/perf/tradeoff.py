@@ -2,7 +2,7 @@
 """Speed against accuracy: sweeps perilin's settings on four benchmarks that have an exact or a
 tabulated reference, and records the error, the time and the memory of every run.
 
-    /usr/bin/python3 tests/perf/tradeoff.py --out docs            # ~15-25 min on 2 cores
+    /usr/bin/python3 tests/perf/tradeoff.py --out docs            # 89 runs, ~10 min on 2 cores
 
 writes docs/tradeoff.csv (one row per run), docs/tradeoff.png (error against seconds, one panel
 per benchmark, the Pareto front drawn; needs matplotlib) and the generated blocks of
@@ -11,9 +11,11 @@ is replaced, everything else is kept; a missing file is created with the blocks 
 markdown is also printed. Without --out nothing is written and the markdown is printed.
 
     --from-csv docs/tradeoff.csv    rebuild the plot and the tables from an earlier sweep, no runs
+                                    (the "regenerate" block of tradeoff.md is then left as it is)
     --only a,d                      some benchmarks only (a b c d, see BENCHMARKS)
     --repeat N                      run each setting shorter than 10 s N times and keep the fastest
                                     (default 2: the machine is shared and short runs are noisy)
+    --timeout S                     seconds per run before it counts as failed (default 900)
     --dry-run                       print the commands only
 
 Benchmarks (error measure, all from summary.json):
@@ -26,12 +28,15 @@ linear_continued, surface correction volume (none for npmb), CG + GAMG at rtol 1
 m x spacing grid for a and d (with m = 1 and m = 6 as extremes). Seconds are timing.total_s of
 summary.json (problem creation to the end of the analysis; process start-up and output writing
 excluded); memory is memory_mb (peak resident set). A run that fails is recorded with perilin's
-message. The binary is $PERILIN if set, else build/perilin. Standard library (+ matplotlib for
-the plot).
+message. Each row also carries the lattice limit of its setting (what the infinite lattice gives
+when dx -> 0 at fixed m, computed here from lattice sums: see lattice_value), against which the
+convergence table compares the three-point extrapolation of the runs. The binary is $PERILIN if
+set, else build/perilin. Standard library (+ matplotlib for the plot).
 """
 import argparse
 import csv
 import datetime
+import errno
 import json
 import math
 import os
@@ -51,7 +56,7 @@ PLATE_SIGMA, PLATE_E = 1.0e6, 1.0e9
 M_SWEEP = ["2", "3", "3.015", "3.2", "4", "5"]
 M_EXTREME = ["1", "6"]
 PV = ["none", "linear", "linear_continued"]
-SOLVERS = ["gamg:1e-10", "gamg:1e-8", "gamg:1e-6", "gamg:1e-4", "mumps"]
+SOLVERS = ["gamg:1e-10", "gamg:1e-8", "gamg:1e-6", "gamg:1e-4", "gamg:1e-3", "gamg:1e-2", "mumps"]
 BASE_SOLVER = "gamg:1e-10"
 REPEAT_BELOW_S = 10  # --repeat applies to runs shorter than this (the noisy ones); longer runs run once
 
@@ -198,11 +203,62 @@ def alpha(r, d, h, rule):
     return min(1.0, (d + h / 2 - r) / h)
 
 
+def mppd_lattice(m, nu, pv, surface):
+    """(nu_eff, E_eff / E) of the infinite square mppd lattice (plane stress, unit spacing) in
+    homogeneous strain (theta = 0), as docs/tools/lamina_tables.py and tests/scenes/test_lamina.c
+    compute it, with the partial-volume rule and the surface factor of a bulk particle."""
+    c = 6 / (math.pi * m ** 3 * (1 - nu))
+    g = 6 * (1 - 3 * nu) / (math.pi * m ** 3 * (1 - nu * nu))
+    C = [[0.0] * 3 for _ in range(3)]
+    R = int(m) + 2
+    vol = 1.0
+    for i in range(-R, R + 1):
+        for j in range(-R, R + 1):
+            if i == j == 0:
+                continue
+            L = math.hypot(i, j)
+            a = alpha(L, m, 1.0, pv)
+            if a <= 0:
+                continue
+            vol += a
+            ex, ey = i / L, j / L
+            tx, ty = -ey, ex
+            bs = (ex * ex, ey * ey, ex * ey)
+            bg = (tx * ex, ty * ey, 0.5 * (tx * ey + ty * ex))
+            for p in range(3):
+                for q in range(3):
+                    C[p][q] += 0.5 * a * (c * L * bs[p] * bs[q] + g * L * bg[p] * bg[q])
+    lam = math.pi * m * m / vol if surface == "volume" else 1.0
+    det = C[0][0] * C[1][1] - C[0][1] * C[1][0]
+    return C[0][1] / C[0][0], lam * det / C[0][0]
+
+
+def bending_l2(nu, nu_eff, e_eff, n=100):
+    """error.l2_rel of the elastic bending solution with (E_eff, nu_eff) against the one with (E, nu)
+    on the whole square (the interior of src/reference.c when delta -> 0), rigid motion removed."""
+    pts = [((i + 0.5) / n * 2 - 1, (j + 0.5) / n * 2 - 1) for i in range(n) for j in range(n)]
+    ref = [(x * y, -(x * x + nu * y * y) / 2) for x, y in pts]
+    s = 1 / e_eff
+    err = [(s * x * y - r[0], -s * (x * x + nu_eff * y * y) / 2 - r[1]) for (x, y), r in zip(pts, ref)]
+    mx, my = sum(e[0] for e in err) / len(err), sum(e[1] for e in err) / len(err)
+    w = sum(-y * e[0] + x * e[1] for (x, y), e in zip(pts, err)) / sum(x * x + y * y for x, y in pts)
+    err = [(e[0] - mx + w * y, e[1] - my - w * x) for (x, y), e in zip(pts, err)]
+    return math.sqrt(sum(a * a + b * b for a, b in err) / sum(a * a + b * b for a, b in ref))
+
+
 def lattice_value(key, m, pv, surface):
-    """What the infinite lattice of the setting gives for the benchmark's quantity (long waves,
-    homogeneous strain): c / c_theory for the npmb bar (C11 of the cubic lattice), e_xx E / sigma
-    for the plane-stress pmb plate (the surface factor of a bulk particle included). None for the
-    micropolar lamina benchmarks (not computed here)."""
+    """What the infinite lattice of the setting predicts for the benchmark's quantity when dx -> 0 at
+    fixed m (homogeneous strain, long waves):
+      a: error.l2_rel of the elastic bending solution with the mppd lattice's E_eff, nu_eff;
+      b: f1 / f_exact = sqrt(E_eff / E) (at nu = 0 the mppd lattice is E_eff times the isotropic
+         stiffness, so every frequency scales by sqrt(E_eff/E)); the reference is FEM, not exact;
+      c: c / c_theory = sqrt(C11 / (K + 4G/3)) of the cubic npmb lattice;
+      d: e_xx E / sigma of the plane-stress pmb lattice."""
+    if key == "a":
+        nu_eff, e_eff = mppd_lattice(float(m), 0.25, pv, surface)
+        return bending_l2(0.25, nu_eff, e_eff)
+    if key == "b":
+        return math.sqrt(mppd_lattice(float(m), 0.0, pv, surface)[1])
     m = float(m)
     R = int(m + 2)
     if key == "c":
@@ -243,6 +299,26 @@ def lattice_value(key, m, pv, surface):
 # ---------------------------------------------------------------------------------------------
 # running
 
+def start(cmd, timeout):
+    """Run perilin; while the binary is being relinked (EACCES, ETXTBSY), wait and retry."""
+    for attempt in range(60):
+        try:
+            return subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=timeout)
+        except OSError as e:
+            if e.errno not in (errno.EACCES, errno.ETXTBSY, errno.ENOENT) or attempt == 59:
+                raise
+            sys.stderr.write("(binary busy: %s; retrying in 5 s)\n" % e.strerror)
+            time.sleep(5)
+
+
+def binary_id():
+    try:
+        st = os.stat(PERILIN)
+        return "%d-%d" % (st.st_mtime_ns, st.st_size)
+    except OSError:
+        return None
+
+
 def run_one(key, s, repeat, timeout):
     row = dict(benchmark=key, m=s["m"], dx=s["dx"], partial_volume=s["pv"], surface=s["surface"], solver=s["solver"])
     best = None
@@ -252,7 +328,7 @@ def run_one(key, s, repeat, timeout):
             row["command"] = " ".join(["build/perilin" if c == PERILIN else c for c in cmd[:-2]] + ["-output_dir", "TMP"])
             t0 = time.time()
             try:
-                res = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, timeout=timeout)
+                res = start(cmd, timeout)
             except subprocess.TimeoutExpired:
                 row.update(status="failed", message="timeout after %d s" % timeout, wall_s=time.time() - t0)
                 return row
@@ -354,6 +430,31 @@ def fit(xs, ys):
     return slope, local
 
 
+def extrapolate(hs, vs):
+    """v = v_inf + C h^p through three points (h decreasing): (v_inf, p), or None when the values are
+    not monotone or no p in [0.02, 10] fits."""
+    (h1, h2, h3), (v1, v2, v3) = hs, vs
+    d1, d2 = v1 - v2, v2 - v3
+    if d1 * d2 <= 0:
+        return None
+    r = d1 / d2
+
+    def g(p):
+        return (h1 ** p - h2 ** p) / (h2 ** p - h3 ** p) - r
+    lo, hi = 0.02, 10.0
+    if g(lo) * g(hi) > 0:
+        return None
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if g(lo) * g(mid) <= 0:
+            hi = mid
+        else:
+            lo = mid
+    p = 0.5 * (lo + hi)
+    c = d2 / (h2 ** p - h3 ** p)
+    return v3 - c * h3 ** p, p
+
+
 def find(rows, key, **kw):
     for r in rows:
         if r["benchmark"] == key and all(r[k] == v for k, v in kw.items()):
@@ -383,7 +484,7 @@ def table_runs(rows, key):
     mine.sort(key=lambda r: (min(order.get(s, 9) for s in r["sweeps"].split("; ")), dx_value(r["dx"]), float(r["m"]),
                              r["partial_volume"], r["surface"], r["solver"]))
     has_lat = any(r["lattice_value"] is not None for r in mine)
-    head = ["setting (vs base)", "sweeps", "error", b["quantity"]] + (["lattice"] if has_lat else []) + \
+    head = ["setting (vs base)", "sweeps", "error", b["quantity"]] + (["lattice limit"] if has_lat else []) + \
         ["seconds", "memory MB", "particles", "its", "front"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in mine:
@@ -393,11 +494,17 @@ def table_runs(rows, key):
         else:
             val = "%.5f" % r["value"] if key != "a" else pct(r["value"])
             cells = [r["label"], r["sweeps"], pct(r["error"]), val] + \
-                (["%.5f" % r["lattice_value"] if r["lattice_value"] is not None else "—"] if has_lat else []) + \
+                ([lattice_cell(key, r["lattice_value"])] if has_lat else []) + \
                 [fmt_s(r["total_s"]), "%.0f" % r["memory_mb"], "{:,}".format(r["particles"]), str(r["iterations"]),
                  "★" if id(r) in front else ""]
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines)
+
+
+def lattice_cell(key, v):
+    if v is None:
+        return "—"
+    return pct(v) if key == "a" else "%.5f" % v
 
 
 def table_grid(rows, key):
@@ -421,8 +528,10 @@ def table_grid(rows, key):
 
 
 def orders(rows):
-    """Slopes of log(error) against log(dx) at fixed m and against log(m) at fixed dx."""
-    lines = ["| benchmark | fixed | varied | errors | fitted order | local orders |", "|---|---|---|---|---|---|"]
+    """Slopes of log(error) against log(dx) at fixed m and against log(m) at fixed dx, the dx -> 0
+    limit of the three-point fit, and the lattice's own error where it is computed."""
+    lines = ["| benchmark | fixed | varied | errors | fitted order | local orders | Δx → 0 (3-point fit "
+             "v = v∞ + C Δxᵖ): limit, error, p | lattice error |", "|---|---|---|---|---|---|---|---|"]
     for key, b in BENCHMARKS.items():
         base = base_setting(key)
         same = dict(partial_volume=base["pv"], surface=base["surface"], solver=BASE_SOLVER)
@@ -433,19 +542,47 @@ def orders(rows):
             if len(pts) < 2:
                 continue
             slope, local = fit([dx_value(r["dx"]) for r in pts], [r["error"] for r in pts])
-            lines.append("| %s | m = %s | Δx = %s | %s | %s | %s |" % (
+            ex = extrapolate([dx_value(r["dx"]) for r in pts], [r["value"] for r in pts]) if len(pts) == 3 else None
+            if ex is None:
+                lim = "not monotone" if len(pts) == 3 else "—"
+            elif key == "a":
+                lim = "%s, p = %.2f" % (pct(ex[0]), ex[1]) if ex[0] > 0 else "none (the fit's limit is negative)"
+            else:
+                lim = "%.5f, %s, p = %.2f" % (ex[0], pct(abs(ex[0] - 1)), ex[1])
+            lat = lattice_value(key, m, base["pv"], base["surface"])
+            lines.append("| %s | m = %s | Δx = %s | %s | %.2f | %s | %s | %s |" % (
                 key, m, " → ".join(r["dx"] for r in pts), " → ".join(pct(r["error"]) for r in pts),
-                "%.2f" % slope, ", ".join("%.2f" % x for x in local)))
+                slope, ", ".join("%.2f" % x for x in local), lim, lattice_error(key, lat)))
         dxs = b["dx"] if b["grid"] else [base["dx"]]
         for dx in dxs:
             pts = [find(rows, key, m=m, dx=dx, **same) for m in M_SWEEP + (["6"] if b["grid"] else [])]
             pts = [r for r in pts if r and r["status"] == "ok"]
             if len(pts) < 2:
                 continue
-            slope, local = fit([float(r["m"]) for r in pts], [r["error"] for r in pts])
-            lines.append("| %s | Δx = %s | m = %s | %s | %s | %s |" % (
-                key, dx, ", ".join(r["m"] for r in pts), " → ".join(pct(r["error"]) for r in pts),
-                "%.2f" % slope, ", ".join("%.2f" % x for x in local)))
+            slope, _ = fit([float(r["m"]) for r in pts], [r["error"] for r in pts])
+            lats = [lattice_value(key, r["m"], base["pv"], base["surface"]) for r in pts]
+            lines.append("| %s | Δx = %s | m = %s | %s | %.2f | — | — | %s |" % (
+                key, dx, ", ".join(r["m"] for r in pts), " → ".join(pct(r["error"]) for r in pts), slope,
+                " → ".join(lattice_error(key, v) for v in lats)))
+    return "\n".join(lines)
+
+
+def lattice_error(key, v):
+    if v is None:
+        return "—"
+    return pct(v) if key == "a" else pct(abs(v - 1))
+
+
+def floors():
+    """The lattice's own error (infinite lattice, homogeneous strain / long waves) against m."""
+    ms = ["1", "1.5", "2", "2.5", "3", "3.015", "3.2", "4", "5", "6", "8", "10"]
+    cols = [("c", "linear_continued", "none"), ("c", "linear", "none"), ("c", "none", "none"),
+            ("d", "linear_continued", "volume"), ("d", "linear_continued", "none"), ("d", "linear", "volume"),
+            ("d", "none", "none")]
+    head = ["m"] + ["(%s) %s%s" % (k, pv, ", surface " + sf if k == "d" else "") for k, pv, sf in cols]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for m in ms:
+        lines.append("| %s | %s |" % (m, " | ".join("%+.2f %%" % (100 * (lattice_value(k, m, pv, sf) - 1)) for k, pv, sf in cols)))
     return "\n".join(lines)
 
 
@@ -483,6 +620,13 @@ def failures(rows):
     return "\n".join(lines)
 
 
+def overhead(rows):
+    d = sorted(r["wall_s"] - r["total_s"] for r in rows if r["status"] == "ok" and r["wall_s"] is not None)
+    if not d:
+        return "?", "?", "?"
+    return "%.2f" % d[len(d) // 2], "%.2f" % d[0], "%.2f" % d[-1]
+
+
 def blocks(rows, info):
     out = {}
     if info:  # with --from-csv the block of the sweep that made the CSV is kept
@@ -492,7 +636,10 @@ def blocks(rows, info):
             "Last sweep: %s, %d runs (%d failed), %s of runs (sum of the processes' wall clock: %.0f s);"
             " load average at the start %s on %d cores. Binary: `build/perilin`, commit `%s`." % (
                 info["date"], len(rows), sum(r["status"] != "ok" for r in rows), info["elapsed"],
-                sum(r["wall_s"] or 0 for r in rows), info["load"], os.cpu_count() or 0, info["commit"])])
+                sum(r["wall_s"] or 0 for r in rows), info["load"], os.cpu_count() or 0, info["commit"]),
+            "",
+            "Seconds below are `timing.total_s`. Each process also spends %s s (median; range %s–%s s) outside it:"
+            " MPI/PETSc start-up, output writing and exit." % overhead(rows)])
     for key, b in BENCHMARKS.items():
         if any(r["benchmark"] == key for r in rows):
             base = base_setting(key)
@@ -504,6 +651,7 @@ def blocks(rows, info):
             if b["grid"]:
                 out["grid_" + key] = table_grid(rows, key)
     out["orders"] = orders(rows)
+    out["floors"] = floors()
     out["recommended"] = recommended(rows)
     out["failures"] = failures(rows)
     return out
@@ -561,8 +709,9 @@ def plot(rows, path):
             xs.append(r["total_s"])
             ys.append(r["error"])
         ax.plot(xs, ys, "-", color="0.4", lw=1, zorder=2)
-        for r in front:
-            ax.annotate(r["label"], (r["total_s"], r["error"]), fontsize=6.5, xytext=(4, 3), textcoords="offset points")
+        for i, r in enumerate(front):
+            ax.annotate(r["label"], (r["total_s"], r["error"]), fontsize=6.5, xytext=(4, 3 if i % 2 == 0 else -9),
+                        textcoords="offset points")
         nfail = sum(r["benchmark"] == key and r["status"] != "ok" for r in rows)
         ax.set_xscale("log")
         ax.set_yscale("log")
@@ -609,10 +758,13 @@ def main():
         if not a.dry_run and not os.access(PERILIN, os.X_OK):
             sys.exit("no perilin binary at %s (build it, or set PERILIN)" % PERILIN)
         load = "%.1f" % os.getloadavg()[0]
-        start = datetime.datetime.now()
+        started = datetime.datetime.now()
+        bin0 = binary_id()
         rows, elapsed = sweep(keys, a.repeat, a.timeout, a.dry_run)
         if a.dry_run:
             return
+        if binary_id() != bin0:
+            sys.stderr.write("warning: build/perilin changed during the sweep\n")
         try:
             commit = subprocess.run(["git", "log", "-1", "--format=%h"], capture_output=True, text=True, cwd=ROOT).stdout.strip()
             dirty = subprocess.run(["git", "status", "--porcelain", "src", "include", "models"], capture_output=True, text=True,
@@ -620,7 +772,9 @@ def main():
             commit += " (with uncommitted changes in src/, include/ or models/)" if dirty else ""
         except OSError:
             commit = "?"
-        info = dict(date=start.strftime("%Y-%m-%d %H:%M"), elapsed="%.1f min" % (elapsed / 60), load=load, commit=commit)
+        if binary_id() != bin0:
+            commit += "; **build/perilin was rebuilt during the sweep**"
+        info = dict(date=started.strftime("%Y-%m-%d %H:%M"), elapsed="%.1f min" % (elapsed / 60), load=load, commit=commit)
     bl = blocks(rows, info)
     text = render(bl, None)
     print(text)
