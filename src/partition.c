@@ -6,7 +6,7 @@
 #include "perilin.h"
 #include <metis.h>
 
-static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, PetscMPIInt nparts, PetscInt part[], PetscInt *edgecut)
+static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, PetscMPIInt nparts, PetscInt part[])
 {
   PeriBonds g;
   idx_t    *xadj, *adjncy, *where, nv = (idx_t)p->n, ncon = 1, np = nparts, objval = 0, options[METIS_NOPTIONS];
@@ -36,7 +36,6 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, P
   status                     = METIS_PartGraphKway(&nv, &ncon, xadj, adjncy, NULL, NULL, NULL, &np, NULL, NULL, options, &objval, where);
   PetscCheck(status == METIS_OK, PETSC_COMM_SELF, PETSC_ERR_LIB, "METIS_PartGraphKway failed with status %d on %" PetscInt_FMT " particles and %d parts", status, p->n, (int)nparts);
   for (PetscInt i = 0; i < p->n; i++) part[i] = (PetscInt)where[i];
-  *edgecut = (PetscInt)objval;
   PetscCall(PetscFree3(xadj, adjncy, where));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -45,7 +44,7 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, P
   PeriPartition - partitions the particles over the ranks of comm. perm[k] is the old index of new
   particle k; rank r owns new particles range[r]..range[r+1]-1. Collective.
 @*/
-PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PetscInt *edgecut, PetscInt **perm, PetscInt **range)
+PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal delta, PetscInt **perm, PetscInt **range)
 {
   PetscMPIInt rank, size;
   PetscInt   *part, *fill;
@@ -56,15 +55,12 @@ PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal de
   PetscCall(PetscMalloc1(p->n, perm));
   PetscCall(PetscCalloc1(size + 1, range));
   PetscCall(PetscCalloc1(p->n, &part));
-  *edgecut = 0;
   if (size > 1) {
     PetscCheck(p->n >= size, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " particles cannot be shared by %d ranks", p->n, size);
     PetscReal hmax = 0;
     for (PetscInt i = 0; i < p->n; i++) hmax = PetscMax(hmax, p->spacing[i]);
-    (void)pv;
-    if (rank == 0) PetscCall(MetisPartition(p, PetscMin(delta, 1.5 * hmax), size, part, edgecut));
+    if (rank == 0) PetscCall(MetisPartition(p, PetscMin(delta, 1.5 * hmax), size, part));
     PetscCallMPI(MPI_Bcast(part, (PetscMPIInt)p->n, MPIU_INT, 0, comm));
-    PetscCallMPI(MPI_Bcast(edgecut, 1, MPIU_INT, 0, comm));
   }
   for (PetscInt i = 0; i < p->n; i++) (*range)[part[i] + 1]++;
   for (PetscMPIInt r = 0; r < size; r++) (*range)[r + 1] += (*range)[r];

@@ -210,7 +210,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
 {
   PeriScene           s         = p->scene;
   PetscReal           thickness = 1;
-  PetscInt           *perm, *range, edgecut;
+  PetscInt           *perm, *range;
   PeriNode            mat;
   PeriCalibrationData cal;
   PetscLogDouble      t0, t1;
@@ -230,7 +230,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
 
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Partition, 0, 0, 0, 0));
-  PetscCall(PeriPartition(p->comm, &p->particles, p->delta, p->partial_volume, &edgecut, &perm, &range));
+  PetscCall(PeriPartition(p->comm, &p->particles, p->delta, &perm, &range));
   if (p->size > 1) PetscCall(PeriParticlesPermute(&p->particles, perm));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Partition, 0, 0, 0, 0));
   PetscCall(PetscMalloc1(p->particles.n, &p->owner));
@@ -253,7 +253,6 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   }
   PetscCall(PetscFree(perm));
   PetscCall(PetscFree(range));
-  (void)edgecut;
 
   for (PetscInt i = 0; i < p->particles.n; i++)
     PetscCheck(p->neighbor_count[i] > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)p->particles.x[3 * i], (double)p->particles.x[3 * i + 1], (double)p->particles.x[3 * i + 2], (double)p->delta, (double)p->particles.spacing[i]);
