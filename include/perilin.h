@@ -82,7 +82,13 @@ typedef struct {
   PetscReal  lower[3], upper[3];
   PetscBool  periodic[3];
   PetscReal  mean_spacing;
+  /* fictitious boundary layers (src/layers.c): NULL when the scene has none */
+  PetscInt      *image;   /* -1 for a particle of the body; else the body particle it mirrors */
+  unsigned char *crossed; /* faces crossed to reach the particle: bit 2 axis + (upper face) */
+  PetscInt       nfictitious;
 } PeriParticles;
+
+#define PeriParticleIsFictitious(pt, k) ((pt)->image && (pt)->image[k] >= 0)
 
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
@@ -121,7 +127,8 @@ PETSC_EXTERN const char *const PeriPartialVolumes[];
 
 typedef enum {
   PERI_SURFACE_NONE,
-  PERI_SURFACE_VOLUME
+  PERI_SURFACE_VOLUME,
+  PERI_SURFACE_ENERGY
 } PeriSurfaceCorrection;
 PETSC_EXTERN const char *const PeriSurfaceCorrections[];
 
@@ -159,12 +166,18 @@ typedef struct {
   PetscReal xi[3], length;
   PetscReal Vi, Vj;
   PetscReal weight; /* alpha * lambda */
+  PetscReal mu;     /* the bond's shear modulus across materials (Oterkus & Madenci eq. 60); 0: the material's */
 } PeriBondGeometry;
 
 /* What calibration may use besides the material: the discrete family volumes sum_j alpha_ij V_j. */
 typedef struct {
-  PetscInt         n;
-  const PetscReal *family_volume;
+  PetscInt              n;
+  const PetscReal      *family_volume;
+  const PetscReal      *mu; /* shear modulus per particle (material.mu_by_region), or NULL: uniform */
+  MPI_Comm              comm;
+  const PeriParticles  *particles;
+  const PeriBonds      *bonds; /* this rank's bonds, for corrections computed from the family */
+  PeriSurfaceCorrection surface;
 } PeriCalibrationData;
 
 typedef struct _p_PeriModel *PeriModel;
@@ -178,6 +191,10 @@ typedef struct {
   void (*bond_stiffness)(PeriModel, const PeriBondGeometry *, PetscReal[]);
   /* The bond's strain measures (stretch, sliding, ...) from the two particles' DOFs. */
   void (*bond_measures)(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
+  /* State-based models only (else NULL): the dense stiffness of particle i's energy, which depends
+     on its whole family fam[0..n-1] (all with fam[k].i == i): ((n+1) dofs)^2, row-major, the DOFs
+     of i first, then those of fam[0], fam[1], ... */
+  PetscErrorCode (*family_stiffness)(PeriModel, PetscInt, const PeriBondGeometry[], PetscReal[]);
   /* Values of the rigid-body (zero-energy) modes at a point, nmodes x dofs; returns nmodes. */
   PetscInt (*rigid_modes)(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
   PetscErrorCode (*destroy)(PeriModel); /* frees what data points to; data itself is freed after; may be NULL */
@@ -193,6 +210,8 @@ struct _p_PeriModel {
   PetscInt           nmeasures;
   const char *const *measure_names;
   PetscBool          allows_surface_correction;
+  const char *const *surface_corrections;      /* allowed corrections.surface values; NULL: none, volume */
+  PetscBool          antiplane;                /* one DOF, the out-of-plane displacement uz: stresses tau_xz, tau_yz */
   const char *const *keys;                     /* the model's own scene keys besides model.type and model.plane, or NULL */
   PetscBool          inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
   PetscBool          rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
@@ -226,6 +245,8 @@ PETSC_EXTERN PetscErrorCode PeriModelCreate_NPMB(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriModelCreate_PDS(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriModelCreate_MPPD(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriModelCreate_Gerstle(PeriModel);
+PETSC_EXTERN PetscErrorCode PeriModelCreate_Antiplane(PeriModel);
+PETSC_EXTERN PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel);
 
 /* ------------------------------------------------------------------ the problem (src/problem.c) */
 typedef struct {
@@ -245,7 +266,10 @@ typedef struct {
   PetscReal strain_energy;
   PetscReal max_abs_u[PERI_MAX_DOF];
   PetscInt  nbonds_total;
-  PetscInt  edge_cut; /* bonds between particles of different ranks */
+  PetscBool symmetric;      /* the operator solved was symmetric */
+  PetscInt  free_modes;     /* rigid motions left free with balanced loads: solved orthogonal to them */
+  PetscReal load_imbalance; /* share of the load along those motions, removed */
+  PetscInt  edge_cut;       /* bonds between particles of different ranks */
   /* against the scene's reference field (src/reference.c) */
   PetscBool has_reference;
   PetscInt  interior_particles;
@@ -291,6 +315,31 @@ typedef struct {
   PetscReal  factor_s, solve_s;
 } PeriModal;
 
+/* Fictitious boundary layers outside the body's faces (Oterkus & Madenci sec. 6, src/layers.c):
+ * each fictitious particle copies its mirror image in the body, u_f = sign u_m + offset. */
+typedef enum {
+  PERI_LAYER_NONE,
+  PERI_LAYER_DISPLACEMENT,
+  PERI_LAYER_SHEAR_STRESS,
+  PERI_LAYER_FREE
+} PeriLayerKind;
+PETSC_EXTERN const char *const PeriLayerKinds[];
+
+typedef struct {
+  PetscInt      nfaces;
+  PeriLayerKind kind[6]; /* per face 2 axis + (upper face) */
+  PetscReal     value[6];
+  Mat           T; /* u = T u_body + g: identity on body DOFs, the mirror relation on fictitious ones */
+  Vec           g;
+} PeriLayers;
+
+/* Torsion of a bar (antiplane models): the twist psi enters the free-surface conditions. */
+typedef struct {
+  PetscBool active;
+  PetscReal twist, center[2];
+  PetscReal torque, J, J_rectangle, max_stress, max_at[2]; /* results, per unit length; kept contiguous (broadcast as 6 reals) */
+} PeriTorsion;
+
 typedef struct _p_PeriProblem *PeriProblem;
 struct _p_PeriProblem {
   MPI_Comm              comm;
@@ -306,6 +355,12 @@ struct _p_PeriProblem {
   PetscReal            *family_volume;  /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
   PetscInt             *neighbor_count; /* per particle (all ranks) */
   PetscInt             *owner;          /* rank owning each particle (all ranks) */
+  PetscReal            *mu;             /* shear modulus per particle when material.mu_by_region is given, else NULL */
+  PetscReal            *bond_mu;        /* per local bond: the shear modulus across materials (eq. 60), or NULL */
+  PeriBonds             family;         /* state-based models: every bond of each owned particle (both directions) */
+  PeriLayers            layers;
+  PeriTorsion           torsion;
+  PetscReal            *tau; /* antiplane models, rank 0: tau_xz, tau_yz per particle after the solve */
   PeriModel             model;
   Mat                   K;                       /* stiffness */
   char                  mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
@@ -336,17 +391,18 @@ PETSC_EXTERN PetscErrorCode PeriProblemDestroy(PeriProblem *);
 PETSC_EXTERN PetscErrorCode PeriProblemCreateVec(PeriProblem, Vec *);
 PETSC_EXTERN PetscErrorCode PeriProblemBondGeometry(PeriProblem, PetscInt, PetscInt, PeriBondGeometry *);
 PETSC_EXTERN PetscErrorCode PeriProblemEvaluateEnergy(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriProblemFamilyGeometry(PeriProblem, PetscInt, PetscInt *, PeriBondGeometry[]);
+PETSC_EXTERN PetscInt       PeriProblemMaxFamily(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriProblemFindProbe(PeriProblem, const char[], PeriProbe **);
 
 /* assembly (src/assembly.c) */
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriProblem, Mat *);
-PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriProblem, PetscInt *, Vec[]);
+PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriProblem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriProblem, Mat);
 
 /* boundary conditions and loads (src/boundary.c) */
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriLoadsAssemble(PeriProblem, Vec);
-PETSC_EXTERN PetscErrorCode PeriCheckRigidMotion(PeriProblem);
 
 /* reference solutions (src/reference.c) */
 PETSC_EXTERN PetscErrorCode PeriReferenceSetUp(PeriProblem);
@@ -359,7 +415,15 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Static(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Modal(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriAssembleMass(PeriProblem, Mat *);
-PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[], size_t, Vec[]);
+
+/* fictitious boundary layers and torsion (src/layers.c) */
+PETSC_EXTERN PetscErrorCode PeriLayersAddParticles(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriLayersSetUp(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriLayersApply(PeriProblem, Mat *, Vec);
+PETSC_EXTERN PetscErrorCode PeriLayersComplete(PeriProblem, Vec);
+PETSC_EXTERN PetscErrorCode PeriLayersDestroy(PeriLayers *);
+PETSC_EXTERN PetscErrorCode PeriTorsionEvaluate(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriWriteModesCSV(PeriProblem, const char[]);
 
 /* output (src/output/) */

@@ -13,5 +13,7 @@ PetscErrorCode PeriModelRegisterAll(void)
   PetscCall(PeriModelRegister("pds", PeriModelCreate_PDS));
   PetscCall(PeriModelRegister("mppd", PeriModelCreate_MPPD));
   PetscCall(PeriModelRegister("gerstle", PeriModelCreate_Gerstle));
+  PetscCall(PeriModelRegister("antiplane", PeriModelCreate_Antiplane));
+  PetscCall(PeriModelRegister("antiplane_os", PeriModelCreate_AntiplaneOS));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

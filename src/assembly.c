@@ -83,6 +83,57 @@ static void RowAdd(PetscInt bs, PetscInt j, const PetscReal *B, PetscInt ld, Pet
     for (PetscInt c = 0; c < bs; c++) dst[a * bs + c] += B[a * ld + c];
 }
 
+/* Inserts every owned particle's family stiffness (state-based models) into K. */
+static PetscErrorCode InsertFamilies(PeriProblem p, Mat K)
+{
+  PeriModel         m  = p->model;
+  const PetscInt    bs = m->dofs, nmax = PeriProblemMaxFamily(p);
+  PeriBondGeometry *fam;
+  PetscReal        *Ke;
+  PetscInt         *idx;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc3(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, nmax + 1, &idx));
+  for (PetscInt i = p->family.rstart; i < p->family.rend; i++) {
+    PetscInt n;
+    PetscCall(PeriProblemFamilyGeometry(p, i, &n, fam));
+    PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
+    idx[0] = i;
+    for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
+    PetscCall(MatSetValuesBlocked(K, n + 1, idx, n + 1, idx, Ke, ADD_VALUES));
+  }
+  PetscCall(PetscFree3(fam, Ke, idx));
+  PetscCall(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* State-based models: particle i's energy couples every pair of its family, so K reaches 2 delta.
+ * The pattern is exact from a first pass into PETSc's preallocator. */
+static PetscErrorCode AssembleFamilies(PeriProblem p, Mat *K)
+{
+  const PetscInt bs = p->model->dofs, nloc = p->bonds.rend - p->bonds.rstart;
+  Mat            pre;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreate(p->comm, &pre));
+  PetscCall(MatSetSizes(pre, nloc * bs, nloc * bs, p->particles.n * bs, p->particles.n * bs));
+  PetscCall(MatSetBlockSize(pre, bs));
+  PetscCall(MatSetType(pre, MATPREALLOCATOR));
+  PetscCall(MatSetUp(pre));
+  PetscCall(InsertFamilies(p, pre));
+  PetscCall(MatCreate(p->comm, K));
+  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, p->particles.n * bs, p->particles.n * bs));
+  PetscCall(MatSetBlockSize(*K, bs));
+  PetscCall(MatSetType(*K, p->mat_type[0] ? p->mat_type : MATBAIJ));
+  PetscCall(MatSetFromOptions(*K));
+  PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *K));
+  PetscCall(MatDestroy(&pre));
+  PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(InsertFamilies(p, *K));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAssembleStiffness - assembles K = sum over live bonds of the model's bond blocks. The type is
   p->mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
@@ -103,6 +154,13 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
+  if (m->ops.family_stiffness) {
+    PetscCall(AssembleFamilies(p, K));
+    PetscCall(MatSetOption(*K, MAT_SYMMETRIC, PETSC_TRUE));
+    PetscCall(MatSetOption(*K, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+    PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(Preallocation(p, &dnz, &onz, &dnzu, &onzu));
   for (PetscInt i = 0; i < nloc; i++) maxcol = PetscMax(maxcol, dnz[i] + onz[i]);
   PetscCall(MatCreate(p->comm, K));
@@ -191,10 +249,12 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
 
 /*@C
   PeriRigidModes - the model's rigid-body modes as vectors (coordinates relative to the body's
-  centre, so translations and rotations are nearly orthogonal), each scaled to unit norm.
-  Collective; modes[] must hold PERI_MAX_MODES vectors, created here.
+  centre, so translations and rotations are nearly orthogonal), each scaled to unit norm; zero on
+  fictitious layer particles, whose rows the static solve replaces. norm[k] (may be NULL) gets the
+  norm that mode k had before scaling. Collective; modes[] must hold PERI_MAX_MODES vectors,
+  created here.
 @*/
-PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[])
+PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[], PetscReal norm[])
 {
   const PeriParticles *pt = &p->particles;
   PeriModel            m  = p->model;
@@ -214,11 +274,11 @@ PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[])
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
     m->ops.rigid_modes(m, X, vals);
     for (PetscInt k = 0; k < nm; k++)
-      for (PetscInt c = 0; c < m->dofs; c++) a[k][(i - rstart) * m->dofs + c] = m->inactive[c] ? 0 : vals[k][c];
+      for (PetscInt c = 0; c < m->dofs; c++) a[k][(i - rstart) * m->dofs + c] = m->inactive[c] || PeriParticleIsFictitious(pt, i) ? 0 : vals[k][c];
   }
   for (PetscInt k = 0; k < nm; k++) {
     PetscCall(VecRestoreArray(modes[k], &a[k]));
-    PetscCall(VecNormalize(modes[k], NULL));
+    PetscCall(VecNormalize(modes[k], norm ? &norm[k] : NULL));
   }
   *nmodes = nm;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -235,7 +295,7 @@ PetscErrorCode PeriSetNearNullSpace(PeriProblem p, Mat A)
   MatNullSpace nsp;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriRigidModes(p, &nm, modes));
+  PetscCall(PeriRigidModes(p, &nm, modes, NULL));
   /* Gram-Schmidt: MatNullSpaceCreate wants an orthonormal set */
   for (PetscInt k = 0; k < nm; k++) {
     for (PetscInt l = 0; l < k; l++) {

@@ -259,21 +259,25 @@ static void SymmetricEigen(PetscInt n, PetscReal A[PERI_MAX_MODES][PERI_MAX_MODE
 }
 
 /*@C
-  PeriRigidMotionFree - how many combinations of the rigid-body modes the constrained DOFs leave
-  free (K is singular when any is), and the main motion of the first, named. Collective.
+  PeriRigidMotionFree - how many combinations of the rigid-body modes the constrained DOFs and the
+  fictitious layers leave free (K is singular when any is), the main motion of the first, named,
+  and (when free is not NULL) those combinations as orthonormal vectors, created here. Collective.
 @*/
-PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], size_t len)
+PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], size_t len, Vec free[])
 {
+  static const char *const names1[] = {"translation along z"};
   static const char *const names2[] = {"translation along x", "translation along y", "rotation about z"};
   static const char *const names3[] = {"translation along x", "translation along y", "translation along z", "rotation about x", "rotation about y", "rotation about z"};
+  const PeriParticles     *pt       = &p->particles;
+  PeriModel                m        = p->model;
   Vec                      modes[PERI_MAX_MODES];
   PetscInt                 nm;
-  PetscReal                G[PERI_MAX_MODES][PERI_MAX_MODES] = {{0}}, V[PERI_MAX_MODES][PERI_MAX_MODES], w[PERI_MAX_MODES];
+  PetscReal                G[PERI_MAX_MODES][PERI_MAX_MODES] = {{0}}, V[PERI_MAX_MODES][PERI_MAX_MODES], w[PERI_MAX_MODES], norm[PERI_MAX_MODES];
   const PetscScalar       *a[PERI_MAX_MODES];
   PetscInt                 rstart;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriRigidModes(p, &nm, modes));
+  PetscCall(PeriRigidModes(p, &nm, modes, norm));
   PetscCall(VecGetOwnershipRange(modes[0], &rstart, NULL));
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecGetArrayRead(modes[k], &a[k]));
   for (PetscInt c = 0; c < p->nconstrained; c++) {
@@ -282,7 +286,28 @@ PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], 
       for (PetscInt l = 0; l < nm; l++) G[k][l] += PetscRealPart(a[k][row] * a[l][row]);
   }
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecRestoreArrayRead(modes[k], &a[k]));
-  for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
+  if (p->layers.T) {
+    /* a fictitious particle's relation u_f = s u_m + o holds a mode v unless v_f = s v_m */
+    PetscReal centre[3], X[3], vf[PERI_MAX_MODES][PERI_MAX_DOF], vm[PERI_MAX_MODES][PERI_MAX_DOF];
+    for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
+    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
+      PetscInt           mi = pt->image ? pt->image[i] : -1, ncols;
+      const PetscInt    *cols;
+      const PetscScalar *vals;
+      PetscReal          sign;
+      if (mi < 0) continue;
+      PetscCall(MatGetRow(p->layers.T, i, &ncols, &cols, &vals));
+      sign = PetscRealPart(vals[0]);
+      PetscCall(MatRestoreRow(p->layers.T, i, &ncols, &cols, &vals));
+      for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
+      m->ops.rigid_modes(m, X, vf);
+      for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * mi + d] - centre[d];
+      m->ops.rigid_modes(m, X, vm);
+      for (PetscInt c = 0; c < m->dofs; c++)
+        for (PetscInt k = 0; k < nm; k++)
+          for (PetscInt l = 0; l < nm; l++) G[k][l] += (vf[k][c] - sign * vm[k][c]) * (vf[l][c] - sign * vm[l][c]) / (norm[k] * norm[l]);
+    }
+  }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, G, PERI_MAX_MODES * PERI_MAX_MODES, MPIU_REAL, MPI_SUM, p->comm));
   /* G holds sums of squares of unit vectors' entries: a free motion gives an eigenvalue of about
    * round-off; one constrained particle already gives ~1/N */
@@ -292,28 +317,26 @@ PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], 
   for (PetscInt k = 0; k < nm; k++) {
     PetscInt best = 0;
     if (w[k] > 1e-12 / p->particles.n) continue;
+    if (free) {
+      PetscCall(VecDuplicate(modes[0], &free[*nfree]));
+      PetscCall(VecZeroEntries(free[*nfree]));
+      for (PetscInt l = 0; l < nm; l++) PetscCall(VecAXPY(free[*nfree], V[l][k], modes[l]));
+      for (PetscInt q = 0; q < *nfree; q++) {
+        PetscScalar dot;
+        PetscCall(VecDot(free[*nfree], free[q], &dot));
+        PetscCall(VecAXPY(free[*nfree], -dot, free[q]));
+      }
+      PetscCall(VecNormalize(free[*nfree], NULL));
+    }
     if ((*nfree)++ || !what) continue;
     for (PetscInt l = 0; l < nm; l++)
       if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
-    if (nm == 3 || nm == 6)
-      PetscCall(PetscSNPrintf(what, len, "%s", (nm == 3 ? names2 : names3)[best]));
+    if (nm == 1 || nm == 3 || nm == 6)
+      PetscCall(PetscSNPrintf(what, len, "%s", (nm == 1 ? names1 : nm == 3 ? names2
+                                                                           : names3)[best]));
     else
       PetscCall(PetscSNPrintf(what, len, "rigid mode %" PetscInt_FMT, best));
   }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriCheckRigidMotion - errors when the constrained DOFs leave a rigid-body motion free (K would
-  be singular), naming the motion. Collective.
-@*/
-PetscErrorCode PeriCheckRigidMotion(PeriProblem p)
-{
-  PetscInt nfree;
-  char     what[128];
-
-  PetscFunctionBeginUser;
-  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what)));
-  PetscCheck(!nfree, p->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular. Constrain it in bc (e.g. fix the component on a small region)", p->scene->file, what);
+  for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

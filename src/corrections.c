@@ -2,7 +2,7 @@
  * correction) and the volume-method surface correction factor of Diana & Casolo eq. (16). */
 #include "perilin.h"
 
-const char *const PeriSurfaceCorrections[] = {"none", "volume", NULL};
+const char *const PeriSurfaceCorrections[] = {"none", "volume", "energy", NULL};
 
 /*@C
   PeriNeighborhoodVolumes - family volume sum_j alpha_ij V_j (the particle itself excluded) and

@@ -71,10 +71,10 @@ PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_
 @*/
 PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal delta)
 {
-  static const char *const keys[] = {"E", "nu", "K", "rho", "rho_by_region", "thickness", NULL};
+  static const char *const keys[] = {"E", "nu", "K", "mu", "rho", "rho_by_region", "mu_by_region", "thickness", NULL};
   PeriNode                 mat, node;
-  PetscReal                lo, hi, E = 0, nu = 0, K = 0;
-  PetscBool                hasE, hasnu, hasK;
+  PetscReal                lo, hi, E = 0, nu = 0, K = 0, mu = 0;
+  PetscBool                hasE, hasnu, hasK, hasmu;
 
   PetscFunctionBeginUser;
   m->delta = delta;
@@ -83,14 +83,17 @@ PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal del
   PetscCall(PeriSceneGetReal(scene, mat, "E", PETSC_FALSE, &E, &hasE));
   PetscCall(PeriSceneGetReal(scene, mat, "nu", PETSC_FALSE, &nu, &hasnu));
   PetscCall(PeriSceneGetReal(scene, mat, "K", PETSC_FALSE, &K, &hasK));
-  PeriInputCheck(hasE || hasK, scene, mat, "E", "is required (or give the bulk modulus K)");
-  PeriInputCheck(!(hasE && hasK), scene, mat, "K", "give E or K, not both");
+  PetscCall(PeriSceneGetReal(scene, mat, "mu", PETSC_FALSE, &mu, &hasmu));
+  PeriInputCheck(hasE || hasK || hasmu, scene, mat, "E", "is required (or give the bulk modulus K or the shear modulus mu)");
+  PeriInputCheck((hasE ? 1 : 0) + (hasK ? 1 : 0) + (hasmu ? 1 : 0) == 1, scene, mat, hasE ? (hasK ? "K" : "mu") : "mu", "give one of E, K and mu");
   PeriInputCheck(!hasE || E > 0, scene, mat, "E", "must be positive, got %g", (double)E);
   PeriInputCheck(!hasK || K > 0, scene, mat, "K", "must be positive, got %g", (double)K);
+  PeriInputCheck(!hasmu || mu > 0, scene, mat, "mu", "must be positive, got %g", (double)mu);
   m->ops.nu_range(m, &lo, &hi);
   if (!hasnu) {
-    PeriInputCheck(lo == hi, scene, mat, "nu", "is required by model %s (admissible range %g to %g)", m->type, (double)lo, (double)hi);
-    nu = lo;
+    /* antiplane models need only the shear modulus: nu is then irrelevant and taken as 0 */
+    PeriInputCheck(lo == hi || m->antiplane, scene, mat, "nu", "is required by model %s (admissible range %g to %g)", m->type, (double)lo, (double)hi);
+    nu = lo == hi ? lo : 0;
   } else if (lo == hi) {
     /* 0.333 means 1/3: bond-based models have one Poisson ratio, accept it to 3 digits */
     PeriInputCheck(PetscAbsReal(nu - lo) < 1e-3, scene, mat, "nu", "model %s in this setting has the fixed Poisson ratio %g; got %g (use a model with shear bonds for other values)", m->type, (double)lo, (double)nu);
@@ -99,6 +102,7 @@ PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal del
     PeriInputCheck(nu >= lo && nu <= hi, scene, mat, "nu", "must lie in [%g, %g] for model %s, got %g", (double)lo, (double)hi, m->type, (double)nu);
   PeriInputCheck(nu > -1 && nu < 0.5, scene, mat, "nu", "must lie in (-1, 1/2), got %g", (double)nu);
   if (hasK) E = 3 * K * (1 - 2 * nu);
+  if (hasmu) E = 2 * mu * (1 + nu);
   m->material.E   = E;
   m->material.nu  = nu;
   m->material.K   = E / (3 * (1 - 2 * nu));

@@ -190,6 +190,18 @@ PetscErrorCode PeriParticlesPermute(PeriParticles *p, const PetscInt perm[])
     q.spacing[k]     = p->spacing[o];
     q.source_line[k] = p->source_line[o];
   }
+  if (p->image) {
+    PetscInt *inv;
+    PetscCall(PetscMalloc1(p->n, &inv));
+    for (PetscInt k = 0; k < p->n; k++) inv[perm[k]] = k;
+    PetscCall(PetscMalloc2(p->n, &q.image, p->n, &q.crossed));
+    for (PetscInt k = 0; k < p->n; k++) {
+      PetscInt o   = perm[k];
+      q.image[k]   = p->image[o] < 0 ? -1 : inv[p->image[o]];
+      q.crossed[k] = p->crossed[o];
+    }
+    PetscCall(PetscFree(inv));
+  }
   PetscCall(PeriParticlesDestroy(p));
   *p = q;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -200,5 +212,6 @@ PetscErrorCode PeriParticlesDestroy(PeriParticles *p)
   PetscFunctionBeginUser;
   PetscCall(PetscFree(p->x));
   PetscCall(PetscFree3(p->volume, p->spacing, p->source_line));
+  PetscCall(PetscFree2(p->image, p->crossed));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -90,6 +90,17 @@ static PetscErrorCode ReadCorrections(PeriProblem p)
   PetscCall(PeriSceneGetChoice(s, c, "partial_volume", PeriPartialVolumes, &pv, NULL));
   PetscCall(PeriSceneGetChoice(s, c, "surface", PeriSurfaceCorrections, &sc, &found));
   PeriInputCheck(sc == PERI_SURFACE_NONE || p->model->allows_surface_correction, s, c, "surface", "model %s normalizes each particle's micromodulus by its own family volume, which already corrects surfaces: use surface: none", p->model->type);
+  {
+    static const char *const defaults[] = {"none", "volume", NULL};
+    const char *const       *allowed    = p->model->surface_corrections ? p->model->surface_corrections : defaults;
+    char                     list[128]  = "";
+    PetscBool                ok         = PETSC_FALSE;
+    for (PetscInt k = 0; allowed[k]; k++) {
+      ok = (PetscBool)(ok || !strcmp(allowed[k], PeriSurfaceCorrections[sc]));
+      PeriListAppend(list, sizeof(list), allowed[k]);
+    }
+    PeriInputCheck(ok, s, c, "surface", "model %s takes %s, not %s", p->model->type, list, PeriSurfaceCorrections[sc]);
+  }
   p->partial_volume = (PeriPartialVolume)pv;
   p->surface        = (PeriSurfaceCorrection)sc;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -121,6 +132,7 @@ static PetscErrorCode ReadProbes(PeriProblem p)
     PetscCall(PeriSceneGetRealArray(s, map, map->child[k]->key, PETSC_TRUE, pt->dim, pt->dim, pr->x, &n));
     for (PetscInt i = 0; i < pt->n; i++) {
       PetscReal d2 = 0;
+      if (PeriParticleIsFictitious(pt, i)) continue;
       for (PetscInt d = 0; d < pt->dim; d++) d2 += PetscSqr(pt->x[3 * i + d] - pr->x[d]);
       /* ties go to the lexicographically smallest position, whatever the numbering (ranks) */
       if (d2 < best || (d2 == best && LexLess(&pt->x[3 * i], &pt->x[3 * pr->particle]))) {
@@ -195,10 +207,94 @@ static PetscErrorCode CreateModel(PeriProblem p)
 
 static PetscErrorCode CheckRootKeys(PeriScene s)
 {
-  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", NULL};
+  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", "boundary_layers", "torsion", NULL};
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckKeys(s, s->root, keys));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The point X folded back into the body's box through the faces it lies beyond: a fictitious
+ * layer particle has the material of its mirror image. */
+static void FoldIntoBody(const PeriParticles *pt, const PetscReal X[], PetscReal Y[])
+{
+  for (PetscInt d = 0; d < 3; d++) {
+    Y[d] = X[d];
+    if (d >= pt->dim) continue;
+    if (Y[d] < pt->lower[d]) Y[d] = 2 * pt->lower[d] - Y[d];
+    if (Y[d] > pt->upper[d]) Y[d] = 2 * pt->upper[d] - Y[d];
+  }
+}
+
+static PetscReal ShearModulusAt(PeriProblem p, PetscInt nr, PeriRegion *const reg[], const PetscReal val[], const PetscReal X[])
+{
+  PetscReal Y[3], mu = p->model->material.G;
+  FoldIntoBody(&p->particles, X, Y);
+  for (PetscInt k = 0; k < nr; k++)
+    if (PeriRegionContains(reg[k], Y)) mu = val[k];
+  return mu;
+}
+
+static int CompareReal(const void *a, const void *b)
+{
+  PetscReal x = *(const PetscReal *)a, y = *(const PetscReal *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* material.mu_by_region: the shear modulus of every particle, and of every bond that crosses an
+ * interface, the harmonic mean over its length (Oterkus & Madenci eq. 60), exact for box regions:
+ * the bond is cut where it crosses a region's or the body's faces. */
+static PetscErrorCode ReadShearModuli(PeriProblem p)
+{
+  PeriScene            s  = p->scene;
+  const PeriParticles *pt = &p->particles;
+  const PeriBonds     *b  = &p->bonds;
+  PeriNode             mat, map;
+  PeriRegion         **reg;
+  PetscReal           *val, *cut;
+  PetscInt             nr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
+  PetscCall(PeriSceneGetMap(s, mat, "mu_by_region", PETSC_FALSE, &map));
+  if (!map) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(p->model->antiplane, s, map, NULL, "applies to the cross-section models (antiplane, antiplane_os), not %s", p->model->type);
+  nr = map->n;
+  PetscCall(PetscMalloc3(nr, &reg, nr, &val, 6 * (nr + 1) + 2, &cut));
+  for (PetscInt k = 0; k < nr; k++) {
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, p->nregions, p->regions, &reg[k]));
+    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &val[k], NULL));
+    PeriInputCheck(val[k] > 0, s, map, map->child[k]->key, "must be positive, got %g", (double)val[k]);
+  }
+  PetscCall(PetscMalloc1(pt->n, &p->mu));
+  for (PetscInt i = 0; i < pt->n; i++) p->mu[i] = ShearModulusAt(p, nr, reg, val, &pt->x[3 * i]);
+  PetscCall(PetscMalloc1(b->nbonds, &p->bond_mu));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      const PetscReal *X = &pt->x[3 * i], *xi = &b->xi[3 * k];
+      PetscInt         nc  = 0;
+      PetscReal        inv = 0;
+      /* the parameters t in (0, 1) where X + t xi crosses a face */
+      cut[nc++] = 0;
+      for (PetscInt r = 0; r <= nr; r++)
+        for (PetscInt d = 0; d < pt->dim; d++) {
+          PetscReal lo = r < nr ? reg[r]->lower[d] : pt->lower[d], hi = r < nr ? reg[r]->upper[d] : pt->upper[d];
+          if (xi[d] == 0) continue;
+          for (PetscInt e = 0; e < 2; e++) {
+            PetscReal t = ((e ? hi : lo) - X[d]) / xi[d];
+            if (t > 0 && t < 1) cut[nc++] = t;
+          }
+        }
+      cut[nc++] = 1;
+      qsort(cut, (size_t)nc, sizeof(PetscReal), CompareReal);
+      for (PetscInt c = 0; c + 1 < nc; c++) {
+        PetscReal Y[3], t = 0.5 * (cut[c] + cut[c + 1]);
+        for (PetscInt d = 0; d < 3; d++) Y[d] = X[d] + t * xi[d];
+        inv += (cut[c + 1] - cut[c]) / ShearModulusAt(p, nr, reg, val, Y);
+      }
+      p->bond_mu[k] = 1 / inv;
+    }
+  PetscCall(PetscFree3(reg, val, cut));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -226,6 +322,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(ReadHorizon(p));
   PetscCall(PeriModelSetFromScene(p->model, s, p->delta));
   PetscCall(ReadCorrections(p));
+  PetscCall(PeriLayersAddParticles(p));
   PetscCall(ReadOutput(p, s->file));
 
   PetscCall(PetscTime(&t0));
@@ -239,6 +336,8 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
 
   PetscCall(PetscLogEventBegin(PERI_EVENT_Neighbors, 0, 0, 0, 0));
   PetscCall(PeriNeighborSearch(&p->particles, p->delta, p->partial_volume, range[p->rank], range[p->rank + 1], PETSC_TRUE, &p->bonds));
+  /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
+  if (p->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&p->particles, p->delta, p->partial_volume, range[p->rank], range[p->rank + 1], PETSC_FALSE, &p->family));
   PetscCall(PetscMalloc2(p->particles.n, &p->family_volume, p->particles.n, &p->neighbor_count));
   PetscCall(PeriNeighborhoodVolumes(p->comm, &p->particles, &p->bonds, p->family_volume, p->neighbor_count));
   PetscCall(PeriSurfaceCorrectionApply(p->surface, &p->particles, p->delta, p->family_volume, &p->bonds));
@@ -256,15 +355,22 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
 
   for (PetscInt i = 0; i < p->particles.n; i++)
     PetscCheck(p->neighbor_count[i] > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)p->particles.x[3 * i], (double)p->particles.x[3 * i + 1], (double)p->particles.x[3 * i + 2], (double)p->delta, (double)p->particles.spacing[i]);
+  PetscCall(PeriRegionsCreateFromScene(s, &p->particles, p->delta, &p->nregions, &p->regions));
+  PetscCall(ReadShearModuli(p));
   cal.n             = p->particles.n;
   cal.family_volume = p->family_volume;
+  cal.mu            = p->mu;
+  cal.comm          = p->comm;
+  cal.particles     = &p->particles;
+  cal.bonds         = &p->bonds;
+  cal.surface       = p->surface;
   PetscCall(p->model->ops.calibrate(p->model, &cal));
   if (p->model->warning[0]) PetscCall(PetscPrintf(p->comm, "perilin: warning: %s\n", p->model->warning));
 
-  PetscCall(PeriRegionsCreateFromScene(s, &p->particles, p->delta, &p->nregions, &p->regions));
   PetscCall(ReadProbes(p));
   PetscCall(PeriReferenceSetUp(p));
   PetscCall(PeriBoundarySetUp(p));
+  PetscCall(PeriLayersSetUp(p));
   /* the loads too, so that a bad load is reported before any solve */
   PetscCall(PeriProblemCreateVec(p, &p->f));
   PetscCall(PeriLoadsAssemble(p, p->f));
@@ -297,6 +403,7 @@ PetscErrorCode PeriProblemBondGeometry(PeriProblem p, PetscInt i, PetscInt k, Pe
   g->Vi     = pt->volume[i];
   g->Vj     = pt->volume[g->j];
   g->weight = b->alpha[k] * b->lambda[k];
+  g->mu     = p->bond_mu ? p->bond_mu[k] : 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -372,19 +479,138 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Gathers the family of owned particle i from p->family (state-based models). */
+PetscErrorCode PeriProblemFamilyGeometry(PeriProblem p, PetscInt i, PetscInt *n, PeriBondGeometry fam[])
+{
+  const PeriBonds     *b  = &p->family;
+  const PeriParticles *pt = &p->particles;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+    PeriBondGeometry *g = &fam[(*n)++];
+    if (!b->live[k]) {
+      (*n)--;
+      continue;
+    }
+    g->i = i;
+    g->j = b->j[k];
+    for (PetscInt d = 0; d < 3; d++) g->xi[d] = b->xi[3 * k + d];
+    g->length = b->length[k];
+    g->Vi     = pt->volume[i];
+    g->Vj     = pt->volume[g->j];
+    g->weight = b->alpha[k] * b->lambda[k];
+    g->mu     = 0;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Largest family in p->family, for workspace. */
+PetscInt PeriProblemMaxFamily(PeriProblem p)
+{
+  PetscInt nmax = 0;
+  for (PetscInt i = p->family.rstart; i < p->family.rend; i++) nmax = PetscMax(nmax, p->family.offset[i - p->family.rstart + 1] - p->family.offset[i - p->family.rstart]);
+  return nmax;
+}
+
+/* Energy of the state-based particles' families: W_i V_i = u^T K_i u / 2 of each owned particle. */
+static PetscErrorCode FamilyEnergy(PeriProblem p, const PetscScalar u[], PetscReal W[], PetscReal *energy)
+{
+  PeriModel         m  = p->model;
+  const PetscInt    bs = m->dofs, nmax = PeriProblemMaxFamily(p);
+  PeriBondGeometry *fam;
+  PetscReal        *Ke, *ue;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc3(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, (nmax + 1) * bs, &ue));
+  for (PetscInt i = p->family.rstart; i < p->family.rend; i++) {
+    PetscInt  n, N;
+    PetscReal e = 0;
+    PetscCall(PeriProblemFamilyGeometry(p, i, &n, fam));
+    N = (n + 1) * bs;
+    PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
+    for (PetscInt c = 0; c < bs; c++) {
+      ue[c] = PetscRealPart(u[i * bs + c]);
+      for (PetscInt t = 0; t < n; t++) ue[(t + 1) * bs + c] = PetscRealPart(u[fam[t].j * bs + c]);
+    }
+    for (PetscInt a = 0; a < N; a++)
+      for (PetscInt c = 0; c < N; c++) e += 0.5 * ue[a] * Ke[a * N + c] * ue[c];
+    W[i] += e / p->particles.volume[i];
+    if (!PeriParticleIsFictitious(&p->particles, i)) *energy += e;
+  }
+  PetscCall(PetscFree3(fam, Ke, ue));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Antiplane models: the corrected shear angles grad uz = M^-1 R with M = sum w alpha xi xi^T V_j
+ * and R = sum w alpha (u_j - u_i) xi V_j (w = 1/|xi|^2), exact for every linear field (eq. 53 with
+ * the full 2x2 moment, so also at corners), and tau = mu (grad uz + twist terms). Rank 0 gets
+ * tau_xz, tau_yz of every particle. */
+static PetscErrorCode ShearStresses(PeriProblem p, const PetscScalar u[])
+{
+  const PeriBonds     *b  = &p->bonds;
+  const PeriParticles *pt = &p->particles;
+  const PetscInt       n  = pt->n;
+  PetscReal           *acc; /* per particle: M00 M01 M11 R0 R1 */
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(5 * n, &acc));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscInt         j  = b->j[k];
+      const PetscReal *xi = &b->xi[3 * k];
+      PetscReal        w = b->alpha[k] / (b->length[k] * b->length[k]), e = PetscRealPart(u[j] - u[i]);
+      if (!b->live[k] || j == i) continue;
+      for (PetscInt end = 0; end < 2; end++) {
+        PetscReal *A = &acc[5 * (end ? j : i)], V = pt->volume[end ? i : j];
+        A[0] += w * xi[0] * xi[0] * V;
+        A[1] += w * xi[0] * xi[1] * V;
+        A[2] += w * xi[1] * xi[1] * V;
+        A[3] += w * e * xi[0] * V;
+        A[4] += w * e * xi[1] * V;
+      }
+    }
+  PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, 0, p->comm));
+  PetscCall(PetscFree(p->tau));
+  if (p->rank == 0) {
+    PetscCall(PetscMalloc1(2 * n, &p->tau));
+    for (PetscInt i = 0; i < n; i++) {
+      const PetscReal *A   = &acc[5 * i];
+      PetscReal        det = A[0] * A[2] - A[1] * A[1], gx = 0, gy = 0, mu = p->mu ? p->mu[i] : p->model->material.G;
+      if (det > 1e-12 * PetscSqr(A[0] + A[2])) {
+        gx = (A[2] * A[3] - A[1] * A[4]) / det;
+        gy = (A[0] * A[4] - A[1] * A[3]) / det;
+      } else if (A[0] + A[2] > 0) { /* a one-dimensional family (a row of particles): along it only */
+        gx = A[0] > 0 ? A[3] / A[0] : 0;
+        gy = A[2] > 0 ? A[4] / A[2] : 0;
+      }
+      if (p->torsion.active) {
+        gx -= p->torsion.twist * (pt->x[3 * i + 1] - p->torsion.center[1]);
+        gy += p->torsion.twist * (pt->x[3 * i] - p->torsion.center[0]);
+      }
+      p->tau[2 * i]     = mu * gx;
+      p->tau[2 * i + 1] = mu * gy;
+    }
+  }
+  PetscCall(PetscFree(acc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriProblemEvaluateEnergy - from the solution p->u: the strain energy, the energy density W_i
-  = (1/2) sum_j (pair energy) / V_i of every particle (rank 0), the displacements of all particles
-  (rank 0), the probes and the largest displacement per component. Collective.
+  PeriProblemEvaluateEnergy - from the solution p->u: the strain energy of the body, the energy
+  density W_i = (1/2) sum_j (pair energy) / V_i of every particle (rank 0), the displacements of
+  all particles (rank 0), the probes, the largest displacement per component, and for antiplane
+  models the shear stresses and the torsion results. Collective.
 @*/
 PetscErrorCode PeriProblemEvaluateEnergy(PeriProblem p)
 {
-  VecScatter         scatter;
-  Vec                all;
-  const PetscScalar *u;
-  PeriModel          m = p->model;
-  const PetscInt     n = p->particles.n, bs = m->dofs, nb = 2 * bs;
-  PetscReal         *W, energy = 0, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  VecScatter           scatter;
+  Vec                  all;
+  const PetscScalar   *u;
+  PeriModel            m  = p->model;
+  const PeriParticles *pt = &p->particles;
+  const PetscInt       n = pt->n, bs = m->dofs, nb = 2 * bs;
+  PetscReal           *W, energy = 0, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], umax[PERI_MAX_DOF] = {0, 0, 0};
 
   PetscFunctionBeginUser;
   PetscCall(VecScatterCreateToAll(p->u, &scatter, &all));
@@ -392,25 +618,34 @@ PetscErrorCode PeriProblemEvaluateEnergy(PeriProblem p)
   PetscCall(VecScatterEnd(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(all, &u));
   PetscCall(PetscCalloc1(n, &W));
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
-    for (PetscInt k = p->bonds.offset[i - p->bonds.rstart]; k < p->bonds.offset[i - p->bonds.rstart + 1]; k++) {
-      PeriBondGeometry g;
-      PetscReal        ue[2 * PERI_MAX_DOF], e = 0;
-      if (!p->bonds.live[k] || p->bonds.j[k] == i) continue;
-      PetscCall(PeriProblemBondGeometry(p, i, k, &g));
-      m->ops.bond_stiffness(m, &g, Ke);
-      for (PetscInt c = 0; c < bs; c++) {
-        ue[c]      = PetscRealPart(u[i * bs + c]);
-        ue[bs + c] = PetscRealPart(u[g.j * bs + c]);
+  if (m->ops.family_stiffness)
+    PetscCall(FamilyEnergy(p, u, W, &energy));
+  else
+    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
+      for (PetscInt k = p->bonds.offset[i - p->bonds.rstart]; k < p->bonds.offset[i - p->bonds.rstart + 1]; k++) {
+        PeriBondGeometry g;
+        PetscReal        ue[2 * PERI_MAX_DOF], e = 0;
+        if (!p->bonds.live[k] || p->bonds.j[k] == i) continue;
+        PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+        m->ops.bond_stiffness(m, &g, Ke);
+        for (PetscInt c = 0; c < bs; c++) {
+          ue[c]      = PetscRealPart(u[i * bs + c]);
+          ue[bs + c] = PetscRealPart(u[g.j * bs + c]);
+        }
+        for (PetscInt a = 0; a < nb; a++)
+          for (PetscInt c = 0; c < nb; c++) e += 0.5 * ue[a] * Ke[a * nb + c] * ue[c];
+        /* each end owns half of the pair; fictitious particles are not part of the body */
+        if (!PeriParticleIsFictitious(pt, i)) energy += 0.5 * e;
+        if (!PeriParticleIsFictitious(pt, g.j)) energy += 0.5 * e;
+        W[i] += 0.5 * e / g.Vi;
+        W[g.j] += 0.5 * e / g.Vj;
       }
-      for (PetscInt a = 0; a < nb; a++)
-        for (PetscInt c = 0; c < nb; c++) e += 0.5 * ue[a] * Ke[a * nb + c] * ue[c];
-      energy += e;
-      W[i] += 0.5 * e / g.Vi;
-      W[g.j] += 0.5 * e / g.Vj;
-    }
+  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
+    for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(pt, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
+  PetscCallMPI(MPI_Allreduce(umax, p->results.max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, p->comm));
   PetscCallMPI(MPI_Allreduce(&energy, &p->results.strain_energy, 1, MPIU_REAL, MPI_SUM, p->comm));
   PetscCallMPI(MPI_Reduce(p->rank ? W : MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, 0, p->comm));
+  if (m->antiplane) PetscCall(ShearStresses(p, u));
   PetscCall(PetscFree(p->W));
   PetscCall(PetscFree(p->u_all));
   if (p->rank == 0) {
@@ -422,10 +657,11 @@ PetscErrorCode PeriProblemEvaluateEnergy(PeriProblem p)
       for (PetscInt c = 0; c < bs; c++) pr->u[c] = p->u_all[pr->particle * bs + c];
       pr->W = W[pr->particle];
     }
+    PetscCall(PeriTorsionEvaluate(p));
   } else
     PetscCall(PetscFree(W));
+  if (p->torsion.active) PetscCallMPI(MPI_Bcast(&p->torsion.torque, 6, MPIU_REAL, 0, p->comm));
   PetscCall(VecRestoreArrayRead(all, &u));
-  for (PetscInt c = 0; c < bs; c++) PetscCall(VecStrideNorm(p->u, c, NORM_INFINITY, &p->results.max_abs_u[c]));
   PetscCall(VecDestroy(&all));
   PetscCall(VecScatterDestroy(&scatter));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -477,6 +713,11 @@ PetscErrorCode PeriProblemDestroy(PeriProblem *problem)
   PetscCall(VecDestroy(&p->f));
   PetscCall(PeriModelDestroy(&p->model));
   PetscCall(PeriBondsDestroy(&p->bonds));
+  PetscCall(PeriBondsDestroy(&p->family));
+  PetscCall(PeriLayersDestroy(&p->layers));
+  PetscCall(PetscFree(p->mu));
+  PetscCall(PetscFree(p->bond_mu));
+  PetscCall(PetscFree(p->tau));
   PetscCall(PeriParticlesDestroy(&p->particles));
   PetscCall(PetscFree(p->regions));
   PetscCall(PetscFree(p->probes));

@@ -13,7 +13,7 @@ static PetscReal Tolerance(const PeriParticles *p)
 
 PetscBool PeriRegionContains(const PeriRegion *r, const PetscReal x[])
 {
-  if (r->kind == PERI_REGION_ALL) return PETSC_TRUE;
+  /* "all" is the body's box too: fictitious layer particles lie outside it */
   for (PetscInt d = 0; d < 3; d++)
     if (x[d] < r->lower[d] || x[d] > r->upper[d]) return PETSC_FALSE;
   return PETSC_TRUE;
@@ -89,9 +89,16 @@ PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *
   n = 1 + (map ? map->n : 0);
   PetscCall(PetscCalloc1(n, &r));
   PetscCall(PetscStrncpy(r[0].name, "all", sizeof(r[0].name)));
-  r[0].kind  = PERI_REGION_ALL;
-  r[0].count = p->n;
-  for (PetscInt k = 0; k < p->n; k++) r[0].volume += p->volume[k];
+  r[0].kind = PERI_REGION_ALL;
+  for (PetscInt d = 0; d < 3; d++) {
+    r[0].lower[d] = p->lower[d] - Tolerance(p);
+    r[0].upper[d] = p->upper[d] + Tolerance(p);
+  }
+  for (PetscInt k = 0; k < p->n; k++)
+    if (!PeriParticleIsFictitious(p, k)) {
+      r[0].count++;
+      r[0].volume += p->volume[k];
+    }
   for (PetscInt k = 1; k < n; k++) {
     PeriInputCheck(strcmp(map->child[k - 1]->key, "all"), scene, map->child[k - 1], NULL, "'all' is reserved: it always names every particle");
     PetscCall(RegionFromScene(scene, map->child[k - 1], p, delta, &r[k]));

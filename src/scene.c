@@ -15,10 +15,11 @@ typedef struct {
 
 static const PeriSceneKey scene_keys[] = {
     {"dim", "2 or 3"},
-    {"model.type", "bond model: pmb | npmb | pds | mppd | gerstle (see docs/models/)"},
+    {"model.type", "bond model: pmb | npmb | pds | mppd | gerstle | antiplane | antiplane_os (see docs/models/)"},
     {"model.k_theta", "mppd: rotational spring k_theta [energy/volume^2], instead of the factor"},
     {"model.k_theta_factor", "mppd: k_theta = f c delta^2 / (36 |xi|); default 1"},
     {"model.plane", "2D only: stress | strain"},
+    {"model.stabilization", "antiplane_os: weight of the misfit energy that removes zero-energy modes; default 1"},
     {"material.E", "Young's modulus [stress]"},
     {"material.nu", "Poisson ratio: pmb/npmb only 1/3 (plane stress) or 1/4 (plane strain, 3D); pds/mppd/gerstle (-1, 1/2)"},
     {"material.K", "3D bulk modulus [stress], instead of E"},

@@ -259,7 +259,7 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
   PetscCall(MatCreateSubMatrix(M, isfree, isfree, MAT_INITIAL_MATRIX, &Mff));
   PetscCall(MatSetOption(Kff, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(MatNorm(Kff, NORM_1, &Knorm));
-  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what)));
+  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what), NULL));
   md->nrigid = 0;
 
   /* the scale of the largest omega^2 */

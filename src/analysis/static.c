@@ -38,17 +38,92 @@ static PetscErrorCode DefaultMatType(char type[], size_t len)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* DOFs to hold at 0 so that the free rigid motions v[] (orthonormal) become determined: Gaussian
+ * elimination with complete pivoting on the modes' entries picks well-separated DOFs. Collective;
+ * each rank gets the pins it owns. */
+static PetscErrorCode PinFreeMotions(PeriProblem p, PetscInt nfree, Vec v[], PetscInt *npin, PetscInt pins[])
+{
+  Vec      w[PERI_MAX_MODES], t;
+  PetscInt rstart, rend;
+
+  PetscFunctionBeginUser;
+  *npin = 0;
+  PetscCall(VecGetOwnershipRange(v[0], &rstart, &rend));
+  PetscCall(VecDuplicate(v[0], &t));
+  for (PetscInt q = 0; q < nfree; q++) {
+    PetscCall(VecDuplicate(v[q], &w[q]));
+    PetscCall(VecCopy(v[q], w[q]));
+  }
+  for (PetscInt q = 0; q < nfree; q++) {
+    PetscInt  idx;
+    PetscReal amax, pivot = 0;
+    PetscCall(VecCopy(w[q], t));
+    PetscCall(VecAbs(t));
+    PetscCall(VecMax(t, &idx, &amax));
+    if (idx >= rstart && idx < rend) {
+      PetscCall(VecGetValues(w[q], 1, &idx, &pivot));
+      pins[(*npin)++] = idx;
+    }
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &pivot, 1, MPIU_REAL, MPI_SUM, p->comm));
+    for (PetscInt r = q + 1; r < nfree; r++) {
+      PetscReal c = 0;
+      if (idx >= rstart && idx < rend) PetscCall(VecGetValues(w[r], 1, &idx, &c));
+      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &c, 1, MPIU_REAL, MPI_SUM, p->comm));
+      PetscCall(VecAXPY(w[r], -c / pivot, w[q]));
+    }
+  }
+  for (PetscInt q = 0; q < nfree; q++) PetscCall(VecDestroy(&w[q]));
+  PetscCall(VecDestroy(&t));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Rigid motions the constraints leave free: an error when the loads would accelerate the body;
+ * otherwise (a self-equilibrated free body, a bar in torsion) the loads' round-off share along them
+ * is removed, enough DOFs are pinned to make A regular, and the caller projects the solution. */
+static PetscErrorCode HandleFreeMotions(PeriProblem p, Mat A, Vec u, Vec b, PetscReal diag, PetscInt *nfree, Vec free[])
+{
+  char      what[128];
+  PetscReal bnorm, share = 0;
+  PetscInt  npin, pins[PERI_MAX_MODES];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriRigidMotionFree(p, nfree, what, sizeof(what), free));
+  if (!*nfree) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecNorm(b, NORM_2, &bnorm));
+  for (PetscInt q = 0; q < *nfree; q++) {
+    PetscScalar dot;
+    PetscCall(VecDot(b, free[q], &dot));
+    share += PetscSqr(PetscRealPart(dot));
+  }
+  share                     = bnorm > 0 ? PetscSqrtReal(share) / bnorm : 0;
+  p->results.free_modes     = *nfree;
+  p->results.load_imbalance = share;
+  PetscCheck(bnorm > 0 && share<1e-6, p->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular%s. Constrain it in bc (e.g. fix the component on a small region)", p->scene->file, what, bnorm> 0 ? " and the loads are not balanced along it" : "");
+  for (PetscInt q = 0; q < *nfree; q++) {
+    PetscScalar dot;
+    PetscCall(VecDot(b, free[q], &dot));
+    PetscCall(VecAXPY(b, -dot, free[q]));
+  }
+  PetscCall(PinFreeMotions(p, *nfree, free, &npin, pins));
+  PetscCall(MatZeroRowsColumns(A, npin, pins, diag, u, b));
+  PetscCall(PetscPrintf(p->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAnalysisRun_Static - solves the linear static problem and evaluates energies and probes.
-  Options: every KSP/PC option (-ksp_type, -pc_type, -ksp_rtol, ...). Collective.
+  Fictitious layers are eliminated (A = R K T), prescribed DOFs symmetrically; a free body with
+  balanced loads is solved orthogonal to its rigid motions. Options: every KSP/PC option
+  (-ksp_type, -pc_type, -ksp_rtol, ...). Collective.
 @*/
 PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
 {
   KSP                ksp;
   PC                 pc;
-  Vec                r;
+  Mat                A;
+  Vec                r, b, free[PERI_MAX_MODES];
   PetscReal          diag, fnorm, rnorm;
-  PetscInt           N, nc;
+  PetscInt           N, nc, nfree = 0;
   KSPConvergedReason reason;
   PetscLogDouble     t0, t1;
 
@@ -68,33 +143,43 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
     PetscCall(PeriReferenceEvaluate(p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(PeriCheckRigidMotion(p));
   PetscCall(DefaultMatType(p->mat_type, sizeof(p->mat_type)));
   if (!p->K) PetscCall(PeriProblemAssemble(p));
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(VecDestroy(&p->u));
   PetscCall(MatCreateVecs(p->K, &p->u, NULL));
-  PetscCall(PeriSetNearNullSpace(p, p->K));
+  PetscCall(VecDuplicate(p->f, &b));
+  PetscCall(VecCopy(p->f, b));
+  p->results.symmetric = PETSC_TRUE;
+  if (p->layers.T)
+    PetscCall(PeriLayersApply(p, &A, b));
+  else {
+    PetscCall(PetscObjectReference((PetscObject)p->K));
+    A = p->K;
+  }
+  PetscCall(PeriSetNearNullSpace(p, A));
   PetscCall(VecSetValues(p->u, p->nconstrained, p->constrained, p->constrained_value, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(p->u));
   PetscCall(VecAssemblyEnd(p->u));
   /* a unit of the mean diagonal on eliminated rows keeps the conditioning of the free block */
-  PetscCall(MatCreateVecs(p->K, &r, NULL));
-  PetscCall(MatGetDiagonal(p->K, r));
+  PetscCall(MatCreateVecs(A, &r, NULL));
+  PetscCall(MatGetDiagonal(A, r));
   PetscCall(VecNorm(r, NORM_1, &diag));
   PetscCall(VecGetSize(r, &N));
   diag /= N;
   {
     PetscBool mpisbaij;
-    PetscCall(PetscObjectTypeCompare((PetscObject)p->K, MATMPISBAIJ, &mpisbaij));
+    PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPISBAIJ, &mpisbaij));
     PetscCheck(!mpisbaij, p->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
   }
-  PetscCall(MatZeroRowsColumns(p->K, p->nconstrained, p->constrained, diag, p->u, p->f));
+  PetscCall(MatZeroRowsColumns(A, p->nconstrained, p->constrained, diag, p->u, b));
+  PetscCall(HandleFreeMotions(p, A, p->u, b, diag, &nfree, free));
 
   PetscCall(KSPCreate(p->comm, &ksp));
-  PetscCall(KSPSetOperators(ksp, p->K, p->K));
-  PetscCall(KSPSetType(ksp, KSPCG));
+  PetscCall(KSPSetOperators(ksp, A, A));
+  /* the layers' elimination can leave A unsymmetric (it is checked): then GMRES */
+  PetscCall(KSPSetType(ksp, p->results.symmetric ? KSPCG : KSPGMRES));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCGAMG));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
@@ -107,14 +192,14 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
     PetscCall(PetscOptionsHasName(NULL, NULL, "-ksp_norm_type", &set));
     if (cg && !set) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
   }
-  PetscCall(KSPSolve(ksp, p->f, p->u));
+  PetscCall(KSPSolve(ksp, b, p->u));
   PetscCall(KSPGetConvergedReason(ksp, &reason));
   PetscCall(KSPGetIterationNumber(ksp, &p->results.iterations));
   /* the true relative residual, whatever norm the KSP monitored */
-  PetscCall(MatMult(p->K, p->u, r));
-  PetscCall(VecAYPX(r, -1, p->f));
+  PetscCall(MatMult(A, p->u, r));
+  PetscCall(VecAYPX(r, -1, b));
   PetscCall(VecNorm(r, NORM_2, &rnorm));
-  PetscCall(VecNorm(p->f, NORM_2, &fnorm));
+  PetscCall(VecNorm(b, NORM_2, &fnorm));
   p->results.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
   {
     KSPType kt;
@@ -127,9 +212,18 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscCall(PetscStrncpy(p->results.converged_reason, KSPConvergedReasons[reason], sizeof(p->results.converged_reason)));
   PetscCall(KSPDestroy(&ksp));
   PetscCall(VecDestroy(&r));
+  PetscCall(VecDestroy(&b));
+  PetscCall(MatDestroy(&A));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCheck(reason > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: %s after %" PetscInt_FMT " iterations (relative residual %g): %s", KSPConvergedReasons[reason], p->results.iterations, (double)p->results.residual_norm, Advice(reason));
   PetscCheck(!PetscIsInfOrNanReal(p->results.residual_norm), p->comm, PETSC_ERR_FP, "the static solution contains NaN or Inf: %s", Advice(KSP_DIVERGED_NANORINF));
+  for (PetscInt q = 0; q < nfree; q++) {
+    PetscScalar dot;
+    PetscCall(VecDot(p->u, free[q], &dot));
+    PetscCall(VecAXPY(p->u, -dot, free[q]));
+    PetscCall(VecDestroy(&free[q]));
+  }
+  PetscCall(PeriLayersComplete(p, p->u));
   PetscCall(PetscTime(&t1));
   p->results.solve_s = t1 - t0;
   PetscCall(PeriProblemEvaluateEnergy(p));

@@ -1,0 +1,326 @@
+/* Fictitious boundary layers (Oterkus & Madenci sec. 6) and torsion. A layer of particles outside
+ * a face of a grid body copies the body's particles mirrored through the face:
+ *   displacement u*:   u_f = 2 u* - u_m                     (eqs. 61-62)
+ *   shear_stress tau:  u_f = u_m + (tau/mu) (a_f - a_m)      (eq. 63c, tau = sigma_az on the face)
+ *   free:              u_f = u_m (+ the twist term)          (eqs. 64, 67)
+ * With torsion (twist psi about (x0, y0)) the free and shear-stress faces carry the twist term
+ * psi (y - y0)(x_f - x_m) on x faces and -psi (x - x0)(y_f - y_m) on y faces: the paper's eqs. 65-67
+ * print a 1/mu (dimensionally wrong) and eq. 65b the opposite sign of eqs. 84/86; perilin follows
+ * the traction-free conditions tau_xz = mu (u_z,x - psi (y - y0)) = 0, tau_yz = mu (u_z,y + psi (x - x0)) = 0.
+ * The relations u = T u_body + g are eliminated from the static system: A = R K T (R keeps the
+ * body's rows), which is symmetric for mirror images on a uniform grid (checked at run time). */
+#include "perilin.h"
+
+const char *const PeriLayerKinds[] = {"none", "displacement", "shear_stress", "free", NULL};
+
+static PetscErrorCode ReadTorsion(PeriProblem p)
+{
+  static const char *const keys[] = {"twist", "center", NULL};
+  PeriScene                s      = p->scene;
+  PeriNode                 t;
+  PetscInt                 n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "torsion", PETSC_FALSE, &t));
+  if (!t) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneCheckKeys(s, t, keys));
+  PeriInputCheck(p->model->antiplane, s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", p->model->type);
+  PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &p->torsion.twist, NULL));
+  PeriInputCheck(p->torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
+  p->torsion.center[0] = 0.5 * (p->particles.lower[0] + p->particles.upper[0]);
+  p->torsion.center[1] = 0.5 * (p->particles.lower[1] + p->particles.upper[1]);
+  PetscCall(PeriSceneGetRealArray(s, t, "center", PETSC_FALSE, 2, 2, p->torsion.center, &n));
+  p->torsion.active = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Fictitious cells beyond a face: those a body particle can bond to. A state-based particle's
+ * force also involves its neighbours' shear angles, so there the layer is twice as deep: every
+ * fictitious particle that a body particle bonds to has a complete family. */
+static PetscInt LayerCells(PeriProblem p, PetscReal h)
+{
+  PetscReal R = PeriSearchRadius(p->partial_volume, p->delta, h);
+  return (p->model->ops.family_stiffness ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
+}
+
+/*@C
+  PeriLayersAddParticles - reads boundary_layers and torsion and appends the fictitious particles
+  (with their mirror images) to the grid's particles. Call after the horizon and the corrections
+  are known, before partitioning. Not collective.
+@*/
+PetscErrorCode PeriLayersAddParticles(PeriProblem p)
+{
+  static const char *const keys[]  = {"side", "condition", "value", NULL};
+  static const char *const sides[] = {"x-", "x+", "y-", "y+", NULL};
+  PeriScene                s       = p->scene;
+  PeriParticles           *pt      = &p->particles;
+  PeriLayers              *L       = &p->layers;
+  PeriNode                 list, grid;
+  PetscInt                 cells[2], lo[2] = {0, 0}, hi[2] = {0, 0}, nl, n, k;
+  PetscReal                h;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReadTorsion(p));
+  PetscCall(PeriSceneGetNode(s->root, "boundary_layers", &list));
+  if (!list) {
+    PeriInputCheck(!p->torsion.active, s, s->root, "torsion", "needs boundary_layers: the twist enters through the free faces' fictitious layers");
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PeriInputCheck(list->kind == PERI_NODE_SEQ && list->n > 0, s, list, NULL, "must be a list of layers, each {side: x-|x+|y-|y+, condition: displacement|shear_stress|free, value: ..}");
+  PeriInputCheck(p->model->antiplane, s, list, NULL, "fictitious layers carry the conditions of the cross-section models (antiplane, antiplane_os); for model %s use bc and loads", p->model->type);
+  PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
+  PeriInputCheck(grid, s, list, NULL, "need a grid body (grid:), whose faces the layers mirror; particles.file is not supported");
+  h = pt->mean_spacing;
+  for (PetscInt d = 0; d < 2; d++) cells[d] = (PetscInt)PetscFloorReal((pt->upper[d] - pt->lower[d]) / h + 0.5);
+  nl = LayerCells(p, h);
+  for (PetscInt i = 0; i < list->n; i++) {
+    PeriNode  item = list->child[i];
+    PetscInt  side = 0, kind = 0, face;
+    PetscBool hasv;
+    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a layer is a mapping {side: .., condition: .., value: ..}");
+    PetscCall(PeriSceneCheckKeys(s, item, keys));
+    PetscCall(PeriSceneGetChoice(s, item, "side", sides, &side, NULL));
+    PetscCall(PeriSceneGetChoice(s, item, "condition", PeriLayerKinds + 1, &kind, NULL));
+    kind++;
+    face = side;
+    PeriInputCheck(!pt->periodic[face / 2], s, item, "side", "axis %c is periodic: it has no face", (char)('x' + face / 2));
+    PeriInputCheck(L->kind[face] == PERI_LAYER_NONE, s, item, "side", "face %s already has a layer", sides[face]);
+    L->kind[face] = (PeriLayerKind)kind;
+    PetscCall(PeriSceneGetReal(s, item, "value", kind != PERI_LAYER_FREE, &L->value[face], &hasv));
+    PeriInputCheck(kind != PERI_LAYER_FREE || !hasv, s, item, "value", "a free face takes no value");
+    /* the mirror of the deepest fictitious cell must lie in the body */
+    PeriInputCheck(cells[face / 2] >= nl, s, item, "side", "the body is %" PetscInt_FMT " particles across axis %c but the layer is %" PetscInt_FMT " deep (the horizon): the mirror images would fall outside the body; refine the grid or shorten the horizon", cells[face / 2], (char)('x' + face / 2), nl);
+    if (face % 2)
+      hi[face / 2] = nl;
+    else
+      lo[face / 2] = nl;
+    L->nfaces++;
+  }
+  n = (cells[0] + lo[0] + hi[0]) * (cells[1] + lo[1] + hi[1]) - cells[0] * cells[1];
+  {
+    PetscInt       nb = pt->n, N = pt->n + n;
+    PetscReal     *x, *vol, *sp;
+    PetscInt      *src;
+    unsigned char *crossed;
+    PetscCall(PetscCalloc1(3 * N, &x));
+    PetscCall(PetscMalloc3(N, &vol, N, &sp, N, &src));
+    PetscCall(PetscMalloc2(N, &pt->image, N, &crossed));
+    PetscCall(PetscArraycpy(x, pt->x, 3 * nb));
+    PetscCall(PetscArraycpy(vol, pt->volume, nb));
+    PetscCall(PetscArraycpy(sp, pt->spacing, nb));
+    PetscCall(PetscArraycpy(src, pt->source_line, nb));
+    for (k = 0; k < nb; k++) {
+      pt->image[k] = -1;
+      crossed[k]   = 0;
+    }
+    for (PetscInt c1 = -lo[1]; c1 < cells[1] + hi[1]; c1++)
+      for (PetscInt c0 = -lo[0]; c0 < cells[0] + hi[0]; c0++) {
+        const PetscInt c[2] = {c0, c1};
+        PetscInt       m[2] = {c0, c1};
+        unsigned char  mask = 0;
+        for (PetscInt d = 0; d < 2; d++) {
+          if (c[d] < 0) {
+            mask |= (unsigned char)(1 << (2 * d));
+            m[d] = -1 - c[d];
+          } else if (c[d] >= cells[d]) {
+            mask |= (unsigned char)(1 << (2 * d + 1));
+            m[d] = 2 * cells[d] - 1 - c[d];
+          }
+        }
+        if (!mask) continue;
+        for (PetscInt d = 0; d < 2; d++) x[3 * k + d] = pt->lower[d] + (c[d] + 0.5) * h;
+        vol[k]       = pt->volume[0];
+        sp[k]        = h;
+        src[k]       = 0;
+        pt->image[k] = m[1] * cells[0] + m[0];
+        crossed[k]   = mask;
+        k++;
+      }
+    PetscCall(PetscFree(pt->x));
+    PetscCall(PetscFree3(pt->volume, pt->spacing, pt->source_line));
+    pt->x           = x;
+    pt->volume      = vol;
+    pt->spacing     = sp;
+    pt->source_line = src;
+    pt->crossed     = crossed;
+    pt->n           = N;
+    pt->nfictitious = n;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The relation u(X) = sign u(Y) + offset across one face: Y is X mirrored through it. */
+static void FaceRelation(PeriProblem p, PetscInt face, const PetscReal X[], const PetscReal Y[], PetscReal mu, PetscReal *sign, PetscReal *offset)
+{
+  const PeriLayers *L    = &p->layers;
+  const PetscInt    a    = face / 2;
+  PetscReal         grad = 0;
+
+  if (L->kind[face] == PERI_LAYER_DISPLACEMENT) {
+    *sign   = -1;
+    *offset = 2 * L->value[face];
+    return;
+  }
+  if (L->kind[face] == PERI_LAYER_SHEAR_STRESS) grad = L->value[face] / mu;
+  if (p->torsion.active) grad += a == 0 ? p->torsion.twist * (X[1] - p->torsion.center[1]) : -p->torsion.twist * (X[0] - p->torsion.center[0]);
+  *sign   = 1;
+  *offset = grad * (X[a] - Y[a]);
+}
+
+/*@C
+  PeriLayersSetUp - the relation of every owned fictitious particle to its mirror image: the
+  matrix T and the offsets g of u = T u_body + g. Call after calibration (the shear moduli).
+  Collective.
+@*/
+PetscErrorCode PeriLayersSetUp(PeriProblem p)
+{
+  const PeriParticles *pt     = &p->particles;
+  PeriLayers          *L      = &p->layers;
+  const PetscInt       rstart = p->bonds.rstart, rend = p->bonds.rend;
+
+  PetscFunctionBeginUser;
+  if (!L->nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(MatCreateAIJ(p->comm, rend - rstart, rend - rstart, pt->n, pt->n, 1, NULL, 1, NULL, &L->T));
+  PetscCall(PeriProblemCreateVec(p, &L->g));
+  for (PetscInt i = rstart; i < rend; i++) {
+    PetscInt    m = pt->image[i], faces[2], nf = 0;
+    PetscReal   sign = 1, offset = 0, mu;
+    PetscScalar v;
+    if (m < 0) {
+      PetscCall(MatSetValue(L->T, i, i, 1.0, INSERT_VALUES));
+      continue;
+    }
+    mu = p->mu ? p->mu[m] : p->model->material.G;
+    for (PetscInt f = 0; f < 4; f++)
+      if (pt->crossed[i] & (1 << f)) faces[nf++] = f;
+    if (nf == 1)
+      FaceRelation(p, faces[0], &pt->x[3 * i], &pt->x[3 * m], mu, &sign, &offset);
+    else {
+      /* a corner: through one face to an intermediate image, then through the other; the two
+         orders differ in the twist term, so take their mean */
+      for (PetscInt o = 0; o < 2; o++) {
+        PetscInt  f1 = faces[o], f2 = faces[1 - o], a1 = f1 / 2;
+        PetscReal Y[3], s1, o1, s2, o2;
+        for (PetscInt d = 0; d < 3; d++) Y[d] = pt->x[3 * i + d];
+        Y[a1] = pt->x[3 * m + a1];
+        FaceRelation(p, f1, &pt->x[3 * i], Y, mu, &s1, &o1);
+        FaceRelation(p, f2, Y, &pt->x[3 * m], mu, &s2, &o2);
+        sign = s1 * s2;
+        offset += 0.5 * (o1 + s1 * o2);
+      }
+    }
+    v = sign;
+    PetscCall(MatSetValue(L->T, i, m, v, INSERT_VALUES));
+    PetscCall(VecSetValue(L->g, i, offset, INSERT_VALUES));
+  }
+  PetscCall(MatAssemblyBegin(L->T, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(L->T, MAT_FINAL_ASSEMBLY));
+  PetscCall(VecAssemblyBegin(L->g));
+  PetscCall(VecAssemblyEnd(L->g));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriLayersApply - eliminates the fictitious DOFs: *A = R K T with unit rows on the fictitious
+  DOFs (scaled by the mean diagonal), f <- R (f - K g). Sets MAT_SYMMETRIC from a check of A.
+  Collective.
+@*/
+PetscErrorCode PeriLayersApply(PeriProblem p, Mat *A, Vec f)
+{
+  const PeriParticles *pt = &p->particles;
+  PeriLayers          *L  = &p->layers;
+  Mat                  K = p->K, Kaij = NULL;
+  Vec                  w;
+  PetscInt            *rows, nf = 0, N;
+  PetscReal            diag, kmax;
+  PetscBool            aij, sym;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)K, &aij, MATAIJ, MATSEQAIJ, MATMPIAIJ, ""));
+  if (!aij) {
+    PetscCall(MatConvert(K, MATAIJ, MAT_INITIAL_MATRIX, &Kaij));
+    K = Kaij;
+  }
+  PetscCall(MatMatMult(K, L->T, MAT_INITIAL_MATRIX, PETSC_DEFAULT, A));
+  PetscCall(MatCreateVecs(K, &w, NULL));
+  PetscCall(MatMult(K, L->g, w));
+  PetscCall(VecAXPY(f, -1, w));
+  PetscCall(MatGetDiagonal(K, w));
+  PetscCall(VecNorm(w, NORM_1, &diag));
+  PetscCall(VecGetSize(w, &N));
+  diag /= N;
+  PetscCall(VecDestroy(&w));
+  PetscCall(MatDestroy(&Kaij));
+  PetscCall(PetscMalloc1(p->bonds.rend - p->bonds.rstart, &rows));
+  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
+    if (PeriParticleIsFictitious(pt, i)) rows[nf++] = i;
+  PetscCall(MatZeroRows(*A, nf, rows, diag, NULL, NULL));
+  for (PetscInt k = 0; k < nf; k++) PetscCall(VecSetValue(f, rows[k], 0.0, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(f));
+  PetscCall(VecAssemblyEnd(f));
+  PetscCall(PetscFree(rows));
+  PetscCall(MatNorm(*A, NORM_INFINITY, &kmax));
+  PetscCall(MatIsSymmetric(*A, 1e-12 * kmax, &sym));
+  PetscCall(MatSetOption(*A, MAT_SYMMETRIC, sym));
+  p->results.symmetric = sym;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* u <- T u + g: the fictitious DOFs from their images. Collective. */
+PetscErrorCode PeriLayersComplete(PeriProblem p, Vec u)
+{
+  Vec t;
+
+  PetscFunctionBeginUser;
+  if (!p->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecDuplicate(u, &t));
+  PetscCall(MatMult(p->layers.T, u, t));
+  PetscCall(VecWAXPY(u, 1, p->layers.g, t));
+  PetscCall(VecDestroy(&t));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriLayersDestroy(PeriLayers *L)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&L->T));
+  PetscCall(VecDestroy(&L->g));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The torsion constant of a solid a x b rectangle (Saint-Venant, Prandtl's series). */
+static PetscReal RectangleTorsionConstant(PetscReal A, PetscReal B)
+{
+  PetscReal a = 0.5 * PetscMin(A, B), b = 0.5 * PetscMax(A, B), sum = 0;
+  for (PetscInt n = 1; n < 200; n += 2) sum += PetscTanhReal(n * PETSC_PI * b / (2 * a)) / PetscPowReal((PetscReal)n, 5);
+  return 16.0 / 3.0 * a * a * a * b * (1 - 192 / PetscPowReal(PETSC_PI, 5) * a / b * sum);
+}
+
+/*@C
+  PeriTorsionEvaluate - from the shear stresses p->tau (rank 0): the torque per unit length
+  T = sum (x tau_yz - y tau_xz) A over the body's particles (A = V / l), the torsion constant
+  J = T / (mu psi), the largest stress |tau| and where. Not collective (rank 0 has the fields).
+@*/
+PetscErrorCode PeriTorsionEvaluate(PeriProblem p)
+{
+  const PeriParticles *pt = &p->particles;
+  PeriTorsion         *t  = &p->torsion;
+
+  PetscFunctionBeginUser;
+  if (!t->active || !p->tau) PetscFunctionReturn(PETSC_SUCCESS);
+  t->torque = t->max_stress = 0;
+  for (PetscInt i = 0; i < pt->n; i++) {
+    PetscReal x = pt->x[3 * i] - t->center[0], y = pt->x[3 * i + 1] - t->center[1], tau;
+    if (PeriParticleIsFictitious(pt, i)) continue;
+    t->torque += (x * p->tau[2 * i + 1] - y * p->tau[2 * i]) * pt->volume[i] / pt->thickness;
+    tau = PetscSqrtReal(PetscSqr(p->tau[2 * i]) + PetscSqr(p->tau[2 * i + 1]));
+    if (tau > t->max_stress) {
+      t->max_stress = tau;
+      t->max_at[0]  = pt->x[3 * i];
+      t->max_at[1]  = pt->x[3 * i + 1];
+    }
+  }
+  t->J           = t->torque / (p->model->material.G * t->twist);
+  t->J_rectangle = RectangleTorsionConstant(pt->upper[0] - pt->lower[0], pt->upper[1] - pt->lower[1]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
