@@ -360,7 +360,7 @@ struct _p_PeriProblem {
   PeriBonds             family;         /* state-based models: every bond of each owned particle (both directions) */
   PeriLayers            layers;
   PeriTorsion           torsion;
-  PetscReal            *tau; /* antiplane models, rank 0: tau_xz, tau_yz per particle after the solve */
+  PetscReal            *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
   PeriModel             model;
   Mat                   K;                       /* stiffness */
   char                  mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */

@@ -173,8 +173,12 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
   const PetscInt           bs = m->dofs, dim = p->particles.dim;
   PeriNode                 loads;
   PetscScalar             *a;
+  PetscInt                 ncomp, uz;
 
   PetscFunctionBeginUser;
+  /* a 2D cross-section model's loads act along z: they take 3 components, [0, 0, F] */
+  PetscCall(PeriModelComponentIndex(m, "uz", &uz));
+  ncomp = dim == 2 && uz >= 0 ? 3 : dim;
   PetscCall(VecSet(f, 0));
   PetscCall(PeriSceneGetNode(s->root, "loads", &loads));
   if (!loads) PetscFunctionReturn(PETSC_SUCCESS);
@@ -184,7 +188,7 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
     PeriNode    item = loads->child[k], force, traction, body, field;
     PeriRegion *r;
     PetscReal   A[3][3] = {{0}}, F[3] = {0, 0, 0}, scale;
-    PetscInt    n, comp[3];
+    PetscInt    n, comp[3]            = {-1, -1, -1};
     PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force | traction_field: ..}");
     PetscCall(PeriSceneCheckKeys(s, item, keys));
     PetscCall(PeriRegionFind(s, item, "region", p->nregions, p->regions, &r));
@@ -198,18 +202,18 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
     else
       PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
                                                                           : "body_force",
-                                      PETSC_TRUE, dim, dim, F, &n));
+                                      PETSC_TRUE, dim, ncomp, F, &n));
     PeriInputCheck(!(traction || field) || r->kind == PERI_REGION_LAYER, s, item, traction ? "traction" : "traction_field", "needs a layer region (side: ..), whose face area converts traction to force; region '%s' is not one", r->name);
     /* particle i receives (A X_i + F) scale V_i */
     scale = body ? 1.0 : (traction || field ? r->face_area : 1.0) / r->volume;
-    for (PetscInt d = 0; d < dim; d++) {
+    for (PetscInt d = 0; d < ncomp; d++) {
       PetscCall(AxisComponent(m, d, &comp[d]));
       PeriInputCheck(comp[d] >= 0 || (F[d] == 0 && A[d][0] == 0 && A[d][1] == 0 && A[d][2] == 0), s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
     }
     for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
       const PetscReal *X = &p->particles.x[3 * i];
       if (!PeriRegionContains(r, X)) continue;
-      for (PetscInt d = 0; d < dim; d++) {
+      for (PetscInt d = 0; d < ncomp; d++) {
         PetscReal v = F[d];
         for (PetscInt e = 0; e < dim; e++) v += A[d][e] * X[e];
         if (comp[d] >= 0) a[(i - p->bonds.rstart) * bs + comp[d]] += v * scale * p->particles.volume[i];

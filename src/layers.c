@@ -312,8 +312,8 @@ PetscErrorCode PeriTorsionEvaluate(PeriProblem p)
   for (PetscInt i = 0; i < pt->n; i++) {
     PetscReal x = pt->x[3 * i] - t->center[0], y = pt->x[3 * i + 1] - t->center[1], tau;
     if (PeriParticleIsFictitious(pt, i)) continue;
-    t->torque += (x * p->tau[2 * i + 1] - y * p->tau[2 * i]) * pt->volume[i] / pt->thickness;
-    tau = PetscSqrtReal(PetscSqr(p->tau[2 * i]) + PetscSqr(p->tau[2 * i + 1]));
+    t->torque += (x * p->tau[3 * i + 1] - y * p->tau[3 * i]) * pt->volume[i] / pt->thickness;
+    tau = p->tau[3 * i + 2];
     if (tau > t->max_stress) {
       t->max_stress = tau;
       t->max_at[0]  = pt->x[3 * i];

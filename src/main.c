@@ -43,8 +43,10 @@ static PetscErrorCode Run(int argc, char **argv)
     PetscCall(PetscPrintf(p->comm, "perilin: %" PetscInt_FMT " modes (Hz):", p->modal->nmodes));
     for (PetscInt k = 0; k < p->modal->nmodes; k++) PetscCall(PetscPrintf(p->comm, " %.6g (%s)", (double)p->modal->modes[k].f_hz, p->modal->modes[k].kind));
     PetscCall(PetscPrintf(p->comm, "; results in %s/\n", p->output_dir));
-  } else
+  } else {
+    if (p->torsion.active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)p->torsion.torque, (double)p->torsion.J, (double)p->torsion.J_rectangle, 100 * (double)(p->torsion.J / p->torsion.J_rectangle - 1), (double)p->torsion.max_stress, (double)p->torsion.max_at[0], (double)p->torsion.max_at[1]));
     PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", p->results.strain_energy, p->output_dir));
+  }
   PetscCall(PeriProblemDestroy(&p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

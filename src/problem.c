@@ -545,7 +545,7 @@ static PetscErrorCode FamilyEnergy(PeriProblem p, const PetscScalar u[], PetscRe
 /* Antiplane models: the corrected shear angles grad uz = M^-1 R with M = sum w alpha xi xi^T V_j
  * and R = sum w alpha (u_j - u_i) xi V_j (w = 1/|xi|^2), exact for every linear field (eq. 53 with
  * the full 2x2 moment, so also at corners), and tau = mu (grad uz + twist terms). Rank 0 gets
- * tau_xz, tau_yz of every particle. */
+ * tau_xz, tau_yz and |tau| of every particle. */
 static PetscErrorCode ShearStresses(PeriProblem p, const PetscScalar u[])
 {
   const PeriBonds     *b  = &p->bonds;
@@ -573,7 +573,7 @@ static PetscErrorCode ShearStresses(PeriProblem p, const PetscScalar u[])
   PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, 0, p->comm));
   PetscCall(PetscFree(p->tau));
   if (p->rank == 0) {
-    PetscCall(PetscMalloc1(2 * n, &p->tau));
+    PetscCall(PetscMalloc1(3 * n, &p->tau));
     for (PetscInt i = 0; i < n; i++) {
       const PetscReal *A   = &acc[5 * i];
       PetscReal        det = A[0] * A[2] - A[1] * A[1], gx = 0, gy = 0, mu = p->mu ? p->mu[i] : p->model->material.G;
@@ -588,8 +588,9 @@ static PetscErrorCode ShearStresses(PeriProblem p, const PetscScalar u[])
         gx -= p->torsion.twist * (pt->x[3 * i + 1] - p->torsion.center[1]);
         gy += p->torsion.twist * (pt->x[3 * i] - p->torsion.center[0]);
       }
-      p->tau[2 * i]     = mu * gx;
-      p->tau[2 * i + 1] = mu * gy;
+      p->tau[3 * i]     = mu * gx;
+      p->tau[3 * i + 1] = mu * gy;
+      p->tau[3 * i + 2] = mu * PetscSqrtReal(gx * gx + gy * gy);
     }
   }
   PetscCall(PetscFree(acc));

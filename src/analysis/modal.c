@@ -105,6 +105,7 @@ static PetscErrorCode ReadSettings(PeriProblem p, PetscInt *nev, PetscReal *targ
   PeriInputCheck(*target_hz >= 0, s, a, "target_hz", "must not be negative");
   PetscCall(PeriSceneGetNode(s->root, "material", &mat));
   PeriInputCheck(p->model->material.rho > 0, s, mat, "rho", "a modal analysis needs the density (material.rho > 0)");
+  PeriInputCheck(!p->layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -194,6 +194,28 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   }
   PetscCall(KSPSolve(ksp, b, p->u));
   PetscCall(KSPGetConvergedReason(ksp, &reason));
+  {
+    /* GAMG's default Chebyshev smoother misjudges the spectrum when the stiffness jumps by orders
+       of magnitude (an interface): retry once with symmetric SOR smoothing, unless told otherwise */
+    PetscBool gamg, set;
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-mg_levels_ksp_type", &set));
+    if (reason == KSP_DIVERGED_INDEFINITE_PC && gamg && !set) {
+      PetscInt nl;
+      PetscCall(PCMGGetLevels(pc, &nl));
+      for (PetscInt l = 1; l < nl; l++) {
+        KSP s;
+        PC  sp;
+        PetscCall(PCMGGetSmoother(pc, l, &s));
+        PetscCall(KSPSetType(s, KSPRICHARDSON));
+        PetscCall(KSPGetPC(s, &sp));
+        PetscCall(PCSetType(sp, PCSOR));
+      }
+      PetscCall(PetscPrintf(p->comm, "perilin: note: GAMG with Chebyshev smoothing failed (%s); retrying with SOR smoothing (-mg_levels_ksp_type richardson -mg_levels_pc_type sor)\n", KSPConvergedReasons[reason]));
+      PetscCall(KSPSolve(ksp, b, p->u));
+      PetscCall(KSPGetConvergedReason(ksp, &reason));
+    }
+  }
   PetscCall(KSPGetIterationNumber(ksp, &p->results.iterations));
   /* the true relative residual, whatever norm the KSP monitored */
   PetscCall(MatMult(A, p->u, r));

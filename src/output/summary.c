@@ -26,6 +26,14 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONReal(j, "K", p->model->material.K));
   PetscCall(PeriJSONReal(j, "G", p->model->material.G));
   PetscCall(PeriJSONEndObject(j));
+  if (p->layers.nfaces) {
+    static const char *const faces[] = {"x-", "x+", "y-", "y+"};
+    PetscCall(PeriJSONBeginObject(j, "boundary_layers"));
+    PetscCall(PeriJSONInt(j, "fictitious_particles", p->particles.nfictitious));
+    for (PetscInt f = 0; f < 4; f++)
+      if (p->layers.kind[f]) PetscCall(PeriJSONString(j, faces[f], PeriLayerKinds[p->layers.kind[f]]));
+    PetscCall(PeriJSONEndObject(j));
+  }
   PetscCall(PeriJSONBeginObject(j, "timing"));
   PetscCall(PeriJSONReal(j, "neighbors_s", r->neighbors_s));
   PetscCall(PeriJSONReal(j, "assembly_s", r->assembly_s));
@@ -40,7 +48,25 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONInt(j, "iterations", r->iterations));
   PetscCall(PeriJSONString(j, "converged_reason", r->converged_reason));
   PetscCall(PeriJSONReal(j, "residual_norm", r->residual_norm));
+  PetscCall(PeriJSONString(j, "operator", r->symmetric ? "symmetric" : "unsymmetric"));
+  if (r->free_modes) {
+    PetscCall(PeriJSONInt(j, "free_rigid_motions", r->free_modes));
+    PetscCall(PeriJSONReal(j, "load_share_removed", r->load_imbalance));
+  }
   PetscCall(PeriJSONEndObject(j));
+  if (p->torsion.active && p->tau) {
+    const PeriTorsion *t = &p->torsion;
+    PetscCall(PeriJSONBeginObject(j, "torsion"));
+    PetscCall(PeriJSONReal(j, "twist", t->twist));
+    PetscCall(PeriJSONRealArray(j, "center", 2, t->center));
+    PetscCall(PeriJSONReal(j, "torque", t->torque));
+    PetscCall(PeriJSONReal(j, "J", t->J));
+    PetscCall(PeriJSONReal(j, "J_rectangle_exact", t->J_rectangle));
+    PetscCall(PeriJSONReal(j, "J_error_vs_rectangle", t->J / t->J_rectangle - 1));
+    PetscCall(PeriJSONReal(j, "max_shear_stress", t->max_stress));
+    PetscCall(PeriJSONRealArray(j, "max_shear_stress_at", 2, t->max_at));
+    PetscCall(PeriJSONEndObject(j));
+  }
   if (p->u_all) {
     PetscCall(PeriJSONReal(j, "strain_energy", r->strain_energy));
     PetscCall(PeriJSONBeginObject(j, "max_abs_u"));

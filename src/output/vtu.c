@@ -144,6 +144,12 @@ static PetscErrorCode VTUDescribe(PeriProblem p, VTUArray a[], PetscInt *na)
   PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "neighbors", VTU_INT32, p->neighbor_count, 0, 0));
   PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "rank", VTU_INT32, p->owner, 0, 0));
   if (p->W) PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "strain_energy_density", 1, p->W, 1, NULL));
+  if (p->tau) {
+    static const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
+    PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress", 3, p->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
+    PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress_norm", 1, p->tau, 3, &nmap));
+  }
+  if (p->particles.image) PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "mirror_of", VTU_INT32, p->particles.image, 0, 0)); /* -1: a body particle */
   PetscCall(VTUAddReal(a, na, VTU_POINTS, "Points", 3, p->particles.x, 3, NULL));
   PetscCall(VTUAddInt(a, na, VTU_CELLS, "connectivity", VTU_INT64, NULL, 0, 0));
   PetscCall(VTUAddInt(a, na, VTU_CELLS, "offsets", VTU_INT64, NULL, 1, 0)); /* one point per cell */
