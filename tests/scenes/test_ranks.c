@@ -31,6 +31,10 @@ int main(int argc, char **argv)
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s| on %d ranks vs 1", p->model->type, p->model->components[c], size));
     PeriTestClose(what, p->results.max_abs_u[c], q->results.max_abs_u[c], 1e-7 * q->results.max_abs_u[c] + 1e-300);
   }
+  if (p->torsion.active) {
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: torsion constant J on %d ranks vs 1", p->model->type, size));
+    PeriTestClose(what, p->torsion.J, q->torsion.J, 1e-8 * q->torsion.J);
+  }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));
   PetscCall(PetscFinalize());
