@@ -414,14 +414,18 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisRegister(const char[], PetscErrorCode (*
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Static(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Modal(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriStaticSolve(PeriProblem, KSP *, PetscReal, PetscBool, PetscInt, const PetscInt[], const PetscReal[], KSPConvergedReason *);
+PETSC_EXTERN PetscErrorCode PeriStaticCheckConverged(PeriProblem, KSPConvergedReason);
+PETSC_EXTERN PetscErrorCode PeriStaticDefaultMatType(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAssembleMass(PeriProblem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[], size_t, Vec[]);
 
 /* fictitious boundary layers and torsion (src/layers.c) */
 PETSC_EXTERN PetscErrorCode PeriLayersAddParticles(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriLayersSetUp(PeriProblem);
-PETSC_EXTERN PetscErrorCode PeriLayersApply(PeriProblem, Mat *, Vec);
-PETSC_EXTERN PetscErrorCode PeriLayersComplete(PeriProblem, Vec);
+PETSC_EXTERN PetscErrorCode PeriLayersApply(PeriProblem, PetscReal, Mat *, Vec);
+PETSC_EXTERN PetscErrorCode PeriLayersComplete(PeriProblem, PetscReal, Vec);
 PETSC_EXTERN PetscErrorCode PeriLayersDestroy(PeriLayers *);
 PETSC_EXTERN PetscErrorCode PeriTorsionEvaluate(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriWriteModesCSV(PeriProblem, const char[]);

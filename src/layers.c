@@ -222,10 +222,10 @@ PetscErrorCode PeriLayersSetUp(PeriProblem p)
 
 /*@C
   PeriLayersApply - eliminates the fictitious DOFs: *A = R K T with unit rows on the fictitious
-  DOFs (scaled by the mean diagonal), f <- R (f - K g). Sets MAT_SYMMETRIC from a check of A.
+  DOFs (scaled by the mean diagonal), f <- R (f - lambda K g) (lambda scales the conditions). Sets MAT_SYMMETRIC from a check of A.
   Collective.
 @*/
-PetscErrorCode PeriLayersApply(PeriProblem p, Mat *A, Vec f)
+PetscErrorCode PeriLayersApply(PeriProblem p, PetscReal lambda, Mat *A, Vec f)
 {
   const PeriParticles *pt = &p->particles;
   PeriLayers          *L  = &p->layers;
@@ -244,7 +244,7 @@ PetscErrorCode PeriLayersApply(PeriProblem p, Mat *A, Vec f)
   PetscCall(MatMatMult(K, L->T, MAT_INITIAL_MATRIX, PETSC_DEFAULT, A));
   PetscCall(MatCreateVecs(K, &w, NULL));
   PetscCall(MatMult(K, L->g, w));
-  PetscCall(VecAXPY(f, -1, w));
+  PetscCall(VecAXPY(f, -lambda, w));
   PetscCall(MatGetDiagonal(K, w));
   PetscCall(VecNorm(w, NORM_1, &diag));
   PetscCall(VecGetSize(w, &N));
@@ -266,8 +266,8 @@ PetscErrorCode PeriLayersApply(PeriProblem p, Mat *A, Vec f)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* u <- T u + g: the fictitious DOFs from their images. Collective. */
-PetscErrorCode PeriLayersComplete(PeriProblem p, Vec u)
+/* u <- T u + lambda g: the fictitious DOFs from their images. Collective. */
+PetscErrorCode PeriLayersComplete(PeriProblem p, PetscReal lambda, Vec u)
 {
   Vec t;
 
@@ -275,7 +275,7 @@ PetscErrorCode PeriLayersComplete(PeriProblem p, Vec u)
   if (!p->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecDuplicate(u, &t));
   PetscCall(MatMult(p->layers.T, u, t));
-  PetscCall(VecWAXPY(u, 1, p->layers.g, t));
+  PetscCall(VecWAXPY(u, lambda, p->layers.g, t));
   PetscCall(VecDestroy(&t));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

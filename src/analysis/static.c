@@ -23,7 +23,7 @@ static const char *Advice(KSPConvergedReason reason)
 
 /* The block format (BAIJ) unless the preconditioner cannot take it: in PETSc 3.18 GAMG builds its
  * graph from AIJ only, and MUMPS factors BAIJ by LU only. -mat_type overrides this. */
-static PetscErrorCode DefaultMatType(char type[], size_t len)
+PetscErrorCode PeriStaticDefaultMatType(char type[], size_t len)
 {
   char      pc[64] = PCGAMG, solver[64] = "";
   PetscBool gamg, cholesky, mumps;
@@ -110,20 +110,173 @@ static PetscErrorCode HandleFreeMotions(PeriProblem p, Mat A, Vec u, Vec b, Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* CG (GMRES for an unsymmetric operator) + GAMG, rtol 1e-10, then the options. */
+static PetscErrorCode StaticKSPCreate(PeriProblem p, PetscBool symmetric, KSP *ksp)
+{
+  PC        pc;
+  PetscBool cg, set;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPCreate(p->comm, ksp));
+  PetscCall(KSPSetType(*ksp, symmetric ? KSPCG : KSPGMRES));
+  PetscCall(KSPGetPC(*ksp, &pc));
+  PetscCall(PCSetType(pc, PCGAMG));
+  PetscCall(KSPSetTolerances(*ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
+  PetscCall(KSPSetFromOptions(*ksp));
+  /* CG monitors the preconditioned residual by default, which GAMG lets sit 10-30x above the true
+   * one: make -ksp_rtol bound the true relative residual unless the user chose a norm */
+  PetscCall(PetscObjectTypeCompare((PetscObject)*ksp, KSPCG, &cg));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-ksp_norm_type", &set));
+  if (cg && !set) PetscCall(KSPSetNormType(*ksp, KSP_NORM_UNPRECONDITIONED));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* GAMG's default Chebyshev smoother misjudges the spectrum when the stiffness jumps by orders of
+ * magnitude (an interface): switch the levels to symmetric SOR, unless told otherwise. Returns
+ * whether it did. */
+static PetscErrorCode SmootherFallback(PeriProblem p, KSP ksp, KSPConvergedReason reason, PetscBool *retry)
+{
+  PC        pc;
+  PetscBool gamg, set;
+  PetscInt  nl;
+
+  PetscFunctionBeginUser;
+  *retry = PETSC_FALSE;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-mg_levels_ksp_type", &set));
+  if (reason != KSP_DIVERGED_INDEFINITE_PC || !gamg || set) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PCMGGetLevels(pc, &nl));
+  for (PetscInt l = 1; l < nl; l++) {
+    KSP s;
+    PC  sp;
+    PetscCall(PCMGGetSmoother(pc, l, &s));
+    PetscCall(KSPSetType(s, KSPRICHARDSON));
+    PetscCall(KSPGetPC(s, &sp));
+    PetscCall(PCSetType(sp, PCSOR));
+  }
+  PetscCall(PetscPrintf(p->comm, "perilin: note: GAMG with Chebyshev smoothing failed (%s); retrying with SOR smoothing (-mg_levels_ksp_type richardson -mg_levels_pc_type sor)\n", KSPConvergedReasons[reason]));
+  *retry = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriAnalysisRun_Static - solves the linear static problem and evaluates energies and probes.
-  Fictitious layers are eliminated (A = R K T), prescribed DOFs symmetrically; a free body with
-  balanced loads is solved orthogonal to its rigid motions. Options: every KSP/PC option
-  (-ksp_type, -pc_type, -ksp_rtol, ...). Collective.
+  PeriStaticSolve - solves K u = lambda f for p->u with the prescribed values and the layers'
+  offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
+  eliminated (A = R K T), prescribed DOFs symmetrically; a free body with balanced loads is solved
+  orthogonal to its rigid motions. p->K is kept unless inplace. *ksp is created on first use
+  (CG + GAMG, or GMRES for an unsymmetric operator, then the options). Sets p->results' solver
+  fields and returns the converged reason instead of failing. Collective.
+@*/
+PetscErrorCode PeriStaticSolve(PeriProblem p, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
+{
+  Mat       A;
+  Vec       r, b, free[PERI_MAX_MODES];
+  PetscReal diag, fnorm, rnorm, *values;
+  PetscInt  N, nfree = 0, nrows, *rows;
+  PetscBool retry;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
+  if (!p->u) PetscCall(MatCreateVecs(p->K, &p->u, NULL));
+  PetscCall(VecDuplicate(p->f, &b));
+  PetscCall(VecCopy(p->f, b));
+  PetscCall(VecScale(b, lambda));
+  p->results.symmetric = PETSC_TRUE;
+  if (p->layers.T)
+    PetscCall(PeriLayersApply(p, lambda, &A, b));
+  else if (inplace) {
+    PetscCall(PetscObjectReference((PetscObject)p->K));
+    A = p->K;
+  } else
+    PetscCall(MatDuplicate(p->K, MAT_COPY_VALUES, &A));
+  PetscCall(PeriSetNearNullSpace(p, A));
+  nrows = p->nconstrained + nhold;
+  PetscCall(PetscMalloc2(nrows, &rows, nrows, &values));
+  for (PetscInt k = 0; k < p->nconstrained; k++) {
+    rows[k]   = p->constrained[k];
+    values[k] = lambda * p->constrained_value[k];
+  }
+  for (PetscInt k = 0; k < nhold; k++) {
+    rows[p->nconstrained + k]   = hold[k];
+    values[p->nconstrained + k] = held[k];
+  }
+  PetscCall(VecSetValues(p->u, nrows, rows, values, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(p->u));
+  PetscCall(VecAssemblyEnd(p->u));
+  /* a unit of the mean diagonal on eliminated rows keeps the conditioning of the free block */
+  PetscCall(MatCreateVecs(A, &r, NULL));
+  PetscCall(MatGetDiagonal(A, r));
+  PetscCall(VecNorm(r, NORM_1, &diag));
+  PetscCall(VecGetSize(r, &N));
+  diag /= N;
+  {
+    PetscBool mpisbaij;
+    PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPISBAIJ, &mpisbaij));
+    PetscCheck(!mpisbaij, p->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
+  }
+  PetscCall(MatZeroRowsColumns(A, nrows, rows, diag, p->u, b));
+  PetscCall(PetscFree2(rows, values));
+  PetscCall(HandleFreeMotions(p, A, p->u, b, diag, &nfree, free));
+
+  if (!*ksp) PetscCall(StaticKSPCreate(p, p->results.symmetric, ksp));
+  PetscCall(KSPSetOperators(*ksp, A, A));
+  PetscCall(KSPSolve(*ksp, b, p->u));
+  PetscCall(KSPGetConvergedReason(*ksp, reason));
+  PetscCall(SmootherFallback(p, *ksp, *reason, &retry));
+  if (retry) {
+    PetscCall(KSPSolve(*ksp, b, p->u));
+    PetscCall(KSPGetConvergedReason(*ksp, reason));
+  }
+  PetscCall(KSPGetIterationNumber(*ksp, &p->results.iterations));
+  /* the true relative residual, whatever norm the KSP monitored */
+  PetscCall(MatMult(A, p->u, r));
+  PetscCall(VecAYPX(r, -1, b));
+  PetscCall(VecNorm(r, NORM_2, &rnorm));
+  PetscCall(VecNorm(b, NORM_2, &fnorm));
+  p->results.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
+  {
+    KSPType kt;
+    PCType  pt;
+    PC      pc;
+    PetscCall(KSPGetType(*ksp, &kt));
+    PetscCall(KSPGetPC(*ksp, &pc));
+    PetscCall(PCGetType(pc, &pt));
+    PetscCall(PetscStrncpy(p->results.ksp_type, kt, sizeof(p->results.ksp_type)));
+    PetscCall(PetscStrncpy(p->results.pc_type, pt, sizeof(p->results.pc_type)));
+  }
+  PetscCall(PetscStrncpy(p->results.converged_reason, KSPConvergedReasons[*reason], sizeof(p->results.converged_reason)));
+  for (PetscInt q = 0; q < nfree; q++) {
+    PetscScalar dot;
+    PetscCall(VecDot(p->u, free[q], &dot));
+    PetscCall(VecAXPY(p->u, -dot, free[q]));
+    PetscCall(VecDestroy(&free[q]));
+  }
+  PetscCall(PeriLayersComplete(p, lambda, p->u));
+  PetscCall(VecDestroy(&r));
+  PetscCall(VecDestroy(&b));
+  PetscCall(MatDestroy(&A));
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What a failed static solve tells the user. */
+PetscErrorCode PeriStaticCheckConverged(PeriProblem p, KSPConvergedReason reason)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(reason > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: %s after %" PetscInt_FMT " iterations (relative residual %g): %s", KSPConvergedReasons[reason], p->results.iterations, (double)p->results.residual_norm, Advice(reason));
+  PetscCheck(!PetscIsInfOrNanReal(p->results.residual_norm), p->comm, PETSC_ERR_FP, "the static solution contains NaN or Inf: %s", Advice(KSP_DIVERGED_NANORINF));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisRun_Static - solves the linear static problem once and evaluates energies and probes.
+  Options: every KSP/PC option (-ksp_type, -pc_type, -ksp_rtol, ...). Collective.
 @*/
 PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
 {
-  KSP                ksp;
-  PC                 pc;
-  Mat                A;
-  Vec                r, b, free[PERI_MAX_MODES];
-  PetscReal          diag, fnorm, rnorm;
-  PetscInt           N, nc, nfree = 0;
+  KSP                ksp = NULL;
+  PetscInt           nc;
   KSPConvergedReason reason;
   PetscLogDouble     t0, t1;
 
@@ -143,109 +296,13 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
     PetscCall(PeriReferenceEvaluate(p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(DefaultMatType(p->mat_type, sizeof(p->mat_type)));
+  PetscCall(PeriStaticDefaultMatType(p->mat_type, sizeof(p->mat_type)));
   if (!p->K) PetscCall(PeriProblemAssemble(p));
   PetscCall(PetscTime(&t0));
-  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(VecDestroy(&p->u));
-  PetscCall(MatCreateVecs(p->K, &p->u, NULL));
-  PetscCall(VecDuplicate(p->f, &b));
-  PetscCall(VecCopy(p->f, b));
-  p->results.symmetric = PETSC_TRUE;
-  if (p->layers.T)
-    PetscCall(PeriLayersApply(p, &A, b));
-  else {
-    PetscCall(PetscObjectReference((PetscObject)p->K));
-    A = p->K;
-  }
-  PetscCall(PeriSetNearNullSpace(p, A));
-  PetscCall(VecSetValues(p->u, p->nconstrained, p->constrained, p->constrained_value, INSERT_VALUES));
-  PetscCall(VecAssemblyBegin(p->u));
-  PetscCall(VecAssemblyEnd(p->u));
-  /* a unit of the mean diagonal on eliminated rows keeps the conditioning of the free block */
-  PetscCall(MatCreateVecs(A, &r, NULL));
-  PetscCall(MatGetDiagonal(A, r));
-  PetscCall(VecNorm(r, NORM_1, &diag));
-  PetscCall(VecGetSize(r, &N));
-  diag /= N;
-  {
-    PetscBool mpisbaij;
-    PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPISBAIJ, &mpisbaij));
-    PetscCheck(!mpisbaij, p->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
-  }
-  PetscCall(MatZeroRowsColumns(A, p->nconstrained, p->constrained, diag, p->u, b));
-  PetscCall(HandleFreeMotions(p, A, p->u, b, diag, &nfree, free));
-
-  PetscCall(KSPCreate(p->comm, &ksp));
-  PetscCall(KSPSetOperators(ksp, A, A));
-  /* the layers' elimination can leave A unsymmetric (it is checked): then GMRES */
-  PetscCall(KSPSetType(ksp, p->results.symmetric ? KSPCG : KSPGMRES));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCGAMG));
-  PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
-  PetscCall(KSPSetFromOptions(ksp));
-  {
-    /* CG monitors the preconditioned residual by default, which GAMG lets sit 10-30x above the true
-     * one: make -ksp_rtol bound the true relative residual unless the user chose a norm */
-    PetscBool cg, set;
-    PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPCG, &cg));
-    PetscCall(PetscOptionsHasName(NULL, NULL, "-ksp_norm_type", &set));
-    if (cg && !set) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
-  }
-  PetscCall(KSPSolve(ksp, b, p->u));
-  PetscCall(KSPGetConvergedReason(ksp, &reason));
-  {
-    /* GAMG's default Chebyshev smoother misjudges the spectrum when the stiffness jumps by orders
-       of magnitude (an interface): retry once with symmetric SOR smoothing, unless told otherwise */
-    PetscBool gamg, set;
-    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
-    PetscCall(PetscOptionsHasName(NULL, NULL, "-mg_levels_ksp_type", &set));
-    if (reason == KSP_DIVERGED_INDEFINITE_PC && gamg && !set) {
-      PetscInt nl;
-      PetscCall(PCMGGetLevels(pc, &nl));
-      for (PetscInt l = 1; l < nl; l++) {
-        KSP s;
-        PC  sp;
-        PetscCall(PCMGGetSmoother(pc, l, &s));
-        PetscCall(KSPSetType(s, KSPRICHARDSON));
-        PetscCall(KSPGetPC(s, &sp));
-        PetscCall(PCSetType(sp, PCSOR));
-      }
-      PetscCall(PetscPrintf(p->comm, "perilin: note: GAMG with Chebyshev smoothing failed (%s); retrying with SOR smoothing (-mg_levels_ksp_type richardson -mg_levels_pc_type sor)\n", KSPConvergedReasons[reason]));
-      PetscCall(KSPSolve(ksp, b, p->u));
-      PetscCall(KSPGetConvergedReason(ksp, &reason));
-    }
-  }
-  PetscCall(KSPGetIterationNumber(ksp, &p->results.iterations));
-  /* the true relative residual, whatever norm the KSP monitored */
-  PetscCall(MatMult(A, p->u, r));
-  PetscCall(VecAYPX(r, -1, b));
-  PetscCall(VecNorm(r, NORM_2, &rnorm));
-  PetscCall(VecNorm(b, NORM_2, &fnorm));
-  p->results.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
-  {
-    KSPType kt;
-    PCType  pt;
-    PetscCall(KSPGetType(ksp, &kt));
-    PetscCall(PCGetType(pc, &pt));
-    PetscCall(PetscStrncpy(p->results.ksp_type, kt, sizeof(p->results.ksp_type)));
-    PetscCall(PetscStrncpy(p->results.pc_type, pt, sizeof(p->results.pc_type)));
-  }
-  PetscCall(PetscStrncpy(p->results.converged_reason, KSPConvergedReasons[reason], sizeof(p->results.converged_reason)));
+  PetscCall(PeriStaticSolve(p, &ksp, 1.0, PETSC_TRUE, 0, NULL, NULL, &reason));
   PetscCall(KSPDestroy(&ksp));
-  PetscCall(VecDestroy(&r));
-  PetscCall(VecDestroy(&b));
-  PetscCall(MatDestroy(&A));
-  PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
-  PetscCheck(reason > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: %s after %" PetscInt_FMT " iterations (relative residual %g): %s", KSPConvergedReasons[reason], p->results.iterations, (double)p->results.residual_norm, Advice(reason));
-  PetscCheck(!PetscIsInfOrNanReal(p->results.residual_norm), p->comm, PETSC_ERR_FP, "the static solution contains NaN or Inf: %s", Advice(KSP_DIVERGED_NANORINF));
-  for (PetscInt q = 0; q < nfree; q++) {
-    PetscScalar dot;
-    PetscCall(VecDot(p->u, free[q], &dot));
-    PetscCall(VecAXPY(p->u, -dot, free[q]));
-    PetscCall(VecDestroy(&free[q]));
-  }
-  PetscCall(PeriLayersComplete(p, p->u));
+  PetscCall(PeriStaticCheckConverged(p, reason));
   PetscCall(PetscTime(&t1));
   p->results.solve_s = t1 - t0;
   PetscCall(PeriProblemEvaluateEnergy(p));
