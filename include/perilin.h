@@ -195,6 +195,9 @@ typedef struct {
      on its whole family fam[0..n-1] (all with fam[k].i == i): ((n+1) dofs)^2, row-major, the DOFs
      of i first, then those of fam[0], fam[1], ... */
   PetscErrorCode (*family_stiffness)(PeriModel, PetscInt, const PeriBondGeometry[], PetscReal[]);
+  /* The critical value of the first measure (stretch, shear angle) of this bond for the energy
+     release rate G: breaking every bond across a unit crack area releases G. May be NULL. */
+  PetscReal (*critical_from_G)(PeriModel, const PeriBondGeometry *, PetscReal);
   /* Values of the rigid-body (zero-energy) modes at a point, nmodes x dofs; returns nmodes. */
   PetscInt (*rigid_modes)(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
   PetscErrorCode (*destroy)(PeriModel); /* frees what data points to; data itself is freed after; may be NULL */
@@ -234,6 +237,7 @@ PETSC_EXTERN void           PeriCentralBondBlock(PeriModel, const PeriBondGeomet
 PETSC_EXTERN void           PeriAddSpring(PetscInt, const PetscReal[], PetscReal, PetscReal[]);
 PETSC_EXTERN void           PeriPlaneMicromoduli(PeriModel, PetscReal *, PetscReal *);
 PETSC_EXTERN void           PeriShearBondNuRange(PeriModel, PetscReal *, PetscReal *);
+PETSC_EXTERN PetscReal      PeriCriticalStretchSpring(PeriModel, PetscReal, PetscReal);
 PETSC_EXTERN void           PeriBondStretch(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
 PETSC_EXTERN void           PeriBondBasedNuRange(PeriModel, PetscReal *, PetscReal *);
 PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);
@@ -269,6 +273,8 @@ typedef struct {
   PetscBool symmetric;      /* the operator solved was symmetric */
   PetscInt  free_modes;     /* rigid motions left free with balanced loads: solved orthogonal to them */
   PetscReal load_imbalance; /* share of the load along those motions, removed */
+  PetscInt  precracked_bonds;
+  PetscBool free_modes_noted; /* the note on free motions is printed once per run */
   PetscInt  edge_cut;       /* bonds between particles of different ranks */
   /* against the scene's reference field (src/reference.c) */
   PetscBool has_reference;
@@ -340,6 +346,29 @@ typedef struct {
   PetscReal torque, J, J_rectangle, max_stress, max_at[2]; /* results, per unit length; kept contiguous (broadcast as 6 reals) */
 } PeriTorsion;
 
+/* Bond failure criteria (failure:, src/failure.c); 0 = criterion not given. */
+typedef struct {
+  PetscBool active;
+  PetscReal stretch, G, compressive, sliding, friction_angle, cohesion, shear_angle;
+  PetscInt  istretch, isliding, ishear; /* the model's measures, -1 when absent */
+} PeriFailure;
+
+/* One load step of the quasi-static analysis. */
+typedef struct {
+  PetscReal lambda, control_u, seconds;
+  PetscInt  broken, broken_total, iterations, ksp_iterations;
+} PeriStep;
+
+typedef struct {
+  PetscInt  nsteps, cap;
+  PeriStep *steps;
+  PetscReal peak_load_factor, critical_load_factor;
+  PetscInt  broken_bonds, fragments_held, pc_setups, solves;
+  PetscBool failed, complete;
+  char      ending[160];
+  char      control[PERI_NAME_LEN];
+} PeriQuasistatic;
+
 typedef struct _p_PeriProblem *PeriProblem;
 struct _p_PeriProblem {
   MPI_Comm              comm;
@@ -361,6 +390,10 @@ struct _p_PeriProblem {
   PeriLayers            layers;
   PeriTorsion           torsion;
   PetscReal            *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
+  PeriFailure           failure;
+  PetscReal            *damage;      /* rank 0, scenes with failure: phi per particle */
+  PeriQuasistatic      *quasistatic; /* the quasi-static analysis' results */
+  PetscInt              output_every;
   PeriModel             model;
   Mat                   K;                       /* stiffness */
   char                  mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
@@ -421,6 +454,14 @@ PETSC_EXTERN PetscErrorCode PeriStaticDefaultMatType(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAssembleMass(PeriProblem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[], size_t, Vec[]);
 
+/* failure, cracks, damage, pieces (src/failure.c) */
+PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriProblem);
+PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriProblem, const PeriBondGeometry *, const PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriDamage(PeriProblem, PetscReal **);
+PETSC_EXTERN PetscErrorCode PeriComponents(PeriProblem, PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriWriteStepsCSV(PeriProblem, const char[]);
+
 /* fictitious boundary layers and torsion (src/layers.c) */
 PETSC_EXTERN PetscErrorCode PeriLayersAddParticles(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriLayersSetUp(PeriProblem);
@@ -441,6 +482,7 @@ PETSC_EXTERN PetscErrorCode PeriJSONEndArray(PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriJSONString(PeriJSON, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriJSONReal(PeriJSON, const char[], PetscReal);
 PETSC_EXTERN PetscErrorCode PeriJSONInt(PeriJSON, const char[], PetscInt);
+PETSC_EXTERN PetscErrorCode PeriJSONBool(PeriJSON, const char[], PetscBool);
 PETSC_EXTERN PetscErrorCode PeriJSONRealArray(PeriJSON, const char[], PetscInt, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
 PETSC_EXTERN PetscErrorCode PeriWriteVTU(PeriProblem, const char[]);

@@ -58,6 +58,14 @@ static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal
   r[0] = (uj[0] - ui[0]) / b->length;
 }
 
+/* eq. 78: breaking every bond across a unit crack area releases G_IIIc = (c mu/2) r_c^2 l delta^4 / 2
+ * (eq. 77), so r_c = sqrt(2 pi G / (3 mu delta)); mu is the bond's modulus */
+static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
+{
+  PetscReal mu = b->mu > 0 ? b->mu : m->material.G;
+  return PetscSqrtReal(2 * PETSC_PI * G / (3 * mu * m->delta));
+}
+
 static PetscInt RigidModes(PeriModel m, const PetscReal X[], PetscReal modes[][PERI_MAX_DOF])
 {
   (void)m;
@@ -279,6 +287,7 @@ static PetscErrorCode Create(PeriModel m)
   m->ops.nu_range      = NuRange;
   m->ops.bond_measures = BondMeasures;
   m->ops.rigid_modes   = RigidModes;
+  m->ops.critical_from_G = CriticalFromG;
   m->ops.destroy       = Destroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

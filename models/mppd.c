@@ -92,6 +92,13 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
   PeriAddSpring(6, bt, w * kth, Ke);
 }
 
+/* the normal springs' critical stretch (the shear and rotational springs are left out of the energy balance) */
+static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
+{
+  (void)b;
+  return PeriCriticalStretchSpring(m, ((const MPPD *)m->data)->c, G);
+}
+
 static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[], const PetscReal uj[], PetscReal h[])
 {
   PetscReal bs[6], bg[6], bt[6], u[6] = {ui[0], ui[1], ui[2], uj[0], uj[1], uj[2]};
@@ -141,6 +148,7 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->ops.calibrate      = Calibrate;
   m->ops.bond_stiffness = BondStiffness;
   m->ops.bond_measures  = BondMeasures;
+  m->ops.critical_from_G = CriticalFromG;
   m->ops.rigid_modes    = RigidModes;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -34,6 +34,20 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
   PeriCentralBondBlock(m, b, c * b->Vi * b->Vj * b->weight / (b->length * b->length), Ke);
 }
 
+/* The energy of every bond across a unit crack area at stretch s, each bond counted once with
+ * its pair energy c s^2 V_i V_j / 2: G = t (c s^2/2) int_0^delta A_seg(z) dz = c s^2 t delta^3 / 3 in 2D
+ * (A_seg the circular segment beyond the crack line), G = (c s^2/2) int_0^delta V_cap(z) dz =
+ * pi c s^2 delta^4 / 8 in 3D. Ganzenmueller's eq. 21 (and Diehl's eq. 16) count each bond from both
+ * sides, G = (2/3) c s^2 t delta^3, which makes s_c and the critical loads too small by sqrt(2)
+ * (docs/failure.md). c is the bond's c_ij. */
+static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
+{
+  const NPMB *np = (const NPMB *)m->data;
+  PetscReal   c  = 0.5 * (np->c[b->i] + np->c[b->j]);
+  if (m->dim == 3) return PetscSqrtReal(8 * G / (PETSC_PI * c * PetscPowReal(m->delta, 4)));
+  return PetscSqrtReal(3 * G / (c * m->material.thickness * PetscPowReal(m->delta, 3)));
+}
+
 static PetscErrorCode Destroy(PeriModel m)
 {
   PetscFunctionBeginUser;
@@ -54,5 +68,6 @@ PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
   m->ops.calibrate             = Calibrate;
   m->ops.bond_stiffness        = BondStiffness;
   m->ops.destroy               = Destroy;
+  m->ops.critical_from_G       = CriticalFromG;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -47,6 +47,13 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
   PeriAddSpring(4, bg, w * pds->g, Ke);
 }
 
+/* the normal springs' critical stretch (the shear springs are left out of the energy balance) */
+static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
+{
+  (void)b;
+  return PeriCriticalStretchSpring(m, ((const PDS *)m->data)->c, G);
+}
+
 static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[], const PetscReal uj[], PetscReal h[])
 {
   PetscReal bs[4], bg[4], u[4] = {ui[0], ui[1], uj[0], uj[1]};
@@ -75,6 +82,7 @@ PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   m->ops.calibrate      = Calibrate;
   m->ops.bond_stiffness = BondStiffness;
   m->ops.bond_measures  = BondMeasures;
+  m->ops.critical_from_G = CriticalFromG;
   /* the rotation is not a zero-energy mode for g != 0, but it is the near-null space AMG wants */
   m->ops.rigid_modes = PeriTranslationalRigidModes;
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -25,6 +25,12 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
   PeriCentralBondBlock(m, b, pmb->c * b->Vi * b->Vj * b->weight / b->length, Ke);
 }
 
+static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
+{
+  (void)b;
+  return PeriCriticalStretchSpring(m, ((const PMB *)m->data)->c, G);
+}
+
 PetscErrorCode PeriModelCreate_PMB(PeriModel m)
 {
   PMB *pmb;
@@ -34,6 +40,7 @@ PetscErrorCode PeriModelCreate_PMB(PeriModel m)
   m->data = pmb;
   PeriModelSetCentralForce(m);
   m->ops.calibrate      = Calibrate;
-  m->ops.bond_stiffness = BondStiffness;
+  m->ops.bond_stiffness  = BondStiffness;
+  m->ops.critical_from_G = CriticalFromG;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

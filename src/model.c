@@ -204,6 +204,16 @@ void PeriShearBondNuRange(PeriModel m, PetscReal *lo, PetscReal *hi)
   *hi = 0.5 - 1e-6;
 }
 
+/* Critical stretch of a spring with pair energy c s^2 |xi| V_i V_j / 2 for the energy release rate G:
+ * the energy of all bonds across a unit crack area at stretch s is G = c s^2 t delta^4 / 4 in 2D
+ * and pi c s^2 delta^5 / 10 in 3D (Silling & Askari; Ha & Bobaru), so s_c = sqrt(4G/(c t delta^4))
+ * (plane stress pmb: sqrt(4 pi G / (9 E delta))) and sqrt(10 G/(pi c delta^5)) = sqrt(5G/(9K delta)). */
+PetscReal PeriCriticalStretchSpring(PeriModel m, PetscReal c, PetscReal G)
+{
+  if (m->dim == 3) return PetscSqrtReal(10 * G / (PETSC_PI * c * PetscPowReal(m->delta, 5)));
+  return PetscSqrtReal(4 * G / (c * m->material.thickness * PetscPowReal(m->delta, 4)));
+}
+
 /* Linearized stretch s = e . (u_j - u_i) / |xi|. */
 void PeriBondStretch(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[], const PetscReal uj[], PetscReal s[])
 {

@@ -148,11 +148,11 @@ static PetscErrorCode ReadProbes(PeriProblem p)
 
 static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
 {
-  static const char *const keys[] = {"dir", "vtk", NULL};
+  static const char *const keys[] = {"dir", "vtk", "every", NULL};
   PeriScene                s      = p->scene;
   PeriNode                 o;
   char                     base[PETSC_MAX_PATH_LEN], *slash, *dot;
-  static const char *const akeys[] = {"type", "nev", "target_hz", NULL};
+  static const char *const akeys[] = {"type", "nev", "target_hz", "load_factor_max", "load_factor_step", "min_step", "adaptive", "break", "break_fraction", "max_iterations", "reuse_preconditioner", "control_probe", "runaway_fraction", NULL};
   PeriNode                 a;
 
   PetscFunctionBeginUser;
@@ -164,6 +164,8 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneCheckKeys(s, o, keys));
   PetscCall(PeriSceneGetString(s, o, "dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
   PetscCall(PeriSceneGetBool(s, o, "vtk", &p->vtk, NULL));
+  PetscCall(PeriSceneGetInt(s, o, "every", PETSC_FALSE, &p->output_every, NULL));
+  PeriInputCheck(p->output_every >= 0, s, o, "every", "must not be negative (0: only the end), got %" PetscInt_FMT, p->output_every);
   PetscCall(PetscStrncpy(p->analysis, "static", sizeof(p->analysis)));
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
   PetscCall(PeriSceneCheckKeys(s, a, akeys));
@@ -207,7 +209,7 @@ static PetscErrorCode CreateModel(PeriProblem p)
 
 static PetscErrorCode CheckRootKeys(PeriScene s)
 {
-  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", "boundary_layers", "torsion", NULL};
+  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", "boundary_layers", "torsion", "failure", "cracks", NULL};
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckKeys(s, s->root, keys));
@@ -339,6 +341,8 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
   if (p->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&p->particles, p->delta, p->partial_volume, range[p->rank], range[p->rank + 1], PETSC_FALSE, &p->family));
   PetscCall(PetscMalloc2(p->particles.n, &p->family_volume, p->particles.n, &p->neighbor_count));
+  /* a crack is geometry: the family volumes, the surface correction and the calibration see it */
+  PetscCall(PeriCracksApply(p));
   PetscCall(PeriNeighborhoodVolumes(p->comm, &p->particles, &p->bonds, p->family_volume, p->neighbor_count));
   PetscCall(PeriSurfaceCorrectionApply(p->surface, &p->particles, p->delta, p->family_volume, &p->bonds));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Neighbors, 0, 0, 0, 0));
@@ -368,6 +372,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   if (p->model->warning[0]) PetscCall(PetscPrintf(p->comm, "perilin: warning: %s\n", p->model->warning));
 
   PetscCall(ReadProbes(p));
+  PetscCall(PeriFailureSetUp(p));
   PetscCall(PeriReferenceSetUp(p));
   PetscCall(PeriBoundarySetUp(p));
   PetscCall(PeriLayersSetUp(p));
@@ -440,6 +445,7 @@ PetscErrorCode PeriAnalysisRegisterAll(void)
   done = PETSC_TRUE;
   PetscCall(PeriAnalysisRegister("static", PeriAnalysisRun_Static));
   PetscCall(PeriAnalysisRegister("modal", PeriAnalysisRun_Modal));
+  PetscCall(PeriAnalysisRegister("quasistatic", PeriAnalysisRun_Quasistatic));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -572,6 +578,11 @@ static PetscErrorCode ShearStresses(PeriProblem p, const PetscScalar u[])
     }
   PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, 0, p->comm));
   PetscCall(PetscFree(p->tau));
+  PetscCall(PetscFree(p->damage));
+  if (p->quasistatic) {
+    PetscCall(PetscFree(p->quasistatic->steps));
+    PetscCall(PetscFree(p->quasistatic));
+  }
   if (p->rank == 0) {
     PetscCall(PetscMalloc1(3 * n, &p->tau));
     for (PetscInt i = 0; i < n; i++) {
@@ -693,6 +704,10 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.vtu", p->output_dir));
     PetscCall(PeriWriteVTU(p, path));
   }
+  if (p->quasistatic) {
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/steps.csv", p->output_dir));
+    PetscCall(PeriWriteStepsCSV(p, path));
+  }
   if (p->modal) {
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", p->output_dir));
     PetscCall(PeriWriteModesCSV(p, path));
@@ -719,6 +734,11 @@ PetscErrorCode PeriProblemDestroy(PeriProblem *problem)
   PetscCall(PetscFree(p->mu));
   PetscCall(PetscFree(p->bond_mu));
   PetscCall(PetscFree(p->tau));
+  PetscCall(PetscFree(p->damage));
+  if (p->quasistatic) {
+    PetscCall(PetscFree(p->quasistatic->steps));
+    PetscCall(PetscFree(p->quasistatic));
+  }
   PetscCall(PeriParticlesDestroy(&p->particles));
   PetscCall(PetscFree(p->regions));
   PetscCall(PetscFree(p->probes));

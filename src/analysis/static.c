@@ -80,14 +80,30 @@ static PetscErrorCode PinFreeMotions(PeriProblem p, PetscInt nfree, Vec v[], Pet
 /* Rigid motions the constraints leave free: an error when the loads would accelerate the body;
  * otherwise (a self-equilibrated free body, a bar in torsion) the loads' round-off share along them
  * is removed, enough DOFs are pinned to make A regular, and the caller projects the solution. */
-static PetscErrorCode HandleFreeMotions(PeriProblem p, Mat A, Vec u, Vec b, PetscReal diag, PetscInt *nfree, Vec free[])
+static PetscErrorCode HandleFreeMotions(PeriProblem p, Mat A, Vec u, Vec b, PetscReal diag, PetscInt nhold, const PetscInt hold[], PetscInt *nfree, Vec free[])
 {
   char      what[128];
   PetscReal bnorm, share = 0;
-  PetscInt  npin, pins[PERI_MAX_MODES];
+  PetscInt  npin, pins[PERI_MAX_MODES], nkeep = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PeriRigidMotionFree(p, nfree, what, sizeof(what), free));
+  /* held pieces do not move with the body: the motions live on the rest */
+  for (PetscInt q = 0; q < *nfree; q++) {
+    PetscReal norm;
+    for (PetscInt k = 0; k < nhold; k++) PetscCall(VecSetValue(free[q], hold[k], 0.0, INSERT_VALUES));
+    PetscCall(VecAssemblyBegin(free[q]));
+    PetscCall(VecAssemblyEnd(free[q]));
+    for (PetscInt r = 0; r < nkeep; r++) {
+      PetscScalar dot;
+      PetscCall(VecDot(free[q], free[r], &dot));
+      PetscCall(VecAXPY(free[q], -dot, free[r]));
+    }
+    PetscCall(VecNormalize(free[q], &norm));
+    if (norm > 1e-8) free[nkeep++] = free[q];
+    else PetscCall(VecDestroy(&free[q]));
+  }
+  *nfree = nkeep;
   if (!*nfree) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecNorm(b, NORM_2, &bnorm));
   for (PetscInt q = 0; q < *nfree; q++) {
@@ -106,7 +122,8 @@ static PetscErrorCode HandleFreeMotions(PeriProblem p, Mat A, Vec u, Vec b, Pets
   }
   PetscCall(PinFreeMotions(p, *nfree, free, &npin, pins));
   PetscCall(MatZeroRowsColumns(A, npin, pins, diag, u, b));
-  PetscCall(PetscPrintf(p->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
+  if (!p->results.free_modes_noted) PetscCall(PetscPrintf(p->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
+  p->results.free_modes_noted = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -217,7 +234,7 @@ PetscErrorCode PeriStaticSolve(PeriProblem p, KSP *ksp, PetscReal lambda, PetscB
   }
   PetscCall(MatZeroRowsColumns(A, nrows, rows, diag, p->u, b));
   PetscCall(PetscFree2(rows, values));
-  PetscCall(HandleFreeMotions(p, A, p->u, b, diag, &nfree, free));
+  PetscCall(HandleFreeMotions(p, A, p->u, b, diag, nhold, hold, &nfree, free));
 
   if (!*ksp) PetscCall(StaticKSPCreate(p, p->results.symmetric, ksp));
   PetscCall(KSPSetOperators(*ksp, A, A));

@@ -354,6 +354,14 @@ PetscErrorCode PeriJSONInt(PeriJSON j, const char key[], PetscInt v)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+PetscErrorCode PeriJSONBool(PeriJSON j, const char key[], PetscBool v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(JSONBeginValue(j, key));
+  PetscCall(JSONPrintf(j, "%s", v ? "true" : "false"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Written on one line: "key": [a, b, c]. */
 PetscErrorCode PeriJSONRealArray(PeriJSON j, const char key[], PetscInt n, const PetscReal v[])
 {

@@ -54,6 +54,22 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
     PetscCall(PeriJSONReal(j, "load_share_removed", r->load_imbalance));
   }
   PetscCall(PeriJSONEndObject(j));
+  if (p->quasistatic) {
+    const PeriQuasistatic *q = p->quasistatic;
+    PetscCall(PeriJSONBeginObject(j, "quasistatic"));
+    PetscCall(PeriJSONInt(j, "steps", q->nsteps));
+    PetscCall(PeriJSONReal(j, "peak_load_factor", q->peak_load_factor));
+    if (q->failed) PetscCall(PeriJSONReal(j, "critical_load_factor", q->critical_load_factor));
+    PetscCall(PeriJSONInt(j, "broken_bonds", q->broken_bonds));
+    PetscCall(PeriJSONInt(j, "precracked_bonds", r->precracked_bonds));
+    PetscCall(PeriJSONBool(j, "failed", q->failed));
+    PetscCall(PeriJSONBool(j, "complete", q->complete));
+    PetscCall(PeriJSONString(j, "ending", q->ending));
+    PetscCall(PeriJSONInt(j, "solves", q->solves));
+    PetscCall(PeriJSONInt(j, "preconditioner_setups", q->pc_setups));
+    if (q->control[0]) PetscCall(PeriJSONString(j, "control_probe", q->control));
+    PetscCall(PeriJSONEndObject(j));
+  }
   if (p->torsion.active && p->tau) {
     const PeriTorsion *t = &p->torsion;
     PetscCall(PeriJSONBeginObject(j, "torsion"));

@@ -149,6 +149,7 @@ static PetscErrorCode VTUDescribe(PeriProblem p, VTUArray a[], PetscInt *na)
     PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress", 3, p->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
     PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress_norm", 1, p->tau, 3, &nmap));
   }
+  if (p->damage) PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "damage", 1, p->damage, 1, NULL));
   if (p->particles.image) PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "mirror_of", VTU_INT32, p->particles.image, 0, 0)); /* -1: a body particle */
   PetscCall(VTUAddReal(a, na, VTU_POINTS, "Points", 3, p->particles.x, 3, NULL));
   PetscCall(VTUAddInt(a, na, VTU_CELLS, "connectivity", VTU_INT64, NULL, 0, 0));

@@ -1,0 +1,409 @@
+/* Quasi-static load stepping with bond failure (docs/failure.md). The scene's loads, prescribed
+ * values and layer conditions are scaled by a load factor lambda. At each lambda: solve, break
+ * the bonds past the failure criterion (all of them, or the most critical fraction), subtract
+ * their blocks from K, and solve again at the same lambda until no bond breaks. Pieces cut off
+ * from the constraints are held where they are; when a loaded piece is cut off, the solve fails,
+ * or no equilibrium is found, the body has failed: with adaptive steps the step is halved from the
+ * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
+#include "perilin.h"
+#include <signal.h>
+#include <unistd.h>
+
+static volatile sig_atomic_t interrupted = 0;
+static void                  OnInterrupt(int sig)
+{
+  (void)sig;
+  interrupted = 1;
+}
+
+typedef struct {
+  PetscReal max, step, min_step, fraction, runaway;
+  PetscBool adaptive, all, reuse, quiet;
+  PetscInt  max_iterations;
+  PeriProbe *control;
+} Settings;
+
+static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
+{
+  static const char *const policies[] = {"all", "fraction", NULL};
+  PeriScene                s          = p->scene;
+  PeriNode                 a;
+  PetscInt                 policy = 0;
+  char                     name[PERI_NAME_LEN] = "";
+  PetscBool                has;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
+  PeriInputCheck(p->failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
+  PetscCall(PeriSceneGetReal(s, a, "load_factor_max", PETSC_TRUE, &st->max, NULL));
+  PetscCall(PeriSceneGetReal(s, a, "load_factor_step", PETSC_TRUE, &st->step, NULL));
+  PeriInputCheck(st->max > 0, s, a, "load_factor_max", "must be positive, got %g", (double)st->max);
+  PeriInputCheck(st->step > 0 && st->step <= st->max, s, a, "load_factor_step", "must lie in (0, load_factor_max], got %g", (double)st->step);
+  st->min_step = st->step / 64;
+  PetscCall(PeriSceneGetReal(s, a, "min_step", PETSC_FALSE, &st->min_step, NULL));
+  PeriInputCheck(st->min_step > 0 && st->min_step <= st->step, s, a, "min_step", "must lie in (0, load_factor_step], got %g", (double)st->min_step);
+  st->adaptive = PETSC_TRUE;
+  PetscCall(PeriSceneGetBool(s, a, "adaptive", &st->adaptive, NULL));
+  PetscCall(PeriSceneGetChoice(s, a, "break", policies, &policy, NULL));
+  st->all      = policy == 0 ? PETSC_TRUE : PETSC_FALSE;
+  st->fraction = 0.1;
+  PetscCall(PeriSceneGetReal(s, a, "break_fraction", PETSC_FALSE, &st->fraction, &has));
+  PeriInputCheck(!has || !st->all, s, a, "break_fraction", "applies to break: fraction only");
+  PeriInputCheck(st->fraction > 0 && st->fraction <= 1, s, a, "break_fraction", "must lie in (0, 1], got %g", (double)st->fraction);
+  st->runaway = 0.01;
+  PetscCall(PeriSceneGetReal(s, a, "runaway_fraction", PETSC_FALSE, &st->runaway, NULL));
+  PeriInputCheck(st->runaway > 0 && st->runaway <= 1, s, a, "runaway_fraction", "must lie in (0, 1], got %g", (double)st->runaway);
+  st->max_iterations = 100;
+  PetscCall(PeriSceneGetInt(s, a, "max_iterations", PETSC_FALSE, &st->max_iterations, NULL));
+  PeriInputCheck(st->max_iterations >= 1, s, a, "max_iterations", "must be at least 1");
+  st->reuse = PETSC_TRUE;
+  PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));
+  st->control = p->nprobes ? &p->probes[0] : NULL;
+  PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, name, sizeof(name), &has));
+  if (has) {
+    st->control = NULL;
+    for (PetscInt k = 0; k < p->nprobes; k++)
+      if (!strcmp(p->probes[k].name, name)) st->control = &p->probes[k];
+    PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", name);
+  }
+  st->quiet = PETSC_FALSE;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-quiet", &st->quiet, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Evaluates every live bond of this rank against the criterion and breaks those past it (all, or
+ * those within the top fraction of the worst index), subtracting their blocks from K. Returns the
+ * global number broken. */
+static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nbroken)
+{
+  PeriBonds         *b = &p->bonds;
+  PeriModel          m = p->model;
+  const PetscInt     bs = m->dofs, nb = 2 * bs;
+  VecScatter         scatter;
+  Vec                all;
+  const PetscScalar *u;
+  PetscReal         *index, worst = 0, threshold = 1, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PetscInt           mine = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecScatterCreateToAll(p->u, &scatter, &all));
+  PetscCall(VecScatterBegin(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGetArrayRead(all, &u));
+  PetscCall(PetscMalloc1(b->nbonds, &index));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PeriBondGeometry g;
+      PetscReal        ui[PERI_MAX_DOF], uj[PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
+      index[k] = 0;
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+      for (PetscInt c = 0; c < bs; c++) {
+        ui[c] = PetscRealPart(u[i * bs + c]);
+        uj[c] = PetscRealPart(u[g.j * bs + c]);
+      }
+      m->ops.bond_measures(m, &g, ui, uj, meas);
+      index[k] = PeriBondFailureIndex(p, &g, meas);
+      worst    = PetscMax(worst, index[k]);
+    }
+  PetscCall(VecRestoreArrayRead(all, &u));
+  PetscCall(VecDestroy(&all));
+  PetscCall(VecScatterDestroy(&scatter));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, p->comm));
+  /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
+  if (!st->all && worst > 1) threshold = worst - st->fraction * (worst - 1);
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PeriBondGeometry g;
+      PetscInt         idx[2];
+      if (!b->live[k] || index[k] < threshold || index[k] < 1) continue;
+      PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+      m->ops.bond_stiffness(m, &g, Ke);
+      for (PetscInt a = 0; a < nb * nb; a++) Ke[a] = -Ke[a];
+      idx[0] = i;
+      idx[1] = g.j;
+      PetscCall(MatSetValuesBlocked(p->K, 2, idx, 2, idx, Ke, ADD_VALUES));
+      b->live[k] = 0;
+      mine++;
+    }
+  PetscCall(PetscFree(index));
+  PetscCall(MatAssemblyBegin(p->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(p->K, MAT_FINAL_ASSEMBLY));
+  PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, p->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The pieces of the body: a piece is anchored when it holds a prescribed DOF or a fictitious
+ * particle of a displacement layer. With none anchored, the largest piece is the body (its rigid
+ * motions are handled by the solve). Every other piece is held where it is (hold/held: owned DOFs
+ * and their current values); *lost when a held piece carries load. */
+static PetscErrorCode Pieces(PeriProblem p, PetscInt *nhold, PetscInt **hold, PetscReal **held, PetscInt *npieces, PetscBool *lost)
+{
+  const PeriParticles *pt = &p->particles;
+  const PetscInt       n = pt->n, bs = p->model->dofs, rstart = p->bonds.rstart, rend = p->bonds.rend;
+  PetscInt            *label, *anchored, *size, *loaded, main = -1, big = 0, lostl = 0;
+  const PetscScalar   *f, *u = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(n, &label));
+  PetscCall(PetscCalloc3(n, &anchored, n, &size, n, &loaded));
+  PetscCall(PeriComponents(p, label));
+  for (PetscInt k = 0; k < p->nconstrained; k++) anchored[label[p->constrained[k] / bs]] = 1;
+  PetscCall(VecGetArrayRead(p->f, &f));
+  for (PetscInt i = rstart; i < rend; i++) {
+    if (PeriParticleIsFictitious(pt, i)) {
+      for (PetscInt face = 0; face < 4; face++)
+        if ((pt->crossed[i] & (1 << face)) && p->layers.kind[face] == PERI_LAYER_DISPLACEMENT) anchored[label[i]] = 1;
+    }
+    for (PetscInt c = 0; c < bs; c++)
+      if (f[(i - rstart) * bs + c] != 0) loaded[label[i]] = 1;
+  }
+  PetscCall(VecRestoreArrayRead(p->f, &f));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, anchored, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, loaded, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
+  *npieces = 0;
+  for (PetscInt i = 0; i < n; i++) {
+    if (!size[label[i]]++) (*npieces)++;
+  }
+  {
+    PetscBool any = PETSC_FALSE;
+    for (PetscInt i = 0; i < n; i++) any = (PetscBool)(any || anchored[i]);
+    if (!any)
+      for (PetscInt i = 0; i < n; i++)
+        if (size[i] > big) {
+          big  = size[i];
+          main = i;
+        }
+  }
+  PetscCall(PetscMalloc2((rend - rstart) * bs, hold, (rend - rstart) * bs, held));
+  *nhold = 0;
+  if (p->u) PetscCall(VecGetArrayRead(p->u, &u));
+  for (PetscInt i = rstart; i < rend; i++) {
+    PetscInt l = label[i];
+    if (anchored[l] || l == main) continue;
+    if (loaded[l]) lostl = 1;
+    for (PetscInt c = 0; c < bs; c++) {
+      (*hold)[*nhold]   = i * bs + c;
+      (*held)[(*nhold)++] = u ? PetscRealPart(u[(i - rstart) * bs + c]) : 0;
+    }
+  }
+  if (p->u) PetscCall(VecRestoreArrayRead(p->u, &u));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lostl, 1, MPIU_INT, MPI_MAX, p->comm));
+  *lost = lostl ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscFree(label));
+  PetscCall(PetscFree3(anchored, size, loaded));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode RecordStep(PeriQuasistatic *q, const PeriStep *s)
+{
+  PetscFunctionBeginUser;
+  if (q->nsteps == q->cap) {
+    PeriStep *n;
+    q->cap = PetscMax(64, 2 * q->cap);
+    PetscCall(PetscMalloc1(q->cap, &n));
+    if (q->nsteps) PetscCall(PetscArraycpy(n, q->steps, q->nsteps));
+    PetscCall(PetscFree(q->steps));
+    q->steps = n;
+  }
+  q->steps[q->nsteps++] = *s;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The control probe's first component at the current solution (collective). */
+static PetscErrorCode ControlValue(PeriProblem p, PeriProbe *probe, PetscReal *v)
+{
+  PetscInt row;
+
+  PetscFunctionBeginUser;
+  *v = 0;
+  if (!probe) PetscFunctionReturn(PETSC_SUCCESS);
+  row = probe->particle * p->model->dofs;
+  if (p->owner[probe->particle] == p->rank) {
+    PetscScalar x;
+    PetscCall(VecGetValues(p->u, 1, &row, &x));
+    *v = PetscRealPart(x);
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, v, 1, MPIU_REAL, MPI_SUM, p->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Progress(PeriProblem p, const Settings *st, const PeriStep *s)
+{
+  PetscFunctionBeginUser;
+  if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
+  if (isatty(STDOUT_FILENO)) {
+    char     bar[41];
+    PetscInt fill = (PetscInt)(40 * s->lambda / st->max);
+    for (PetscInt k = 0; k < 40; k++) bar[k] = k < fill ? '#' : '.';
+    bar[40] = 0;
+    PetscCall(PetscPrintf(p->comm, "\r[%s] ", bar));
+  }
+  PetscCall(PetscPrintf(p->comm, "step %4" PetscInt_FMT "  lambda %-12.6g u %-12.5g broken %6" PetscInt_FMT " (total %8" PetscInt_FMT ")  equilibrium its %3" PetscInt_FMT "  ksp its %5" PetscInt_FMT "  %.2f s\n", p->quasistatic->nsteps, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode WriteSnapshot(PeriProblem p)
+{
+  char path[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriProblemEvaluateEnergy(p));
+  PetscCall(PeriDamage(p, &p->damage));
+  if (p->rank == 0) PetscCall(PeriOutputDirCreate(p->output_dir));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles_%04" PetscInt_FMT ".vtu", p->output_dir, p->quasistatic->nsteps));
+  PetscCall(PeriWriteVTU(p, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisRun_Quasistatic - the load-stepping loop with bond failure. Collective.
+@*/
+PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
+{
+  Settings         st;
+  PeriQuasistatic *q;
+  KSP              ksp = NULL;
+  PetscReal        lambda = 0, dl;
+  PetscInt         total = 0, since_setup = 0, nbonds;
+  unsigned char   *live0;
+  void (*previous)(int);
+  PetscLogDouble t0, tstep, t;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReadSettings(p, &st));
+  PetscCall(PetscNew(&p->quasistatic));
+  q = p->quasistatic;
+  PetscCall(PetscStrncpy(q->control, st.control ? st.control->name : "", sizeof(q->control)));
+  PetscCall(PeriStaticDefaultMatType(p->mat_type, sizeof(p->mat_type)));
+  PetscCall(PeriProblemAssemble(p));
+  PetscCall(PetscMalloc1(p->bonds.nbonds, &live0));
+  PetscCallMPI(MPI_Allreduce(&p->bonds.nbonds, &nbonds, 1, MPIU_INT, MPI_SUM, p->comm));
+  PetscCall(PetscTime(&t0));
+  previous = signal(SIGINT, OnInterrupt);
+  dl       = st.step;
+  if (!st.quiet) PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st.max, (double)st.step, st.adaptive ? "adaptive" : "fixed", st.all ? "all-violators" : "most-critical-fraction"));
+  while (lambda < st.max * (1 - 1e-12) && !interrupted) {
+    PetscReal          trial = PetscMin(lambda + dl, st.max);
+    PeriStep           s     = {0};
+    PetscBool          failed = PETSC_FALSE, settled = PETSC_FALSE;
+    KSPConvergedReason reason;
+    char               why[160] = "";
+    PetscCall(PetscArraycpy(live0, p->bonds.live, p->bonds.nbonds));
+    PetscCall(PetscTime(&tstep));
+    for (s.iterations = 0; s.iterations < st.max_iterations && !interrupted; s.iterations++) {
+      PetscInt   nhold = 0, npieces = 0, nb;
+      PetscInt  *hold;
+      PetscReal *held;
+      PetscBool  lost = PETSC_FALSE;
+      PetscCall(Pieces(p, &nhold, &hold, &held, &npieces, &lost));
+      if (lost) {
+        PetscCall(PetscFree2(hold, held));
+        failed = PETSC_TRUE;
+        PetscCall(PetscSNPrintf(why, sizeof(why), "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", npieces));
+        break;
+      }
+      /* a new preconditioner only when many bonds changed since the last one (or never built) */
+      if (ksp) PetscCall(KSPSetReusePreconditioner(ksp, (PetscBool)(st.reuse && since_setup < PetscMax(1, nbonds / 1000))));
+      if (!ksp || !st.reuse || since_setup >= PetscMax(1, nbonds / 1000)) {
+        q->pc_setups++;
+        since_setup = 0;
+      }
+      PetscCall(PeriStaticSolve(p, &ksp, trial, PETSC_FALSE, nhold, hold, held, &reason));
+      PetscCall(PetscFree2(hold, held));
+      q->solves++;
+      s.ksp_iterations += p->results.iterations;
+      if (reason <= 0 || PetscIsInfOrNanReal(p->results.residual_norm)) {
+        failed = PETSC_TRUE;
+        PetscCall(PetscSNPrintf(why, sizeof(why), "the solve failed (%s): the body can no longer carry the load", KSPConvergedReasons[reason]));
+        break;
+      }
+      PetscCall(BreakBonds(p, &st, &nb));
+      if (!nb) {
+        settled = PETSC_TRUE;
+        break;
+      }
+      s.broken += nb;
+      since_setup += nb;
+      if (st.adaptive && s.broken > st.runaway * nbonds) {
+        /* a crack running away at this load: a smaller step tells whether it would settle */
+        failed = PETSC_TRUE;
+        PetscCall(PetscSNPrintf(why, sizeof(why), "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s.broken, (double)st.runaway));
+        break;
+      }
+    }
+    if (!failed && !settled && !interrupted) {
+      failed = PETSC_TRUE;
+      PetscCall(PetscSNPrintf(why, sizeof(why), "no equilibrium after %" PetscInt_FMT " iterations: bonds keep breaking at this load", st.max_iterations));
+    }
+    if (interrupted) break;
+    if (failed) {
+      if (st.adaptive && dl > st.min_step * (1 + 1e-12)) {
+        /* back to the last equilibrium, with half the step */
+        PetscCall(PetscArraycpy(p->bonds.live, live0, p->bonds.nbonds));
+        PetscCall(PeriProblemAssemble(p));
+        since_setup = nbonds;
+        dl          = PetscMax(0.5 * dl, st.min_step);
+        continue;
+      }
+      q->failed               = PETSC_TRUE;
+      q->critical_load_factor = trial;
+      total += s.broken;
+      PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
+      break;
+    }
+    lambda = trial;
+    total += s.broken;
+    PetscCall(PetscTime(&t));
+    s.lambda       = lambda;
+    s.broken_total = total;
+    s.seconds      = t - tstep;
+    PetscCall(ControlValue(p, st.control, &s.control_u));
+    PetscCall(RecordStep(q, &s));
+    q->peak_load_factor = lambda;
+    PetscCall(Progress(p, &st, &s));
+    if (p->output_every && q->nsteps % p->output_every == 0 && p->vtk) PetscCall(WriteSnapshot(p));
+    /* many breaks: smaller steps; none: back towards the scene's step */
+    if (st.adaptive) dl = s.broken > nbonds / 100 ? PetscMax(0.5 * dl, st.min_step) : s.broken ? dl : PetscMin(2 * dl, st.step);
+  }
+  signal(SIGINT, previous);
+  q->broken_bonds = total;
+  q->complete     = interrupted ? PETSC_FALSE : PETSC_TRUE;
+  if (interrupted) PetscCall(PetscStrncpy(q->ending, "interrupted (SIGINT): the results so far", sizeof(q->ending)));
+  else if (!q->failed) PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st.max));
+  PetscCall(KSPDestroy(&ksp));
+  PetscCall(PetscFree(live0));
+  PetscCall(PetscTime(&t));
+  p->results.solve_s = t - t0;
+  PetscCall(PeriProblemEvaluateEnergy(p));
+  PetscCall(PeriDamage(p, &p->damage));
+  if (!st.quiet) PetscCall(PetscPrintf(p->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, total, q->solves, q->pc_setups));
+  if (!st.quiet && q->failed) PetscCall(PetscPrintf(p->comm, "perilin: critical load factor %g (failure between %g and %g)\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteStepsCSV - one row per load step. Rank 0 writes (temporary name, then rename). Collective.
+@*/
+PetscErrorCode PeriWriteStepsCSV(PeriProblem p, const char path[])
+{
+  char  tmp[PETSC_MAX_PATH_LEN];
+  FILE *fp;
+  int   bad = 0;
+
+  PetscFunctionBeginUser;
+  if (p->rank || !p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(tmp, sizeof(tmp), "%s.tmp", path));
+  fp = fopen(tmp, "w");
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", tmp);
+  bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,equilibrium_iterations,ksp_iterations,seconds\n") < 0;
+  for (PetscInt k = 0; k < p->quasistatic->nsteps; k++) {
+    const PeriStep *s = &p->quasistatic->steps[k];
+    bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f\n", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
+  }
+  bad |= fclose(fp) != 0;
+  if (bad) remove(tmp);
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing %s failed", tmp);
+  PetscCall(PeriFileCommit(tmp, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,216 @@
+/* Bond failure: the scene's criteria (failure:), pre-existing cracks (cracks:), the damage per
+ * particle and the connected pieces of the body. Sources: Ganzenmueller sec. 3.2 and Diehl &
+ * Schweitzer (critical stretch from G), Diana & Casolo eqs. 44-58 (tension, compression, sliding,
+ * friction), Oterkus & Madenci eqs. 70, 78-79 (critical shear angle, damage). docs/failure.md. */
+#include "perilin.h"
+
+/*@C
+  PeriFailureSetUp - reads failure: and checks each criterion against the model's measures.
+  Not collective.
+@*/
+PetscErrorCode PeriFailureSetUp(PeriProblem p)
+{
+  static const char *const keys[] = {"critical_stretch", "G", "compressive_stretch", "sliding", "friction_angle", "cohesion", "shear_angle", NULL};
+  PeriScene                s      = p->scene;
+  PeriFailure             *F      = &p->failure;
+  PeriModel                m      = p->model;
+  PeriNode                 node;
+  PetscBool                has[7];
+  PetscReal               *val[7] = {&F->stretch, &F->G, &F->compressive, &F->sliding, &F->friction_angle, &F->cohesion, &F->shear_angle};
+
+  PetscFunctionBeginUser;
+  F->istretch = F->isliding = F->ishear = -1;
+  for (PetscInt k = 0; k < m->nmeasures; k++) {
+    if (!strcmp(m->measure_names[k], "stretch")) F->istretch = k;
+    if (!strcmp(m->measure_names[k], "sliding")) F->isliding = k;
+    if (!strcmp(m->measure_names[k], "shear_angle")) F->ishear = k;
+  }
+  PetscCall(PeriSceneGetMap(s, s->root, "failure", PETSC_FALSE, &node));
+  if (!node) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneCheckKeys(s, node, keys));
+  for (PetscInt k = 0; keys[k]; k++) {
+    PetscCall(PeriSceneGetReal(s, node, keys[k], PETSC_FALSE, val[k], &has[k]));
+    PeriInputCheck(!has[k] || *val[k] > 0 || k == 5, s, node, keys[k], "must be positive, got %g", (double)*val[k]);
+  }
+  PeriInputCheck(!has[5] || F->cohesion >= 0, s, node, "cohesion", "must not be negative, got %g", (double)F->cohesion);
+  PeriInputCheck(has[0] || has[1] || has[2] || has[3] || has[4] || has[6], s, node, NULL, "give at least one criterion: %s", "critical_stretch, G, compressive_stretch, sliding, friction_angle with cohesion, shear_angle");
+  PeriInputCheck(!(has[0] && has[1]), s, node, "G", "give critical_stretch or G, not both");
+  PeriInputCheck(!(has[6] && has[1]), s, node, "G", "give shear_angle or G, not both");
+  PeriInputCheck(!(has[0] || has[2]) || F->istretch >= 0, s, node, has[0] ? "critical_stretch" : "compressive_stretch", "model %s has no stretch measure", m->type);
+  PeriInputCheck(!(has[3] || has[4] || has[5]) || F->isliding >= 0, s, node, has[3] ? "sliding" : "friction_angle", "model %s has no sliding measure (pds, mppd, gerstle have)", m->type);
+  PeriInputCheck(!has[6] || F->ishear >= 0, s, node, "shear_angle", "model %s has no shear angle (antiplane models have)", m->type);
+  PeriInputCheck(!has[1] || m->ops.critical_from_G, s, node, "G", "model %s cannot convert an energy release rate into a critical measure; give it directly", m->type);
+  PeriInputCheck(has[4] == has[5], s, node, has[4] ? "cohesion" : "friction_angle", "frictional sliding needs both friction_angle (degrees) and cohesion");
+  PeriInputCheck(!has[4] || F->friction_angle < 90, s, node, "friction_angle", "must lie in (0, 90) degrees, got %g", (double)F->friction_angle);
+  PeriInputCheck(!m->ops.family_stiffness, s, node, NULL, "model %s is state-based: its bonds cannot break yet (use antiplane)", m->type);
+  F->active = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Do the open segments P0P1 and Q0Q1 cross (a touch at an end point does not count)? */
+static PetscBool SegmentsCross(const PetscReal P0[], const PetscReal P1[], const PetscReal Q0[], const PetscReal Q1[])
+{
+  PetscReal d1 = (P1[0] - P0[0]) * (Q0[1] - P0[1]) - (P1[1] - P0[1]) * (Q0[0] - P0[0]);
+  PetscReal d2 = (P1[0] - P0[0]) * (Q1[1] - P0[1]) - (P1[1] - P0[1]) * (Q1[0] - P0[0]);
+  PetscReal d3 = (Q1[0] - Q0[0]) * (P0[1] - Q0[1]) - (Q1[1] - Q0[1]) * (P0[0] - Q0[0]);
+  PetscReal d4 = (Q1[0] - Q0[0]) * (P1[1] - Q0[1]) - (Q1[1] - Q0[1]) * (P1[0] - Q0[0]);
+  return (PetscBool)(d1 * d2 < 0 && d3 * d4 < 0);
+}
+
+static PetscInt CutBonds(const PeriParticles *pt, PeriBonds *b, PetscInt nc, const PetscReal seg[])
+{
+  PetscInt cut = 0;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscReal X1[2] = {pt->x[3 * i] + b->xi[3 * k], pt->x[3 * i + 1] + b->xi[3 * k + 1]};
+      for (PetscInt c = 0; c < nc && b->live[k]; c++)
+        if (SegmentsCross(&pt->x[3 * i], X1, &seg[4 * c], &seg[4 * c + 2])) {
+          b->live[k] = 0;
+          cut++;
+        }
+    }
+  return cut;
+}
+
+/*@C
+  PeriCracksApply - reads cracks: (2D segments {from: [x, y], to: [x, y]}) and removes every bond
+  that crosses one, before the family volumes and the calibration see the body. Collective.
+@*/
+PetscErrorCode PeriCracksApply(PeriProblem p)
+{
+  static const char *const keys[] = {"from", "to", NULL};
+  PeriScene                s      = p->scene;
+  PeriNode                 list;
+  PetscReal               *seg;
+  PetscInt                 cut, n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(s->root, "cracks", &list));
+  if (!list) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(list->kind == PERI_NODE_SEQ, s, list, NULL, "must be a list of segments, each {from: [x, y], to: [x, y]}");
+  PeriInputCheck(p->particles.dim == 2, s, list, NULL, "cracks are 2D segments; 3D scenes cannot have them yet");
+  PetscCall(PetscMalloc1(4 * list->n, &seg));
+  for (PetscInt c = 0; c < list->n; c++) {
+    PeriNode item = list->child[c];
+    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a crack is a segment {from: [x, y], to: [x, y]}");
+    PetscCall(PeriSceneCheckKeys(s, item, keys));
+    PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
+    PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
+    PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");
+  }
+  cut = CutBonds(&p->particles, &p->bonds, list->n, seg);
+  if (p->family.offset) CutBonds(&p->particles, &p->family, list->n, seg);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, p->comm));
+  p->results.precracked_bonds = cut;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriBondFailureIndex - how far the bond is past the scene's criteria: the largest of s/s_c
+  (tension), -s/s_cc (compression), |gamma|/gamma_0, |gamma|/(a - s tan beta) (friction) and
+  |r|/r_c; the bond breaks when it reaches 1. meas[] are the model's measures. Not collective.
+@*/
+PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const PetscReal meas[])
+{
+  const PeriFailure *F   = &p->failure;
+  PetscReal          idx = 0, crit = 0;
+
+  if (F->G > 0) crit = p->model->ops.critical_from_G(p->model, g, F->G);
+  if (F->istretch >= 0) {
+    PetscReal s = meas[F->istretch], sc = F->stretch > 0 ? F->stretch : crit;
+    if (s > 0 && sc > 0) idx = PetscMax(idx, s / sc);
+    if (s < 0 && F->compressive > 0) idx = PetscMax(idx, -s / F->compressive);
+  }
+  if (F->isliding >= 0) {
+    PetscReal gam = PetscAbsReal(meas[F->isliding]);
+    if (F->sliding > 0) idx = PetscMax(idx, gam / F->sliding);
+    if (F->friction_angle > 0) {
+      /* Diana & Casolo's frictional sliding: the limit grows with compression, vanishes in tension */
+      PetscReal s = F->istretch >= 0 ? meas[F->istretch] : 0, lim = F->cohesion - s * PetscTanReal(F->friction_angle * PETSC_PI / 180);
+      idx = PetscMax(idx, lim > 0 ? gam / lim : (gam > 0 ? PETSC_MAX_REAL : 0));
+    }
+  }
+  if (F->ishear >= 0) {
+    PetscReal rc = F->shear_angle > 0 ? F->shear_angle : crit;
+    if (rc > 0) idx = PetscMax(idx, PetscAbsReal(meas[F->ishear]) / rc);
+  }
+  return idx;
+}
+
+/*@C
+  PeriDamage - phi_i = 1 - (sum of live alpha V_j) / (sum over every bond found, the pre-cracked
+  included) (Oterkus & Madenci eq. 79). Rank 0 gets the n values. Collective.
+@*/
+PetscErrorCode PeriDamage(PeriProblem p, PetscReal **damage)
+{
+  const PeriBonds     *b  = &p->bonds;
+  const PeriParticles *pt = &p->particles;
+  PetscReal           *acc;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(2 * pt->n, &acc));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscInt j = b->j[k];
+      acc[2 * i] += b->alpha[k] * pt->volume[j];
+      acc[2 * j] += b->alpha[k] * pt->volume[i];
+      if (!b->live[k]) continue;
+      acc[2 * i + 1] += b->alpha[k] * pt->volume[j];
+      acc[2 * j + 1] += b->alpha[k] * pt->volume[i];
+    }
+  PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(2 * pt->n), MPIU_REAL, MPI_SUM, 0, p->comm));
+  PetscCall(PetscFree(*damage));
+  if (p->rank == 0) {
+    PetscCall(PetscMalloc1(pt->n, damage));
+    for (PetscInt i = 0; i < pt->n; i++) (*damage)[i] = acc[2 * i] > 0 ? 1 - acc[2 * i + 1] / acc[2 * i] : 1;
+  }
+  PetscCall(PetscFree(acc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscInt Find(PetscInt parent[], PetscInt i)
+{
+  while (parent[i] != i) {
+    parent[i] = parent[parent[i]];
+    i         = parent[i];
+  }
+  return i;
+}
+
+static void Union(PetscInt parent[], PetscInt a, PetscInt b)
+{
+  a = Find(parent, a);
+  b = Find(parent, b);
+  if (a != b) parent[PetscMax(a, b)] = PetscMin(a, b);
+}
+
+/*@C
+  PeriComponents - the connected pieces of the body through its live bonds: label[i] = the
+  smallest particle index of i's piece, on every rank. Each rank joins its bonds (union-find),
+  rank 0 merges the ranks' forests. Collective.
+@*/
+PetscErrorCode PeriComponents(PeriProblem p, PetscInt label[])
+{
+  const PeriBonds *b = &p->bonds;
+  const PetscInt   n = p->particles.n;
+  PetscInt        *all = NULL;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < n; i++) label[i] = i;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      if (b->live[k]) Union(label, i, b->j[k]);
+  for (PetscInt i = 0; i < n; i++) label[i] = Find(label, i);
+  if (p->size > 1) {
+    if (p->rank == 0) PetscCall(PetscMalloc1(n * p->size, &all));
+    PetscCallMPI(MPI_Gather(label, (PetscMPIInt)n, MPIU_INT, all, (PetscMPIInt)n, MPIU_INT, 0, p->comm));
+    if (p->rank == 0) {
+      for (PetscMPIInt r = 1; r < p->size; r++)
+        for (PetscInt i = 0; i < n; i++) Union(label, i, all[r * n + i]);
+      for (PetscInt i = 0; i < n; i++) label[i] = Find(label, i);
+    }
+    PetscCall(PetscFree(all));
+    PetscCallMPI(MPI_Bcast(label, (PetscMPIInt)n, MPIU_INT, 0, p->comm));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
