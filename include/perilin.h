@@ -275,7 +275,7 @@ typedef struct {
   PetscReal load_imbalance; /* share of the load along those motions, removed */
   PetscInt  precracked_bonds;
   PetscBool free_modes_noted; /* the note on free motions is printed once per run */
-  PetscInt  edge_cut;       /* bonds between particles of different ranks */
+  PetscInt  edge_cut;         /* bonds between particles of different ranks */
   /* against the scene's reference field (src/reference.c) */
   PetscBool has_reference;
   PetscInt  interior_particles;
@@ -460,6 +460,7 @@ PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriProblem);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriProblem, const PeriBondGeometry *, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriDamage(PeriProblem, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriComponents(PeriProblem, PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriPieces(PeriProblem, PetscInt *, PetscInt **, PetscReal **, PetscInt *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriWriteStepsCSV(PeriProblem, const char[]);
 
 /* fictitious boundary layers and torsion (src/layers.c) */
@@ -469,6 +470,7 @@ PETSC_EXTERN PetscErrorCode PeriLayersApply(PeriProblem, PetscReal, Mat *, Vec);
 PETSC_EXTERN PetscErrorCode PeriLayersComplete(PeriProblem, PetscReal, Vec);
 PETSC_EXTERN PetscErrorCode PeriLayersDestroy(PeriLayers *);
 PETSC_EXTERN PetscErrorCode PeriTorsionEvaluate(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriTorsionLoads(PeriProblem, Vec);
 PETSC_EXTERN PetscErrorCode PeriWriteModesCSV(PeriProblem, const char[]);
 
 /* output (src/output/) */

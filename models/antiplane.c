@@ -278,17 +278,17 @@ static PetscErrorCode Create(PeriModel m)
   PetscFunctionBeginUser;
   PetscCheck(m->dim == 2, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "model %s is a cross-section model (antiplane shear, torsion); use dim: 2", m->type);
   PetscCall(PetscNew(&ap));
-  m->data              = ap;
-  m->dofs              = 1;
-  m->components        = components;
-  m->nmeasures         = 1;
-  m->measure_names     = measures;
-  m->antiplane         = PETSC_TRUE;
-  m->ops.nu_range      = NuRange;
-  m->ops.bond_measures = BondMeasures;
-  m->ops.rigid_modes   = RigidModes;
+  m->data                = ap;
+  m->dofs                = 1;
+  m->components          = components;
+  m->nmeasures           = 1;
+  m->measure_names       = measures;
+  m->antiplane           = PETSC_TRUE;
+  m->ops.nu_range        = NuRange;
+  m->ops.bond_measures   = BondMeasures;
+  m->ops.rigid_modes     = RigidModes;
   m->ops.critical_from_G = CriticalFromG;
-  m->ops.destroy       = Destroy;
+  m->ops.destroy         = Destroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -73,15 +73,15 @@ PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   PetscFunctionBeginUser;
   PetscCheck(m->dim == 2, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "model pds is two-dimensional (plane stress or plane strain); use dim: 2");
   PetscCall(PetscNew(&pds));
-  m->data               = pds;
-  m->dofs               = 2;
-  m->components         = components;
-  m->nmeasures          = 2;
-  m->measure_names      = measures;
-  m->ops.nu_range       = PeriShearBondNuRange;
-  m->ops.calibrate      = Calibrate;
-  m->ops.bond_stiffness = BondStiffness;
-  m->ops.bond_measures  = BondMeasures;
+  m->data                = pds;
+  m->dofs                = 2;
+  m->components          = components;
+  m->nmeasures           = 2;
+  m->measure_names       = measures;
+  m->ops.nu_range        = PeriShearBondNuRange;
+  m->ops.calibrate       = Calibrate;
+  m->ops.bond_stiffness  = BondStiffness;
+  m->ops.bond_measures   = BondMeasures;
   m->ops.critical_from_G = CriticalFromG;
   /* the rotation is not a zero-energy mode for g != 0, but it is the near-null space AMG wants */
   m->ops.rigid_modes = PeriTranslationalRigidModes;

@@ -39,7 +39,7 @@ PetscErrorCode PeriModelCreate_PMB(PeriModel m)
   PetscCall(PetscNew(&pmb));
   m->data = pmb;
   PeriModelSetCentralForce(m);
-  m->ops.calibrate      = Calibrate;
+  m->ops.calibrate       = Calibrate;
   m->ops.bond_stiffness  = BondStiffness;
   m->ops.critical_from_G = CriticalFromG;
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -180,6 +180,7 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
   PetscCall(PeriModelComponentIndex(m, "uz", &uz));
   ncomp = dim == 2 && uz >= 0 ? 3 : dim;
   PetscCall(VecSet(f, 0));
+  PetscCall(PeriTorsionLoads(p, f));
   PetscCall(PeriSceneGetNode(s->root, "loads", &loads));
   if (!loads) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(loads->kind == PERI_NODE_SEQ, s, loads, NULL, "must be a list of loads, each {region: .., force: [..]}");

@@ -191,8 +191,8 @@ static void Union(PetscInt parent[], PetscInt a, PetscInt b)
 @*/
 PetscErrorCode PeriComponents(PeriProblem p, PetscInt label[])
 {
-  const PeriBonds *b = &p->bonds;
-  const PetscInt   n = p->particles.n;
+  const PeriBonds *b   = &p->bonds;
+  const PetscInt   n   = p->particles.n;
   PetscInt        *all = NULL;
 
   PetscFunctionBeginUser;
@@ -212,5 +212,70 @@ PetscErrorCode PeriComponents(PeriProblem p, PetscInt label[])
     PetscCall(PetscFree(all));
     PetscCallMPI(MPI_Bcast(label, (PetscMPIInt)n, MPIU_INT, 0, p->comm));
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriPieces - the pieces of the body: a piece is anchored when it holds a prescribed DOF or a fictitious
+ * particle of a displacement layer. With none anchored, the largest piece is the body (its rigid
+ * motions are handled by the solve). Every other piece is held where it is (hold/held: owned DOFs
+ * and their current values, freed by the caller with PetscFree2); *lost when a held piece carries
+ * load. Collective.
+@*/
+PetscErrorCode PeriPieces(PeriProblem p, PetscInt *nhold, PetscInt **hold, PetscReal **held, PetscInt *npieces, PetscBool *lost)
+{
+  const PeriParticles *pt = &p->particles;
+  const PetscInt       n = pt->n, bs = p->model->dofs, rstart = p->bonds.rstart, rend = p->bonds.rend;
+  PetscInt            *label, *anchored, *size, *loaded, main = -1, big = 0, lostl = 0;
+  const PetscScalar   *f, *u = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(n, &label));
+  PetscCall(PetscCalloc3(n, &anchored, n, &size, n, &loaded));
+  PetscCall(PeriComponents(p, label));
+  for (PetscInt k = 0; k < p->nconstrained; k++) anchored[label[p->constrained[k] / bs]] = 1;
+  PetscCall(VecGetArrayRead(p->f, &f));
+  for (PetscInt i = rstart; i < rend; i++) {
+    if (PeriParticleIsFictitious(pt, i)) {
+      for (PetscInt face = 0; face < 4; face++)
+        if ((pt->crossed[i] & (1 << face)) && p->layers.kind[face] == PERI_LAYER_DISPLACEMENT) anchored[label[i]] = 1;
+    }
+    for (PetscInt c = 0; c < bs; c++)
+      if (f[(i - rstart) * bs + c] != 0) loaded[label[i]] = 1;
+  }
+  PetscCall(VecRestoreArrayRead(p->f, &f));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, anchored, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, loaded, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
+  *npieces = 0;
+  for (PetscInt i = 0; i < n; i++) {
+    if (!size[label[i]]++) (*npieces)++;
+  }
+  {
+    PetscBool any = PETSC_FALSE;
+    for (PetscInt i = 0; i < n; i++) any = (PetscBool)(any || anchored[i]);
+    if (!any)
+      for (PetscInt i = 0; i < n; i++)
+        if (size[i] > big) {
+          big  = size[i];
+          main = i;
+        }
+  }
+  PetscCall(PetscMalloc2((rend - rstart) * bs, hold, (rend - rstart) * bs, held));
+  *nhold = 0;
+  if (p->u) PetscCall(VecGetArrayRead(p->u, &u));
+  for (PetscInt i = rstart; i < rend; i++) {
+    PetscInt l = label[i];
+    if (anchored[l] || l == main) continue;
+    if (loaded[l]) lostl = 1;
+    for (PetscInt c = 0; c < bs; c++) {
+      (*hold)[*nhold]     = i * bs + c;
+      (*held)[(*nhold)++] = u ? PetscRealPart(u[(i - rstart) * bs + c]) : 0;
+    }
+  }
+  if (p->u) PetscCall(VecRestoreArrayRead(p->u, &u));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lostl, 1, MPIU_INT, MPI_MAX, p->comm));
+  *lost = lostl ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PetscFree(label));
+  PetscCall(PetscFree3(anchored, size, loaded));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -62,10 +62,7 @@ PetscErrorCode PeriLayersAddParticles(PeriProblem p)
   PetscFunctionBeginUser;
   PetscCall(ReadTorsion(p));
   PetscCall(PeriSceneGetNode(s->root, "boundary_layers", &list));
-  if (!list) {
-    PeriInputCheck(!p->torsion.active, s, s->root, "torsion", "needs boundary_layers: the twist enters through the free faces' fictitious layers");
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
+  if (!list) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(list->kind == PERI_NODE_SEQ && list->n > 0, s, list, NULL, "must be a list of layers, each {side: x-|x+|y-|y+, condition: displacement|shear_stress|free, value: ..}");
   PeriInputCheck(p->model->antiplane, s, list, NULL, "fictitious layers carry the conditions of the cross-section models (antiplane, antiplane_os); for model %s use bc and loads", p->model->type);
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
@@ -285,6 +282,66 @@ PetscErrorCode PeriLayersDestroy(PeriLayers *L)
   PetscFunctionBeginUser;
   PetscCall(MatDestroy(&L->T));
   PetscCall(VecDestroy(&L->g));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriTorsionLoads - without fictitious layers the twist enters every bond as a prescribed relative
+  displacement e0 = psi ((X_i - X0) x (X_j - X0))_z (the rigid twist's contribution to the shear
+  angle, so the pair energy is that of (u_j - u_i + e0)): f -= K_b (0, e0) per live bond, or per
+  family for state-based models. Free faces and crack faces are then natural PD free surfaces,
+  traction-free with the twist. Adds to f (owned rows, and others through the stash). Collective.
+@*/
+PetscErrorCode PeriTorsionLoads(PeriProblem p, Vec f)
+{
+  const PeriParticles *pt  = &p->particles;
+  PeriModel            m   = p->model;
+  const PetscReal      psi = p->torsion.twist, *c = p->torsion.center;
+
+  PetscFunctionBeginUser;
+  if (!p->torsion.active || p->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  if (m->ops.family_stiffness) {
+    PetscInt          nmax = PeriProblemMaxFamily(p), n;
+    PeriBondGeometry *fam;
+    PetscReal        *Ke, *e, *fe;
+    PetscInt         *idx;
+    PetscCall(PetscMalloc5(nmax, &fam, PetscSqr(nmax + 1), &Ke, nmax + 1, &e, nmax + 1, &fe, nmax + 1, &idx));
+    for (PetscInt i = p->family.rstart; i < p->family.rend; i++) {
+      PetscCall(PeriProblemFamilyGeometry(p, i, &n, fam));
+      PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
+      e[0]   = 0;
+      idx[0] = i;
+      for (PetscInt t = 0; t < n; t++) {
+        PetscInt j = fam[t].j;
+        e[t + 1]   = psi * ((pt->x[3 * i] - c[0]) * (pt->x[3 * j + 1] - c[1]) - (pt->x[3 * j] - c[0]) * (pt->x[3 * i + 1] - c[1]));
+        idx[t + 1] = j;
+      }
+      for (PetscInt a = 0; a <= n; a++) {
+        fe[a] = 0;
+        for (PetscInt b = 0; b <= n; b++) fe[a] -= Ke[a * (n + 1) + b] * e[b];
+      }
+      PetscCall(VecSetValues(f, n + 1, idx, fe, ADD_VALUES));
+    }
+    PetscCall(PetscFree5(fam, Ke, e, fe, idx));
+  } else {
+    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
+      for (PetscInt k = p->bonds.offset[i - p->bonds.rstart]; k < p->bonds.offset[i - p->bonds.rstart + 1]; k++) {
+        PeriBondGeometry g;
+        PetscReal        Ke[4], e0, fe[2];
+        PetscInt         idx[2];
+        if (!p->bonds.live[k] || p->bonds.j[k] == i) continue;
+        PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+        m->ops.bond_stiffness(m, &g, Ke);
+        e0     = psi * ((pt->x[3 * i] - c[0]) * (pt->x[3 * g.j + 1] - c[1]) - (pt->x[3 * g.j] - c[0]) * (pt->x[3 * i + 1] - c[1]));
+        fe[0]  = -Ke[1] * e0;
+        fe[1]  = -Ke[3] * e0;
+        idx[0] = i;
+        idx[1] = g.j;
+        PetscCall(VecSetValues(f, 2, idx, fe, ADD_VALUES));
+      }
+  }
+  PetscCall(VecAssemblyBegin(f));
+  PetscCall(VecAssemblyEnd(f));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

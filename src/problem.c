@@ -578,11 +578,6 @@ static PetscErrorCode ShearStresses(PeriProblem p, const PetscScalar u[])
     }
   PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, 0, p->comm));
   PetscCall(PetscFree(p->tau));
-  PetscCall(PetscFree(p->damage));
-  if (p->quasistatic) {
-    PetscCall(PetscFree(p->quasistatic->steps));
-    PetscCall(PetscFree(p->quasistatic));
-  }
   if (p->rank == 0) {
     PetscCall(PetscMalloc1(3 * n, &p->tau));
     for (PetscInt i = 0; i < n; i++) {

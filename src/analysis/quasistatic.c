@@ -17,9 +17,9 @@ static void                  OnInterrupt(int sig)
 }
 
 typedef struct {
-  PetscReal max, step, min_step, fraction, runaway;
-  PetscBool adaptive, all, reuse, quiet;
-  PetscInt  max_iterations;
+  PetscReal  max, step, min_step, fraction, runaway;
+  PetscBool  adaptive, all, reuse, quiet;
+  PetscInt   max_iterations;
   PeriProbe *control;
 } Settings;
 
@@ -28,7 +28,7 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
   static const char *const policies[] = {"all", "fraction", NULL};
   PeriScene                s          = p->scene;
   PeriNode                 a;
-  PetscInt                 policy = 0;
+  PetscInt                 policy              = 0;
   char                     name[PERI_NAME_LEN] = "";
   PetscBool                has;
 
@@ -76,8 +76,8 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
  * global number broken. */
 static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nbroken)
 {
-  PeriBonds         *b = &p->bonds;
-  PeriModel          m = p->model;
+  PeriBonds         *b  = &p->bonds;
+  PeriModel          m  = p->model;
   const PetscInt     bs = m->dofs, nb = 2 * bs;
   VecScatter         scatter;
   Vec                all;
@@ -130,68 +130,6 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   PetscCall(MatAssemblyBegin(p->K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(p->K, MAT_FINAL_ASSEMBLY));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, p->comm));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The pieces of the body: a piece is anchored when it holds a prescribed DOF or a fictitious
- * particle of a displacement layer. With none anchored, the largest piece is the body (its rigid
- * motions are handled by the solve). Every other piece is held where it is (hold/held: owned DOFs
- * and their current values); *lost when a held piece carries load. */
-static PetscErrorCode Pieces(PeriProblem p, PetscInt *nhold, PetscInt **hold, PetscReal **held, PetscInt *npieces, PetscBool *lost)
-{
-  const PeriParticles *pt = &p->particles;
-  const PetscInt       n = pt->n, bs = p->model->dofs, rstart = p->bonds.rstart, rend = p->bonds.rend;
-  PetscInt            *label, *anchored, *size, *loaded, main = -1, big = 0, lostl = 0;
-  const PetscScalar   *f, *u = NULL;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(n, &label));
-  PetscCall(PetscCalloc3(n, &anchored, n, &size, n, &loaded));
-  PetscCall(PeriComponents(p, label));
-  for (PetscInt k = 0; k < p->nconstrained; k++) anchored[label[p->constrained[k] / bs]] = 1;
-  PetscCall(VecGetArrayRead(p->f, &f));
-  for (PetscInt i = rstart; i < rend; i++) {
-    if (PeriParticleIsFictitious(pt, i)) {
-      for (PetscInt face = 0; face < 4; face++)
-        if ((pt->crossed[i] & (1 << face)) && p->layers.kind[face] == PERI_LAYER_DISPLACEMENT) anchored[label[i]] = 1;
-    }
-    for (PetscInt c = 0; c < bs; c++)
-      if (f[(i - rstart) * bs + c] != 0) loaded[label[i]] = 1;
-  }
-  PetscCall(VecRestoreArrayRead(p->f, &f));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, anchored, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, loaded, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
-  *npieces = 0;
-  for (PetscInt i = 0; i < n; i++) {
-    if (!size[label[i]]++) (*npieces)++;
-  }
-  {
-    PetscBool any = PETSC_FALSE;
-    for (PetscInt i = 0; i < n; i++) any = (PetscBool)(any || anchored[i]);
-    if (!any)
-      for (PetscInt i = 0; i < n; i++)
-        if (size[i] > big) {
-          big  = size[i];
-          main = i;
-        }
-  }
-  PetscCall(PetscMalloc2((rend - rstart) * bs, hold, (rend - rstart) * bs, held));
-  *nhold = 0;
-  if (p->u) PetscCall(VecGetArrayRead(p->u, &u));
-  for (PetscInt i = rstart; i < rend; i++) {
-    PetscInt l = label[i];
-    if (anchored[l] || l == main) continue;
-    if (loaded[l]) lostl = 1;
-    for (PetscInt c = 0; c < bs; c++) {
-      (*hold)[*nhold]   = i * bs + c;
-      (*held)[(*nhold)++] = u ? PetscRealPart(u[(i - rstart) * bs + c]) : 0;
-    }
-  }
-  if (p->u) PetscCall(VecRestoreArrayRead(p->u, &u));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lostl, 1, MPIU_INT, MPI_MAX, p->comm));
-  *lost = lostl ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PetscFree(label));
-  PetscCall(PetscFree3(anchored, size, loaded));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -263,7 +201,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
 {
   Settings         st;
   PeriQuasistatic *q;
-  KSP              ksp = NULL;
+  KSP              ksp    = NULL;
   PetscReal        lambda = 0, dl;
   PetscInt         total = 0, since_setup = 0, nbonds;
   unsigned char   *live0;
@@ -284,8 +222,8 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   dl       = st.step;
   if (!st.quiet) PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st.max, (double)st.step, st.adaptive ? "adaptive" : "fixed", st.all ? "all-violators" : "most-critical-fraction"));
   while (lambda < st.max * (1 - 1e-12) && !interrupted) {
-    PetscReal          trial = PetscMin(lambda + dl, st.max);
-    PeriStep           s     = {0};
+    PetscReal          trial  = PetscMin(lambda + dl, st.max);
+    PeriStep           s      = {0};
     PetscBool          failed = PETSC_FALSE, settled = PETSC_FALSE;
     KSPConvergedReason reason;
     char               why[160] = "";
@@ -296,7 +234,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
       PetscInt  *hold;
       PetscReal *held;
       PetscBool  lost = PETSC_FALSE;
-      PetscCall(Pieces(p, &nhold, &hold, &held, &npieces, &lost));
+      PetscCall(PeriPieces(p, &nhold, &hold, &held, &npieces, &lost));
       if (lost) {
         PetscCall(PetscFree2(hold, held));
         failed = PETSC_TRUE;
@@ -325,6 +263,8 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
       }
       s.broken += nb;
       since_setup += nb;
+      /* a twist carried by the bonds themselves loses the broken bonds' share */
+      if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
       if (st.adaptive && s.broken > st.runaway * nbonds) {
         /* a crack running away at this load: a smaller step tells whether it would settle */
         failed = PETSC_TRUE;
@@ -342,6 +282,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
         /* back to the last equilibrium, with half the step */
         PetscCall(PetscArraycpy(p->bonds.live, live0, p->bonds.nbonds));
         PetscCall(PeriProblemAssemble(p));
+        if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
         since_setup = nbonds;
         dl          = PetscMax(0.5 * dl, st.min_step);
         continue;
@@ -364,13 +305,16 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
     PetscCall(Progress(p, &st, &s));
     if (p->output_every && q->nsteps % p->output_every == 0 && p->vtk) PetscCall(WriteSnapshot(p));
     /* many breaks: smaller steps; none: back towards the scene's step */
-    if (st.adaptive) dl = s.broken > nbonds / 100 ? PetscMax(0.5 * dl, st.min_step) : s.broken ? dl : PetscMin(2 * dl, st.step);
+    if (st.adaptive) dl = s.broken > nbonds / 100 ? PetscMax(0.5 * dl, st.min_step) : s.broken ? dl
+                                                                                               : PetscMin(2 * dl, st.step);
   }
   signal(SIGINT, previous);
   q->broken_bonds = total;
   q->complete     = interrupted ? PETSC_FALSE : PETSC_TRUE;
-  if (interrupted) PetscCall(PetscStrncpy(q->ending, "interrupted (SIGINT): the results so far", sizeof(q->ending)));
-  else if (!q->failed) PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st.max));
+  if (interrupted)
+    PetscCall(PetscStrncpy(q->ending, "interrupted (SIGINT): the results so far", sizeof(q->ending)));
+  else if (!q->failed)
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st.max));
   PetscCall(KSPDestroy(&ksp));
   PetscCall(PetscFree(live0));
   PetscCall(PetscTime(&t));

@@ -100,8 +100,10 @@ static PetscErrorCode HandleFreeMotions(PeriProblem p, Mat A, Vec u, Vec b, Pets
       PetscCall(VecAXPY(free[q], -dot, free[r]));
     }
     PetscCall(VecNormalize(free[q], &norm));
-    if (norm > 1e-8) free[nkeep++] = free[q];
-    else PetscCall(VecDestroy(&free[q]));
+    if (norm > 1e-8)
+      free[nkeep++] = free[q];
+    else
+      PetscCall(VecDestroy(&free[q]));
   }
   *nfree = nkeep;
   if (!*nfree) PetscFunctionReturn(PETSC_SUCCESS);
@@ -317,7 +319,17 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   if (!p->K) PetscCall(PeriProblemAssemble(p));
   PetscCall(PetscTime(&t0));
   PetscCall(VecDestroy(&p->u));
-  PetscCall(PeriStaticSolve(p, &ksp, 1.0, PETSC_TRUE, 0, NULL, NULL, &reason));
+  {
+    /* pieces cut off by cracks: held in place when unloaded, an error when loaded */
+    PetscInt   nhold, npieces, *hold;
+    PetscReal *held;
+    PetscBool  lost;
+    PetscCall(PeriPieces(p, &nhold, &hold, &held, &npieces, &lost));
+    PetscCheck(!lost, p->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", p->scene->file, npieces);
+    if (npieces > 1) PetscCall(PetscPrintf(p->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
+    PetscCall(PeriStaticSolve(p, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));
+    PetscCall(PetscFree2(hold, held));
+  }
   PetscCall(KSPDestroy(&ksp));
   PetscCall(PeriStaticCheckConverged(p, reason));
   PetscCall(PetscTime(&t1));

@@ -1,0 +1,102 @@
+/* Quasi-static failure and cracked sections (docs/failure.md):
+ * - Ganzenmueller's edge-crack patch (npmb, plane stress, G = 1): the critical traction within 5 %
+ *   of LEFM's 130.6 Pa (K_I = sqrt(G E), eq. 23) at dx = 0.04 and 0.02;
+ * - Oterkus & Madenci 8.3: the central crack grows along its own line: every damaged particle
+ *   within one horizon of y = 0, the damage beyond the initial tips and symmetric;
+ * - a micropolar block sheared by displacement breaks bonds by frictional sliding;
+ * - 8.5: torsion of an edge-cracked bar (a/b = 0.25, 0.5, 0.75): on the crack faces the stress
+ *   is along the crack (mean |tau_yz| below 10 % of the uncracked peak and of mean |tau_xz|), the
+ *   largest stress sits at the tip, and J falls as the crack deepens.
+ * usage: test_fracture edge_crack.yaml cracked_bar.yaml micropolar_shear.yaml torsion/edge_crack.yaml */
+#include "testing.h"
+
+static PetscErrorCode Run(const char scene[], const char spacing[], PeriProblem *p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriTestSetOption("-grid_spacing", spacing));
+  PetscCall(PeriTestSetOption("-quiet", "true"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, scene, p));
+  PetscCall(PeriTestSetOption("-grid_spacing", NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+int main(int argc, char **argv)
+{
+  const PetscReal    a8 = 0.125, F = 1.12 - 0.23 * a8 + 10.6 * a8 * a8 - 21.7 * a8 * a8 * a8 + 30.4 * a8 * a8 * a8 * a8;
+  const PetscReal    lefm       = PetscSqrtReal(1.0 * 1e4) / PetscSqrtReal(PETSC_PI * a8) / F; /* plane stress */
+  static const char *spacings[] = {"0.04", "0.02"};
+  PeriProblem        p;
+  char               what[256];
+
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCheck(argc >= 5, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_fracture edge_crack.yaml cracked_bar.yaml micropolar_shear.yaml torsion_edge_crack.yaml");
+  PeriTestClose("LEFM sigma_F plane stress [Pa]", lefm, 130.6, 0.05);
+  for (PetscInt k = 0; k < 2; k++) {
+    PetscCall(Run(argv[1], spacings[k], &p));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "edge crack dx = %s: critical traction / LEFM", spacings[k]));
+    PeriTestClose(what, p->quasistatic->critical_load_factor / lefm, 1, 0.05);
+    PeriTestClose("edge crack: failed, and the bracket is min_step wide", p->quasistatic->critical_load_factor - p->quasistatic->peak_load_factor, 0.25, 1e-9);
+    PetscCall(PeriProblemDestroy(&p));
+  }
+
+  PetscCall(Run(argv[2], "0.02", &p));
+  PeriTestClose("cracked bar: the crack grew (bonds broken)", (PetscReal)(p->quasistatic->broken_bonds > 0), 1, 0);
+  if (p->rank == 0) {
+    PetscReal ymax = 0, xmin = 0, xmax = 0;
+    for (PetscInt i = 0; i < p->particles.n; i++) {
+      const PetscReal *X = &p->particles.x[3 * i];
+      if (p->damage[i] <= 0.01) continue;
+      ymax = PetscMax(ymax, PetscAbsReal(X[1]));
+      xmin = PetscMin(xmin, X[0]);
+      xmax = PetscMax(xmax, X[0]);
+    }
+    PeriTestClose("cracked bar: damaged particles within a horizon of y = 0", ymax, 0, p->delta);
+    PeriTestClose("cracked bar: damage beyond the initial tips (x = 0.1 + delta)", (PetscReal)(xmax > 0.1 + p->delta && xmin < -0.1 - p->delta), 1, 0);
+    PeriTestClose("cracked bar: the growth is symmetric", xmax + xmin, 0, 1.01 * p->particles.mean_spacing);
+  }
+  PetscCall(PeriProblemDestroy(&p));
+
+  PetscCall(Run(argv[3], "0.005", &p));
+  PeriTestClose("micropolar shear: bonds broke by sliding before the last load", (PetscReal)(p->quasistatic->broken_bonds > 0 && p->quasistatic->peak_load_factor > 0), 1, 0);
+  PetscCall(PeriProblemDestroy(&p));
+
+  {
+    static const char *tips[] = {"-0.25", "0", "0.25"};
+    PetscReal          Jprev = 0.4573300474, tau0 = 1.1161e7; /* the uncracked J and peak stress (test_antiplane) */
+    for (PetscInt k = 0; k < 3; k++) {
+      PetscReal tip = atof(tips[k]);
+      PetscCall(PeriTestSetOption("-cracks_0_to_0", tips[k]));
+      PetscCall(Run(argv[4], "0.02", &p));
+      if (p->rank == 0) {
+        const PeriParticles *pt  = &p->particles;
+        PetscReal            syz = 0, sxz = 0, n = 0, best = 0, bx = 0, by = 0;
+        for (PetscInt i = 0; i < pt->n; i++) {
+          const PetscReal *X = &pt->x[3 * i];
+          if (p->tau[3 * i + 2] > best) {
+            best = p->tau[3 * i + 2];
+            bx   = X[0];
+            by   = X[1];
+          }
+          if (PetscAbsReal(PetscAbsReal(X[1]) - 0.5 * pt->mean_spacing) > 1e-9 || X[0] > tip - p->delta) continue;
+          syz += PetscAbsReal(p->tau[3 * i + 1]);
+          sxz += PetscAbsReal(p->tau[3 * i]);
+          n += 1;
+        }
+        PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: mean |tau_yz| on the faces / uncracked peak", tips[k]));
+        PeriTestClose(what, syz / n / tau0, 0, 0.1);
+        PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: mean |tau_yz| / mean |tau_xz| on the faces", tips[k]));
+        PeriTestClose(what, syz / sxz, 0, 0.2);
+        PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: distance of the peak stress from the tip", tips[k]));
+        PeriTestClose(what, PetscSqrtReal(PetscSqr(bx - tip) + by * by), 0, 2 * p->delta);
+      }
+      PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: J below the shallower crack's", tips[k]));
+      PeriTestClose(what, (PetscReal)(p->torsion.J < Jprev), 1, 0);
+      Jprev = p->torsion.J;
+      PetscCall(PeriProblemDestroy(&p));
+    }
+    PetscCall(PeriTestSetOption("-cracks_0_to_0", NULL));
+  }
+  PetscCall(PeriTestSetOption("-quiet", NULL));
+  PetscCall(PetscFinalize());
+  return 0;
+}

@@ -1,0 +1,63 @@
+/* Failure criteria on single bonds, against the formulas (docs/failure.md): the index of tension,
+ * compression, sliding and frictional sliding, the critical stretch from G of pmb (Silling &
+ * Askari / Ha & Bobaru, plane stress sqrt(4 pi G / (9 E delta))) and of the antiplane shear angle
+ * (Oterkus & Madenci eq. 78); and a plate with a crack that cuts off an unloaded piece solves,
+ * the piece held, the damage of the cut particles positive.
+ * usage: test_failure tests/scenes/fragment.yaml */
+#include "testing.h"
+
+int main(int argc, char **argv)
+{
+  PeriProblem      p;
+  PeriBondGeometry g = {0};
+  PetscReal        meas[PERI_MAX_MEASURE];
+
+  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_failure fragment.yaml");
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
+  /* the scene: s_c = 0.01, compressive 0.02 */
+  meas[0] = 0.005;
+  PeriTestClose("tension index s/s_c", PeriBondFailureIndex(p, &g, meas), 0.5, 1e-14);
+  meas[0] = 0.012;
+  PeriTestClose("tension index past s_c", PeriBondFailureIndex(p, &g, meas), 1.2, 1e-14);
+  meas[0] = -0.03;
+  PeriTestClose("compression index -s/s_cc", PeriBondFailureIndex(p, &g, meas), 1.5, 1e-14);
+  /* the cut-off piece: held, the rest loaded and solved */
+  PeriTestClose("static solve converged with a held piece", (PetscReal)(p->results.residual_norm < 1e-8), 1, 0);
+  PetscCall(PeriDamage(p, &p->damage));
+  if (p->rank == 0) {
+    PetscReal dmax = 0;
+    for (PetscInt i = 0; i < p->particles.n; i++) dmax = PetscMax(dmax, p->damage[i]);
+    PeriTestClose("largest damage of the cut particles in (0, 1)", (PetscReal)(dmax > 0.2 && dmax < 1), 1, 0);
+  }
+  PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->results.precracked_bonds > 0), 1, 0);
+  /* G: pmb, plane stress: s_c = sqrt(4 pi G / (9 E delta)) */
+  p->failure.stretch = 0;
+  p->failure.G       = 100;
+  meas[0]            = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->delta));
+  PeriTestClose("pmb plane stress: s at s_c from G gives index 1", PeriBondFailureIndex(p, &g, meas), 1, 1e-12);
+  PetscCall(PeriProblemDestroy(&p));
+
+  /* sliding and friction (pds): gamma_0 = 0.01; friction 30 degrees, cohesion 0.005 */
+  PetscCall(PeriTestSetOption("-model_type", "pds"));
+  PetscCall(PeriTestSetOption("-material_nu", "0.2"));
+  PetscCall(PeriTestSetOption("-failure_sliding", "0.01"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
+  meas[0] = 0;
+  meas[1] = -0.008;
+  PeriTestClose("pds sliding index |gamma|/gamma_0", PeriBondFailureIndex(p, &g, meas), 0.8, 1e-14);
+  p->failure.sliding        = 0;
+  p->failure.friction_angle = 30;
+  p->failure.cohesion       = 0.005;
+  meas[0]                   = -0.004; /* compression raises the limit to a - s tan(beta) */
+  meas[1]                   = 0.006;
+  PeriTestClose("frictional sliding index", PeriBondFailureIndex(p, &g, meas), 0.006 / (0.005 + 0.004 * PetscTanReal(PETSC_PI / 6)), 1e-14);
+  meas[0] = 0.01; /* tension beyond a / tan(beta): no sliding strength left */
+  PeriTestClose("frictional sliding in tension breaks", (PetscReal)(PeriBondFailureIndex(p, &g, meas) >= 1), 1, 0);
+  PetscCall(PeriProblemDestroy(&p));
+  PetscCall(PeriTestSetOption("-model_type", NULL));
+  PetscCall(PeriTestSetOption("-material_nu", NULL));
+  PetscCall(PeriTestSetOption("-failure_sliding", NULL));
+  PetscCall(PetscFinalize());
+  return 0;
+}
