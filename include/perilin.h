@@ -142,6 +142,7 @@ typedef struct {
   PetscReal     *alpha;  /* partial-volume factor */
   PetscReal     *lambda; /* surface correction factor */
   unsigned char *live;   /* 1 intact, 0 broken */
+  PetscReal     *intact; /* softening bonds (Diana & Casolo eqs. 45-46): the remaining share of stiffness in (0, 1]; NULL otherwise */
   PetscInt       nbonds; /* local */
 } PeriBonds;
 
@@ -350,7 +351,8 @@ typedef struct {
 typedef struct {
   PetscBool active;
   PetscReal stretch, G, compressive, sliding, friction_angle, cohesion, shear_angle;
-  PetscInt  istretch, isliding, ishear; /* the model's measures, -1 when absent */
+  PetscReal ultimate, ultimate_compressive; /* softening: the stretch where the stiffness is gone (0: brittle) */
+  PetscInt  istretch, isliding, ishear;     /* the model's measures, -1 when absent */
 } PeriFailure;
 
 /* One load step of the quasi-static analysis. */
@@ -458,6 +460,7 @@ PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[],
 PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriProblem);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriProblem, const PeriBondGeometry *, const PetscReal[]);
+PETSC_EXTERN PetscReal      PeriBondSoftening(PeriProblem, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriDamage(PeriProblem, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriComponents(PeriProblem, PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriPieces(PeriProblem, PetscInt *, PetscInt **, PetscReal **, PetscInt *, PetscBool *);

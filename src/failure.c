@@ -10,13 +10,13 @@
 @*/
 PetscErrorCode PeriFailureSetUp(PeriProblem p)
 {
-  static const char *const keys[] = {"critical_stretch", "G", "compressive_stretch", "sliding", "friction_angle", "cohesion", "shear_angle", NULL};
+  static const char *const keys[] = {"critical_stretch", "G", "compressive_stretch", "sliding", "friction_angle", "cohesion", "shear_angle", "ultimate_stretch", "ultimate_compressive_stretch", NULL};
   PeriScene                s      = p->scene;
   PeriFailure             *F      = &p->failure;
   PeriModel                m      = p->model;
   PeriNode                 node;
-  PetscBool                has[7];
-  PetscReal               *val[7] = {&F->stretch, &F->G, &F->compressive, &F->sliding, &F->friction_angle, &F->cohesion, &F->shear_angle};
+  PetscBool                has[9];
+  PetscReal               *val[9] = {&F->stretch, &F->G, &F->compressive, &F->sliding, &F->friction_angle, &F->cohesion, &F->shear_angle, &F->ultimate, &F->ultimate_compressive};
 
   PetscFunctionBeginUser;
   F->istretch = F->isliding = F->ishear = -1;
@@ -43,6 +43,12 @@ PetscErrorCode PeriFailureSetUp(PeriProblem p)
   PeriInputCheck(has[4] == has[5], s, node, has[4] ? "cohesion" : "friction_angle", "frictional sliding needs both friction_angle (degrees) and cohesion");
   PeriInputCheck(!has[4] || F->friction_angle < 90, s, node, "friction_angle", "must lie in (0, 90) degrees, got %g", (double)F->friction_angle);
   PeriInputCheck(!m->ops.family_stiffness, s, node, NULL, "model %s is state-based: its bonds cannot break yet (use antiplane)", m->type);
+  PeriInputCheck(!has[7] || (has[0] && F->ultimate > F->stretch), s, node, "ultimate_stretch", "softening needs critical_stretch (where it starts) below ultimate_stretch (where the bond is gone)");
+  PeriInputCheck(!has[8] || (has[2] && F->ultimate_compressive > F->compressive), s, node, "ultimate_compressive_stretch", "softening needs compressive_stretch below ultimate_compressive_stretch");
+  if (has[7] || has[8]) {
+    PetscCall(PetscMalloc1(p->bonds.nbonds, &p->bonds.intact));
+    for (PetscInt k = 0; k < p->bonds.nbonds; k++) p->bonds.intact[k] = 1;
+  }
   F->active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -117,9 +123,12 @@ PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const P
 
   if (F->G > 0) crit = p->model->ops.critical_from_G(p->model, g, F->G);
   if (F->istretch >= 0) {
-    PetscReal s = meas[F->istretch], sc = F->stretch > 0 ? F->stretch : crit;
+    /* with softening the bond is gone at the ultimate stretch; before, PeriBondSoftening weakens it */
+    PetscReal s = meas[F->istretch], sc = F->ultimate > 0 ? F->ultimate : F->stretch > 0 ? F->stretch
+                                                                                         : crit;
+    PetscReal scc = F->ultimate_compressive > 0 ? F->ultimate_compressive : F->compressive;
     if (s > 0 && sc > 0) idx = PetscMax(idx, s / sc);
-    if (s < 0 && F->compressive > 0) idx = PetscMax(idx, -s / F->compressive);
+    if (s < 0 && scc > 0) idx = PetscMax(idx, -s / scc);
   }
   if (F->isliding >= 0) {
     PetscReal gam = PetscAbsReal(meas[F->isliding]);
@@ -135,6 +144,21 @@ PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const P
     if (rc > 0) idx = PetscMax(idx, PetscAbsReal(meas[F->ishear]) / rc);
   }
   return idx;
+}
+
+/*@C
+  PeriBondSoftening - the share of its stiffness a bond keeps at stretch s (Diana & Casolo eqs.
+  45-46): 1 below the critical stretch, falling linearly to 0 at the ultimate stretch, in tension
+  and (when given) in compression. Not collective.
+@*/
+PetscReal PeriBondSoftening(PeriProblem p, const PetscReal meas[])
+{
+  const PeriFailure *F = &p->failure;
+  PetscReal          s = F->istretch >= 0 ? meas[F->istretch] : 0, mu = 1;
+
+  if (F->ultimate > 0 && s > F->stretch) mu = PetscMax(0, (F->ultimate - s) / (F->ultimate - F->stretch));
+  if (F->ultimate_compressive > 0 && -s > F->compressive) mu = PetscMax(0, (F->ultimate_compressive + s) / (F->ultimate_compressive - F->compressive));
+  return mu;
 }
 
 /*@C
@@ -155,8 +179,8 @@ PetscErrorCode PeriDamage(PeriProblem p, PetscReal **damage)
       acc[2 * i] += b->alpha[k] * pt->volume[j];
       acc[2 * j] += b->alpha[k] * pt->volume[i];
       if (!b->live[k]) continue;
-      acc[2 * i + 1] += b->alpha[k] * pt->volume[j];
-      acc[2 * j + 1] += b->alpha[k] * pt->volume[i];
+      acc[2 * i + 1] += b->alpha[k] * (b->intact ? b->intact[k] : 1) * pt->volume[j];
+      acc[2 * j + 1] += b->alpha[k] * (b->intact ? b->intact[k] : 1) * pt->volume[i];
     }
   PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(2 * pt->n), MPIU_REAL, MPI_SUM, 0, p->comm));
   PetscCall(PetscFree(*damage));

@@ -230,6 +230,7 @@ PetscErrorCode PeriBondsDestroy(PeriBonds *b)
   PetscCall(PetscFree(b->alpha));
   PetscCall(PetscFree(b->lambda));
   PetscCall(PetscFree(b->live));
+  PetscCall(PetscFree(b->intact));
   b->nbonds = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

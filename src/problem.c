@@ -407,7 +407,7 @@ PetscErrorCode PeriProblemBondGeometry(PeriProblem p, PetscInt i, PetscInt k, Pe
   g->length = b->length[k];
   g->Vi     = pt->volume[i];
   g->Vj     = pt->volume[g->j];
-  g->weight = b->alpha[k] * b->lambda[k];
+  g->weight = b->alpha[k] * b->lambda[k] * (b->intact ? b->intact[k] : 1);
   g->mu     = p->bond_mu ? p->bond_mu[k] : 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -67,6 +67,8 @@ static const PeriSceneKey scene_keys[] = {
     {"failure.friction_angle", "pds/mppd/gerstle: frictional sliding gamma_l = cohesion - s tan(angle), degrees"},
     {"failure.cohesion", "pds/mppd/gerstle: the sliding limit without stretch"},
     {"failure.shear_angle", "antiplane: critical shear angle r_c"},
+    {"failure.ultimate_stretch", "softening (eq. 45): the stiffness falls linearly from critical_stretch to 0 here"},
+    {"failure.ultimate_compressive_stretch", "softening in compression (eq. 46)"},
     {"cracks.<k>.from/to", "a pre-existing crack: 2D segment; bonds crossing it are removed before the first step"},
     {"analysis.load_factor_max", "quasistatic: the largest load factor"},
     {"analysis.load_factor_step", "quasistatic: the load-factor step (the largest with adaptive steps)"},

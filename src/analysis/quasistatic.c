@@ -72,8 +72,9 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
 }
 
 /* Evaluates every live bond of this rank against the criterion and breaks those past it (all, or
- * those within the top fraction of the worst index), subtracting their blocks from K. Returns the
- * global number broken. */
+ * those within the top fraction of the worst index), subtracting their blocks from K; softening
+ * bonds lose stiffness by eqs. 45-46 (irreversibly). Returns the global number of bonds broken or
+ * softened by more than 1 %. */
 static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nbroken)
 {
   PeriBonds         *b  = &p->bonds;
@@ -82,7 +83,7 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   VecScatter         scatter;
   Vec                all;
   const PetscScalar *u;
-  PetscReal         *index, worst = 0, threshold = 1, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PetscReal         *index, *soft, worst = 0, threshold = 1, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
   PetscInt           mine = 0;
 
   PetscFunctionBeginUser;
@@ -90,7 +91,7 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   PetscCall(VecScatterBegin(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecScatterEnd(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(all, &u));
-  PetscCall(PetscMalloc1(b->nbonds, &index));
+  PetscCall(PetscMalloc2(b->nbonds, &index, b->nbonds, &soft));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PeriBondGeometry g;
@@ -104,6 +105,7 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       }
       m->ops.bond_measures(m, &g, ui, uj, meas);
       index[k] = PeriBondFailureIndex(p, &g, meas);
+      soft[k]  = b->intact ? PeriBondSoftening(p, meas) : 1;
       worst    = PetscMax(worst, index[k]);
     }
   PetscCall(VecRestoreArrayRead(all, &u));
@@ -116,17 +118,28 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PeriBondGeometry g;
       PetscInt         idx[2];
-      if (!b->live[k] || index[k] < threshold || index[k] < 1) continue;
+      PetscReal        scale;
+      PetscBool        breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
+      if (!b->live[k] || b->j[k] == i) continue;
+      if (!breaks && !(b->intact && soft[k] < b->intact[k])) continue;
+      /* K changes by (new share / old share - 1) times the bond's present block */
       PetscCall(PeriProblemBondGeometry(p, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
-      for (PetscInt a = 0; a < nb * nb; a++) Ke[a] = -Ke[a];
+      scale = breaks ? -1 : soft[k] / b->intact[k] - 1;
+      for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
       idx[0] = i;
       idx[1] = g.j;
       PetscCall(MatSetValuesBlocked(p->K, 2, idx, 2, idx, Ke, ADD_VALUES));
-      b->live[k] = 0;
-      mine++;
+      if (breaks || soft[k] <= 0) {
+        b->live[k] = 0;
+        mine++;
+      } else {
+        /* softening: iterate until no bond loses more than 1 % of its stiffness */
+        if (b->intact[k] - soft[k] > 1e-2) mine++;
+        b->intact[k] = soft[k];
+      }
     }
-  PetscCall(PetscFree(index));
+  PetscCall(PetscFree2(index, soft));
   PetscCall(MatAssemblyBegin(p->K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(p->K, MAT_FINAL_ASSEMBLY));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, p->comm));
@@ -205,6 +218,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   PetscReal        lambda = 0, dl;
   PetscInt         total = 0, since_setup = 0, nbonds;
   unsigned char   *live0;
+  PetscReal       *intact0 = NULL;
   void (*previous)(int);
   PetscLogDouble t0, tstep, t;
 
@@ -216,6 +230,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   PetscCall(PeriStaticDefaultMatType(p->mat_type, sizeof(p->mat_type)));
   PetscCall(PeriProblemAssemble(p));
   PetscCall(PetscMalloc1(p->bonds.nbonds, &live0));
+  if (p->bonds.intact) PetscCall(PetscMalloc1(p->bonds.nbonds, &intact0));
   PetscCallMPI(MPI_Allreduce(&p->bonds.nbonds, &nbonds, 1, MPIU_INT, MPI_SUM, p->comm));
   PetscCall(PetscTime(&t0));
   previous = signal(SIGINT, OnInterrupt);
@@ -228,6 +243,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
     KSPConvergedReason reason;
     char               why[160] = "";
     PetscCall(PetscArraycpy(live0, p->bonds.live, p->bonds.nbonds));
+    if (intact0) PetscCall(PetscArraycpy(intact0, p->bonds.intact, p->bonds.nbonds));
     PetscCall(PetscTime(&tstep));
     for (s.iterations = 0; s.iterations < st.max_iterations && !interrupted; s.iterations++) {
       PetscInt   nhold = 0, npieces = 0, nb;
@@ -281,6 +297,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
       if (st.adaptive && dl > st.min_step * (1 + 1e-12)) {
         /* back to the last equilibrium, with half the step */
         PetscCall(PetscArraycpy(p->bonds.live, live0, p->bonds.nbonds));
+        if (intact0) PetscCall(PetscArraycpy(p->bonds.intact, intact0, p->bonds.nbonds));
         PetscCall(PeriProblemAssemble(p));
         if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
         since_setup = nbonds;
@@ -317,6 +334,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st.max));
   PetscCall(KSPDestroy(&ksp));
   PetscCall(PetscFree(live0));
+  PetscCall(PetscFree(intact0));
   PetscCall(PetscTime(&t));
   p->results.solve_s = t - t0;
   PetscCall(PeriProblemEvaluateEnergy(p));

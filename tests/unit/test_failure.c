@@ -58,6 +58,30 @@ int main(int argc, char **argv)
   PetscCall(PeriTestSetOption("-model_type", NULL));
   PetscCall(PeriTestSetOption("-material_nu", NULL));
   PetscCall(PeriTestSetOption("-failure_sliding", NULL));
+  /* softening (eqs. 45-46): halfway between the critical and the ultimate stretch a bond keeps
+     half its stiffness; the strip's energy falls below the linear one once its strain passes s_0 */
+  if (argc >= 3) {
+    PetscReal E1, E2, dmax = 0;
+    PetscCall(PeriTestSetOption("-quiet", "true"));
+    PetscCall(PeriTestSetOption("-analysis_load_factor_max", "0.5"));
+    PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
+    meas[0] = 2e-3;
+    PeriTestClose("softening share at (s_0 + s_u)/2", PeriBondSoftening(p, meas), 0.5, 1e-14);
+    E1 = p->results.strain_energy;
+    PetscCall(PeriProblemDestroy(&p));
+    PetscCall(PeriTestSetOption("-analysis_load_factor_max", "4"));
+    PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
+    E2 = p->results.strain_energy;
+    if (p->rank == 0)
+      for (PetscInt i = 0; i < p->particles.n; i++) dmax = PetscMax(dmax, p->damage[i]);
+    PetscCallMPI(MPI_Bcast(&dmax, 1, MPIU_REAL, 0, PETSC_COMM_WORLD));
+    PeriTestClose("strip below s_0 at load 0.5: nothing softened", (PetscReal)(E1 > 0), 1, 0);
+    PeriTestClose("softened strip: energy at load 4 / (64 x energy at load 0.5) below 0.95", (PetscReal)(E2 / (64 * E1) < 0.95), 1, 0);
+    PeriTestClose("softened strip: largest damage in (0, 1)", (PetscReal)(dmax > 0 && dmax < 1), 1, 0);
+    PetscCall(PeriProblemDestroy(&p));
+    PetscCall(PeriTestSetOption("-analysis_load_factor_max", NULL));
+    PetscCall(PeriTestSetOption("-quiet", NULL));
+  }
   PetscCall(PetscFinalize());
   return 0;
 }
