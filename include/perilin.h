@@ -493,6 +493,8 @@ PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
 PETSC_EXTERN PetscErrorCode PeriWriteVTU(PeriProblem, const char[]);
 PETSC_EXTERN PetscErrorCode PeriOutputDirCreate(const char[]);
 PETSC_EXTERN PetscErrorCode PeriFileCommit(const char[], const char[]);
+PETSC_EXTERN PetscErrorCode PeriFileOpenTemporary(const char[], char[], size_t, FILE **);
+PETSC_EXTERN PetscErrorCode PeriFileCloseCommit(FILE *, const char[], const char[], int);
 
 /* log events */
 PETSC_EXTERN PetscLogEvent  PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;

@@ -394,13 +394,9 @@ PetscErrorCode PeriProblemCreateVec(PeriProblem p, Vec *v)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The kernel's view of local bond k of owned particle i. */
-PetscErrorCode PeriProblemBondGeometry(PeriProblem p, PetscInt i, PetscInt k, PeriBondGeometry *g)
+/* The kernel's view of bond k of owned particle i in the list b (bond_mu: per bond, or NULL). */
+static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const PetscReal bond_mu[], PetscInt i, PetscInt k, PeriBondGeometry *g)
 {
-  const PeriBonds     *b  = &p->bonds;
-  const PeriParticles *pt = &p->particles;
-
-  PetscFunctionBeginUser;
   g->i = i;
   g->j = b->j[k];
   for (PetscInt d = 0; d < 3; d++) g->xi[d] = b->xi[3 * k + d];
@@ -408,7 +404,14 @@ PetscErrorCode PeriProblemBondGeometry(PeriProblem p, PetscInt i, PetscInt k, Pe
   g->Vi     = pt->volume[i];
   g->Vj     = pt->volume[g->j];
   g->weight = b->alpha[k] * b->lambda[k] * (b->intact ? b->intact[k] : 1);
-  g->mu     = p->bond_mu ? p->bond_mu[k] : 0;
+  g->mu     = bond_mu ? bond_mu[k] : 0;
+}
+
+/* The kernel's view of local bond k of owned particle i. */
+PetscErrorCode PeriProblemBondGeometry(PeriProblem p, PetscInt i, PetscInt k, PeriBondGeometry *g)
+{
+  PetscFunctionBeginUser;
+  FillGeometry(&p->particles, &p->bonds, p->bond_mu, i, k, g);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -493,21 +496,8 @@ PetscErrorCode PeriProblemFamilyGeometry(PeriProblem p, PetscInt i, PetscInt *n,
 
   PetscFunctionBeginUser;
   *n = 0;
-  for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-    PeriBondGeometry *g = &fam[(*n)++];
-    if (!b->live[k]) {
-      (*n)--;
-      continue;
-    }
-    g->i = i;
-    g->j = b->j[k];
-    for (PetscInt d = 0; d < 3; d++) g->xi[d] = b->xi[3 * k + d];
-    g->length = b->length[k];
-    g->Vi     = pt->volume[i];
-    g->Vj     = pt->volume[g->j];
-    g->weight = b->alpha[k] * b->lambda[k];
-    g->mu     = 0;
-  }
+  for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+    if (b->live[k]) FillGeometry(pt, b, NULL, i, k, &fam[(*n)++]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -396,9 +396,7 @@ PetscErrorCode PeriWriteModesCSV(PeriProblem p, const char path[])
 
   PetscFunctionBeginUser;
   if (p->rank || !p->modal) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscSNPrintf(tmp, sizeof(tmp), "%s.tmp", path));
-  fp = fopen(tmp, "w");
-  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", tmp);
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "mode,f_hz,omega2,residual,kind") < 0;
   for (PetscInt c = 0; c < p->model->dofs; c++) bad |= fprintf(fp, ",share_%s", p->model->components[c]) < 0;
   bad |= fprintf(fp, ",meff_x,meff_y,meff_z\n") < 0;
@@ -408,9 +406,6 @@ PetscErrorCode PeriWriteModesCSV(PeriProblem p, const char path[])
     for (PetscInt c = 0; c < p->model->dofs; c++) bad |= fprintf(fp, ",%.6f", (double)m->energy_share[c]) < 0;
     bad |= fprintf(fp, ",%.6f,%.6f,%.6f\n", (double)m->effective_mass[0], (double)m->effective_mass[1], (double)m->effective_mass[2]) < 0;
   }
-  bad |= fclose(fp) != 0;
-  if (bad) remove(tmp);
-  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing %s failed", tmp);
-  PetscCall(PeriFileCommit(tmp, path));
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -355,17 +355,12 @@ PetscErrorCode PeriWriteStepsCSV(PeriProblem p, const char path[])
 
   PetscFunctionBeginUser;
   if (p->rank || !p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscSNPrintf(tmp, sizeof(tmp), "%s.tmp", path));
-  fp = fopen(tmp, "w");
-  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", tmp);
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,equilibrium_iterations,ksp_iterations,seconds\n") < 0;
   for (PetscInt k = 0; k < p->quasistatic->nsteps; k++) {
     const PeriStep *s = &p->quasistatic->steps[k];
     bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f\n", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
   }
-  bad |= fclose(fp) != 0;
-  if (bad) remove(tmp);
-  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing %s failed", tmp);
-  PetscCall(PeriFileCommit(tmp, path));
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

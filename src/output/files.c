@@ -72,3 +72,24 @@ PetscErrorCode PeriFileCommit(const char tmp[], const char final[])
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* A writer's temporary file "<path>.tmp", opened for writing. Not collective. */
+PetscErrorCode PeriFileOpenTemporary(const char path[], char tmp[], size_t len, FILE **fp)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(tmp, len, "%s.tmp", path));
+  *fp = fopen(tmp, "w");
+  PetscCheck(*fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", tmp);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Closes fp and commits tmp to path, or removes tmp when a write failed (bad). Not collective. */
+PetscErrorCode PeriFileCloseCommit(FILE *fp, const char tmp[], const char path[], int bad)
+{
+  PetscFunctionBeginUser;
+  bad |= fclose(fp) != 0;
+  if (bad) remove(tmp);
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing %s failed", tmp);
+  PetscCall(PeriFileCommit(tmp, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
