@@ -235,7 +235,18 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   PetscCall(PetscTime(&t0));
   previous = signal(SIGINT, OnInterrupt);
   dl       = st.step;
-  if (!st.quiet) PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st.max, (double)st.step, st.adaptive ? "adaptive" : "fixed", st.all ? "all-violators" : "most-critical-fraction"));
+  if (!st.quiet) {
+    const PeriFailure *F = &p->failure;
+    PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st.max, (double)st.step, st.adaptive ? "adaptive" : "fixed", st.all ? "all-violators" : "most-critical-fraction"));
+    PetscCall(PetscPrintf(p->comm, "perilin: failure:"));
+    if (F->stretch > 0) PetscCall(PetscPrintf(p->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
+    if (F->G > 0) PetscCall(PetscPrintf(p->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, p->model->type));
+    if (F->compressive > 0) PetscCall(PetscPrintf(p->comm, " -s > %g", (double)F->compressive));
+    if (F->sliding > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g", (double)F->sliding));
+    if (F->friction_angle > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g - s tan(%g deg)", (double)F->cohesion, (double)F->friction_angle));
+    if (F->shear_angle > 0) PetscCall(PetscPrintf(p->comm, " |r| > r_c = %g", (double)F->shear_angle));
+    PetscCall(PetscPrintf(p->comm, " (formulas: docs/failure.md)\n"));
+  }
   while (lambda < st.max * (1 - 1e-12) && !interrupted) {
     PetscReal          trial  = PetscMin(lambda + dl, st.max);
     PeriStep           s      = {0};
@@ -264,6 +275,8 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
         since_setup = 0;
       }
       PetscCall(PeriStaticSolve(p, &ksp, trial, PETSC_FALSE, nhold, hold, held, &reason));
+      /* later solves start from the last solution: few bonds change between them */
+      PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
       PetscCall(PetscFree2(hold, held));
       q->solves++;
       s.ksp_iterations += p->results.iterations;
