@@ -463,6 +463,7 @@ PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriProblem, const PeriBondGeom
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriProblem, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriDamage(PeriProblem, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriComponents(PeriProblem, PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriFamilySync(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriPieces(PeriProblem, PetscInt *, PetscInt **, PetscReal **, PetscInt *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriWriteStepsCSV(PeriProblem, const char[]);
 

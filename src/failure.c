@@ -42,7 +42,6 @@ PetscErrorCode PeriFailureSetUp(PeriProblem p)
   PeriInputCheck(!has[1] || m->ops.critical_from_G, s, node, "G", "model %s cannot convert an energy release rate into a critical measure; give it directly", m->type);
   PeriInputCheck(has[4] == has[5], s, node, has[4] ? "cohesion" : "friction_angle", "frictional sliding needs both friction_angle (degrees) and cohesion");
   PeriInputCheck(!has[4] || F->friction_angle < 90, s, node, "friction_angle", "must lie in (0, 90) degrees, got %g", (double)F->friction_angle);
-  PeriInputCheck(!m->ops.family_stiffness, s, node, NULL, "model %s is state-based: its bonds cannot break yet (use antiplane)", m->type);
   PeriInputCheck(!has[7] || (has[0] && F->ultimate > F->stretch), s, node, "ultimate_stretch", "softening needs critical_stretch (where it starts) below ultimate_stretch (where the bond is gone)");
   PeriInputCheck(!has[8] || (has[2] && F->ultimate_compressive > F->compressive), s, node, "ultimate_compressive_stretch", "softening needs compressive_stretch below ultimate_compressive_stretch");
   if (has[7] || has[8]) {
@@ -189,6 +188,57 @@ PetscErrorCode PeriDamage(PeriProblem p, PetscReal **damage)
     for (PetscInt i = 0; i < pt->n; i++) (*damage)[i] = acc[2 * i] > 0 ? 1 - acc[2 * i + 1] / acc[2 * i] : 1;
   }
   PetscCall(PetscFree(acc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static int ComparePair(const void *a, const void *b)
+{
+  const PetscInt *x = (const PetscInt *)a, *y = (const PetscInt *)b;
+  if (x[0] != y[0]) return x[0] < y[0] ? -1 : 1;
+  return x[1] < y[1] ? -1 : x[1] > y[1];
+}
+
+/*@C
+  PeriFamilySync - state-based models keep each particle's whole family (p->family, both
+  directions); this marks dead every family entry whose bond is dead in p->bonds (stored once, at
+  the smaller index, possibly on another rank): the dead pairs are gathered on every rank.
+  Collective.
+@*/
+PetscErrorCode PeriFamilySync(PeriProblem p)
+{
+  const PeriBonds *b = &p->bonds;
+  PeriBonds       *F = &p->family;
+  PetscInt        *mine, *all, nmine = 0, nall;
+  PetscMPIInt      n2, *counts, *displs;
+
+  PetscFunctionBeginUser;
+  if (!F->offset) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < b->nbonds; k++) nmine += !b->live[k];
+  PetscCall(PetscMalloc1(2 * nmine + 1, &mine));
+  nmine = 0;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      if (!b->live[k]) {
+        mine[2 * nmine]       = i;
+        mine[2 * nmine++ + 1] = b->j[k];
+      }
+  PetscCall(PetscMalloc2(p->size, &counts, p->size, &displs));
+  PetscCall(PetscMPIIntCast(2 * nmine, &n2));
+  PetscCallMPI(MPI_Allgather(&n2, 1, MPI_INT, counts, 1, MPI_INT, p->comm));
+  displs[0] = 0;
+  for (PetscMPIInt r = 1; r < p->size; r++) displs[r] = displs[r - 1] + counts[r - 1];
+  nall = (displs[p->size - 1] + counts[p->size - 1]) / 2;
+  PetscCall(PetscMalloc1(2 * nall + 1, &all));
+  PetscCallMPI(MPI_Allgatherv(mine, n2, MPIU_INT, all, counts, displs, MPIU_INT, p->comm));
+  qsort(all, (size_t)nall, 2 * sizeof(PetscInt), ComparePair);
+  for (PetscInt i = F->rstart; i < F->rend; i++)
+    for (PetscInt k = F->offset[i - F->rstart]; k < F->offset[i - F->rstart + 1]; k++) {
+      PetscInt key[2] = {PetscMin(i, F->j[k]), PetscMax(i, F->j[k])};
+      F->live[k]      = bsearch(key, all, (size_t)nall, 2 * sizeof(PetscInt), ComparePair) ? 0 : 1;
+    }
+  PetscCall(PetscFree(mine));
+  PetscCall(PetscFree(all));
+  PetscCall(PetscFree2(counts, displs));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -122,14 +122,17 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       PetscBool        breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
       if (!b->live[k] || b->j[k] == i) continue;
       if (!breaks && !(b->intact && soft[k] < b->intact[k])) continue;
-      /* K changes by (new share / old share - 1) times the bond's present block */
-      PetscCall(PeriProblemBondGeometry(p, i, k, &g));
-      m->ops.bond_stiffness(m, &g, Ke);
-      scale = breaks ? -1 : soft[k] / b->intact[k] - 1;
-      for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
-      idx[0] = i;
-      idx[1] = g.j;
-      PetscCall(MatSetValuesBlocked(p->K, 2, idx, 2, idx, Ke, ADD_VALUES));
+      /* K changes by (new share / old share - 1) times the bond's present block (state-based
+         models: K is reassembled from the synchronized families below) */
+      if (m->ops.bond_stiffness) {
+        PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+        m->ops.bond_stiffness(m, &g, Ke);
+        scale = breaks ? -1 : soft[k] / b->intact[k] - 1;
+        for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
+        idx[0] = i;
+        idx[1] = g.j;
+        PetscCall(MatSetValuesBlocked(p->K, 2, idx, 2, idx, Ke, ADD_VALUES));
+      }
       if (breaks || soft[k] <= 0) {
         b->live[k] = 0;
         mine++;
@@ -143,6 +146,10 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   PetscCall(MatAssemblyBegin(p->K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(p->K, MAT_FINAL_ASSEMBLY));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, p->comm));
+  if (*nbroken && !m->ops.bond_stiffness) {
+    PetscCall(PeriFamilySync(p));
+    PetscCall(PeriProblemAssemble(p));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -310,6 +317,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
       if (st.adaptive && dl > st.min_step * (1 + 1e-12)) {
         /* back to the last equilibrium, with half the step */
         PetscCall(PetscArraycpy(p->bonds.live, live0, p->bonds.nbonds));
+        PetscCall(PeriFamilySync(p));
         if (intact0) PetscCall(PetscArraycpy(p->bonds.intact, intact0, p->bonds.nbonds));
         PetscCall(PeriProblemAssemble(p));
         if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
