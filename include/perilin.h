@@ -142,6 +142,7 @@ typedef struct {
   PetscReal     *alpha;  /* partial-volume factor */
   PetscReal     *lambda; /* surface correction factor */
   unsigned char *live;   /* 1 intact, 0 broken */
+  unsigned char *cause;  /* scenes with failure: why a dead bond broke (PeriFailureCause) */
   PetscReal     *intact; /* softening bonds (Diana & Casolo eqs. 45-46): the remaining share of stiffness in (0, 1]; NULL otherwise */
   PetscInt       nbonds; /* local */
 } PeriBonds;
@@ -347,6 +348,17 @@ typedef struct {
   PetscReal torque, J, J_rectangle, max_stress, max_at[2]; /* results, per unit length; kept contiguous (broadcast as 6 reals) */
 } PeriTorsion;
 
+/* Why a bond broke: a pre-existing crack, or the criterion that broke it. */
+typedef enum {
+  PERI_CAUSE_CRACK,
+  PERI_CAUSE_TENSION,
+  PERI_CAUSE_COMPRESSION,
+  PERI_CAUSE_SLIDING,
+  PERI_CAUSE_SHEAR_ANGLE,
+  PERI_NCAUSES
+} PeriFailureCause;
+PETSC_EXTERN const char *const PeriFailureCauses[];
+
 /* Bond failure criteria (failure:, src/failure.c); 0 = criterion not given. */
 typedef struct {
   PetscBool active;
@@ -393,7 +405,7 @@ struct _p_PeriProblem {
   PeriTorsion           torsion;
   PetscReal            *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
   PeriFailure           failure;
-  PetscReal            *damage;      /* rank 0, scenes with failure: phi per particle */
+  PetscReal            *damage;      /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
   PeriQuasistatic      *quasistatic; /* the quasi-static analysis' results */
   PetscInt              output_every;
   PeriModel             model;
@@ -459,7 +471,7 @@ PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[],
 /* failure, cracks, damage, pieces (src/failure.c) */
 PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriProblem);
-PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriProblem, const PeriBondGeometry *, const PetscReal[]);
+PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriProblem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriProblem, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriDamage(PeriProblem, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriComponents(PeriProblem, PetscInt[]);

@@ -4,6 +4,8 @@
  * friction), Oterkus & Madenci eqs. 70, 78-79 (critical shear angle, damage). docs/failure.md. */
 #include "perilin.h"
 
+const char *const PeriFailureCauses[] = {"crack", "tension", "compression", "sliding", "shear_angle", NULL};
+
 /*@C
   PeriFailureSetUp - reads failure: and checks each criterion against the model's measures.
   Not collective.
@@ -44,6 +46,7 @@ PetscErrorCode PeriFailureSetUp(PeriProblem p)
   PeriInputCheck(!has[4] || F->friction_angle < 90, s, node, "friction_angle", "must lie in (0, 90) degrees, got %g", (double)F->friction_angle);
   PeriInputCheck(!has[7] || (has[0] && F->ultimate > F->stretch), s, node, "ultimate_stretch", "softening needs critical_stretch (where it starts) below ultimate_stretch (where the bond is gone)");
   PeriInputCheck(!has[8] || (has[2] && F->ultimate_compressive > F->compressive), s, node, "ultimate_compressive_stretch", "softening needs compressive_stretch below ultimate_compressive_stretch");
+  PetscCall(PetscCalloc1(p->bonds.nbonds, &p->bonds.cause));
   if (has[7] || has[8]) {
     PetscCall(PetscMalloc1(p->bonds.nbonds, &p->bonds.intact));
     for (PetscInt k = 0; k < p->bonds.nbonds; k++) p->bonds.intact[k] = 1;
@@ -113,12 +116,14 @@ PetscErrorCode PeriCracksApply(PeriProblem p)
 /*@C
   PeriBondFailureIndex - how far the bond is past the scene's criteria: the largest of s/s_c
   (tension), -s/s_cc (compression), |gamma|/gamma_0, |gamma|/(a - s tan beta) (friction) and
-  |r|/r_c; the bond breaks when it reaches 1. meas[] are the model's measures. Not collective.
+  |r|/r_c; the bond breaks when it reaches 1. meas[] are the model's measures; cause (may be NULL)
+  gets the criterion that gave the index. Not collective.
 @*/
-PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const PetscReal meas[])
+PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause)
 {
   const PeriFailure *F   = &p->failure;
   PetscReal          idx = 0, crit = 0;
+  PeriFailureCause   c = PERI_CAUSE_CRACK;
 
   if (F->G > 0) crit = p->model->ops.critical_from_G(p->model, g, F->G);
   if (F->istretch >= 0) {
@@ -126,22 +131,36 @@ PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const P
     PetscReal s = meas[F->istretch], sc = F->ultimate > 0 ? F->ultimate : F->stretch > 0 ? F->stretch
                                                                                          : crit;
     PetscReal scc = F->ultimate_compressive > 0 ? F->ultimate_compressive : F->compressive;
-    if (s > 0 && sc > 0) idx = PetscMax(idx, s / sc);
-    if (s < 0 && scc > 0) idx = PetscMax(idx, -s / scc);
+    if (s > 0 && sc > 0 && s / sc > idx) {
+      idx = s / sc;
+      c   = PERI_CAUSE_TENSION;
+    }
+    if (s < 0 && scc > 0 && -s / scc > idx) {
+      idx = -s / scc;
+      c   = PERI_CAUSE_COMPRESSION;
+    }
   }
   if (F->isliding >= 0) {
-    PetscReal gam = PetscAbsReal(meas[F->isliding]);
-    if (F->sliding > 0) idx = PetscMax(idx, gam / F->sliding);
+    PetscReal gam = PetscAbsReal(meas[F->isliding]), v = 0;
+    if (F->sliding > 0) v = gam / F->sliding;
     if (F->friction_angle > 0) {
       /* Diana & Casolo's frictional sliding: the limit grows with compression, vanishes in tension */
       PetscReal s = F->istretch >= 0 ? meas[F->istretch] : 0, lim = F->cohesion - s * PetscTanReal(F->friction_angle * PETSC_PI / 180);
-      idx = PetscMax(idx, lim > 0 ? gam / lim : (gam > 0 ? PETSC_MAX_REAL : 0));
+      v = PetscMax(v, lim > 0 ? gam / lim : (gam > 0 ? PETSC_MAX_REAL : 0));
+    }
+    if (v > idx) {
+      idx = v;
+      c   = PERI_CAUSE_SLIDING;
     }
   }
   if (F->ishear >= 0) {
     PetscReal rc = F->shear_angle > 0 ? F->shear_angle : crit;
-    if (rc > 0) idx = PetscMax(idx, PetscAbsReal(meas[F->ishear]) / rc);
+    if (rc > 0 && PetscAbsReal(meas[F->ishear]) / rc > idx) {
+      idx = PetscAbsReal(meas[F->ishear]) / rc;
+      c   = PERI_CAUSE_SHEAR_ANGLE;
+    }
   }
+  if (cause) *cause = c;
   return idx;
 }
 
@@ -162,30 +181,39 @@ PetscReal PeriBondSoftening(PeriProblem p, const PetscReal meas[])
 
 /*@C
   PeriDamage - phi_i = 1 - (sum of live alpha V_j) / (sum over every bond found, the pre-cracked
-  included) (Oterkus & Madenci eq. 79). Rank 0 gets the n values. Collective.
+  included) (Oterkus & Madenci eq. 79), softened bonds weighed by their remaining share; and per
+  criterion (Diana & Casolo eqs. 47, 48, 51) the share of the family lost to it. Rank 0 gets
+  PERI_NCAUSES + 1 values per particle: the total, then one per PeriFailureCause. Collective.
 @*/
 PetscErrorCode PeriDamage(PeriProblem p, PetscReal **damage)
 {
   const PeriBonds     *b  = &p->bonds;
   const PeriParticles *pt = &p->particles;
+  const PetscInt       w  = PERI_NCAUSES + 2; /* all, live, then the lost share per cause */
   PetscReal           *acc;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc1(2 * pt->n, &acc));
+  PetscCall(PetscCalloc1(w * pt->n, &acc));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscInt j = b->j[k];
-      acc[2 * i] += b->alpha[k] * pt->volume[j];
-      acc[2 * j] += b->alpha[k] * pt->volume[i];
-      if (!b->live[k]) continue;
-      acc[2 * i + 1] += b->alpha[k] * (b->intact ? b->intact[k] : 1) * pt->volume[j];
-      acc[2 * j + 1] += b->alpha[k] * (b->intact ? b->intact[k] : 1) * pt->volume[i];
+      PetscInt  j    = b->j[k];
+      PetscReal left = b->live[k] ? (b->intact ? b->intact[k] : 1) : 0;
+      for (PetscInt e = 0; e < 2; e++) {
+        PetscReal *a = &acc[w * (e ? j : i)], V = b->alpha[k] * pt->volume[e ? i : j];
+        a[0] += V;
+        a[1] += left * V;
+        a[2 + (b->cause ? b->cause[k] : 0)] += (1 - left) * V;
+      }
     }
-  PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(2 * pt->n), MPIU_REAL, MPI_SUM, 0, p->comm));
+  PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(w * pt->n), MPIU_REAL, MPI_SUM, 0, p->comm));
   PetscCall(PetscFree(*damage));
   if (p->rank == 0) {
-    PetscCall(PetscMalloc1(pt->n, damage));
-    for (PetscInt i = 0; i < pt->n; i++) (*damage)[i] = acc[2 * i] > 0 ? 1 - acc[2 * i + 1] / acc[2 * i] : 1;
+    PetscCall(PetscMalloc1((PERI_NCAUSES + 1) * pt->n, damage));
+    for (PetscInt i = 0; i < pt->n; i++) {
+      const PetscReal *a                = &acc[w * i];
+      (*damage)[(PERI_NCAUSES + 1) * i] = a[0] > 0 ? 1 - a[1] / a[0] : 1;
+      for (PetscInt c = 0; c < PERI_NCAUSES; c++) (*damage)[(PERI_NCAUSES + 1) * i + 1 + c] = a[0] > 0 ? a[2 + c] / a[0] : 0;
+    }
   }
   PetscCall(PetscFree(acc));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -231,6 +231,7 @@ PetscErrorCode PeriBondsDestroy(PeriBonds *b)
   PetscCall(PetscFree(b->lambda));
   PetscCall(PetscFree(b->live));
   PetscCall(PetscFree(b->intact));
+  PetscCall(PetscFree(b->cause));
   b->nbonds = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -83,6 +83,7 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   VecScatter         scatter;
   Vec                all;
   const PetscScalar *u;
+  PeriFailureCause  *cause;
   PetscReal         *index, *soft, worst = 0, threshold = 1, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
   PetscInt           mine = 0;
 
@@ -91,7 +92,7 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   PetscCall(VecScatterBegin(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecScatterEnd(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(all, &u));
-  PetscCall(PetscMalloc2(b->nbonds, &index, b->nbonds, &soft));
+  PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PeriBondGeometry g;
@@ -104,7 +105,7 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
         uj[c] = PetscRealPart(u[g.j * bs + c]);
       }
       m->ops.bond_measures(m, &g, ui, uj, meas);
-      index[k] = PeriBondFailureIndex(p, &g, meas);
+      index[k] = PeriBondFailureIndex(p, &g, meas, &cause[k]);
       soft[k]  = b->intact ? PeriBondSoftening(p, meas) : 1;
       worst    = PetscMax(worst, index[k]);
     }
@@ -134,15 +135,17 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
         PetscCall(MatSetValuesBlocked(p->K, 2, idx, 2, idx, Ke, ADD_VALUES));
       }
       if (breaks || soft[k] <= 0) {
-        b->live[k] = 0;
+        b->live[k]  = 0;
+        b->cause[k] = (unsigned char)cause[k];
         mine++;
       } else {
         /* softening: iterate until no bond loses more than 1 % of its stiffness */
         if (b->intact[k] - soft[k] > 1e-2) mine++;
         b->intact[k] = soft[k];
+        b->cause[k]  = (unsigned char)cause[k];
       }
     }
-  PetscCall(PetscFree2(index, soft));
+  PetscCall(PetscFree3(index, soft, cause));
   PetscCall(MatAssemblyBegin(p->K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(p->K, MAT_FINAL_ASSEMBLY));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, p->comm));

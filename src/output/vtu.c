@@ -149,7 +149,21 @@ static PetscErrorCode VTUDescribe(PeriProblem p, VTUArray a[], PetscInt *na)
     PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress", 3, p->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
     PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress_norm", 1, p->tau, 3, &nmap));
   }
-  if (p->damage) PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "damage", 1, p->damage, 1, NULL));
+  if (p->damage) {
+    /* the total, and the share lost to each criterion the scene uses (Diana & Casolo eqs. 47, 48, 51) */
+    static char           names[PERI_NCAUSES][32];
+    static const PetscInt map0 = 0;
+    static PetscInt       maps[PERI_NCAUSES];
+    const PeriFailure    *F      = &p->failure;
+    const PetscBool       used[] = {(PetscBool)(p->results.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
+    PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "damage", 1, p->damage, PERI_NCAUSES + 1, &map0));
+    for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
+      if (!used[c]) continue;
+      maps[c] = 1 + c;
+      PetscCall(PetscSNPrintf(names[c], sizeof(names[c]), "damage_%s", PeriFailureCauses[c]));
+      PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, names[c], 1, p->damage, PERI_NCAUSES + 1, &maps[c]));
+    }
+  }
   if (p->particles.image) PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "mirror_of", VTU_INT32, p->particles.image, 0, 0)); /* -1: a body particle */
   PetscCall(VTUAddReal(a, na, VTU_POINTS, "Points", 3, p->particles.x, 3, NULL));
   PetscCall(VTUAddInt(a, na, VTU_CELLS, "connectivity", VTU_INT64, NULL, 0, 0));

@@ -50,7 +50,7 @@ int main(int argc, char **argv)
       PetscReal ymax = 0, xmin = 0, xmax = 0;
       for (PetscInt i = 0; i < p->particles.n; i++) {
         const PetscReal *X = &p->particles.x[3 * i];
-        if (p->damage[i] <= 0.01) continue;
+        if (p->damage[(PERI_NCAUSES + 1) * i] <= 0.01) continue;
         ymax = PetscMax(ymax, PetscAbsReal(X[1]));
         xmin = PetscMin(xmin, X[0]);
         xmax = PetscMax(xmax, X[0]);
