@@ -20,7 +20,7 @@ static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, con
   return n;
 }
 
-static PetscErrorCode Run(int argc, char **argv)
+static PetscErrorCode Run(int argc, char **argv, PetscBool *incomplete)
 {
   PeriProblem p;
   PetscBool   help_asked;
@@ -47,6 +47,8 @@ static PetscErrorCode Run(int argc, char **argv)
     if (p->torsion.active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)p->torsion.torque, (double)p->torsion.J, (double)p->torsion.J_rectangle, 100 * (double)(p->torsion.J / p->torsion.J_rectangle - 1), (double)p->torsion.max_stress, (double)p->torsion.max_at[0], (double)p->torsion.max_at[1]));
     PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", p->results.strain_energy, p->output_dir));
   }
+  /* an interrupted quasi-static run wrote what it had: say so in the exit status too */
+  *incomplete = (PetscBool)(p->quasistatic && !p->quasistatic->complete);
   PetscCall(PeriProblemDestroy(&p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -55,10 +57,11 @@ int main(int argc, char **argv)
 {
   PetscErrorCode ierr;
   PetscMPIInt    size, rank;
+  PetscBool      incomplete = PETSC_FALSE;
 
   PetscCall(PetscInitialize(&argc, &argv, NULL, help));
   PetscCall(PetscPushErrorHandler(CaptureError, NULL));
-  ierr = Run(argc, argv);
+  ierr = Run(argc, argv, &incomplete);
   PetscCall(PetscPopErrorHandler());
   if (ierr) {
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
@@ -70,5 +73,5 @@ int main(int argc, char **argv)
     return 1;
   }
   PetscCall(PetscFinalize());
-  return 0;
+  return incomplete ? 130 : 0;
 }
