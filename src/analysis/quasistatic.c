@@ -228,7 +228,9 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   PetscReal        lambda = 0, dl;
   PetscInt         total = 0, since_setup = 0, nbonds;
   unsigned char   *live0;
-  PetscReal       *intact0 = NULL;
+  PetscReal       *intact0 = NULL, *held = NULL;
+  PetscInt        *hold = NULL, nhold = 0, npieces = 1;
+  PetscBool        lost = PETSC_FALSE, stale = PETSC_TRUE;
   void (*previous)(int);
   PetscLogDouble t0, tstep, t;
 
@@ -267,13 +269,14 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
     if (intact0) PetscCall(PetscArraycpy(intact0, p->bonds.intact, p->bonds.nbonds));
     PetscCall(PetscTime(&tstep));
     for (s.iterations = 0; s.iterations < st.max_iterations && !interrupted; s.iterations++) {
-      PetscInt   nhold = 0, npieces = 0, nb;
-      PetscInt  *hold;
-      PetscReal *held;
-      PetscBool  lost = PETSC_FALSE;
-      PetscCall(PeriPieces(p, &nhold, &hold, &held, &npieces, &lost));
-      if (lost) {
+      PetscInt nb;
+      /* the pieces change only when bonds do */
+      if (stale) {
         PetscCall(PetscFree2(hold, held));
+        PetscCall(PeriPieces(p, &nhold, &hold, &held, &npieces, &lost));
+        stale = PETSC_FALSE;
+      }
+      if (lost) {
         failed = PETSC_TRUE;
         PetscCall(PetscSNPrintf(why, sizeof(why), "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", npieces));
         break;
@@ -287,7 +290,6 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
       PetscCall(PeriStaticSolve(p, &ksp, trial, PETSC_FALSE, nhold, hold, held, &reason));
       /* later solves start from the last solution: few bonds change between them */
       PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
-      PetscCall(PetscFree2(hold, held));
       q->solves++;
       s.ksp_iterations += p->results.iterations;
       if (reason <= 0 || PetscIsInfOrNanReal(p->results.residual_norm)) {
@@ -296,6 +298,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
         break;
       }
       PetscCall(BreakBonds(p, &st, &nb));
+      stale = (PetscBool)(nb > 0);
       if (!nb) {
         settled = PETSC_TRUE;
         break;
@@ -323,6 +326,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
         PetscCall(PeriFamilySync(p));
         if (intact0) PetscCall(PetscArraycpy(p->bonds.intact, intact0, p->bonds.nbonds));
         PetscCall(PeriProblemAssemble(p));
+        stale = PETSC_TRUE;
         if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
         since_setup = nbonds;
         dl          = PetscMax(0.5 * dl, st.min_step);
@@ -358,6 +362,7 @@ PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st.max));
   PetscCall(KSPDestroy(&ksp));
   PetscCall(PetscFree(live0));
+  PetscCall(PetscFree2(hold, held));
   PetscCall(PetscFree(intact0));
   PetscCall(PetscTime(&t));
   p->results.solve_s = t - t0;
