@@ -1,34 +1,123 @@
 #!/usr/bin/env bash
-# Every scene here is invalid: perilin must exit non-zero, print the message of its "# expect:"
-# line (a regular expression), crash on none, and leave no output directory behind.
+# Runs the invalid scenes of one category: run.sh PERILIN DIR CATEGORY runs DIR/CATEGORY/*.yaml.
+# Each scene is invalid: perilin must exit with a non-zero status below 128 (or the one of its
+# "# exit:" line), print "perilin: error:" exactly once with a message matching its "# expect:"
+# line, and leave no output behind. Header lines at the top of a case (all optional but expect):
+#   # expect: REGEX        grep -E against stderr
+#   # args: OPTIONS        extra options, word-split by the shell
+#   # ranks: N             run under mpiexec -n N
+#   # exit: STATUS         the exact exit status expected
+#   # setup: COMMAND       run by bash before perilin, with $out the output directory
+#   # keep: FILE...        the outputs the case may leave (paths relative to $out, globs allowed)
+# Without setup and keep no output directory may be left; with setup it must be exactly as the
+# setup left it, apart from the files of keep. Every case runs with stdin from /dev/null and a
+# timeout of 60 s; the runner always passes -output_dir "$out".
 set -u
+if [ $# -ne 3 ]; then
+  echo "usage: $0 PERILIN DIR CATEGORY" >&2
+  exit 2
+fi
 perilin=$1
 dir=$2
+category=$3
+timeout_s=60
 pass=0
 fail=0
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-for scene in "$dir"/*.yaml; do
+
+# header KEY FILE: the value of the first "# KEY: " line of the comment block at the top of FILE.
+header() {
+  awk -v key="$1" '!/^#/ { exit } index($0, "# " key ": ") == 1 { print substr($0, length(key) + 5); exit }' "$2"
+}
+
+# snapshot DIR: one line per path below DIR (type, checksum of files), sorted; empty if DIR is absent.
+snapshot() {
+  [ -e "$1" ] || return 0
+  (cd "$1" && find . -mindepth 1 | LC_ALL=C sort | while IFS= read -r p; do
+    if [ -f "$p" ] && [ ! -L "$p" ]; then echo "f ${p#./} $(md5sum < "$p" | cut -c1-32)"
+    elif [ -d "$p" ] && [ ! -L "$p" ]; then echo "d ${p#./}"
+    else echo "o ${p#./} $(ls -ld "$p" | cut -c1-10)"
+    fi
+  done)
+}
+
+# allowed PATH PATTERNS...: whether PATH (relative to $out) matches one of the keep patterns.
+allowed() {
+  local p=$1 pat
+  shift
+  for pat in "$@"; do
+    # shellcheck disable=SC2053
+    [[ $p == $pat || $p == $pat/* ]] && return 0
+  done
+  return 1
+}
+
+shopt -s nullglob
+scenes=("$dir/$category"/*.yaml)
+shopt -u nullglob
+if [ ${#scenes[@]} -eq 0 ]; then
+  echo "FAIL bad_input/$category: no cases in $dir/$category"
+  exit 1
+fi
+
+for scene in "${scenes[@]}"; do
   name=$(basename "$scene" .yaml)
-  expect=$(sed -n '1s/^# expect: //p' "$scene")
+  expect=$(header expect "$scene")
+  args=$(header args "$scene")
+  ranks=$(header ranks "$scene")
+  want_exit=$(header exit "$scene")
+  setup=$(header setup "$scene")
+  keep=$(header keep "$scene")
   out="$tmp/$name-out"
-  "$perilin" "$scene" -output_dir "$out" > "$tmp/stdout" 2> "$tmp/stderr" < /dev/null
-  code=$?
+  rm -rf "$out"
   problem=""
-  if [ "$code" -eq 0 ]; then problem="exit code 0"
-  elif [ "$code" -gt 128 ]; then problem="killed by signal $((code - 128))"
-  elif ! grep -Eq -- "$expect" "$tmp/stderr"; then problem="message does not match '$expect'"
-  elif [ -e "$out" ]; then problem="output left behind in $out"
-  elif [ "$(wc -l < "$tmp/stderr")" -gt 3 ]; then problem="more than one message"
+  if [ -z "$expect" ]; then problem="no '# expect:' line"; fi
+  if [ -z "$problem" ] && [ -n "$setup" ]; then
+    if ! out="$out" bash -c "$setup" > "$tmp/setup.log" 2>&1 < /dev/null; then
+      problem="setup failed: $(head -c 200 "$tmp/setup.log")"
+    fi
+  fi
+  before=$(snapshot "$out")
+  existed=no
+  [ -e "$out" ] && existed=yes
+  if [ -z "$problem" ]; then
+    launcher=()
+    if [ -n "$ranks" ]; then
+      launcher=(env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpiexec --oversubscribe -n "$ranks")
+    fi
+    # shellcheck disable=SC2086
+    timeout -k 5 "$timeout_s" "${launcher[@]}" "$perilin" "$scene" -output_dir "$out" $args \
+      > "$tmp/stdout" 2> "$tmp/stderr" < /dev/null
+    code=$?
+    after=$(snapshot "$out")
+    changed=$(diff <(echo "$before") <(echo "$after") | sed -n 's/^[<>] [fdo] \([^ ]*\).*/\1/p' | LC_ALL=C sort -u)
+    left=""
+    while IFS= read -r p; do
+      [ -z "$p" ] && continue
+      # shellcheck disable=SC2086
+      if ! allowed "$p" $keep; then left="$left $p"; fi
+    done <<< "$changed"
+    if [ "$existed" = no ] && [ -z "$keep" ] && [ -e "$out" ]; then left=" (the directory itself)$left"; fi
+    nerr=$(grep -c 'perilin: error:' "$tmp/stderr")
+    if [ "$code" -eq 124 ] || [ "$code" -eq 137 ]; then problem="hang: no exit within $timeout_s s"
+    elif [ -n "$want_exit" ] && [ "$code" -ne "$want_exit" ]; then problem="exit status $code, expected $want_exit"
+    elif [ -z "$want_exit" ] && [ "$code" -eq 0 ]; then problem="exit status 0"
+    elif [ -z "$want_exit" ] && [ "$code" -gt 128 ]; then problem="killed by signal $((code - 128))"
+    elif ! grep -Eq -- "$expect" "$tmp/stderr"; then problem="message does not match '$expect'"
+    elif [ -n "$left" ]; then problem="output left behind in $out:$left"
+    elif [ "$nerr" -ne 1 ]; then problem="'perilin: error:' printed $nerr times, expected once"
+    fi
   fi
   if [ -n "$problem" ]; then
-    echo "FAIL $name: $problem"
-    sed 's/^/    /' "$tmp/stderr"
+    echo "FAIL $category/$name: $problem"
+    [ -f "$tmp/stderr" ] && head -n 20 "$tmp/stderr" | sed 's/^/    /'
     fail=$((fail + 1))
   else
-    echo "ok   $name: $(head -c 200 "$tmp/stderr")"
+    echo "ok   $category/$name: $(grep -m1 'perilin: error:' "$tmp/stderr" | head -c 200)"
     pass=$((pass + 1))
   fi
+  rm -f "$tmp/stderr" "$tmp/stdout"
 done
-echo "bad_input: $pass passed, $fail failed"
+echo "bad_input/$category: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
