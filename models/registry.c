@@ -1,13 +1,15 @@
 /* The one place models are listed. */
 #include "perilin.h"
 
+/* Global, not static: the registry's finalizer (src/model.c) resets it, so that a second
+ * PetscInitialize in one process registers the models again. */
+PetscBool PeriModelRegisterAllCalled = PETSC_FALSE;
+
 PetscErrorCode PeriModelRegisterAll(void)
 {
-  static PetscBool done = PETSC_FALSE;
-
   PetscFunctionBeginUser;
-  if (done) PetscFunctionReturn(PETSC_SUCCESS);
-  done = PETSC_TRUE;
+  if (PeriModelRegisterAllCalled) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriModelRegisterAllCalled = PETSC_TRUE;
   PetscCall(PeriModelRegister("pmb", PeriModelCreate_PMB));
   PetscCall(PeriModelRegister("npmb", PeriModelCreate_NPMB));
   PetscCall(PeriModelRegister("pds", PeriModelCreate_PDS));

@@ -4,10 +4,22 @@
 #include "perilin.h"
 
 static PetscFunctionList PeriModelList = NULL;
+PETSC_EXTERN PetscBool   PeriModelRegisterAllCalled; /* models/registry.c */
+
+/* Run by PetscFinalize: frees the list and forgets it was filled, as PETSc's own packages do. */
+static PetscErrorCode PeriModelFinalizePackage(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFunctionListDestroy(&PeriModelList));
+  PeriModelRegisterAllCalled = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 PetscErrorCode PeriModelRegister(const char name[], PetscErrorCode (*create)(PeriModel))
 {
   PetscFunctionBeginUser;
+  /* whoever registers first (PeriModelRegisterAll or a user's model) arranges the cleanup */
+  if (!PeriModelList) PetscCall(PetscRegisterFinalize(PeriModelFinalizePackage));
   PetscCall(PetscFunctionListAdd(&PeriModelList, name, create));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -5,14 +5,24 @@
 PetscLogEvent PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;
 PetscLogStage PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
 
+static PetscBool PeriPackageInitialized = PETSC_FALSE;
+
+/* PetscFinalize drops the log events and stages: a second PetscInitialize must register them again. */
+static PetscErrorCode PeriFinalizePackage(void)
+{
+  PetscFunctionBeginUser;
+  PeriPackageInitialized = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriInitializePackage(void)
 {
-  static PetscBool done = PETSC_FALSE;
-  PetscClassId     id;
+  PetscClassId id;
 
   PetscFunctionBeginUser;
-  if (done) PetscFunctionReturn(PETSC_SUCCESS);
-  done = PETSC_TRUE;
+  if (PeriPackageInitialized) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriPackageInitialized = PETSC_TRUE;
+  PetscCall(PetscRegisterFinalize(PeriFinalizePackage));
   PetscCall(PetscClassIdRegister("perilin", &id));
   PetscCall(PetscLogEventRegister("PeriPartition", id, &PERI_EVENT_Partition));
   PetscCall(PetscLogEventRegister("PeriNeighbors", id, &PERI_EVENT_Neighbors));
@@ -430,22 +440,31 @@ PetscErrorCode PeriProblemAssemble(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscFunctionList PeriAnalysisList = NULL;
+static PetscFunctionList PeriAnalysisList              = NULL;
+static PetscBool         PeriAnalysisRegisterAllCalled = PETSC_FALSE;
+
+/* Run by PetscFinalize: frees the list and forgets it was filled, as PETSc's own packages do. */
+static PetscErrorCode PeriAnalysisFinalizePackage(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFunctionListDestroy(&PeriAnalysisList));
+  PeriAnalysisRegisterAllCalled = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 PetscErrorCode PeriAnalysisRegister(const char name[], PetscErrorCode (*run)(PeriProblem))
 {
   PetscFunctionBeginUser;
+  if (!PeriAnalysisList) PetscCall(PetscRegisterFinalize(PeriAnalysisFinalizePackage));
   PetscCall(PetscFunctionListAdd(&PeriAnalysisList, name, run));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode PeriAnalysisRegisterAll(void)
 {
-  static PetscBool done = PETSC_FALSE;
-
   PetscFunctionBeginUser;
-  if (done) PetscFunctionReturn(PETSC_SUCCESS);
-  done = PETSC_TRUE;
+  if (PeriAnalysisRegisterAllCalled) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriAnalysisRegisterAllCalled = PETSC_TRUE;
   PetscCall(PeriAnalysisRegister("static", PeriAnalysisRun_Static));
   PetscCall(PeriAnalysisRegister("modal", PeriAnalysisRun_Modal));
   PetscCall(PeriAnalysisRegister("quasistatic", PeriAnalysisRun_Quasistatic));
