@@ -174,6 +174,7 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
   PeriNode                 loads;
   PetscScalar             *a;
   PetscInt                 ncomp, uz;
+  PetscReal                largest;
 
   PetscFunctionBeginUser;
   /* a 2D cross-section model's loads act along z: they take 3 components, [0, 0, F] */
@@ -211,15 +212,27 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
       PetscCall(AxisComponent(m, d, &comp[d]));
       PeriInputCheck(comp[d] >= 0 || (F[d] == 0 && A[d][0] == 0 && A[d][1] == 0 && A[d][2] == 0), s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
     }
+    largest = 0;
     for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
       const PetscReal *X = &p->particles.x[3 * i];
       if (!PeriRegionContains(r, X)) continue;
       for (PetscInt d = 0; d < ncomp; d++) {
         PetscReal v = F[d];
         for (PetscInt e = 0; e < dim; e++) v += A[d][e] * X[e];
-        if (comp[d] >= 0) a[(i - p->bonds.rstart) * bs + comp[d]] += v * scale * p->particles.volume[i];
+        if (comp[d] < 0) continue;
+        v *= scale * p->particles.volume[i];
+        a[(i - p->bonds.rstart) * bs + comp[d]] += v;
+        /* NaN must fail the check below, so it counts as infinitely large */
+        largest = PetscIsInfOrNanReal(v) ? PETSC_INFINITY : PetscMax(largest, PetscAbsReal(v));
       }
     }
+    /* Finite but huge values (1e308) overflow the solver's inner products, which then stops with
+       a NaN residual that blames the operator; say here that the load is at fault. */
+    PetscCallMPI(MPIU_Allreduce(MPI_IN_PLACE, &largest, 1, MPIU_REAL, MPIU_MAX, p->comm));
+    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(p->particles.n * bs)), s, item, field ? "traction_field" : force  ? "force"
+                                                                                                                               : traction ? "traction"
+                                                                                                                                          : "body_force",
+                   "the load is too large for double precision: a particle force of %g overflows the solver's inner products (keep particle forces below about 1e150)", (double)largest);
   }
   PetscCall(VecRestoreArray(f, &a));
   PetscFunctionReturn(PETSC_SUCCESS);
