@@ -210,78 +210,74 @@ static PetscErrorCode StoreShape(PeriProblem p, Vec full, PetscInt k)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriAnalysisRun_Modal - the lowest analysis.nev natural modes (above analysis.target_hz) of the
-  constrained body; rigid-body modes of a free body are counted and skipped. Options: every
-  -eps_* and -st_* option (e.g. -st_pc_factor_mat_solver_type, -eps_tol). Collective.
-@*/
-PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
+/* The true residual of every inner solve of the spectral transform, (K - sigma M) y = b. An
+ * inexact one (an iterative KSP with a loose -st_ksp_rtol, or preonly with a mere preconditioner)
+ * makes shift-and-invert converge to wrong modes, and SLEPc does not notice. */
+typedef struct {
+  PeriProblem p;
+  Vec         r;
+  PetscReal   worst; /* the largest ||b - A y|| / ||b|| so far */
+  PetscInt    nsolves;
+} InnerCheck;
+
+/* KSP post-solve hook. It fails at the first bad solve, on every rank at once (the norms are
+ * collective), instead of letting the eigensolver iterate on wrong operators up to -eps_max_it. */
+static PetscErrorCode InnerSolveCheck(KSP ksp, Vec b, Vec y, void *ctx)
 {
-  PeriModal     *md;
-  PetscInt       nev, nfree, nconv, nreq, nd, *order;
-  PetscReal      target_hz, scale, sigma, Knorm, *lam;
-  Mat            M, Kff, Mff;
-  IS             isfree;
-  Vec            x, r, y, full, mdiag;
-  EPS            eps;
-  ST             st;
-  KSP            ksp;
-  PC             pc;
-  PetscLogDouble t0, t1, t2;
-  char           what[128];
+  InnerCheck *c = (InnerCheck *)ctx;
+  Mat         A;
+  PetscReal   bn, rn, rel, rtol, tol;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadSettings(p, &nev, &target_hz));
-  PetscCall(SlepcInitialize(NULL, NULL, NULL, NULL));
-  PetscCall(PetscStrncpy(p->mat_type, MATAIJ, sizeof(p->mat_type)));
-  if (!p->K) PetscCall(PeriProblemAssemble(p));
-  PetscCall(PetscTime(&t0));
-  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
-  PetscCall(PeriAssembleMass(p, &M));
-  PetscCall(MatCreateVecs(M, &mdiag, NULL));
-  PetscCall(MatGetDiagonal(M, mdiag));
-  PetscCall(PetscNew(&md));
-  p->modal = md;
-  /* rotations carry inertia, not mass: the total mass is that of the particles */
-  {
-    PetscReal *rho;
-    PetscCall(Densities(p, &rho));
-    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) md->total_mass += rho[i - p->bonds.rstart] * p->particles.volume[i];
-    PetscCall(PetscFree(rho));
+  PetscCall(KSPGetOperators(ksp, &A, NULL));
+  if (!c->r) PetscCall(VecDuplicate(b, &c->r));
+  PetscCall(MatMult(A, y, c->r));
+  PetscCall(VecAYPX(c->r, -1.0, b));
+  PetscCall(VecNorm(b, NORM_2, &bn));
+  PetscCall(VecNorm(c->r, NORM_2, &rn));
+  rel = bn > 0 ? rn / bn : (rn > 0 ? PETSC_INFINITY : 0);
+  c->nsolves++;
+  if (rel > c->worst || PetscIsNanReal(rel)) c->worst = rel;
+  PetscCall(KSPGetTolerances(ksp, &rtol, NULL, NULL, NULL));
+  tol = PeriResidualTolerance(c->p, rtol);
+  if (PetscUnlikely(!(rel <= tol))) {
+    KSPType            kt;
+    PCType             pt;
+    PC                 pc;
+    KSPConvergedReason reason;
+    PetscInt           its;
+    PetscCall(KSPGetType(ksp, &kt));
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PCGetType(pc, &pt));
+    PetscCall(KSPGetConvergedReason(ksp, &reason));
+    PetscCall(KSPGetIterationNumber(ksp, &its));
+    SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_NOT_CONVERGED,
+            "%s: inner solve %" PetscInt_FMT " of the spectral transform, (K - sigma M) y = b, left the true relative residual ||b - (K - sigma M) y|| / ||b|| = %.3g, above the tolerance %.3g "
+            "(KSP %s, PC %s: %s after %" PetscInt_FMT " iterations): the modes would be wrong. Use a direct factorization (-st_ksp_type preonly -st_pc_type cholesky, the default) "
+            "or a tighter -st_ksp_rtol (now %g); solver.residual_tol raises the tolerance",
+            c->p->scene->file, c->nsolves, (double)rel, (double)tol, kt, pt, KSPConvergedReasons[reason], its, (double)rtol);
   }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, p->comm));
-  md->target_hz = target_hz;
-  PetscCall(MainAxis(p, &md->axis));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
-  PetscCall(FreeDOFs(p, &isfree));
-  PetscCall(ISGetSize(isfree, &md->nfree_dofs));
-  PetscCheck(md->nfree_dofs > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", p->scene->file);
-  PetscCall(MatCreateSubMatrix(p->K, isfree, isfree, MAT_INITIAL_MATRIX, &Kff));
-  PetscCall(MatCreateSubMatrix(M, isfree, isfree, MAT_INITIAL_MATRIX, &Mff));
-  PetscCall(MatSetOption(Kff, MAT_SYMMETRIC, PETSC_TRUE));
-  PetscCall(MatNorm(Kff, NORM_1, &Knorm));
-  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what), NULL));
-  md->nrigid = 0;
+/* Krylov-Schur, shift-and-invert at sigma with a direct factorization, the nreq pairs nearest
+ * sigma; then every -eps_* and -st_* option; then the check of the inner solves. */
+static PetscErrorCode CreateEPS(PeriProblem p, Mat Kff, Mat Mff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
+{
+  ST        st;
+  KSP       ksp;
+  PC        pc;
+  PetscBool precond;
 
-  /* the scale of the largest omega^2 */
-  {
-    PetscReal Mnorm;
-    PetscCall(MatNorm(Mff, NORM_1, &Mnorm));
-    scale = Knorm / Mnorm;
-  }
-  sigma = PetscSqr(2 * PETSC_PI * target_hz);
-  /* a free body makes K singular: shift just below its zero eigenvalues */
-  if (nfree && target_hz == 0) sigma = -1e-8 * scale;
-  nreq = PetscMin(nev + nfree, md->nfree_dofs);
-
-  PetscCall(EPSCreate(p->comm, &eps));
-  PetscCall(EPSSetOperators(eps, Kff, Mff));
-  PetscCall(EPSSetProblemType(eps, EPS_GHEP));
-  PetscCall(EPSSetDimensions(eps, nreq, PETSC_DEFAULT, PETSC_DEFAULT));
-  PetscCall(EPSSetTarget(eps, sigma));
-  PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
-  PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
-  PetscCall(EPSGetST(eps, &st));
+  PetscFunctionBeginUser;
+  PetscCall(EPSCreate(p->comm, eps));
+  PetscCall(EPSSetOperators(*eps, Kff, Mff));
+  PetscCall(EPSSetProblemType(*eps, EPS_GHEP));
+  PetscCall(EPSSetDimensions(*eps, nreq, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(EPSSetTarget(*eps, sigma));
+  PetscCall(EPSSetWhichEigenpairs(*eps, EPS_TARGET_MAGNITUDE));
+  PetscCall(EPSSetTolerances(*eps, 1e-10, PETSC_DEFAULT));
+  PetscCall(EPSGetST(*eps, &st));
   PetscCall(STSetType(st, STSINVERT));
   PetscCall(STGetKSP(st, &ksp));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
@@ -290,59 +286,292 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
 #if defined(PETSC_HAVE_MUMPS)
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
 #endif
-  PetscCall(EPSSetFromOptions(eps));
-  PetscCall(EPSSetUp(eps));
-  PetscCall(PetscTime(&t1));
-  PetscCall(EPSSolve(eps));
-  PetscCall(PetscTime(&t2));
-  md->factor_s = t1 - t0;
-  md->solve_s  = t2 - t1;
-  PetscCall(EPSGetConverged(eps, &nconv));
-  PetscCheck(nconv > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", p->scene->file);
+  PetscCall(EPSSetFromOptions(*eps));
+  /* STPRECOND (Davidson methods) solves only approximately by design: there only the modes
+   * themselves are checked */
+  PetscCall(PetscObjectTypeCompare((PetscObject)st, STPRECOND, &precond));
+  inner->p     = p;
+  inner->r     = NULL;
+  inner->worst = 0;
+  if (!precond) PetscCall(KSPSetPostSolve(ksp, InnerSolveCheck, inner));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
-  /* ascending omega^2 */
-  PetscCall(PetscMalloc2(nconv, &lam, nconv, &order));
+/* One converged pair as the selection sees it. */
+typedef struct {
+  PetscInt  k;        /* its index among SLEPc's converged pairs */
+  PetscReal lam, key; /* omega^2; the sort key */
+} Pair;
+
+/* The frequency of omega^2 (negative for a negative omega^2, so that it sorts below 0). */
+static PetscReal Frequency(PetscReal lam)
+{
+  return PetscCopysignReal(PetscSqrtReal(PetscAbsReal(lam)), lam) / (2 * PETSC_PI);
+}
+
+/* Stable insertion sort by key, ties to the lower omega^2; a few dozen pairs at most. */
+static void SortPairs(PetscInt n, Pair a[])
+{
+  for (PetscInt i = 1; i < n; i++) {
+    Pair     t = a[i];
+    PetscInt j = i;
+    for (; j > 0 && (t.key < a[j - 1].key || (t.key == a[j - 1].key && t.lam < a[j - 1].lam)); j--) a[j] = a[j - 1];
+    a[j] = t;
+  }
+}
+
+/* The converged pairs the run may return, in the order it returns them: without a target
+ * ascending; with one, by distance |f - target| (ties: the lower frequency first). Of a free body
+ * the lowest nfree with |omega^2| < 1e-6 scale are its rigid-body modes: counted, not returned.
+ * radius: the largest |omega^2 - sigma| among all converged pairs. */
+static PetscErrorCode OrderPairs(EPS eps, PetscReal target_hz, PetscReal sigma, PetscInt nfree, PetscReal scale, PetscInt *nrigid, PetscInt *n, Pair **pairs, PetscReal *radius)
+{
+  PetscInt nconv, m = 0;
+  Pair    *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetConverged(eps, &nconv));
+  PetscCall(PetscMalloc1(nconv, &a));
+  *radius = 0;
   for (PetscInt k = 0; k < nconv; k++) {
     PetscScalar kr;
     PetscCall(EPSGetEigenvalue(eps, k, &kr, NULL));
-    lam[k]   = PetscRealPart(kr);
-    order[k] = k;
+    a[k].k   = k;
+    a[k].lam = a[k].key = PetscRealPart(kr);
+    *radius             = PetscMax(*radius, PetscAbsReal(a[k].lam - sigma));
   }
-  PetscCall(PetscSortRealWithPermutation(nconv, lam, order));
+  SortPairs(nconv, a);
+  *nrigid = 0;
+  for (PetscInt s = 0; s < nconv; s++) {
+    if (*nrigid < nfree && PetscAbsReal(a[s].lam) < 1e-6 * scale) {
+      (*nrigid)++;
+      continue;
+    }
+    a[m] = a[s];
+    if (target_hz > 0) a[m].key = PetscAbsReal(Frequency(a[m].lam) - target_hz);
+    m++;
+  }
+  SortPairs(m, a);
+  *n     = m;
+  *pairs = a;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* SLEPc converges the pairs nearest sigma in omega^2, which favours the modes below the target;
+ * the nev nearest in frequency are surely among them when every omega^2 within the frequency
+ * distance d of the farthest one chosen, up to (2 pi (target + d))^2, lies within the radius
+ * SLEPc covered. */
+static PetscBool Covered(const Pair a[], PetscInt n, PetscInt nev, PetscReal target_hz, PetscReal sigma, PetscReal radius)
+{
+  if (n < nev) return PETSC_FALSE;
+  return (PetscBool)(PetscSqr(2 * PETSC_PI * (target_hz + a[nev - 1].key)) - sigma <= radius);
+}
+
+/* EPSSolve, then the pairs to return; with a target, solved again asking for twice as many
+ * pairs until the nev nearest the target in frequency are surely among the converged ones. */
+static PetscErrorCode SolveModes(PeriProblem p, EPS eps, PetscInt nev, PetscReal target_hz, PetscReal sigma, PetscInt nfree, PetscReal scale, PetscInt *n, Pair **pairs)
+{
+  PeriModal *md = p->modal;
+  PetscInt   nreq, ncv;
+  PetscReal  radius = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetDimensions(eps, &nreq, NULL, NULL));
+  for (;;) {
+    PetscCall(EPSSolve(eps));
+    PetscCall(OrderPairs(eps, target_hz, sigma, nfree, scale, &md->nrigid, n, pairs, &radius));
+    if (target_hz == 0 || nreq >= md->nfree_dofs || Covered(*pairs, *n, nev, target_hz, sigma, radius)) break;
+    PetscCall(PetscFree(*pairs));
+    nreq = PetscMin(2 * nreq, md->nfree_dofs);
+    PetscCall(EPSGetDimensions(eps, NULL, &ncv, NULL));
+    PetscCall(PetscInfo(eps, "target %g Hz: the %" PetscInt_FMT " modes nearest in frequency may lie beyond the converged ones: asking for %" PetscInt_FMT "\n", (double)target_hz, nev, nreq));
+    PetscCall(EPSSetDimensions(eps, nreq, ncv >= 2 * nreq && ncv <= md->nfree_dofs ? ncv : PETSC_DEFAULT, PETSC_DEFAULT));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* ||K x - lam M x|| / (max(|lam|, floor) ||M x||): relative to the eigenvalue, unlike a residual
+ * scaled by ||K||, which hides errors in the low modes. Below floor = sqrt(eps) ||K||_1/||M||_1 an
+ * omega^2 is at the round-off of K x itself: only its error relative to floor can be asked for. */
+static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal floor, Vec r, Vec y, PetscReal *res)
+{
+  PetscReal rn, yn;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatMult(K, x, r));
+  PetscCall(MatMult(M, x, y));
+  PetscCall(VecNorm(y, NORM_2, &yn));
+  PetscCall(VecAXPY(r, -lam, y));
+  PetscCall(VecNorm(r, NORM_2, &rn));
+  *res = rn / (PetscMax(PetscAbsReal(lam), floor) * yn);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Every returned mode must satisfy K x = omega^2 M x to PeriResidualTolerance(eps_tol). */
+static PetscErrorCode CheckModes(PeriProblem p, PetscReal eps_tol)
+{
+  const PeriModal *md   = p->modal;
+  const PetscReal  tol  = PeriResidualTolerance(p, eps_tol);
+  PetscInt         nbad = 0, first = -1;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < md->nmodes; k++)
+    if (!(md->modes[k].residual <= tol)) {
+      nbad++;
+      if (first < 0) first = k;
+    }
+  PetscCheck(!nbad, p->comm, PETSC_ERR_NOT_CONVERGED,
+             "%s: mode %" PetscInt_FMT " (%.6g Hz) has the relative residual ||K x - omega^2 M x|| / (omega^2 ||M x||) = %.3g, above the tolerance %.3g (%" PetscInt_FMT " of the %" PetscInt_FMT
+             " modes fail): its frequency and shape cannot be trusted. Try a tighter -eps_tol (now %g), a larger -eps_ncv, a direct inner solve (-st_ksp_type preonly -st_pc_type cholesky), "
+             "or accept it with a larger solver.residual_tol",
+             p->scene->file, first + 1, (double)md->modes[first].f_hz, (double)md->modes[first].residual, (double)tol, nbad, md->nmodes, (double)eps_tol);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The mass, the free DOFs and the blocks of K and M on them. */
+static PetscErrorCode SetUpModal(PeriProblem p, PetscReal target_hz, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff)
+{
+  PeriModal *md;
+  PetscReal *rho;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriAssembleMass(p, M));
+  PetscCall(MatCreateVecs(*M, mdiag, NULL));
+  PetscCall(MatGetDiagonal(*M, *mdiag));
+  PetscCall(PetscNew(&md));
+  p->modal = md;
+  /* rotations carry inertia, not mass: the total mass is that of the particles */
+  PetscCall(Densities(p, &rho));
+  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) md->total_mass += rho[i - p->bonds.rstart] * p->particles.volume[i];
+  PetscCall(PetscFree(rho));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, p->comm));
+  md->target_hz = target_hz;
+  PetscCall(MainAxis(p, &md->axis));
+  PetscCall(FreeDOFs(p, isfree));
+  PetscCall(ISGetSize(*isfree, &md->nfree_dofs));
+  PetscCheck(md->nfree_dofs > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", p->scene->file);
+  PetscCall(MatCreateSubMatrix(p->K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
+  PetscCall(MatCreateSubMatrix(*M, *isfree, *isfree, MAT_INITIAL_MATRIX, Mff));
+  PetscCall(MatSetOption(*Kff, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Each chosen pair becomes a mode: frequency, residual, kind, shape. */
+static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS isfree, Vec mdiag, PetscInt nev, PetscInt npairs, const Pair pairs[], PetscReal floor)
+{
+  PeriModal *md = p->modal;
+  Vec        x, r, y, full;
+  PetscInt   nd = p->particles.n * p->model->dofs;
+
+  PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(Kff, &x, &r));
   PetscCall(VecDuplicate(r, &y));
   PetscCall(PeriProblemCreateVec(p, &full));
   PetscCall(PetscCalloc1(nev, &md->modes));
-  nd          = p->particles.n * p->model->dofs;
   md->nshapes = PetscMin(nev, PERI_MAX_VTU_MODES);
   if (p->rank == 0) PetscCall(PetscCalloc1(md->nshapes * nd, &md->shapes));
-  for (PetscInt s = 0; s < nconv && md->nmodes < nev; s++) {
-    PetscInt  k = order[s];
-    PeriMode *mode;
-    PetscReal xn, rn, l = lam[k];
-    /* the lowest nfree of a free body are its rigid-body modes, at round-off from zero */
-    if (md->nrigid < nfree && PetscAbsReal(l) < 1e-6 * scale) {
-      md->nrigid++;
-      continue;
-    }
+  for (PetscInt s = 0; s < npairs && md->nmodes < nev; s++) {
+    PeriMode *mode = &md->modes[md->nmodes];
+    PetscReal l    = pairs[s].lam;
     PetscCheck(l > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: a negative eigenvalue omega^2 = %g: the stiffness is indefinite (Poisson ratio above the bond-based value?)", p->scene->file, (double)l);
-    mode = &md->modes[md->nmodes];
-    PetscCall(EPSGetEigenvector(eps, k, x, NULL));
-    /* ||K x - omega^2 M x|| / (||K|| ||x||) */
-    PetscCall(MatMult(Kff, x, r));
-    PetscCall(MatMult(Mff, x, y));
-    PetscCall(VecAXPY(r, -l, y));
-    PetscCall(VecNorm(r, NORM_2, &rn));
-    PetscCall(VecNorm(x, NORM_2, &xn));
-    mode->omega2   = l;
-    mode->f_hz     = PetscSqrtReal(l) / (2 * PETSC_PI);
-    mode->residual = rn / (Knorm * xn);
+    PetscCall(EPSGetEigenvector(eps, pairs[s].k, x, NULL));
+    PetscCall(ModeResidual(Kff, Mff, x, l, floor, r, y, &mode->residual));
+    mode->omega2 = l;
+    mode->f_hz   = Frequency(l);
     PetscCall(VecSet(full, 0));
     PetscCall(VecISCopy(full, isfree, SCATTER_FORWARD, x));
     PetscCall(Classify(p, full, mdiag, mode, md->axis));
     if (md->nmodes < md->nshapes) PetscCall(StoreShape(p, full, md->nmodes));
     md->nmodes++;
   }
+  md->nshapes = PetscMin(md->nmodes, md->nshapes); /* only converged modes go to particles.vtu */
+  PetscCall(VecDestroy(&x));
+  PetscCall(VecDestroy(&r));
+  PetscCall(VecDestroy(&y));
+  PetscCall(VecDestroy(&full));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What summary.json reports of the solver: the inner KSP, and its worst true residual. */
+static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, const InnerCheck *inner)
+{
+  ST       st;
+  KSP      ksp;
+  PC       pc;
+  KSPType  kt;
+  PCType   pt;
+  PetscInt asked, nconv;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPGetType(ksp, &kt));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCGetType(pc, &pt));
+  PetscCall(PetscStrncpy(p->results.ksp_type, kt, sizeof(p->results.ksp_type)));
+  PetscCall(PetscStrncpy(p->results.pc_type, pt, sizeof(p->results.pc_type)));
+  PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
+  PetscCall(EPSGetConverged(eps, &nconv));
+  PetscCall(PetscStrncpy(p->results.converged_reason, nconv >= asked ? "EPS_CONVERGED" : "EPS_PARTIAL", sizeof(p->results.converged_reason)));
+  PetscCall(EPSGetIterationNumber(eps, &p->results.iterations));
+  p->results.residual_norm = inner->worst;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisRun_Modal - analysis.nev natural modes of the constrained body. Without a target
+  (analysis.target_hz = 0) the lowest, in ascending frequency; with one, the nev whose frequencies
+  lie nearest it, in order of |f - target| (ties: the lower first). Rigid-body modes of a free
+  body are counted and skipped. Every inner solve of the spectral transform must leave a true
+  relative residual below PeriResidualTolerance(-st_ksp_rtol), and every returned mode a relative
+  residual ||K x - omega^2 M x|| / (omega^2 ||M x||) below PeriResidualTolerance(-eps_tol): else
+  the run fails with PETSC_ERR_NOT_CONVERGED. Options: every -eps_* and -st_* option (e.g.
+  -st_pc_factor_mat_solver_type, -eps_tol). SLEPc must be initialized. Collective.
+@*/
+PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
+{
+  PeriModal     *md;
+  PetscInt       nev, nfree, npairs = 0;
+  PetscReal      target_hz, scale, sigma, Knorm, Mnorm, eps_tol;
+  Mat            M, Kff, Mff;
+  IS             isfree;
+  Vec            mdiag;
+  EPS            eps;
+  InnerCheck     inner;
+  Pair          *pairs = NULL;
+  PetscLogDouble t0, t1, t2;
+  char           what[128];
+
+  PetscFunctionBeginUser;
+  PetscCall(ReadSettings(p, &nev, &target_hz));
+  PetscCall(PetscStrncpy(p->mat_type, MATAIJ, sizeof(p->mat_type)));
+  if (!p->K) PetscCall(PeriProblemAssemble(p));
+  PetscCall(PetscTime(&t0));
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscCall(SetUpModal(p, target_hz, &M, &mdiag, &isfree, &Kff, &Mff));
+  md = p->modal;
+  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what), NULL));
+  md->nrigid = 0;
+
+  /* the scale of the largest omega^2 */
+  PetscCall(MatNorm(Kff, NORM_1, &Knorm));
+  PetscCall(MatNorm(Mff, NORM_1, &Mnorm));
+  scale = Knorm / Mnorm;
+  sigma = PetscSqr(2 * PETSC_PI * target_hz);
+  /* a free body makes K singular: shift just below its zero eigenvalues */
+  if (nfree && target_hz == 0) sigma = -1e-8 * scale;
+
+  PetscCall(CreateEPS(p, Kff, Mff, sigma, PetscMin(nev + nfree, md->nfree_dofs), &inner, &eps));
+  PetscCall(EPSSetUp(eps));
+  PetscCall(PetscTime(&t1));
+  PetscCall(SolveModes(p, eps, nev, target_hz, sigma, nfree, scale, &npairs, &pairs));
+  PetscCall(PetscTime(&t2));
+  md->factor_s = t1 - t0;
+  md->solve_s  = t2 - t1;
+  PetscCheck(npairs + md->nrigid > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", p->scene->file);
+  PetscCall(CollectModes(p, eps, Kff, Mff, isfree, mdiag, nev, npairs, pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
+  PetscCall(EPSGetTolerances(eps, &eps_tol, NULL));
+  PetscCall(CheckModes(p, eps_tol));
   /* a free bar's lowest longitudinal mode is half a wave over its length */
   if (nfree)
     for (PetscInt k = 0; k < md->nmodes; k++)
@@ -354,27 +583,11 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
       }
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   p->results.solve_s = t2 - t0;
-  {
-    KSPType kt;
-    PCType  pt;
-    PetscCall(KSPGetType(ksp, &kt));
-    PetscCall(KSPGetPC(ksp, &pc));
-    PetscCall(PCGetType(pc, &pt));
-    PetscCall(PetscStrncpy(p->results.ksp_type, kt, sizeof(p->results.ksp_type)));
-    PetscCall(PetscStrncpy(p->results.pc_type, pt, sizeof(p->results.pc_type)));
-    PetscInt asked;
-    PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
-    PetscCall(PetscStrncpy(p->results.converged_reason, nconv >= asked ? "EPS_CONVERGED" : "EPS_PARTIAL", sizeof(p->results.converged_reason)));
-    PetscCall(EPSGetIterationNumber(eps, &p->results.iterations));
-  }
-  md->nshapes = PetscMin(md->nmodes, md->nshapes); /* only converged modes go to particles.vtu */
+  PetscCall(RecordSolver(p, eps, &inner));
   PetscCheck(md->nmodes > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", p->scene->file, md->nrigid);
   if (md->nmodes < nev) PetscCall(PetscPrintf(p->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
-  PetscCall(PetscFree2(lam, order));
-  PetscCall(VecDestroy(&x));
-  PetscCall(VecDestroy(&r));
-  PetscCall(VecDestroy(&y));
-  PetscCall(VecDestroy(&full));
+  PetscCall(PetscFree(pairs));
+  PetscCall(VecDestroy(&inner.r));
   PetscCall(VecDestroy(&mdiag));
   PetscCall(EPSDestroy(&eps));
   PetscCall(MatDestroy(&Kff));

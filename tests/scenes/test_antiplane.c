@@ -11,6 +11,7 @@
  * usage: test_antiplane examples/antiplane/square_bar.yaml examples/antiplane/bimaterial.yaml
  *                       examples/torsion/rect_bar.yaml tests/scenes/square_bar_inner.yaml */
 #include "testing.h"
+#include <slepcsys.h>
 
 static const PetscReal S = 12000, MU = 12e6;
 
@@ -152,7 +153,7 @@ int main(int argc, char **argv)
   const char *const models[] = {"antiplane", "antiplane_os"};
   char              what[256];
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 5, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_antiplane square_bar.yaml bimaterial.yaml rect_bar.yaml square_bar_inner.yaml");
   for (PetscInt k = 0; k < 2; k++) {
     PeriProblem p, q;
@@ -279,6 +280,6 @@ int main(int argc, char **argv)
     PetscCall(PeriTestSetOption("-horizon_m", NULL));
   }
   PetscCall(PeriTestSetOption("-model_type", NULL));
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }

@@ -3,6 +3,7 @@
  * lattice sum sum_j |xi_j| V_j / (pi delta^4) - 1, computed here independently by brute force.
  * The paper's neighbour counts (32 at m = 2, 924 at m = 6) are checked too. */
 #include "testing.h"
+#include <slepcsys.h>
 
 /* sum over lattice points 0 < |xi| <= m of |xi|^p, and their number */
 static void LatticeSum(PetscInt m, PetscInt p, PetscReal *sum, PetscInt *count)
@@ -23,7 +24,7 @@ int main(int argc, char **argv)
 {
   const PetscReal K = 1e9, s = 0.01, Wexact = 4.5 * K * s * s;
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_energy_density examples/pmb/energy_density.yaml");
   for (PetscInt m = 2; m <= 6; m++) {
     char        val[8], what[128];
@@ -59,6 +60,6 @@ int main(int argc, char **argv)
     }
     PetscCall(PeriProblemDestroy(&p));
   }
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }

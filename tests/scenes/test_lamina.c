@@ -14,6 +14,7 @@
  * constants (its 1/|xi|^2 shear springs homogenize to nu_eff = 0.08 at nu = 0 on this lattice,
  * docs/models/mppd.md); pds off by more than 30 % (the paper: 51-200 %). */
 #include "testing.h"
+#include <slepcsys.h>
 
 typedef enum {
   LATTICE_PMB,
@@ -174,7 +175,7 @@ int main(int argc, char **argv)
   PetscMPIInt       rank;
   char              what[160];
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_lamina examples/lamina");
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
 
@@ -235,6 +236,6 @@ int main(int argc, char **argv)
   }
   (void)sigma;
   PetscCall(Extremes(argv[1]));
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }

@@ -6,6 +6,7 @@
  * plate and the probe sampling) and so the elastic value to |lattice error| + 2 %, with and without
  * the surface correction. On several ranks the result must equal a one-rank run to solver tolerance. */
 #include "testing.h"
+#include <slepcsys.h>
 
 /* alpha of the continued linear ramp, as in docs/theory.md */
 static PetscReal Alpha(PetscReal r, PetscReal m)
@@ -57,7 +58,7 @@ int main(int argc, char **argv)
   PetscReal         lat_exx, lat_nu;
   PetscMPIInt       size, rank;
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_plate_traction examples/pmb/plate_traction.yaml");
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
@@ -95,6 +96,6 @@ int main(int argc, char **argv)
     }
     PetscCall(PeriProblemDestroy(&p));
   }
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }

@@ -2,6 +2,7 @@
  * strain energy and the largest displacement of every component (static), or the frequencies
  * (modal), to the solver tolerance. */
 #include "testing.h"
+#include <slepcsys.h>
 
 int main(int argc, char **argv)
 {
@@ -9,7 +10,7 @@ int main(int argc, char **argv)
   PetscMPIInt size;
   char        what[128];
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_ranks SCENE.yaml [options]");
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
@@ -22,7 +23,7 @@ int main(int argc, char **argv)
     }
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
-    PetscCall(PetscFinalize());
+    PetscCall(SlepcFinalize());
     return 0;
   }
   if (p->quasistatic) {
@@ -33,7 +34,7 @@ int main(int argc, char **argv)
     PeriTestClose(what, (PetscReal)p->quasistatic->nsteps, (PetscReal)q->quasistatic->nsteps, 0);
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
-    PetscCall(PetscFinalize());
+    PetscCall(SlepcFinalize());
     return 0;
   }
   PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %d ranks vs 1", p->model->type, size));
@@ -48,6 +49,6 @@ int main(int argc, char **argv)
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }

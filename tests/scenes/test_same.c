@@ -1,13 +1,14 @@
 /* Two scenes that describe the same body must give the same answer: the strain energy and the
  * largest displacement of every component, to the solver tolerance. */
 #include "testing.h"
+#include <slepcsys.h>
 
 int main(int argc, char **argv)
 {
   PeriProblem p, q;
   char        what[256];
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_same A.yaml B.yaml [options]");
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &q));
@@ -19,6 +20,6 @@ int main(int argc, char **argv)
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }

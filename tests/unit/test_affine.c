@@ -3,6 +3,7 @@
  * neighbours' horizons, on which npmb's c_ij and the surface factors depend) lies inside the body.
  * Run with a scene and -model_type. */
 #include "testing.h"
+#include <slepcsys.h>
 
 static PetscErrorCode CheckAffine(const char file[])
 {
@@ -66,9 +67,9 @@ static PetscErrorCode CheckAffine(const char file[])
 
 int main(int argc, char **argv)
 {
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_affine SCENE.yaml [options]");
   PetscCall(CheckAffine(argv[1]));
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }

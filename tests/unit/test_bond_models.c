@@ -5,6 +5,7 @@
  *  - in pds it slides every bond by gamma = w, storing sum_bonds (1/2) alpha lambda V_i V_j g |xi| w^2,
  *    g of Diana & Casolo eq. (21), computed here from the bond list, not from the assembly. */
 #include "testing.h"
+#include <slepcsys.h>
 
 static PetscErrorCode Setup(const char file[], const char model[], const char nu[], const char plane[], PeriProblem *p)
 {
@@ -52,7 +53,7 @@ int main(int argc, char **argv)
   PeriProblem     p, q;
   char            what[160];
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_bond_models tests/scenes/affine_2d.yaml");
 
   for (int k = 0; k < 2; k++) {
@@ -95,6 +96,6 @@ int main(int argc, char **argv)
       PetscCall(PeriProblemDestroy(&p));
     }
   }
-  PetscCall(PetscFinalize());
+  PetscCall(SlepcFinalize());
   return 0;
 }
