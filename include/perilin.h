@@ -268,7 +268,8 @@ typedef struct {
   PetscReal memory_mb, memory_mb_max_rank;
   char      ksp_type[64], pc_type[64], converged_reason[64];
   PetscInt  iterations;
-  PetscReal residual_norm;
+  PetscReal residual_norm; /* true relative residual of the last solve */
+  PetscReal residual_tol;  /* the largest accepted (solver.residual_tol or its default) */
   PetscReal strain_energy;
   PetscReal max_abs_u[PERI_MAX_DOF];
   PetscInt  nbonds_total;
@@ -374,13 +375,16 @@ typedef struct {
 } PeriStep;
 
 typedef struct {
-  PetscInt  nsteps, cap;
-  PeriStep *steps;
-  PetscReal peak_load_factor, critical_load_factor;
-  PetscInt  broken_bonds, fragments_held, pc_setups, solves;
-  PetscBool failed, complete;
-  char      ending[160];
-  char      control[PERI_NAME_LEN];
+  PetscInt   nsteps, cap;
+  PeriStep  *steps;
+  PetscReal  peak_load_factor, critical_load_factor;
+  PetscInt   broken_bonds;                      /* at the last equilibrium: steps.csv's last broken_total */
+  PetscInt   failure_step, failed_trial_broken; /* the step that failed, and the bonds its trial broke */
+  PetscReal *trial_damage;                      /* rank 0: the damage of the failed trial (like p->damage) */
+  PetscInt   fragments_held, pc_setups, solves;
+  PetscBool  failed, complete;
+  char       ending[160];
+  char       control[PERI_NAME_LEN];
 } PeriQuasistatic;
 
 typedef struct _p_PeriProblem *PeriProblem;
@@ -419,12 +423,16 @@ struct _p_PeriProblem {
   PeriProbe            *probes;
   char                  analysis[PERI_NAME_LEN];
   char                  output_dir[PETSC_MAX_PATH_LEN];
+  char                  staging_dir[PETSC_MAX_PATH_LEN]; /* where the outputs are written until the set is committed */
+  PetscBool             write_output;                    /* set by the executable: check output.dir before computing */
   PetscBool             vtk;
   PetscReal            *W;     /* strain energy density per particle (rank 0, after the solve) */
   PetscReal            *u_all; /* displacements of all particles (rank 0, after the solve) */
   PeriResults           results;
   PeriReference         reference;
-  PeriModal            *modal; /* modal analysis results, when the scene asks for modes */
+  PeriModal            *modal;        /* modal analysis results, when the scene asks for modes */
+  int                   interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
+  PetscReal             residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
   PetscLogDouble        t_start;
 };
 
@@ -441,6 +449,7 @@ PETSC_EXTERN PetscErrorCode PeriProblemEvaluateEnergy(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriProblemFamilyGeometry(PeriProblem, PetscInt, PetscInt *, PeriBondGeometry[]);
 PETSC_EXTERN PetscInt       PeriProblemMaxFamily(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriProblemFindProbe(PeriProblem, const char[], PeriProbe **);
+PETSC_EXTERN PetscReal      PeriResidualTolerance(PeriProblem, PetscReal);
 
 /* assembly (src/assembly.c) */
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriProblem, Mat *);
@@ -464,6 +473,7 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Modal(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriStaticSolve(PeriProblem, KSP *, PetscReal, PetscBool, PetscInt, const PetscInt[], const PetscReal[], KSPConvergedReason *);
 PETSC_EXTERN PetscErrorCode PeriStaticCheckConverged(PeriProblem, KSPConvergedReason);
+PETSC_EXTERN PetscErrorCode PeriStaticConverged(PeriProblem, KSP, KSPConvergedReason, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriStaticDefaultMatType(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAssembleMass(PeriProblem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriProblem, PetscInt *, char[], size_t, Vec[]);
@@ -504,10 +514,21 @@ PETSC_EXTERN PetscErrorCode PeriJSONBool(PeriJSON, const char[], PetscBool);
 PETSC_EXTERN PetscErrorCode PeriJSONRealArray(PeriJSON, const char[], PetscInt, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
 PETSC_EXTERN PetscErrorCode PeriWriteVTU(PeriProblem, const char[]);
+PETSC_EXTERN PetscErrorCode PeriWritePVD(const char[], PetscInt, const PetscReal[], const char *const[]);
+PETSC_EXTERN PetscErrorCode PeriWriteModeShapes(PeriProblem, const char[]);
+PETSC_EXTERN PetscErrorCode PeriWriteSnapshotsPVD(PeriProblem, const char[]);
 PETSC_EXTERN PetscErrorCode PeriOutputDirCreate(const char[]);
 PETSC_EXTERN PetscErrorCode PeriFileCommit(const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriFileOpenTemporary(const char[], char[], size_t, FILE **);
 PETSC_EXTERN PetscErrorCode PeriFileCloseCommit(FILE *, const char[], const char[], int);
+PETSC_EXTERN PetscErrorCode PeriOutputSetOpen(MPI_Comm, char[], size_t, char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriOutputSetCommit(MPI_Comm, const char[], const char[]);
+PETSC_EXTERN void           PeriOutputSetDiscard(void);
+
+/* signals (src/signals.c) */
+PETSC_EXTERN PetscErrorCode PeriSignalsInstall(void);
+PETSC_EXTERN PetscErrorCode PeriSignalReceived(MPI_Comm, int *);
+PETSC_EXTERN int            PeriSignalPending(void);
 
 /* log events */
 PETSC_EXTERN PetscLogEvent  PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;

@@ -1,5 +1,8 @@
 /* perilin SCENE.yaml [PETSc options]: run a scene, write summary.json and particles.vtu. */
 #include "perilin.h"
+#include <slepcsys.h>
+#include <signal.h>
+#include <unistd.h>
 
 static const char help[] = "perilin: implicit static and modal peridynamics.\n"
                            "Usage: perilin SCENE.yaml [-material_nu 0.25 -model_type npmb ... PETSc options]\n";
@@ -12,7 +15,7 @@ static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, con
   (void)comm;
   (void)ctx;
   if (p == PETSC_ERROR_INITIAL && !first_error[0]) {
-    if (n == PETSC_ERR_USER_INPUT)
+    if (n == PETSC_ERR_USER_INPUT || n == PETSC_ERR_NOT_CONVERGED)
       PetscSNPrintf(first_error, sizeof(first_error), "%s", mess ? mess : "invalid input");
     else
       PetscSNPrintf(first_error, sizeof(first_error), "%s (PETSc error %d in %s() at %s:%d)", mess ? mess : "error", (int)n, fun, file, line);
@@ -20,7 +23,26 @@ static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, con
   return n;
 }
 
-static PetscErrorCode Run(int argc, char **argv, PetscBool *incomplete)
+/* The one-paragraph report on stdout: what ran, what it cost, the main results. */
+static PetscErrorCode Report(PeriProblem p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis, p->model->type, p->particles.n, p->results.nbonds_total, p->particles.n * p->model->dofs, p->size));
+  PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", p->results.neighbors_s, p->results.assembly_s, p->results.solve_s, p->results.ksp_type, p->results.pc_type, p->results.iterations, p->results.converged_reason, (double)p->results.residual_norm, p->results.memory_mb));
+  if (p->interrupted) {
+    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", p->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", p->u_all ? "the last complete state was written" : "no result was reached", p->output_dir));
+  } else if (p->modal) {
+    PetscCall(PetscPrintf(p->comm, "perilin: %" PetscInt_FMT " modes (Hz):", p->modal->nmodes));
+    for (PetscInt k = 0; k < p->modal->nmodes; k++) PetscCall(PetscPrintf(p->comm, " %.6g (%s)", (double)p->modal->modes[k].f_hz, p->modal->modes[k].kind));
+    PetscCall(PetscPrintf(p->comm, "; results in %s/\n", p->output_dir));
+  } else {
+    if (p->torsion.active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)p->torsion.torque, (double)p->torsion.J, (double)p->torsion.J_rectangle, 100 * (double)(p->torsion.J / p->torsion.J_rectangle - 1), (double)p->torsion.max_stress, (double)p->torsion.max_at[0], (double)p->torsion.max_at[1]));
+    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", p->results.strain_energy, p->output_dir));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Run(int argc, char **argv, int *status)
 {
   PeriProblem p;
   PetscBool   help_asked;
@@ -33,45 +55,58 @@ static PetscErrorCode Run(int argc, char **argv, PetscBool *incomplete)
   }
   PetscCheck(argc >= 2 && argv[1][0] != '-', PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "usage: perilin SCENE.yaml [options]; perilin -help lists the scene keys");
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
+  p->write_output = PETSC_TRUE;
   PetscCall(PeriProblemLoad(p, argv[1]));
   PetscCall(PeriProblemSetUp(p));
   PetscCall(PeriProblemRun(p));
   PetscCall(PeriProblemWriteOutput(p));
-  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis, p->model->type, p->particles.n, p->results.nbonds_total, p->particles.n * p->model->dofs, p->size));
-  PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s), peak memory %.1f MB\n", p->results.neighbors_s, p->results.assembly_s, p->results.solve_s, p->results.ksp_type, p->results.pc_type, p->results.iterations, p->results.converged_reason, p->results.memory_mb));
-  if (p->modal) {
-    PetscCall(PetscPrintf(p->comm, "perilin: %" PetscInt_FMT " modes (Hz):", p->modal->nmodes));
-    for (PetscInt k = 0; k < p->modal->nmodes; k++) PetscCall(PetscPrintf(p->comm, " %.6g (%s)", (double)p->modal->modes[k].f_hz, p->modal->modes[k].kind));
-    PetscCall(PetscPrintf(p->comm, "; results in %s/\n", p->output_dir));
-  } else {
-    if (p->torsion.active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)p->torsion.torque, (double)p->torsion.J, (double)p->torsion.J_rectangle, 100 * (double)(p->torsion.J / p->torsion.J_rectangle - 1), (double)p->torsion.max_stress, (double)p->torsion.max_at[0], (double)p->torsion.max_at[1]));
-    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", p->results.strain_energy, p->output_dir));
-  }
-  /* an interrupted quasi-static run wrote what it had: say so in the exit status too */
-  *incomplete = (PetscBool)(p->quasistatic && !p->quasistatic->complete);
+  PetscCall(Report(p));
+  /* a run stopped by a signal says so in its exit status too: 128 + the signal, as shells do */
+  *status = p->interrupted ? 128 + p->interrupted : 0;
   PetscCall(PeriProblemDestroy(&p));
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether every rank failed (they all reach this barrier within a few seconds): then rank 0
+ * alone prints the error and all end cleanly. Otherwise some rank still waits in a collective
+ * call, and only MPI_Abort ends it. */
+static PetscBool EveryRankFailed(void)
+{
+  MPI_Request req;
+  int         done = 0;
+  double      t0   = MPI_Wtime();
+
+  if (MPI_Ibarrier(PETSC_COMM_WORLD, &req) != MPI_SUCCESS) return PETSC_FALSE;
+  while (!done && MPI_Wtime() - t0 < 3.0) {
+    if (MPI_Test(&req, &done, MPI_STATUS_IGNORE) != MPI_SUCCESS) return PETSC_FALSE;
+    if (!done) usleep(1000);
+  }
+  return done ? PETSC_TRUE : PETSC_FALSE;
 }
 
 int main(int argc, char **argv)
 {
   PetscErrorCode ierr;
   PetscMPIInt    size, rank;
-  PetscBool      incomplete = PETSC_FALSE;
+  int            status = 0;
 
-  PetscCall(PetscInitialize(&argc, &argv, NULL, help));
+  /* SLEPc once for the whole run (it initializes PETSc): the modal analysis needs it */
+  PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
+  PetscCall(PeriSignalsInstall());
   PetscCall(PetscPushErrorHandler(CaptureError, NULL));
-  ierr = Run(argc, argv, &incomplete);
+  ierr = Run(argc, argv, &status);
   PetscCall(PetscPopErrorHandler());
   if (ierr) {
+    PetscBool all;
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
-    if (rank == 0 || size > 1) fprintf(stderr, "perilin: error: %s\n", first_error[0] ? first_error : "unknown error");
-    /* another rank may still wait in a collective call: only an abort ends them all */
-    if (size > 1) MPI_Abort(PETSC_COMM_WORLD, 1);
-    PetscCall(PetscFinalize());
+    if (rank == 0) PeriOutputSetDiscard(); /* the previous results stay as they were */
+    all = size == 1 ? PETSC_TRUE : EveryRankFailed();
+    if (rank == 0 || !all) fprintf(stderr, "perilin: error: %s\n", first_error[0] ? first_error : "unknown error");
+    if (!all) MPI_Abort(PETSC_COMM_WORLD, 1);
+    PetscCall(SlepcFinalize());
     return 1;
   }
-  PetscCall(PetscFinalize());
-  return incomplete ? 130 : 0;
+  PetscCall(SlepcFinalize());
+  return status;
 }

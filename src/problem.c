@@ -183,6 +183,31 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* solver.residual_tol: every solve's true relative residual must lie below it. */
+static PetscErrorCode ReadSolver(PeriProblem p)
+{
+  static const char *const keys[] = {"residual_tol", NULL};
+  PeriScene                s      = p->scene;
+  PeriNode                 node;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &node));
+  PetscCall(PeriSceneCheckKeys(s, node, keys));
+  PetscCall(PeriSceneGetReal(s, node, "residual_tol", PETSC_FALSE, &p->residual_tol, NULL));
+  PeriInputCheck(p->residual_tol >= 0 && p->residual_tol < 1, s, node, "residual_tol", "must lie in [0, 1) (0: the default, max(100 rtol, 1e-6)), got %g", (double)p->residual_tol);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriResidualTolerance - the largest true relative residual a solve run with relative tolerance
+  rtol may leave: solver.residual_tol, or by default max(100 rtol, 1e-6). The factor 100 leaves
+  room for the preconditioned norm that some KSPs monitor; the floor, for round-off in K.
+@*/
+PetscReal PeriResidualTolerance(PeriProblem p, PetscReal rtol)
+{
+  return p->residual_tol > 0 ? p->residual_tol : PetscMax(100 * rtol, 1e-6);
+}
+
 static PetscErrorCode CreateModel(PeriProblem p)
 {
   static const char *const keys[] = {"type", "plane", NULL}, *const planes[] = {"stress", "strain", NULL};
@@ -219,7 +244,7 @@ static PetscErrorCode CreateModel(PeriProblem p)
 
 static PetscErrorCode CheckRootKeys(PeriScene s)
 {
-  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", "boundary_layers", "torsion", "failure", "cracks", NULL};
+  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", "boundary_layers", "torsion", "failure", "cracks", "solver", NULL};
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckKeys(s, s->root, keys));
@@ -327,6 +352,10 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
   PetscCall(CheckRootKeys(s));
   PetscCall(CreateModel(p));
+  PetscCall(ReadOutput(p, s->file));
+  PetscCall(ReadSolver(p));
+  /* a bad output.dir is found before anything is computed */
+  if (p->write_output) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
   PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &thickness, NULL));
   PeriInputCheck(thickness > 0, s, mat, "thickness", "must be positive, got %g", (double)thickness);
@@ -335,7 +364,6 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PeriModelSetFromScene(p->model, s, p->delta));
   PetscCall(ReadCorrections(p));
   PetscCall(PeriLayersAddParticles(p));
-  PetscCall(ReadOutput(p, s->file));
 
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Partition, 0, 0, 0, 0));
@@ -495,8 +523,10 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
     PetscCall(PetscFree(names));
     PeriInputCheck(PETSC_FALSE, p->scene, a, "type", "unknown analysis '%s'; available: %s", p->analysis, list);
   }
+  /* a signal during the set-up: no analysis, only the summary saying so */
+  PetscCall(PeriSignalReceived(p->comm, &p->interrupted));
   PetscCall(PetscLogStagePush(PERI_STAGE_Solve));
-  PetscCall((*run)(p));
+  if (!p->interrupted) PetscCall((*run)(p));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscTime(&t));
   p->results.total_s = t - p->t_start;
@@ -694,8 +724,9 @@ PetscErrorCode PeriProblemFindProbe(PeriProblem p, const char name[], PeriProbe 
 }
 
 /*@C
-  PeriProblemWriteOutput - writes summary.json (and particles.vtu) into the output directory,
-  each file under a temporary name first. Collective.
+  PeriProblemWriteOutput - writes the output set (summary.json, particles.vtu and the analysis'
+  files) into the staging directory and swaps it in for the output directory as a whole.
+  Collective.
 @*/
 PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
 {
@@ -703,21 +734,27 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Output));
-  if (p->rank == 0) PetscCall(PeriOutputDirCreate(p->output_dir));
-  if (p->vtk) {
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.vtu", p->output_dir));
+  if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
+  /* an analysis stopped before it had a state writes no fields: only the summary saying so */
+  if (p->vtk && (!p->interrupted || p->u_all)) {
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.vtu", p->staging_dir));
     PetscCall(PeriWriteVTU(p, path));
   }
   if (p->quasistatic) {
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/steps.csv", p->output_dir));
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/steps.csv", p->staging_dir));
     PetscCall(PeriWriteStepsCSV(p, path));
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.pvd", p->staging_dir));
+    PetscCall(PeriWriteSnapshotsPVD(p, path));
   }
   if (p->modal) {
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", p->output_dir));
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", p->staging_dir));
     PetscCall(PeriWriteModesCSV(p, path));
+    if (p->vtk) PetscCall(PeriWriteModeShapes(p, p->staging_dir));
   }
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/summary.json", p->output_dir));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/summary.json", p->staging_dir));
   PetscCall(PeriWriteSummary(p, path));
+  PetscCall(PeriOutputSetCommit(p->comm, p->staging_dir, p->output_dir));
+  p->staging_dir[0] = 0;
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -728,6 +765,7 @@ PetscErrorCode PeriProblemDestroy(PeriProblem *problem)
 
   PetscFunctionBeginUser;
   if (!p) PetscFunctionReturn(PETSC_SUCCESS);
+  if (p->staging_dir[0] && p->rank == 0) PeriOutputSetDiscard(); /* never committed: the previous results stay */
   PetscCall(MatDestroy(&p->K));
   PetscCall(VecDestroy(&p->u));
   PetscCall(VecDestroy(&p->f));
@@ -741,6 +779,7 @@ PetscErrorCode PeriProblemDestroy(PeriProblem *problem)
   PetscCall(PetscFree(p->damage));
   if (p->quasistatic) {
     PetscCall(PetscFree(p->quasistatic->steps));
+    PetscCall(PetscFree(p->quasistatic->trial_damage));
     PetscCall(PetscFree(p->quasistatic));
   }
   PetscCall(PeriParticlesDestroy(&p->particles));

@@ -85,6 +85,7 @@ static const PeriSceneKey scene_keys[] = {
     {"analysis.type", "static | modal | quasistatic"},
     {"analysis.nev", "modal: number of modes (default 6)"},
     {"analysis.target_hz", "modal: compute the modes nearest this frequency [1/time] (default 0: the lowest)"},
+    {"solver.residual_tol", "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; default max(100 rtol, 1e-6)"},
     {"output.dir", "output directory; default <scene name>-out"},
     {"output.vtk", "true | false: write particles.vtu (default true)"},
 };

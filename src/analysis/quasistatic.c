@@ -9,12 +9,8 @@
 #include <signal.h>
 #include <unistd.h>
 
-static volatile sig_atomic_t interrupted = 0;
-static void                  OnInterrupt(int sig)
-{
-  (void)sig;
-  interrupted = 1;
-}
+#define PERI_MAX_LOAD_STEPS 100000
+#define PERI_MAX_BISECTION  1048576.0 /* 2^20 */
 
 typedef struct {
   PetscReal  max, step, min_step, fraction, runaway;
@@ -41,7 +37,10 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
   PeriInputCheck(st->step > 0 && st->step <= st->max, s, a, "load_factor_step", "must lie in (0, load_factor_max], got %g", (double)st->step);
   st->min_step = st->step / 64;
   PetscCall(PeriSceneGetReal(s, a, "min_step", PETSC_FALSE, &st->min_step, NULL));
-  PeriInputCheck(st->min_step > 0 && st->min_step <= st->step, s, a, "min_step", "must lie in (0, load_factor_step], got %g", (double)st->min_step);
+  /* bounded so that a run ends: each halving below the step costs a failed trial's solves, and
+     a bracket finer than 2^-20 of a step does not change the critical load meaningfully */
+  PeriInputCheck(st->max / st->step <= PERI_MAX_LOAD_STEPS, s, a, "load_factor_step", "%g would take %.3g steps to reach load_factor_max %g (at most %d): use a larger step (adaptive steps refine it where bonds break)", (double)st->step, (double)(st->max / st->step), (double)st->max, PERI_MAX_LOAD_STEPS);
+  PeriInputCheck(st->min_step >= st->step / PERI_MAX_BISECTION && st->min_step <= st->step, s, a, "min_step", "must lie in [load_factor_step / 2^20, load_factor_step] = [%g, %g], got %g", (double)(st->step / PERI_MAX_BISECTION), (double)st->step, (double)st->min_step);
   st->adaptive = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "adaptive", &st->adaptive, NULL));
   PetscCall(PeriSceneGetChoice(s, a, "break", policies, &policy, NULL));
@@ -204,172 +203,308 @@ static PetscErrorCode Progress(PeriProblem p, const Settings *st, const PeriStep
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode WriteSnapshot(PeriProblem p)
+/* The state of the last equilibrium: what the outputs describe when a later step fails or the
+ * run is interrupted, so that every file of the set shows one state. */
+typedef struct {
+  Vec            u;
+  unsigned char *live;
+  PetscReal     *intact;
+} Equilibrium;
+
+static PetscErrorCode EquilibriumCreate(PeriProblem p, Equilibrium *e)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateVecs(p->K, &e->u, NULL)); /* lambda = 0: no displacement */
+  PetscCall(PetscMalloc1(p->bonds.nbonds, &e->live));
+  PetscCall(PetscArraycpy(e->live, p->bonds.live, p->bonds.nbonds));
+  e->intact = NULL;
+  if (p->bonds.intact) {
+    PetscCall(PetscMalloc1(p->bonds.nbonds, &e->intact));
+    PetscCall(PetscArraycpy(e->intact, p->bonds.intact, p->bonds.nbonds));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode EquilibriumSave(PeriProblem p, Equilibrium *e)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecCopy(p->u, e->u));
+  PetscCall(PetscArraycpy(e->live, p->bonds.live, p->bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(e->intact, p->bonds.intact, p->bonds.nbonds));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Back to the last equilibrium: bonds (and the families and K built from them when the loop goes
+ * on), and, with restore_u, the displacements. */
+static PetscErrorCode EquilibriumRestore(PeriProblem p, Equilibrium *e, PetscBool reassemble, PetscBool restore_u)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscArraycpy(p->bonds.live, e->live, p->bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(p->bonds.intact, e->intact, p->bonds.nbonds));
+  PetscCall(PeriFamilySync(p));
+  if (reassemble) {
+    PetscCall(PeriProblemAssemble(p));
+    if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
+  }
+  if (restore_u) {
+    if (!p->u) PetscCall(VecDuplicate(e->u, &p->u));
+    PetscCall(VecCopy(e->u, p->u));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode EquilibriumDestroy(Equilibrium *e)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecDestroy(&e->u));
+  PetscCall(PetscFree(e->live));
+  PetscCall(PetscFree(e->intact));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* particles_NNNN.vtu (or another name) of the present state, in the output set. */
+static PetscErrorCode WriteState(PeriProblem p, const char name[])
 {
   char path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
   PetscCall(PeriProblemEvaluateEnergy(p));
   PetscCall(PeriDamage(p, &p->damage));
-  if (p->rank == 0) PetscCall(PeriOutputDirCreate(p->output_dir));
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles_%04" PetscInt_FMT ".vtu", p->output_dir, p->quasistatic->nsteps));
+  if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", p->staging_dir, name));
   PetscCall(PeriWriteVTU(p, path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscErrorCode WriteSnapshot(PeriProblem p)
+{
+  char name[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT ".vtu", p->quasistatic->nsteps));
+  PetscCall(WriteState(p, name));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode PrintCriteria(PeriProblem p, const Settings *st)
+{
+  const PeriFailure *F = &p->failure;
+
+  PetscFunctionBeginUser;
+  if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
+  PetscCall(PetscPrintf(p->comm, "perilin: failure:"));
+  if (F->stretch > 0) PetscCall(PetscPrintf(p->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
+  if (F->G > 0) PetscCall(PetscPrintf(p->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, p->model->type));
+  if (F->compressive > 0) PetscCall(PetscPrintf(p->comm, " -s > %g", (double)F->compressive));
+  if (F->sliding > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g", (double)F->sliding));
+  if (F->friction_angle > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g - s tan(%g deg)", (double)F->cohesion, (double)F->friction_angle));
+  if (F->shear_angle > 0) PetscCall(PetscPrintf(p->comm, " |r| > r_c = %g", (double)F->shear_angle));
+  PetscCall(PetscPrintf(p->comm, " (formulas: docs/failure.md)\n"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The loop state that survives from step to step. */
+typedef struct {
+  KSP        ksp;
+  PetscInt   since_setup, nbonds, nhold, npieces, *hold;
+  PetscReal *held;
+  PetscBool  lost, stale;
+} Loop;
+
+/* How one trial load factor ended. */
+typedef enum {
+  TRIAL_SETTLED,
+  TRIAL_FAILED,
+  TRIAL_INTERRUPTED
+} TrialEnd;
+
+/* Solve, break, solve again at the load factor trial until no bond breaks (or the body fails). */
+static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscReal trial, PetscInt total, PeriStep *s, TrialEnd *end, char why[], size_t len)
+{
+  PeriQuasistatic *q = p->quasistatic;
+
+  PetscFunctionBeginUser;
+  *end = TRIAL_FAILED;
+  for (s->iterations = 0; s->iterations < st->max_iterations; s->iterations++) {
+    KSPConvergedReason reason;
+    PetscInt           nb;
+    PetscBool          ok;
+    PetscCall(PeriSignalReceived(p->comm, &p->interrupted));
+    if (p->interrupted) {
+      *end = TRIAL_INTERRUPTED;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    /* the pieces change only when bonds do */
+    if (L->stale) {
+      PetscCall(PetscFree2(L->hold, L->held));
+      PetscCall(PeriPieces(p, &L->nhold, &L->hold, &L->held, &L->npieces, &L->lost));
+      L->stale = PETSC_FALSE;
+    }
+    if (L->lost) {
+      PetscCall(PetscSNPrintf(why, len, "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", L->npieces));
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    /* a new preconditioner only when many bonds changed since the last one (or never built) */
+    if (L->ksp) PetscCall(KSPSetReusePreconditioner(L->ksp, (PetscBool)(st->reuse && L->since_setup < PetscMax(1, L->nbonds / 1000))));
+    if (!L->ksp || !st->reuse || L->since_setup >= PetscMax(1, L->nbonds / 1000)) {
+      q->pc_setups++;
+      L->since_setup = 0;
+    }
+    PetscCall(PeriStaticSolve(p, &L->ksp, trial, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
+    /* later solves start from the last solution: few bonds change between them */
+    PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
+    q->solves++;
+    s->ksp_iterations += p->results.iterations;
+    PetscCall(PeriStaticConverged(p, L->ksp, reason, &ok));
+    PetscCall(PeriSignalReceived(p->comm, &p->interrupted));
+    if (p->interrupted) {
+      *end = TRIAL_INTERRUPTED;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    if (!ok) {
+      /* the body as set up is linear: a solve that fails before any bond broke fails at every
+         load, so it is the solver's failure, not the body's */
+      if (total == 0 && s->broken == 0) PetscCall(PeriStaticCheckConverged(p, reason));
+      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)p->results.residual_norm));
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    PetscCall(BreakBonds(p, st, &nb));
+    L->stale = (PetscBool)(nb > 0);
+    if (!nb) {
+      *end = TRIAL_SETTLED;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    s->broken += nb;
+    L->since_setup += nb;
+    /* a twist carried by the bonds themselves loses the broken bonds' share */
+    if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
+    if (st->adaptive && s->broken > st->runaway * L->nbonds) {
+      /* a crack running away at this load: a smaller step tells whether it would settle */
+      PetscCall(PetscSNPrintf(why, len, "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s->broken, (double)st->runaway));
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+  }
+  PetscCall(PetscSNPrintf(why, len, "no equilibrium after %" PetscInt_FMT " iterations: bonds keep breaking at this load", st->max_iterations));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The body failed at trial: the trial's state goes to failed_trial.vtu (named as such), and
+ * everything else describes the last equilibrium. */
+static PetscErrorCode Failed(PeriProblem p, Equilibrium *eq, PetscReal trial, const PeriStep *s, const char why[])
+{
+  PeriQuasistatic *q = p->quasistatic;
+
+  PetscFunctionBeginUser;
+  q->failed               = PETSC_TRUE;
+  q->critical_load_factor = trial;
+  q->failure_step         = q->nsteps + 1;
+  q->failed_trial_broken  = s->broken;
+  PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
+  if (p->vtk) PetscCall(WriteState(p, "failed_trial.vtu"));
+  PetscCall(PeriDamage(p, &q->trial_damage)); /* where the failure went, for the caller */
+  PetscCall(EquilibriumRestore(p, eq, PETSC_FALSE, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* An accepted step: recorded, reported, saved, and the next step size chosen. */
+static PetscErrorCode Accept(PeriProblem p, const Settings *st, Equilibrium *eq, PeriStep *s, PetscReal *dl, PetscInt nbonds)
+{
+  PeriQuasistatic *q = p->quasistatic;
+
+  PetscFunctionBeginUser;
+  PetscCall(ControlValue(p, st->control, &s->control_u));
+  PetscCall(RecordStep(q, s));
+  q->peak_load_factor = s->lambda;
+  q->broken_bonds     = s->broken_total;
+  PetscCall(EquilibriumSave(p, eq));
+  PetscCall(Progress(p, st, s));
+  if (p->output_every && q->nsteps % p->output_every == 0 && p->vtk) PetscCall(WriteSnapshot(p));
+  /* many breaks: smaller steps; none: back towards the scene's step */
+  if (st->adaptive) *dl = s->broken > nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : s->broken ? *dl
+                                                                                                   : PetscMin(2 * *dl, st->step);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Finish(PeriProblem p, const Settings *st)
+{
+  PeriQuasistatic *q = p->quasistatic;
+
+  PetscFunctionBeginUser;
+  q->complete = p->interrupted ? PETSC_FALSE : PETSC_TRUE;
+  if (p->interrupted)
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", p->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  else if (!q->failed)
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st->max));
+  PetscCall(PeriProblemEvaluateEnergy(p));
+  PetscCall(PeriDamage(p, &p->damage));
+  if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscPrintf(p->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
+  if (q->failed) PetscCall(PetscPrintf(p->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriAnalysisRun_Quasistatic - the load-stepping loop with bond failure. Collective.
+  PeriAnalysisRun_Quasistatic - the load-stepping loop with bond failure. The results (fields,
+  probes, energies, damage) describe the last equilibrium; a failed trial is written apart as
+  failed_trial.vtu. Collective.
 @*/
 PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
 {
-  Settings         st;
-  PeriQuasistatic *q;
-  KSP              ksp    = NULL;
-  PetscReal        lambda = 0, dl;
-  PetscInt         total = 0, since_setup = 0, nbonds;
-  unsigned char   *live0;
-  PetscReal       *intact0 = NULL, *held = NULL;
-  PetscInt        *hold = NULL, nhold = 0, npieces = 1;
-  PetscBool        lost = PETSC_FALSE, stale = PETSC_TRUE;
-  void (*previous)(int);
+  Settings       st;
+  Loop           L      = {0};
+  Equilibrium    eq     = {0};
+  PetscReal      lambda = 0, dl;
   PetscLogDouble t0, tstep, t;
 
   PetscFunctionBeginUser;
   PetscCall(ReadSettings(p, &st));
   PetscCall(PetscNew(&p->quasistatic));
-  q = p->quasistatic;
-  PetscCall(PetscStrncpy(q->control, st.control ? st.control->name : "", sizeof(q->control)));
+  PetscCall(PetscStrncpy(p->quasistatic->control, st.control ? st.control->name : "", sizeof(p->quasistatic->control)));
   PetscCall(PeriStaticDefaultMatType(p->mat_type, sizeof(p->mat_type)));
   PetscCall(PeriProblemAssemble(p));
-  PetscCall(PetscMalloc1(p->bonds.nbonds, &live0));
-  if (p->bonds.intact) PetscCall(PetscMalloc1(p->bonds.nbonds, &intact0));
-  PetscCallMPI(MPI_Allreduce(&p->bonds.nbonds, &nbonds, 1, MPIU_INT, MPI_SUM, p->comm));
+  PetscCall(EquilibriumCreate(p, &eq));
+  PetscCallMPI(MPI_Allreduce(&p->bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, p->comm));
+  L.stale = PETSC_TRUE;
   PetscCall(PetscTime(&t0));
-  previous = signal(SIGINT, OnInterrupt);
-  dl       = st.step;
-  if (!st.quiet) {
-    const PeriFailure *F = &p->failure;
-    PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st.max, (double)st.step, st.adaptive ? "adaptive" : "fixed", st.all ? "all-violators" : "most-critical-fraction"));
-    PetscCall(PetscPrintf(p->comm, "perilin: failure:"));
-    if (F->stretch > 0) PetscCall(PetscPrintf(p->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
-    if (F->G > 0) PetscCall(PetscPrintf(p->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, p->model->type));
-    if (F->compressive > 0) PetscCall(PetscPrintf(p->comm, " -s > %g", (double)F->compressive));
-    if (F->sliding > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g", (double)F->sliding));
-    if (F->friction_angle > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g - s tan(%g deg)", (double)F->cohesion, (double)F->friction_angle));
-    if (F->shear_angle > 0) PetscCall(PetscPrintf(p->comm, " |r| > r_c = %g", (double)F->shear_angle));
-    PetscCall(PetscPrintf(p->comm, " (formulas: docs/failure.md)\n"));
-  }
-  while (lambda < st.max * (1 - 1e-12) && !interrupted) {
-    PetscReal          trial  = PetscMin(lambda + dl, st.max);
-    PeriStep           s      = {0};
-    PetscBool          failed = PETSC_FALSE, settled = PETSC_FALSE;
-    KSPConvergedReason reason;
-    char               why[160] = "";
-    PetscCall(PetscArraycpy(live0, p->bonds.live, p->bonds.nbonds));
-    if (intact0) PetscCall(PetscArraycpy(intact0, p->bonds.intact, p->bonds.nbonds));
+  dl = st.step;
+  PetscCall(PrintCriteria(p, &st));
+  while (lambda < st.max * (1 - 1e-12)) {
+    PetscReal trial = PetscMin(lambda + dl, st.max);
+    PeriStep  s     = {0};
+    TrialEnd  end;
+    char      why[160] = "";
     PetscCall(PetscTime(&tstep));
-    for (s.iterations = 0; s.iterations < st.max_iterations && !interrupted; s.iterations++) {
-      PetscInt nb;
-      /* the pieces change only when bonds do */
-      if (stale) {
-        PetscCall(PetscFree2(hold, held));
-        PetscCall(PeriPieces(p, &nhold, &hold, &held, &npieces, &lost));
-        stale = PETSC_FALSE;
-      }
-      if (lost) {
-        failed = PETSC_TRUE;
-        PetscCall(PetscSNPrintf(why, sizeof(why), "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", npieces));
-        break;
-      }
-      /* a new preconditioner only when many bonds changed since the last one (or never built) */
-      if (ksp) PetscCall(KSPSetReusePreconditioner(ksp, (PetscBool)(st.reuse && since_setup < PetscMax(1, nbonds / 1000))));
-      if (!ksp || !st.reuse || since_setup >= PetscMax(1, nbonds / 1000)) {
-        q->pc_setups++;
-        since_setup = 0;
-      }
-      PetscCall(PeriStaticSolve(p, &ksp, trial, PETSC_FALSE, nhold, hold, held, &reason));
-      /* later solves start from the last solution: few bonds change between them */
-      PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
-      q->solves++;
-      s.ksp_iterations += p->results.iterations;
-      if (reason <= 0 || PetscIsInfOrNanReal(p->results.residual_norm)) {
-        failed = PETSC_TRUE;
-        PetscCall(PetscSNPrintf(why, sizeof(why), "the solve failed (%s): the body can no longer carry the load", KSPConvergedReasons[reason]));
-        break;
-      }
-      PetscCall(BreakBonds(p, &st, &nb));
-      stale = (PetscBool)(nb > 0);
-      if (!nb) {
-        settled = PETSC_TRUE;
-        break;
-      }
-      s.broken += nb;
-      since_setup += nb;
-      /* a twist carried by the bonds themselves loses the broken bonds' share */
-      if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
-      if (st.adaptive && s.broken > st.runaway * nbonds) {
-        /* a crack running away at this load: a smaller step tells whether it would settle */
-        failed = PETSC_TRUE;
-        PetscCall(PetscSNPrintf(why, sizeof(why), "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s.broken, (double)st.runaway));
-        break;
-      }
+    PetscCall(Trial(p, &st, &L, trial, p->quasistatic->broken_bonds, &s, &end, why, sizeof(why)));
+    if (end == TRIAL_INTERRUPTED) {
+      PetscCall(EquilibriumRestore(p, &eq, PETSC_FALSE, PETSC_TRUE));
+      break;
     }
-    if (!failed && !settled && !interrupted) {
-      failed = PETSC_TRUE;
-      PetscCall(PetscSNPrintf(why, sizeof(why), "no equilibrium after %" PetscInt_FMT " iterations: bonds keep breaking at this load", st.max_iterations));
+    if (end == TRIAL_FAILED && st.adaptive && dl > st.min_step * (1 + 1e-12)) {
+      /* back to the last equilibrium, with half the step */
+      PetscCall(EquilibriumRestore(p, &eq, PETSC_TRUE, PETSC_FALSE));
+      L.stale       = PETSC_TRUE;
+      L.since_setup = L.nbonds;
+      dl            = PetscMax(0.5 * dl, st.min_step);
+      continue;
     }
-    if (interrupted) break;
-    if (failed) {
-      if (st.adaptive && dl > st.min_step * (1 + 1e-12)) {
-        /* back to the last equilibrium, with half the step */
-        PetscCall(PetscArraycpy(p->bonds.live, live0, p->bonds.nbonds));
-        PetscCall(PeriFamilySync(p));
-        if (intact0) PetscCall(PetscArraycpy(p->bonds.intact, intact0, p->bonds.nbonds));
-        PetscCall(PeriProblemAssemble(p));
-        stale = PETSC_TRUE;
-        if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
-        since_setup = nbonds;
-        dl          = PetscMax(0.5 * dl, st.min_step);
-        continue;
-      }
-      q->failed               = PETSC_TRUE;
-      q->critical_load_factor = trial;
-      total += s.broken;
-      PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
+    if (end == TRIAL_FAILED) {
+      PetscCall(Failed(p, &eq, trial, &s, why));
       break;
     }
     lambda = trial;
-    total += s.broken;
     PetscCall(PetscTime(&t));
     s.lambda       = lambda;
-    s.broken_total = total;
+    s.broken_total = p->quasistatic->broken_bonds + s.broken;
     s.seconds      = t - tstep;
-    PetscCall(ControlValue(p, st.control, &s.control_u));
-    PetscCall(RecordStep(q, &s));
-    q->peak_load_factor = lambda;
-    PetscCall(Progress(p, &st, &s));
-    if (p->output_every && q->nsteps % p->output_every == 0 && p->vtk) PetscCall(WriteSnapshot(p));
-    /* many breaks: smaller steps; none: back towards the scene's step */
-    if (st.adaptive) dl = s.broken > nbonds / 100 ? PetscMax(0.5 * dl, st.min_step) : s.broken ? dl
-                                                                                               : PetscMin(2 * dl, st.step);
+    PetscCall(Accept(p, &st, &eq, &s, &dl, L.nbonds));
   }
-  signal(SIGINT, previous);
-  q->broken_bonds = total;
-  q->complete     = interrupted ? PETSC_FALSE : PETSC_TRUE;
-  if (interrupted)
-    PetscCall(PetscStrncpy(q->ending, "interrupted (SIGINT): the results so far", sizeof(q->ending)));
-  else if (!q->failed)
-    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st.max));
-  PetscCall(KSPDestroy(&ksp));
-  PetscCall(PetscFree(live0));
-  PetscCall(PetscFree2(hold, held));
-  PetscCall(PetscFree(intact0));
+  PetscCall(KSPDestroy(&L.ksp));
+  PetscCall(PetscFree2(L.hold, L.held));
+  PetscCall(EquilibriumDestroy(&eq));
   PetscCall(PetscTime(&t));
   p->results.solve_s = t - t0;
-  PetscCall(PeriProblemEvaluateEnergy(p));
-  PetscCall(PeriDamage(p, &p->damage));
-  if (!st.quiet) PetscCall(PetscPrintf(p->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, total, q->solves, q->pc_setups));
-  if (!st.quiet && q->failed) PetscCall(PetscPrintf(p->comm, "perilin: critical load factor %g (failure between %g and %g)\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor));
+  PetscCall(Finish(p, &st));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -391,5 +526,30 @@ PetscErrorCode PeriWriteStepsCSV(PeriProblem p, const char path[])
     bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f\n", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
+  (output.every) by load factor. Rank 0 writes. Collective.
+@*/
+PetscErrorCode PeriWriteSnapshotsPVD(PeriProblem p, const char path[])
+{
+  PeriQuasistatic *q = p->quasistatic;
+  PetscReal       *times;
+  char           **files;
+  PetscInt         n = 0;
+
+  PetscFunctionBeginUser;
+  if (p->rank || !q || !p->output_every || !p->vtk || q->nsteps < p->output_every) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc2(q->nsteps, &times, q->nsteps, &files));
+  for (PetscInt k = p->output_every; k <= q->nsteps; k += p->output_every) {
+    times[n] = q->steps[k - 1].lambda;
+    PetscCall(PetscMalloc1(32, &files[n]));
+    PetscCall(PetscSNPrintf(files[n++], 32, "particles_%04" PetscInt_FMT ".vtu", k));
+  }
+  PetscCall(PeriWritePVD(path, n, times, (const char *const *)files));
+  for (PetscInt k = 0; k < n; k++) PetscCall(PetscFree(files[k]));
+  PetscCall(PetscFree2(times, files));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

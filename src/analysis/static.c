@@ -21,6 +21,13 @@ static const char *Advice(KSPConvergedReason reason)
   }
 }
 
+/* What to tell the user when KSP claims convergence but the true residual is too large. */
+static const char *AdviceResidual(PeriProblem p)
+{
+  if (!strcmp(p->results.ksp_type, KSPPREONLY)) return "preonly applies the preconditioner once, which solves the system only when it is a direct factorization: use -pc_type cholesky (or lu), or drop -ksp_type preonly for the default CG + GAMG";
+  return "tighten -ksp_rtol, or check -ksp_norm_type (the preconditioned norm can be far below the true one); a larger solver.residual_tol accepts the answer as it is";
+}
+
 /* The block format (BAIJ) unless the preconditioner cannot take it: in PETSc 3.18 GAMG builds its
  * graph from AIJ only, and MUMPS factors BAIJ by LU only. -mat_type overrides this. */
 PetscErrorCode PeriStaticDefaultMatType(char type[], size_t len)
@@ -129,6 +136,51 @@ static PetscErrorCode HandleFreeMotions(PeriProblem p, Mat A, Vec u, Vec b, Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* KSP's own convergence test (default or from the options), and a signal check after it. */
+typedef struct {
+  PetscErrorCode (*test)(KSP, PetscInt, PetscReal, KSPConvergedReason *, void *);
+  void *ctx;
+  PetscErrorCode (*destroy)(void *);
+  MPI_Comm comm;
+} InterruptibleTest;
+
+/* Stops the iteration (KSP_DIVERGED_NULL) once any rank has received SIGINT or SIGTERM: the
+ * convergence test runs on every rank at every iteration, so all ranks stop together. */
+static PetscErrorCode ConvergedOrInterrupted(KSP ksp, PetscInt it, PetscReal rnorm, KSPConvergedReason *reason, void *ctx)
+{
+  InterruptibleTest *t = (InterruptibleTest *)ctx;
+  int                sig;
+
+  PetscFunctionBeginUser;
+  PetscCall((*t->test)(ksp, it, rnorm, reason, t->ctx));
+  if (*reason) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSignalReceived(t->comm, &sig));
+  if (sig) *reason = KSP_DIVERGED_NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode InterruptibleTestDestroy(void *ctx)
+{
+  InterruptibleTest *t = (InterruptibleTest *)ctx;
+
+  PetscFunctionBeginUser;
+  if (t->destroy) PetscCall((*t->destroy)(t->ctx));
+  PetscCall(PetscFree(t));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode KSPSetInterruptible(KSP ksp, MPI_Comm comm)
+{
+  InterruptibleTest *t;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&t));
+  t->comm = comm;
+  PetscCall(KSPGetAndClearConvergenceTest(ksp, &t->test, &t->ctx, &t->destroy));
+  PetscCall(KSPSetConvergenceTest(ksp, ConvergedOrInterrupted, t, InterruptibleTestDestroy));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* CG (GMRES for an unsymmetric operator) + GAMG, rtol 1e-10, then the options. */
 static PetscErrorCode StaticKSPCreate(PeriProblem p, PetscBool symmetric, KSP *ksp)
 {
@@ -147,6 +199,7 @@ static PetscErrorCode StaticKSPCreate(PeriProblem p, PetscBool symmetric, KSP *k
   PetscCall(PetscObjectTypeCompare((PetscObject)*ksp, KSPCG, &cg));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ksp_norm_type", &set));
   if (cg && !set) PetscCall(KSPSetNormType(*ksp, KSP_NORM_UNPRECONDITIONED));
+  PetscCall(KSPSetInterruptible(*ksp, p->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -279,12 +332,29 @@ PetscErrorCode PeriStaticSolve(PeriProblem p, KSP *ksp, PetscReal lambda, PetscB
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* What a failed static solve tells the user. */
+/* Whether the last solve is trustworthy: KSP's reason is not enough (preonly reports
+ * CONVERGED_ITS after one application of any preconditioner), so the true relative residual
+ * ||b - A x|| / ||b|| must also lie below solver.residual_tol. */
+PetscErrorCode PeriStaticConverged(PeriProblem p, KSP ksp, KSPConvergedReason reason, PetscBool *ok)
+{
+  PetscReal rtol;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetTolerances(ksp, &rtol, NULL, NULL, NULL));
+  p->results.residual_tol = PeriResidualTolerance(p, rtol);
+  *ok                     = (PetscBool)(reason > 0 && !PetscIsInfOrNanReal(p->results.residual_norm) && p->results.residual_norm <= p->results.residual_tol);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What a failed static solve tells the user (after PeriStaticConverged). */
 PetscErrorCode PeriStaticCheckConverged(PeriProblem p, KSPConvergedReason reason)
 {
+  PetscBool ok = (PetscBool)(reason > 0 && p->results.residual_norm <= p->results.residual_tol);
+
   PetscFunctionBeginUser;
-  PetscCheck(reason > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: %s after %" PetscInt_FMT " iterations (relative residual %g): %s", KSPConvergedReasons[reason], p->results.iterations, (double)p->results.residual_norm, Advice(reason));
-  PetscCheck(!PetscIsInfOrNanReal(p->results.residual_norm), p->comm, PETSC_ERR_FP, "the static solution contains NaN or Inf: %s", Advice(KSP_DIVERGED_NANORINF));
+  PetscCheck(!PetscIsInfOrNanReal(p->results.residual_norm), p->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: the solution contains NaN or Inf (%s/%s, %s): %s", p->results.ksp_type, p->results.pc_type, KSPConvergedReasons[reason], Advice(KSP_DIVERGED_NANORINF));
+  PetscCheck(reason > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g (tolerance %.3g), %s/%s stopped with %s after %" PetscInt_FMT " iterations: %s", (double)p->results.residual_norm, (double)p->results.residual_tol, p->results.ksp_type, p->results.pc_type, KSPConvergedReasons[reason], p->results.iterations, Advice(reason));
+  PetscCheck(ok, p->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g > tolerance %.3g although %s/%s reported %s after %" PetscInt_FMT " iterations: %s", (double)p->results.residual_norm, (double)p->results.residual_tol, p->results.ksp_type, p->results.pc_type, KSPConvergedReasons[reason], p->results.iterations, AdviceResidual(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -329,6 +399,16 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
     if (npieces > 1) PetscCall(PetscPrintf(p->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
     PetscCall(PeriStaticSolve(p, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));
     PetscCall(PetscFree2(hold, held));
+  }
+  PetscCall(PeriSignalReceived(p->comm, &p->interrupted));
+  if (p->interrupted) {
+    /* an unfinished solve is no result: the output will say so and hold no fields */
+    PetscCall(KSPDestroy(&ksp));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  {
+    PetscBool ok;
+    PetscCall(PeriStaticConverged(p, ksp, reason, &ok));
   }
   PetscCall(KSPDestroy(&ksp));
   PetscCall(PeriStaticCheckConverged(p, reason));

@@ -3,9 +3,16 @@
  * Convention: every writer writes "<final>.tmp" and PeriFileCommit()s it only when everything
  * succeeded, removing the tmp on failure, so a crashed or failed run never leaves a half-written
  * file under the final name (rename() replaces the target atomically on POSIX). */
+#define _GNU_SOURCE /* renameat2 */
 #include "perilin.h"
 
+#include <dirent.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <ftw.h>
+#include <libgen.h>
+#include <stdlib.h>
+#include <unistd.h>
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -92,4 +99,195 @@ PetscErrorCode PeriFileCloseCommit(FILE *fp, const char tmp[], const char path[]
   PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing %s failed", tmp);
   PetscCall(PeriFileCommit(tmp, path));
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* ------------------------------------------------------------------ output sets
+ * A run's outputs are one set describing one state: they are written into a staging directory
+ * "<dir>.partial-XXXXXX" beside the output directory, and swapped in as a whole at the end
+ * (renameat2 RENAME_EXCHANGE, then the old set is removed), so no file of an earlier run
+ * survives beside a new run's, and a failed run leaves the previous set untouched. */
+#define PERI_OUTPUT_MARKER ".perilin-output"
+
+/* The staging directory of this process's open set, removed on failure (PeriOutputSetDiscard). */
+static char peri_staging[PETSC_MAX_PATH_LEN];
+
+static int RemoveEntry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
+{
+  (void)sb;
+  (void)flag;
+  (void)ftw;
+  return remove(path);
+}
+
+/* rm -rf path (no symbolic link is followed). */
+static int RemoveTree(const char path[])
+{
+  return nftw(path, RemoveEntry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+/* Whether a file name is one perilin writes into an output directory. */
+static PetscBool IsOutputName(const char name[])
+{
+  static const char *const exact[]       = {"summary.json", "particles.vtu", "particles.pvd", "steps.csv", "modes.csv", "modes.pvd", "failed_trial.vtu", PERI_OUTPUT_MARKER, NULL};
+  static const char *const prefixed[][2] = {{"particles_", ".vtu"}, {"mode_", ".vtu"}};
+  size_t                   n             = strlen(name);
+
+  for (PetscInt k = 0; exact[k]; k++)
+    if (!strcmp(name, exact[k])) return PETSC_TRUE;
+  for (size_t k = 0; k < sizeof(prefixed) / sizeof(prefixed[0]); k++) {
+    size_t a = strlen(prefixed[k][0]), b = strlen(prefixed[k][1]);
+    if (n > a + b && !strncmp(name, prefixed[k][0], a) && !strcmp(name + n - b, prefixed[k][1])) return PETSC_TRUE;
+  }
+  return (PetscBool)(n > 4 && !strcmp(name + n - 4, ".tmp"));
+}
+
+/* An existing output directory may be replaced only when perilin wrote it (its marker, or only
+ * names perilin writes): never a directory of the user's own files such as "." or $HOME. */
+static void CheckReplaceable(const char dir[], char msg[], size_t len)
+{
+  DIR           *d = opendir(dir);
+  struct dirent *e;
+
+  if (!d) {
+    snprintf(msg, len, "cannot read the output directory %s: %s", dir, strerror(errno));
+    return;
+  }
+  while ((e = readdir(d))) {
+    if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+    if (!strcmp(e->d_name, PERI_OUTPUT_MARKER)) {
+      msg[0] = 0;
+      break;
+    }
+    if (!msg[0] && !IsOutputName(e->d_name)) snprintf(msg, len, "the output directory %s holds files perilin did not write (%s): perilin replaces the whole directory with each run, so choose a new output.dir (-output_dir)", dir, e->d_name);
+  }
+  closedir(d);
+}
+
+/* Rank 0's part of PeriOutputSetOpen: msg[0] != 0 on failure. An output directory given as a
+ * symbolic link (to scratch space, say) is replaced where it points, not the link itself. */
+static void OpenStaging(char dir[], size_t dlen, char staging[], size_t len, char msg[], size_t mlen)
+{
+  char        copy[PETSC_MAX_PATH_LEN], *base;
+  struct stat st;
+
+  msg[0] = 0;
+  if (lstat(dir, &st) == 0 && S_ISLNK(st.st_mode) && stat(dir, &st) == 0 && S_ISDIR(st.st_mode) && realpath(dir, copy) && strlen(copy) < dlen) PetscStrncpy(dir, copy, dlen);
+  PetscStrncpy(copy, dir, sizeof(copy));
+  base = basename(copy);
+  if (!dir[0] || !strcmp(base, ".") || !strcmp(base, "..") || !strcmp(base, "/")) {
+    snprintf(msg, mlen, "output.dir '%s' must name a directory of its own (not ., .. or /): perilin replaces it as a whole", dir);
+    return;
+  }
+  if (lstat(dir, &st) == 0 && S_ISLNK(st.st_mode) && stat(dir, &st) != 0) {
+    snprintf(msg, mlen, "cannot create output directory %s: it is a symbolic link to nothing", dir);
+    return;
+  }
+  if (stat(dir, &st) == 0) {
+    if (!S_ISDIR(st.st_mode)) {
+      snprintf(msg, mlen, "cannot create output directory %s: a file of that name exists", dir);
+      return;
+    }
+    CheckReplaceable(dir, msg, mlen);
+    if (msg[0]) return;
+  } else {
+    PetscStrncpy(copy, dir, sizeof(copy));
+    if (PeriOutputDirCreate(dirname(copy))) {
+      snprintf(msg, mlen, "cannot create output directory %s: its parent cannot be created (%s)", dir, strerror(errno));
+      return;
+    }
+  }
+  snprintf(staging, len, "%s.partial-XXXXXX", dir);
+  if (!mkdtemp(staging)) {
+    snprintf(msg, mlen, "cannot create output directory %s: cannot write beside it (%s)", dir, strerror(errno));
+    staging[0] = 0;
+    return;
+  }
+  {
+    /* mkdtemp makes it private (0700): give the set the permissions of any new directory */
+    mode_t mask = umask(0);
+    umask(mask);
+    (void)chmod(staging, 0777 & ~mask);
+  }
+  PetscStrncpy(peri_staging, staging, sizeof(peri_staging));
+}
+
+/*@C
+  PeriOutputSetOpen - checks that the output directory dir can be written (or replaced), resolves
+  it when it is a symbolic link, and creates the staging directory the writers write into. Called
+  before any computation, so a bad output.dir costs nothing. Collective: rank 0 works, every rank gets staging or the same error.
+@*/
+PetscErrorCode PeriOutputSetOpen(MPI_Comm comm, char dir[], size_t dlen, char staging[], size_t len)
+{
+  char        msg[2 * PETSC_MAX_PATH_LEN + 256] = "";
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    /* mkdir -p reports through PETSc errors: keep them quiet, msg carries the cause */
+    PetscCall(PetscPushErrorHandler(PetscIgnoreErrorHandler, NULL));
+    OpenStaging(dir, dlen, staging, len, msg, sizeof(msg));
+    PetscCall(PetscPopErrorHandler());
+  }
+  PetscCallMPI(MPI_Bcast(msg, (PetscMPIInt)sizeof(msg), MPI_CHAR, 0, comm));
+  PetscCheck(!msg[0], comm, PETSC_ERR_USER_INPUT, "%s", msg);
+  PetscCallMPI(MPI_Bcast(staging, (PetscMPIInt)len, MPI_CHAR, 0, comm));
+  PetscCallMPI(MPI_Bcast(dir, (PetscMPIInt)dlen, MPI_CHAR, 0, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Rank 0's part of PeriOutputSetCommit. */
+static PetscErrorCode SwapIn(const char staging[], const char dir[])
+{
+  char        marker[PETSC_MAX_PATH_LEN + 32];
+  FILE       *fp;
+  struct stat st;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(marker, sizeof(marker), "%s/%s", staging, PERI_OUTPUT_MARKER));
+  fp = fopen(marker, "w");
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write %s: %s", marker, strerror(errno));
+  fprintf(fp, "perilin output set: the next run writing here replaces this directory as a whole\n");
+  PetscCheck(fclose(fp) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write %s: %s", marker, strerror(errno));
+  if (stat(dir, &st) != 0) {
+    PetscCheck(rename(staging, dir) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot rename %s to %s: %s", staging, dir, strerror(errno));
+  } else if (renameat2(AT_FDCWD, staging, AT_FDCWD, dir, RENAME_EXCHANGE) == 0) {
+    /* the previous set now lies at the staging name */
+    PetscCheck(RemoveTree(staging) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "the new results are in %s, but the previous ones could not be removed from %s: %s", dir, staging, strerror(errno));
+  } else {
+    /* a file system without RENAME_EXCHANGE: move the old set aside, then the new one in */
+    char old[PETSC_MAX_PATH_LEN + 16];
+    PetscCall(PetscSNPrintf(old, sizeof(old), "%s.old-XXXXXX", dir));
+    PetscCheck(mkdtemp(old) && rmdir(old) == 0 && rename(dir, old) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot replace %s: %s", dir, strerror(errno));
+    PetscCheck(rename(staging, dir) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot rename %s to %s (the previous results are in %s): %s", staging, dir, old, strerror(errno));
+    (void)RemoveTree(old);
+  }
+  peri_staging[0] = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriOutputSetCommit - replaces the output directory by the staging directory as one set.
+  Collective; rank 0 works.
+@*/
+PetscErrorCode PeriOutputSetCommit(MPI_Comm comm, const char staging[], const char dir[])
+{
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) PetscCall(SwapIn(staging, dir));
+  PetscCallMPI(MPI_Barrier(comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriOutputSetDiscard - removes the staging directory of a set that will not be committed (a
+  failed run), leaving the previous results as they were. Not collective; safe in error paths.
+@*/
+void PeriOutputSetDiscard(void)
+{
+  if (!peri_staging[0]) return;
+  (void)RemoveTree(peri_staging);
+  peri_staging[0] = 0;
 }

@@ -1,5 +1,6 @@
 /* summary.json: what the run was, what it cost, and its results (docs/summary.md lists the keys). */
 #include "perilin.h"
+#include <signal.h>
 
 static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
 {
@@ -12,6 +13,10 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONInt(j, "dim", p->particles.dim));
   if (p->particles.dim == 2) PetscCall(PeriJSONString(j, "plane", p->model->plane_strain ? "strain" : "stress"));
   PetscCall(PeriJSONString(j, "analysis", p->analysis));
+  /* false only for a run stopped by a signal: then the fields below describe the last complete
+     state (quasistatic), or there are none */
+  PetscCall(PeriJSONBool(j, "complete", p->interrupted ? PETSC_FALSE : PETSC_TRUE));
+  if (p->interrupted) PetscCall(PeriJSONString(j, "interrupted_by", p->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
   PetscCall(PeriJSONInt(j, "particles", p->particles.n));
   PetscCall(PeriJSONInt(j, "bonds", r->nbonds_total));
   PetscCall(PeriJSONInt(j, "dofs", p->particles.n * bs));
@@ -48,6 +53,9 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONInt(j, "iterations", r->iterations));
   PetscCall(PeriJSONString(j, "converged_reason", r->converged_reason));
   PetscCall(PeriJSONReal(j, "residual_norm", r->residual_norm));
+  if (r->residual_tol > 0) PetscCall(PeriJSONReal(j, "residual_tol", r->residual_tol));
+  /* written results passed every check; an interrupted solve did not finish */
+  PetscCall(PeriJSONBool(j, "converged", p->interrupted && !p->u_all ? PETSC_FALSE : PETSC_TRUE));
   PetscCall(PeriJSONString(j, "operator", r->symmetric ? "symmetric" : "unsymmetric"));
   if (r->free_modes) {
     PetscCall(PeriJSONInt(j, "free_rigid_motions", r->free_modes));
@@ -58,8 +66,13 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
     const PeriQuasistatic *q = p->quasistatic;
     PetscCall(PeriJSONBeginObject(j, "quasistatic"));
     PetscCall(PeriJSONInt(j, "steps", q->nsteps));
+    PetscCall(PeriJSONString(j, "state", "last equilibrium"));
     PetscCall(PeriJSONReal(j, "peak_load_factor", q->peak_load_factor));
-    if (q->failed) PetscCall(PeriJSONReal(j, "critical_load_factor", q->critical_load_factor));
+    if (q->failed) {
+      PetscCall(PeriJSONReal(j, "critical_load_factor", q->critical_load_factor));
+      PetscCall(PeriJSONInt(j, "failure_step", q->failure_step));
+      PetscCall(PeriJSONInt(j, "failed_trial_broken_bonds", q->failed_trial_broken));
+    }
     PetscCall(PeriJSONInt(j, "broken_bonds", q->broken_bonds));
     PetscCall(PeriJSONInt(j, "precracked_bonds", r->precracked_bonds));
     PetscCall(PeriJSONBool(j, "failed", q->failed));

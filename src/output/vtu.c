@@ -301,3 +301,56 @@ PetscErrorCode PeriWriteVTU(PeriProblem p, const char path[])
   PetscCall(PeriFileCommit(tmp, path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriWritePVD - a ParaView collection (.pvd) listing files[k] at time times[k], so that a series
+  (load steps, mode shapes) opens as one data set. Not collective: call it on the writing rank.
+@*/
+PetscErrorCode PeriWritePVD(const char path[], PetscInt n, const PetscReal times[], const char *const files[])
+{
+  char  tmp[PETSC_MAX_PATH_LEN];
+  FILE *fp;
+  int   bad = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  bad |= fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n") < 0;
+  for (PetscInt k = 0; k < n; k++) bad |= fprintf(fp, "    <DataSet timestep=\"%.10g\" group=\"\" part=\"0\" file=\"%s\"/>\n", (double)times[k], files[k]) < 0;
+  bad |= fprintf(fp, "  </Collection>\n</VTKFile>\n") < 0;
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteModeShapes - mode_NN.vtu, one file per stored mode shape with the shape as its
+  "displacement", and modes.pvd listing them by mode number (ParaView steps through the modes
+  like time steps). Collective; rank 0 writes.
+@*/
+PetscErrorCode PeriWriteModeShapes(PeriProblem p, const char dir[])
+{
+  PeriModal     *md    = p->modal;
+  PetscReal     *u_all = p->u_all, *times;
+  char         **files, path[PETSC_MAX_PATH_LEN];
+  const PetscInt nd = p->particles.n * p->model->dofs;
+
+  PetscFunctionBeginUser;
+  if (p->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc2(md->nshapes, &times, md->nshapes, &files));
+  /* each file is particles.vtu's layout with the mode as the displacement field */
+  p->modal = NULL;
+  for (PetscInt k = 0; k < md->nshapes; k++) {
+    times[k] = (PetscReal)(k + 1);
+    PetscCall(PetscMalloc1(32, &files[k]));
+    PetscCall(PetscSNPrintf(files[k], 32, "mode_%02" PetscInt_FMT ".vtu", k + 1));
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", dir, files[k]));
+    p->u_all = &md->shapes[k * nd];
+    PetscCall(PeriWriteVTU(p, path));
+  }
+  p->u_all = u_all;
+  p->modal = md;
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
+  PetscCall(PeriWritePVD(path, md->nshapes, times, (const char *const *)files));
+  for (PetscInt k = 0; k < md->nshapes; k++) PetscCall(PetscFree(files[k]));
+  PetscCall(PetscFree2(times, files));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,55 @@
+/* SIGINT and SIGTERM end a run early but cleanly: the handler only records the signal; the
+ * analyses poll PeriSignalReceived() at points where every rank is (between solves, and in the
+ * KSP convergence test), stop, and write what they have marked "complete": false. mpiexec
+ * forwards both signals to every rank as SIGTERM, then kills the ranks after a grace period
+ * (Open MPI: odls_base_sigkill_timeout, 1 s by default), so the work after the signal is small. */
+#include "perilin.h"
+#include <signal.h>
+
+static volatile sig_atomic_t peri_signal = 0;
+
+static void OnSignal(int sig)
+{
+  /* a second signal means "now": the default action ends the process */
+  if (peri_signal) {
+    signal(sig, SIG_DFL);
+    raise(sig);
+    return;
+  }
+  peri_signal = sig;
+}
+
+/*@C
+  PeriSignalsInstall - from now on SIGINT and SIGTERM are recorded instead of ending the process
+  (this replaces PETSc's own SIGTERM handler, which aborts). Not collective.
+@*/
+PetscErrorCode PeriSignalsInstall(void)
+{
+  struct sigaction sa;
+
+  PetscFunctionBeginUser;
+  memset(&sa, 0, sizeof(sa));
+  sa.sa_handler = OnSignal;
+  sigemptyset(&sa.sa_mask);
+  PetscCheck(sigaction(SIGINT, &sa, NULL) == 0 && sigaction(SIGTERM, &sa, NULL) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "cannot install the SIGINT/SIGTERM handlers");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSignalReceived - the signal any rank of comm has received (0: none), so that every rank
+  takes the same branch. Collective.
+@*/
+PetscErrorCode PeriSignalReceived(MPI_Comm comm, int *sig)
+{
+  int mine = (int)peri_signal;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Allreduce(&mine, sig, 1, MPI_INT, MPI_MAX, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The signal this process received, without communication (for the exit status). */
+int PeriSignalPending(void)
+{
+  return (int)peri_signal;
+}
