@@ -131,13 +131,17 @@ PetscErrorCode PeriBoundarySetUp(PeriProblem p)
   PeriNode       bc;
   PetscReal     *value;
   PetscBool     *set;
-  PetscInt       n = 0;
+  PetscInt       n    = 0;
+  PetscErrorCode ierr = PETSC_SUCCESS;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "bc", &bc));
   PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
   PetscCall(PetscCalloc2(nloc, &value, nloc, &set));
-  for (PetscInt k = 0; bc && k < bc->n; k++) PetscCall(ApplyCondition(p, bc->child[k], value, set));
+  /* a bad condition is an input error, not an exit: free the work arrays before passing it on */
+  for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(p, bc->child[k], value, set);
+  if (ierr) PetscCall(PetscFree2(value, set));
+  PetscCall(ierr);
   for (PetscInt c = 0; c < bs; c++) {
     if (!p->model->inactive[c]) continue;
     PetscCall(PetscPrintf(p->comm, "perilin: note: in model %s at nu = %g the shear springs vanish and %s no longer acts on the displacements: it is held at 0\n", p->model->type, (double)p->model->material.nu, p->model->components[c]));

@@ -57,7 +57,8 @@ PetscErrorCode PeriModelListTypes(char buf[], size_t len)
 PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_strain, PeriModel *model)
 {
   PetscErrorCode (*create)(PeriModel) = NULL;
-  PeriModel m;
+  PeriModel      m;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PeriModelRegisterAll());
@@ -72,7 +73,10 @@ PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_
   m->dim                       = dim;
   m->plane_strain              = plane_strain;
   m->allows_surface_correction = PETSC_TRUE;
-  PetscCall((*create)(m));
+  /* a model may refuse the setting (pds in 3D): an input error, after which nothing may leak */
+  ierr = (*create)(m);
+  if (ierr) PetscCall(PeriModelDestroy(&m));
+  PetscCall(ierr);
   *model = m;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -139,6 +139,61 @@ static PetscBool ShiftPositive(const PetscInt w[3])
   return PETSC_FALSE;
 }
 
+/* Appends the bonds of particle i (those with j >= i when half) to b. Errors on coincident
+ * particles. */
+static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, PetscReal delta, PeriPartialVolume pv, PetscReal r, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
+{
+  const PetscReal *xi = &p->x[3 * i];
+  PetscInt         ci[3], o[3];
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) ci[d] = d < p->dim ? CellOf(cl, p, i, d) : 0;
+  for (o[2] = -cl->reach[2]; o[2] <= cl->reach[2]; o[2]++)
+    for (o[1] = -cl->reach[1]; o[1] <= cl->reach[1]; o[1]++)
+      for (o[0] = -cl->reach[0]; o[0] <= cl->reach[0]; o[0]++) {
+        PetscInt  c[3], wrap[3] = {0, 0, 0}, cell;
+        PetscBool skip = PETSC_FALSE;
+        for (PetscInt d = 0; d < 3; d++) {
+          c[d] = ci[d] + o[d];
+          if (c[d] < 0 || c[d] >= cl->ncell[d]) {
+            if (!p->periodic[d])
+              skip = PETSC_TRUE;
+            else {
+              wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl->ncell[d]);
+              c[d] -= wrap[d] * cl->ncell[d];
+            }
+          }
+        }
+        if (skip) continue;
+        cell = CellIndex(cl, c);
+        for (PetscInt s = cl->start[cell]; s < cl->start[cell + 1]; s++) {
+          PetscInt  j = cl->item[s], self = (j == i);
+          PetscReal x[3], len2            = 0, len, h, alpha;
+          if (half && (j < i || (self && !ShiftPositive(wrap)))) continue;
+          if (self && !wrap[0] && !wrap[1] && !wrap[2]) continue;
+          if (!half && self) continue;
+          for (PetscInt d = 0; d < 3; d++) {
+            x[d] = p->x[3 * j + d] + wrap[d] * cl->length[d] - xi[d];
+            len2 += x[d] * x[d];
+          }
+          if (len2 > r * r) continue;
+          len = PetscSqrtReal(len2);
+          h   = 0.5 * (p->spacing[i] + p->spacing[j]);
+          PetscCheck(len > 1e-8 * h, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "particles %" PetscInt_FMT " and %" PetscInt_FMT " coincide at (%g, %g, %g)%s (distance %g, spacing %g)", p->source_line[i] ? p->source_line[i] : i, p->source_line[j] ? p->source_line[j] : j, (double)xi[0], (double)xi[1], (double)xi[2], p->source_line[i] ? " (the numbers are lines of particles.file)" : "", (double)len, (double)h);
+          alpha = PeriPartialVolumeFactor(pv, len, delta, h);
+          if (alpha <= 0) continue;
+          PetscCall(BondsReserve(b, b->nbonds + 1, cap));
+          b->j[b->nbonds] = j;
+          for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
+          b->length[b->nbonds] = len;
+          b->alpha[b->nbonds]  = alpha;
+          b->live[b->nbonds]   = 1;
+          b->nbonds++;
+        }
+      }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriNeighborSearch - finds the bonds of particles rstart..rend-1 with cell lists. With half,
   each pair is stored once, in the row of its smaller index; otherwise every neighbour is listed
@@ -146,9 +201,10 @@ static PetscBool ShiftPositive(const PetscInt w[3])
 @*/
 PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
 {
-  CellList  cl;
-  PetscReal hmax = 0, r;
-  PetscInt  cap  = 0;
+  CellList       cl;
+  PetscReal      hmax = 0, r;
+  PetscInt       cap  = 0;
+  PetscErrorCode ierr = PETSC_SUCCESS;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(b, sizeof(*b)));
@@ -165,58 +221,15 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
   b->rend   = rend;
   PetscCall(PetscMalloc1(rend - rstart + 1, &b->offset));
   b->offset[0] = 0;
-  for (PetscInt i = rstart; i < rend; i++) {
-    const PetscReal *xi = &p->x[3 * i];
-    PetscInt         ci[3], o[3];
-    for (PetscInt d = 0; d < 3; d++) ci[d] = d < p->dim ? CellOf(&cl, p, i, d) : 0;
-    for (o[2] = -cl.reach[2]; o[2] <= cl.reach[2]; o[2]++)
-      for (o[1] = -cl.reach[1]; o[1] <= cl.reach[1]; o[1]++)
-        for (o[0] = -cl.reach[0]; o[0] <= cl.reach[0]; o[0]++) {
-          PetscInt  c[3], wrap[3] = {0, 0, 0}, cell;
-          PetscBool skip = PETSC_FALSE;
-          for (PetscInt d = 0; d < 3; d++) {
-            c[d] = ci[d] + o[d];
-            if (c[d] < 0 || c[d] >= cl.ncell[d]) {
-              if (!p->periodic[d])
-                skip = PETSC_TRUE;
-              else {
-                wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl.ncell[d]);
-                c[d] -= wrap[d] * cl.ncell[d];
-              }
-            }
-          }
-          if (skip) continue;
-          cell = CellIndex(&cl, c);
-          for (PetscInt s = cl.start[cell]; s < cl.start[cell + 1]; s++) {
-            PetscInt  j = cl.item[s], self = (j == i);
-            PetscReal x[3], len2           = 0, len, h, alpha;
-            if (half && (j < i || (self && !ShiftPositive(wrap)))) continue;
-            if (self && !wrap[0] && !wrap[1] && !wrap[2]) continue;
-            if (!half && self) continue;
-            for (PetscInt d = 0; d < 3; d++) {
-              x[d] = p->x[3 * j + d] + wrap[d] * cl.length[d] - xi[d];
-              len2 += x[d] * x[d];
-            }
-            if (len2 > r * r) continue;
-            len = PetscSqrtReal(len2);
-            h   = 0.5 * (p->spacing[i] + p->spacing[j]);
-            PetscCheck(len > 1e-8 * h, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "particles %" PetscInt_FMT " and %" PetscInt_FMT " coincide at (%g, %g, %g)%s (distance %g, spacing %g)", p->source_line[i] ? p->source_line[i] : i, p->source_line[j] ? p->source_line[j] : j, (double)xi[0], (double)xi[1], (double)xi[2], p->source_line[i] ? " (the numbers are lines of particles.file)" : "", (double)len, (double)h);
-            alpha = PeriPartialVolumeFactor(pv, len, delta, h);
-            if (alpha <= 0) continue;
-            PetscCall(BondsReserve(b, b->nbonds + 1, &cap));
-            b->j[b->nbonds] = j;
-            for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
-            b->length[b->nbonds] = len;
-            b->alpha[b->nbonds]  = alpha;
-            b->live[b->nbonds]   = 1;
-            b->nbonds++;
-          }
-        }
+  /* coincident particles are an input error: the cell list is freed before it is passed on */
+  for (PetscInt i = rstart; i < rend && !ierr; i++) {
+    ierr                      = ParticleBonds(p, &cl, delta, pv, r, i, half, b, &cap);
     b->offset[i - rstart + 1] = b->nbonds;
   }
+  PetscCall(CellListDestroy(&cl));
+  PetscCall(ierr);
   PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
   for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
-  PetscCall(CellListDestroy(&cl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
