@@ -492,15 +492,17 @@ static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* What summary.json reports of the solver: the inner KSP, and its worst true residual. */
-static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, const InnerCheck *inner)
+/* What summary.json reports of the solver: the inner KSP, and its worst true residual. Partial:
+ * fewer pairs converged than asked for, or fewer modes than nev where the body has more. */
+static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, PetscInt nev, const InnerCheck *inner)
 {
-  ST       st;
-  KSP      ksp;
-  PC       pc;
-  KSPType  kt;
-  PCType   pt;
-  PetscInt asked, nconv;
+  ST        st;
+  KSP       ksp;
+  PC        pc;
+  KSPType   kt;
+  PCType    pt;
+  PetscInt  asked, nconv;
+  PetscBool partial;
 
   PetscFunctionBeginUser;
   PetscCall(EPSGetST(eps, &st));
@@ -512,7 +514,8 @@ static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, const InnerCheck *inn
   PetscCall(PetscStrncpy(p->results.pc_type, pt, sizeof(p->results.pc_type)));
   PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &nconv));
-  PetscCall(PetscStrncpy(p->results.converged_reason, nconv >= asked ? "EPS_CONVERGED" : "EPS_PARTIAL", sizeof(p->results.converged_reason)));
+  partial = (PetscBool)(nconv < asked || p->modal->nmodes < PetscMin(nev, p->modal->nfree_dofs - p->modal->nrigid));
+  PetscCall(PetscStrncpy(p->results.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(p->results.converged_reason)));
   PetscCall(EPSGetIterationNumber(eps, &p->results.iterations));
   p->results.residual_norm = inner->worst;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -583,7 +586,7 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
       }
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   p->results.solve_s = t2 - t0;
-  PetscCall(RecordSolver(p, eps, &inner));
+  PetscCall(RecordSolver(p, eps, nev, &inner));
   PetscCheck(md->nmodes > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", p->scene->file, md->nrigid);
   if (md->nmodes < nev) PetscCall(PetscPrintf(p->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
   PetscCall(PetscFree(pairs));
