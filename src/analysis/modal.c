@@ -290,9 +290,10 @@ static PetscErrorCode CreateEPS(PeriProblem p, Mat Kff, Mat Mff, PetscReal sigma
   /* STPRECOND (Davidson methods) solves only approximately by design: there only the modes
    * themselves are checked */
   PetscCall(PetscObjectTypeCompare((PetscObject)st, STPRECOND, &precond));
-  inner->p     = p;
-  inner->r     = NULL;
-  inner->worst = 0;
+  inner->p       = p;
+  inner->r       = NULL;
+  inner->worst   = 0;
+  inner->nsolves = 0;
   if (!precond) PetscCall(KSPSetPostSolve(ksp, InnerSolveCheck, inner));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -309,7 +310,8 @@ static PetscReal Frequency(PetscReal lam)
   return PetscCopysignReal(PetscSqrtReal(PetscAbsReal(lam)), lam) / (2 * PETSC_PI);
 }
 
-/* Stable insertion sort by key, ties to the lower omega^2; a few dozen pairs at most. */
+/* Stable insertion sort by key, ties to the lower omega^2: the converged pairs number about ncv,
+ * small beside the cost of computing them. */
 static void SortPairs(PetscInt n, Pair a[])
 {
   for (PetscInt i = 1; i < n; i++) {
@@ -390,10 +392,10 @@ static PetscErrorCode SolveModes(PeriProblem p, EPS eps, PetscInt nev, PetscReal
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* ||K x - lam M x|| / (max(|lam|, floor) ||M x||): relative to the eigenvalue, unlike a residual
- * scaled by ||K||, which hides errors in the low modes. Below floor = sqrt(eps) ||K||_1/||M||_1 an
- * omega^2 is at the round-off of K x itself: only its error relative to floor can be asked for. */
-static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal floor, Vec r, Vec y, PetscReal *res)
+/* ||K x - lam M x|| / (max(|lam|, lam_floor) ||M x||): relative to the eigenvalue, unlike a residual
+ * scaled by ||K||, which hides errors in the low modes. Below lam_floor = sqrt(eps) ||K||_1/||M||_1 an
+ * omega^2 is at the round-off of K x itself: only its error relative to lam_floor can be asked for. */
+static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal lam_floor, Vec r, Vec y, PetscReal *res)
 {
   PetscReal rn, yn;
 
@@ -403,7 +405,7 @@ static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal
   PetscCall(VecNorm(y, NORM_2, &yn));
   PetscCall(VecAXPY(r, -lam, y));
   PetscCall(VecNorm(r, NORM_2, &rn));
-  *res = rn / (PetscMax(PetscAbsReal(lam), floor) * yn);
+  *res = rn / (PetscMax(PetscAbsReal(lam), lam_floor) * yn);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -457,7 +459,7 @@ static PetscErrorCode SetUpModal(PeriProblem p, PetscReal target_hz, Mat *M, Vec
 }
 
 /* Each chosen pair becomes a mode: frequency, residual, kind, shape. */
-static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS isfree, Vec mdiag, PetscInt nev, PetscInt npairs, const Pair pairs[], PetscReal floor)
+static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS isfree, Vec mdiag, PetscInt nev, PetscInt npairs, const Pair pairs[], PetscReal lam_floor)
 {
   PeriModal *md = p->modal;
   Vec        x, r, y, full;
@@ -467,15 +469,16 @@ static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS 
   PetscCall(MatCreateVecs(Kff, &x, &r));
   PetscCall(VecDuplicate(r, &y));
   PetscCall(PeriProblemCreateVec(p, &full));
-  PetscCall(PetscCalloc1(nev, &md->modes));
-  md->nshapes = PetscMin(nev, PERI_MAX_VTU_MODES);
+  /* no more modes than free DOFs, whatever nev asks for */
+  PetscCall(PetscCalloc1(PetscMin(nev, md->nfree_dofs), &md->modes));
+  md->nshapes = PetscMin(PetscMin(nev, md->nfree_dofs), PERI_MAX_VTU_MODES);
   if (p->rank == 0) PetscCall(PetscCalloc1(md->nshapes * nd, &md->shapes));
   for (PetscInt s = 0; s < npairs && md->nmodes < nev; s++) {
     PeriMode *mode = &md->modes[md->nmodes];
     PetscReal l    = pairs[s].lam;
     PetscCheck(l > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: a negative eigenvalue omega^2 = %g: the stiffness is indefinite (Poisson ratio above the bond-based value?)", p->scene->file, (double)l);
     PetscCall(EPSGetEigenvector(eps, pairs[s].k, x, NULL));
-    PetscCall(ModeResidual(Kff, Mff, x, l, floor, r, y, &mode->residual));
+    PetscCall(ModeResidual(Kff, Mff, x, l, lam_floor, r, y, &mode->residual));
     mode->omega2 = l;
     mode->f_hz   = Frequency(l);
     PetscCall(VecSet(full, 0));
@@ -564,7 +567,7 @@ PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
   /* a free body makes K singular: shift just below its zero eigenvalues */
   if (nfree && target_hz == 0) sigma = -1e-8 * scale;
 
-  PetscCall(CreateEPS(p, Kff, Mff, sigma, PetscMin(nev + nfree, md->nfree_dofs), &inner, &eps));
+  PetscCall(CreateEPS(p, Kff, Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &inner, &eps));
   PetscCall(EPSSetUp(eps));
   PetscCall(PetscTime(&t1));
   PetscCall(SolveModes(p, eps, nev, target_hz, sigma, nfree, scale, &npairs, &pairs));
