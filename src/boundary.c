@@ -353,7 +353,30 @@ PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], 
     if ((*nfree)++ || !what) continue;
     for (PetscInt l = 0; l < nm; l++)
       if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
-    if (nm == 1 || nm == 3 || nm == 6)
+    if (nm == 3 && PetscAbsReal(V[2][k]) > 0.05) {
+      /* A rotation about a held point (a pin) is, about the box centre the modes use, a rotation
+         plus a translation that may be the larger part; naming the translation would point at
+         DOFs that are in fact held, so name the centre of rotation: u = w (-(y - Py), x - Px). */
+      PetscReal wz = V[2][k] / norm[2], P[2];
+      P[0]         = 0.5 * (pt->lower[0] + pt->upper[0]) - V[1][k] / norm[1] / wz;
+      P[1]         = 0.5 * (pt->lower[1] + pt->upper[1]) + V[0][k] / norm[0] / wz;
+      PetscCall(PetscSNPrintf(what, len, "rotation about z around (%g, %g)", (double)P[0], (double)P[1]));
+    } else if (nm == 6 && PetscSqrtReal(V[3][k] * V[3][k] + V[4][k] * V[4][k] + V[5][k] * V[5][k]) > 0.05) {
+      /* the same in 3D: u = t + w x (X - c) is a rotation about the axis along w through
+         P = c + (w x t) / |w|^2 (plus a slide along w, if any) */
+      PetscReal t[3], w[3], w2, P[3];
+      for (PetscInt d = 0; d < 3; d++) {
+        t[d] = V[d][k] / norm[d];
+        w[d] = V[3 + d][k] / norm[3 + d];
+      }
+      w2   = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+      P[0] = 0.5 * (pt->lower[0] + pt->upper[0]) + (w[1] * t[2] - w[2] * t[1]) / w2;
+      P[1] = 0.5 * (pt->lower[1] + pt->upper[1]) + (w[2] * t[0] - w[0] * t[2]) / w2;
+      P[2] = 0.5 * (pt->lower[2] + pt->upper[2]) + (w[0] * t[1] - w[1] * t[0]) / w2;
+      w2   = PetscSqrtReal(w2);
+      for (PetscInt d = 0; d < 3; d++) w[d] = PetscAbsReal(w[d]) < 1e-8 * w2 ? 0 : w[d]; /* no -1e-16 in the message */
+      PetscCall(PetscSNPrintf(what, len, "rotation about the axis along (%.3g, %.3g, %.3g) through (%g, %g, %g)", (double)(w[0] / w2), (double)(w[1] / w2), (double)(w[2] / w2), (double)P[0], (double)P[1], (double)P[2]));
+    } else if (nm == 1 || nm == 3 || nm == 6)
       PetscCall(PetscSNPrintf(what, len, "%s", (nm == 1 ? names1 : nm == 3 ? names2
                                                                            : names3)[best]));
     else

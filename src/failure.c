@@ -80,6 +80,29 @@ static PetscInt CutBonds(const PeriParticles *pt, PeriBonds *b, PetscInt nc, con
   return cut;
 }
 
+/* Whether the 2D segment s = (x0, y0, x1, y1) meets the box [lo, hi] (Liang-Barsky clipping). A
+   crack that misses the body entirely cuts nothing, which is almost always a mistake of units or
+   coordinates, so it is reported rather than ignored. */
+static PetscBool SegmentMeetsBox(const PetscReal s[], const PetscReal lo[], const PetscReal hi[])
+{
+  PetscReal t0 = 0, t1 = 1;
+  for (PetscInt d = 0; d < 2; d++) {
+    PetscReal dx = s[2 + d] - s[d], tol = 1e-9 * (hi[d] - lo[d]);
+    PetscReal pq[2][2] = {
+        {-dx, s[d] - (lo[d] - tol)},
+        {dx, (hi[d] + tol) - s[d]}};
+    for (PetscInt k = 0; k < 2; k++) {
+      if (pq[k][0] == 0) {
+        if (pq[k][1] < 0) return PETSC_FALSE;
+      } else if (pq[k][0] < 0)
+        t0 = PetscMax(t0, pq[k][1] / pq[k][0]);
+      else
+        t1 = PetscMin(t1, pq[k][1] / pq[k][0]);
+    }
+  }
+  return t0 <= t1 ? PETSC_TRUE : PETSC_FALSE;
+}
+
 /*@C
   PeriCracksApply - reads cracks: (2D segments {from: [x, y], to: [x, y]}) and removes every bond
   that crosses one, before the family volumes and the calibration see the body. Collective.
@@ -105,6 +128,7 @@ PetscErrorCode PeriCracksApply(PeriProblem p)
     PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
     PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
     PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");
+    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], p->particles.lower, p->particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)p->particles.lower[0], (double)p->particles.upper[0], (double)p->particles.lower[1], (double)p->particles.upper[1]);
   }
   cut = CutBonds(&p->particles, &p->bonds, list->n, seg);
   if (p->family.offset) CutBonds(&p->particles, &p->family, list->n, seg);

@@ -31,6 +31,8 @@ static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, P
   }
   for (PetscInt d = 0; d < dim; d++) {
     PetscReal L = upper[d] - lower[d], c;
+    /* 1e308 - (-1e308) is inf: say so rather than call inf "not a whole number of spacings" */
+    PeriInputCheck(!PetscIsInfOrNanReal(L), scene, grid, "upper", "the box is too large for double precision: upper - lower = %g - (%g) overflows along axis %" PetscInt_FMT, (double)upper[d], (double)lower[d], d);
     PeriInputCheck(L > 0, scene, grid, "upper", "must exceed grid.lower in every axis (axis %" PetscInt_FMT ": %g <= %g)", d, (double)upper[d], (double)lower[d]);
     c        = L / h;
     cells[d] = (PetscInt)PetscFloorReal(c + 0.5);
@@ -213,5 +215,188 @@ PetscErrorCode PeriParticlesDestroy(PeriParticles *p)
   PetscCall(PetscFree(p->x));
   PetscCall(PetscFree3(p->volume, p->spacing, p->source_line));
   PetscCall(PetscFree2(p->image, p->crossed));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* ------------------------------------------------------------------ the memory a run will need */
+
+/* What a run holds at its peak, from the scene alone (docs/performance.md, "Memory"). */
+typedef struct {
+  PetscReal n, nbonds;  /* particles, bonds (each pair once) */
+  PetscReal per_rank;   /* bytes every rank holds: the runtime and the replicated particle arrays */
+  PetscReal shared;     /* bytes the ranks share: bonds, stiffness matrix, solver, vectors */
+  PetscReal need, have; /* bytes on the node that needs the most, and what it has available */
+} MemoryEstimate;
+
+/* Resident size of PETSc, MPI and the libraries before the scene is read. */
+#define PERI_MEMORY_RUNTIME 45e6
+/* Peak memory over the assembled matrix in the static CG + GAMG solve (matrix, GAMG's graph and
+ * coarse levels, Krylov vectors): docs/performance.md measured 2.5x at 1e6 particles including the
+ * bonds and particles; without them the solver adds about 0.6x the matrix. */
+#define PERI_MEMORY_SOLVER 0.6
+
+/* The grid's particle count and spacing, when the scene has a valid grid. */
+static PetscErrorCode GridSize(PeriScene s, PetscInt dim, PetscReal *n, PetscReal *h)
+{
+  PeriNode  grid;
+  PetscReal lower[3], upper[3];
+  PetscInt  nl, nu;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
+  if (!grid) PetscFunctionReturn(PETSC_SUCCESS); /* particles.file: counted while it is read */
+  PetscCall(PeriSceneGetRealArray(s, grid, "lower", PETSC_TRUE, dim, dim, lower, &nl));
+  PetscCall(PeriSceneGetRealArray(s, grid, "upper", PETSC_TRUE, dim, dim, upper, &nu));
+  PetscCall(PeriSceneGetReal(s, grid, "spacing", PETSC_TRUE, h, NULL));
+  if (!(*h > 0)) PetscFunctionReturn(PETSC_SUCCESS);
+  *n = 1;
+  for (PetscInt d = 0; d < dim; d++) *n *= PetscMax(1, PetscFloorReal((upper[d] - lower[d]) / *h + 0.5));
+  /* beyond GridCreate's limit (or not a number) GridCreate's own message is the clearer one */
+  if (!(*n <= 1e8)) *n = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The neighbour search's radius in spacings: horizon.m or horizon.delta / h, plus half a spacing
+ * for the continued partial-volume ramp (the default); 0 when the horizon is not valid. */
+static PetscErrorCode SearchRadius(PeriScene s, PetscReal h, PetscReal *r)
+{
+  PeriNode  hz, c;
+  PetscReal m = 0, delta = 0;
+  PetscInt  pv = PERI_PARTIAL_VOLUME_LINEAR_CONTINUED;
+  PetscBool hasm, hasd;
+
+  PetscFunctionBeginUser;
+  *r = 0;
+  PetscCall(PeriSceneGetMap(s, s->root, "horizon", PETSC_FALSE, &hz));
+  if (!hz) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetReal(s, hz, "m", PETSC_FALSE, &m, &hasm));
+  PetscCall(PeriSceneGetReal(s, hz, "delta", PETSC_FALSE, &delta, &hasd));
+  if (!hasm) m = delta / h;
+  if (!(m >= 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetMap(s, s->root, "corrections", PETSC_FALSE, &c));
+  PetscCall(PeriSceneGetChoice(s, c, "partial_volume", PeriPartialVolumes, &pv, NULL));
+  *r = m + (pv == PERI_PARTIAL_VOLUME_LINEAR_CONTINUED ? 0.5 : 0);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Lattice points within r spacings of a particle, itself excluded. */
+static PetscReal BallCount(PetscInt dim, PetscReal r)
+{
+  return (dim == 2 ? PETSC_PI * r * r : 4.0 / 3.0 * PETSC_PI * r * r * r) - 1;
+}
+
+/* Bytes of the bonds (include/perilin.h, PeriBonds), the matrix (AIJ for GAMG: 12 bytes per
+ * nonzero; BAIJ: 8, and an index per block) and the solver, for n particles of dofs DOFs and a
+ * search radius of r spacings. State-based models also list each family in full and couple
+ * particles up to 2 delta apart. */
+static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscBool failure, MemoryEstimate *e)
+{
+  const PetscReal dofs = m->dofs, ball = BallCount(m->dim, r);
+  PetscReal       per_bond, blocks, nnz, matrix;
+  char            type[64];
+  PetscBool       aij;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriStaticDefaultMatType(type, sizeof(type)));
+  PetscCall(PetscStrcmp(type, MATAIJ, &aij));
+  e->n      = n;
+  e->nbonds = n * ball / 2;
+  /* the search reserves 1.05 ball / 2 per particle of j, xi, length, alpha, live; then lambda,
+     and with failure the cause and the softening share */
+  per_bond  = 1.05 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1) + sizeof(PetscReal) + (failure ? 1 + sizeof(PetscReal) : 0);
+  blocks    = 1 + (m->ops.family_stiffness ? BallCount(m->dim, 2 * r) : ball);
+  nnz       = n * blocks * dofs * dofs;
+  matrix    = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
+  e->shared = e->nbonds * per_bond * (m->ops.family_stiffness ? 3 : 1) + matrix * (1 + PERI_MEMORY_SOLVER) + 10 * n * dofs * sizeof(PetscScalar);
+  /* coordinates, volume, spacing, line, owner, family volume, neighbour count, the cell list, and
+     the gathered displacements and energy densities */
+  e->per_rank = PERI_MEMORY_RUNTIME + n * (8 * sizeof(PetscReal) + 6 * sizeof(PetscInt) + (2 * dofs + 1) * sizeof(PetscReal));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Bytes this node can still give: MemAvailable, or the cgroup's limit when lower; 0 if unknown. */
+static PetscReal NodeAvailable(void)
+{
+  PetscReal have = 0;
+  char      line[256];
+  FILE     *fp = fopen("/proc/meminfo", "r");
+  if (fp) {
+    while (fgets(line, sizeof(line), fp))
+      if (!strncmp(line, "MemAvailable:", 13)) have = 1024.0 * strtod(line + 13, NULL);
+    fclose(fp);
+  }
+  if ((fp = fopen("/sys/fs/cgroup/memory.max", "r"))) {
+    double limit = 0, used = 0;
+    FILE  *fu = fopen("/sys/fs/cgroup/memory.current", "r");
+    if (fscanf(fp, "%lf", &limit) == 1 && fu && fscanf(fu, "%lf", &used) == 1 && limit - used < have) have = limit - used;
+    if (fu) fclose(fu);
+    fclose(fp);
+  }
+  return have;
+}
+
+/* The need and the memory available on the node whose ratio is the worst, on every rank. */
+static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
+{
+  MPI_Comm    node;
+  PetscMPIInt size, nlocal, rank;
+  struct {
+    double ratio;
+    int    rank;
+  } mine, worst;
+  double nh[2];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
+  PetscCallMPI(MPI_Comm_size(node, &nlocal));
+  PetscCallMPI(MPI_Comm_free(&node));
+  e->need    = nlocal * (e->per_rank + e->shared / size);
+  e->have    = NodeAvailable();
+  mine.ratio = e->have > 0 ? e->need / e->have : 0;
+  mine.rank  = rank;
+  PetscCallMPI(MPI_Allreduce(&mine, &worst, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm));
+  nh[0] = e->need;
+  nh[1] = e->have;
+  PetscCallMPI(MPI_Bcast(nh, 2, MPI_DOUBLE, worst.rank, comm));
+  e->need = nh[0];
+  e->have = nh[1];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriParticlesCheckMemory - estimates, from the scene's grid, horizon and the model, the memory the
+  run will need (bonds, matrix, solver, replicated particle arrays) and refuses with an input error
+  naming grid.spacing when it exceeds what the nodes have available (MemAvailable shared by the
+  node's ranks). Called before any particle is allocated; errors in the grid or horizon are left
+  to the readers that report them. Skipped with -peri_memory_check false, and for particles.file.
+  Collective.
+@*/
+PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
+{
+  MemoryEstimate e = {0};
+  PetscReal      h = 0, r = 0;
+  PetscBool      run = PETSC_TRUE, failure;
+  PeriNode       grid;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_memory_check", &run, NULL));
+  if (!run) PetscFunctionReturn(PETSC_SUCCESS);
+  /* a bad grid or horizon is reported later, in the order of the other checks: quietly skip here */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = GridSize(s, m->dim, &e.n, &h);
+  if (!ierr && e.n > 0) ierr = SearchRadius(s, h, &r);
+  PetscCall(PetscPopErrorHandler());
+  if (ierr || !(e.n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
+  failure = grid ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(Estimate(m, e.n, r, failure, &e));
+  PetscCall(NodeBalance(comm, &e));
+  PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
+  PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));
+  PetscCall(PetscInfo(NULL, "memory estimate: %g bytes on the fullest node, %g available (%g particles, %g bonds)\n", (double)e.need, (double)e.have, (double)e.n, (double)e.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -5,13 +5,15 @@
 
 const char *const PeriReferenceTypes[] = {"none", "uniaxial", "shear", "bending", NULL};
 
+static PetscBool Interior(PeriProblem, PetscInt);
+
 PetscErrorCode PeriReferenceSetUp(PeriProblem p)
 {
   static const char *const keys[] = {"type", "stress", "axis", "center", "E", "nu", NULL}, *const axes[] = {"x", "y", NULL};
   PeriScene      s = p->scene;
   PeriReference *r = &p->reference;
   PeriNode       node;
-  PetscInt       type = PERI_REFERENCE_NONE, n;
+  PetscInt       type = PERI_REFERENCE_NONE, n, ux, uy, ninterior = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "reference", PETSC_FALSE, &node));
@@ -19,10 +21,17 @@ PetscErrorCode PeriReferenceSetUp(PeriProblem p)
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckKeys(s, node, keys));
   PeriInputCheck(p->particles.dim == 2, s, node, NULL, "reference fields are plane elasticity solutions: dim must be 2");
+  PetscCall(PeriModelComponentIndex(p->model, "ux", &ux));
+  PetscCall(PeriModelComponentIndex(p->model, "uy", &uy));
+  /* checked here, not only after the solve, so that a bad scene fails before any work */
+  PeriInputCheck(ux >= 0 && uy >= 0, s, node, NULL, "reference fields need the in-plane displacements ux, uy; model %s has none", p->model->type);
   PetscCall(PeriSceneGetChoice(s, node, "type", PeriReferenceTypes, &type, NULL));
   PeriInputCheck(type != PERI_REFERENCE_NONE, s, node, "type", "is required: uniaxial, shear or bending");
   r->type = (PeriReferenceType)type;
   PetscCall(PeriSceneGetReal(s, node, "stress", PETSC_TRUE, &r->stress, NULL));
+  PeriInputCheck(r->stress != 0, s, node, "stress", "must not be 0: the reference field would vanish and there is nothing to compare with");
+  for (PetscInt i = 0; i < p->particles.n; i++) ninterior += Interior(p, i);
+  PeriInputCheck(ninterior >= 3, s, node, NULL, "only %" PetscInt_FMT " particles lie farther than 2 delta = %g from the edges: too few to measure the interior strain (enlarge the body or reduce the horizon)", ninterior, (double)(2 * p->delta));
   r->axis = 0;
   PetscCall(PeriSceneGetChoice(s, node, "axis", axes, &r->axis, NULL));
   for (PetscInt d = 0; d < 3; d++) r->center[d] = 0.5 * (p->particles.lower[d] + p->particles.upper[d]);

@@ -104,6 +104,7 @@ for scene in "${scenes[@]}"; do
     elif [ -n "$want_exit" ] && [ "$code" -ne "$want_exit" ]; then problem="exit status $code, expected $want_exit"
     elif [ -z "$want_exit" ] && [ "$code" -eq 0 ]; then problem="exit status 0"
     elif [ -z "$want_exit" ] && [ "$code" -gt 128 ]; then problem="killed by signal $((code - 128))"
+    elif grep -q 'PETSC ERROR: Caught signal' "$tmp/stderr"; then problem="crashed (PETSc caught a signal, exit status $code)"
     elif ! grep -Eq -- "$expect" "$tmp/stderr"; then problem="message does not match '$expect'"
     elif [ -n "$left" ]; then problem="output left behind in $out:$left"
     elif [ "$nerr" -ne 1 ]; then problem="'perilin: error:' printed $nerr times, expected once"
