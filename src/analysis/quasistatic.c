@@ -209,6 +209,7 @@ typedef struct {
   Vec            u;
   unsigned char *live;
   PetscReal     *intact;
+  PeriResults    solve; /* the solver fields of the solve that reached it */
 } Equilibrium;
 
 static PetscErrorCode EquilibriumCreate(PeriProblem p, Equilibrium *e)
@@ -229,6 +230,7 @@ static PetscErrorCode EquilibriumSave(PeriProblem p, Equilibrium *e)
 {
   PetscFunctionBeginUser;
   PetscCall(VecCopy(p->u, e->u));
+  e->solve = p->results;
   PetscCall(PetscArraycpy(e->live, p->bonds.live, p->bonds.nbonds));
   if (e->intact) PetscCall(PetscArraycpy(e->intact, p->bonds.intact, p->bonds.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -247,8 +249,18 @@ static PetscErrorCode EquilibriumRestore(PeriProblem p, Equilibrium *e, PetscBoo
     if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
   }
   if (restore_u) {
+    PeriResults *r = &p->results;
     if (!p->u) PetscCall(VecDuplicate(e->u, &p->u));
     PetscCall(VecCopy(e->u, p->u));
+    /* summary.json's solver section describes the solve of this state, not the abandoned one */
+    if (e->solve.ksp_type[0]) {
+      PetscCall(PetscStrncpy(r->ksp_type, e->solve.ksp_type, sizeof(r->ksp_type)));
+      PetscCall(PetscStrncpy(r->pc_type, e->solve.pc_type, sizeof(r->pc_type)));
+      PetscCall(PetscStrncpy(r->converged_reason, e->solve.converged_reason, sizeof(r->converged_reason)));
+      r->iterations    = e->solve.iterations;
+      r->residual_norm = e->solve.residual_norm;
+      r->residual_tol  = e->solve.residual_tol;
+    }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
