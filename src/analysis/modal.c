@@ -524,6 +524,80 @@ static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, PetscInt nev, const I
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* What one modal solve holds: freed whether it succeeds or a check stops it inside SLEPc. */
+typedef struct {
+  Mat        M, Kff, Mff;
+  IS         isfree;
+  Vec        mdiag;
+  EPS        eps;
+  InnerCheck inner;
+  Pair      *pairs;
+} ModalWork;
+
+static PetscErrorCode ModalWorkDestroy(ModalWork *w)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(w->pairs));
+  PetscCall(VecDestroy(&w->inner.r));
+  PetscCall(VecDestroy(&w->mdiag));
+  PetscCall(EPSDestroy(&w->eps));
+  PetscCall(MatDestroy(&w->Kff));
+  PetscCall(MatDestroy(&w->Mff));
+  PetscCall(MatDestroy(&w->M));
+  PetscCall(ISDestroy(&w->isfree));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_hz, ModalWork *w)
+{
+  PeriModal     *md;
+  PetscInt       nfree, npairs = 0;
+  PetscReal      scale, sigma, Knorm, Mnorm, eps_tol;
+  PetscLogDouble t0, t1, t2;
+  char           what[128];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t0));
+  PetscCall(SetUpModal(p, target_hz, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff));
+  md = p->modal;
+  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what), NULL));
+  md->nrigid = 0;
+
+  /* the scale of the largest omega^2 */
+  PetscCall(MatNorm(w->Kff, NORM_1, &Knorm));
+  PetscCall(MatNorm(w->Mff, NORM_1, &Mnorm));
+  scale = Knorm / Mnorm;
+  sigma = PetscSqr(2 * PETSC_PI * target_hz);
+  /* a free body makes K singular: shift just below its zero eigenvalues */
+  if (nfree && target_hz == 0) sigma = -1e-8 * scale;
+
+  PetscCall(CreateEPS(p, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
+  PetscCall(EPSSetUp(w->eps));
+  PetscCall(PetscTime(&t1));
+  PetscCall(SolveModes(p, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
+  PetscCall(PetscTime(&t2));
+  md->factor_s       = t1 - t0;
+  md->solve_s        = t2 - t1;
+  p->results.solve_s = t2 - t0;
+  PetscCheck(npairs + md->nrigid > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", p->scene->file);
+  PetscCall(CollectModes(p, w->eps, w->Kff, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
+  PetscCall(EPSGetTolerances(w->eps, &eps_tol, NULL));
+  PetscCall(CheckModes(p, eps_tol));
+  /* a free bar's lowest longitudinal mode is half a wave over its length */
+  if (nfree)
+    for (PetscInt k = 0; k < md->nmodes; k++)
+      if (!strcmp(md->modes[k].kind, "longitudinal") || !strcmp(md->modes[k].kind, "axial")) {
+        PetscReal L            = p->particles.upper[md->axis] - p->particles.lower[md->axis];
+        md->longitudinal_speed = 2 * L * md->modes[k].f_hz;
+        if (p->particles.dim == 3) md->theory_speed = PetscSqrtReal((p->model->material.K + 4 * p->model->material.G / 3) / p->model->material.rho);
+        break;
+      }
+  PetscCall(RecordSolver(p, w->eps, nev, &w->inner));
+  PetscCheck(md->nmodes > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", p->scene->file, md->nrigid);
+  if (md->nmodes < nev) PetscCall(PetscPrintf(p->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAnalysisRun_Modal - analysis.nev natural modes of the constrained body. Without a target
   (analysis.target_hz = 0) the lowest, in ascending frequency; with one, the nev whose frequencies
@@ -536,70 +610,22 @@ static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, PetscInt nev, const I
 @*/
 PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
 {
-  PeriModal     *md;
-  PetscInt       nev, nfree, npairs = 0;
-  PetscReal      target_hz, scale, sigma, Knorm, Mnorm, eps_tol;
-  Mat            M, Kff, Mff;
-  IS             isfree;
-  Vec            mdiag;
-  EPS            eps;
-  InnerCheck     inner;
-  Pair          *pairs = NULL;
-  PetscLogDouble t0, t1, t2;
-  char           what[128];
+  PetscInt       nev;
+  PetscReal      target_hz;
+  ModalWork      w;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(ReadSettings(p, &nev, &target_hz));
   PetscCall(PetscStrncpy(p->mat_type, MATAIJ, sizeof(p->mat_type)));
   if (!p->K) PetscCall(PeriProblemAssemble(p));
-  PetscCall(PetscTime(&t0));
+  PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
-  PetscCall(SetUpModal(p, target_hz, &M, &mdiag, &isfree, &Kff, &Mff));
-  md = p->modal;
-  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what), NULL));
-  md->nrigid = 0;
-
-  /* the scale of the largest omega^2 */
-  PetscCall(MatNorm(Kff, NORM_1, &Knorm));
-  PetscCall(MatNorm(Mff, NORM_1, &Mnorm));
-  scale = Knorm / Mnorm;
-  sigma = PetscSqr(2 * PETSC_PI * target_hz);
-  /* a free body makes K singular: shift just below its zero eigenvalues */
-  if (nfree && target_hz == 0) sigma = -1e-8 * scale;
-
-  PetscCall(CreateEPS(p, Kff, Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &inner, &eps));
-  PetscCall(EPSSetUp(eps));
-  PetscCall(PetscTime(&t1));
-  PetscCall(SolveModes(p, eps, nev, target_hz, sigma, nfree, scale, &npairs, &pairs));
-  PetscCall(PetscTime(&t2));
-  md->factor_s = t1 - t0;
-  md->solve_s  = t2 - t1;
-  PetscCheck(npairs + md->nrigid > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", p->scene->file);
-  PetscCall(CollectModes(p, eps, Kff, Mff, isfree, mdiag, nev, npairs, pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
-  PetscCall(EPSGetTolerances(eps, &eps_tol, NULL));
-  PetscCall(CheckModes(p, eps_tol));
-  /* a free bar's lowest longitudinal mode is half a wave over its length */
-  if (nfree)
-    for (PetscInt k = 0; k < md->nmodes; k++)
-      if (!strcmp(md->modes[k].kind, "longitudinal") || !strcmp(md->modes[k].kind, "axial")) {
-        PetscReal L            = p->particles.upper[md->axis] - p->particles.lower[md->axis];
-        md->longitudinal_speed = 2 * L * md->modes[k].f_hz;
-        if (p->particles.dim == 3) md->theory_speed = PetscSqrtReal((p->model->material.K + 4 * p->model->material.G / 3) / p->model->material.rho);
-        break;
-      }
+  /* a failed check may return from deep inside SLEPc: free everything, then pass the error on */
+  ierr = ModalSolve(p, nev, target_hz, &w);
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
-  p->results.solve_s = t2 - t0;
-  PetscCall(RecordSolver(p, eps, nev, &inner));
-  PetscCheck(md->nmodes > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", p->scene->file, md->nrigid);
-  if (md->nmodes < nev) PetscCall(PetscPrintf(p->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
-  PetscCall(PetscFree(pairs));
-  PetscCall(VecDestroy(&inner.r));
-  PetscCall(VecDestroy(&mdiag));
-  PetscCall(EPSDestroy(&eps));
-  PetscCall(MatDestroy(&Kff));
-  PetscCall(MatDestroy(&Mff));
-  PetscCall(MatDestroy(&M));
-  PetscCall(ISDestroy(&isfree));
+  PetscCall(ModalWorkDestroy(&w));
+  PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
