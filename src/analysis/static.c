@@ -28,6 +28,33 @@ static const char *AdviceResidual(PeriProblem p)
   return "tighten -ksp_rtol, or check -ksp_norm_type (the preconditioned norm can be far below the true one); a larger solver.residual_tol accepts the answer as it is";
 }
 
+/* PETSc's own LU and Cholesky run on one rank only: on several, a factorization without a
+ * -pc_factor_mat_solver_type is MUMPS's (when PETSc has it), so the README's direct-solver line
+ * works on any number of ranks. */
+static PetscBool ParallelFactor(void)
+{
+#if defined(PETSC_HAVE_MUMPS)
+  PetscMPIInt size;
+  MPI_Comm_size(PETSC_COMM_WORLD, &size);
+  return (PetscBool)(size > 1);
+#else
+  return PETSC_FALSE;
+#endif
+}
+
+static PetscErrorCode DefaultFactorSolver(KSP ksp)
+{
+  PC        pc;
+  PetscBool factor, set;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, ""));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-pc_factor_mat_solver_type", &set));
+  if (factor && !set && ParallelFactor()) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The block format (BAIJ) unless the preconditioner cannot take it: in PETSc 3.18 GAMG builds its
  * graph from AIJ only, and MUMPS factors BAIJ by LU only. -mat_type overrides this. */
 PetscErrorCode PeriStaticDefaultMatType(char type[], size_t len)
@@ -41,6 +68,7 @@ PetscErrorCode PeriStaticDefaultMatType(char type[], size_t len)
   PetscCall(PetscStrcmp(pc, PCGAMG, &gamg));
   PetscCall(PetscStrcmp(pc, PCCHOLESKY, &cholesky));
   PetscCall(PetscStrcmp(solver, MATSOLVERMUMPS, &mumps));
+  mumps = (PetscBool)(mumps || (!solver[0] && ParallelFactor()));
   PetscCall(PetscStrncpy(type, gamg || (cholesky && mumps) ? MATAIJ : MATBAIJ, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -199,6 +227,7 @@ static PetscErrorCode StaticKSPCreate(PeriProblem p, PetscBool symmetric, KSP *k
   PetscCall(PetscObjectTypeCompare((PetscObject)*ksp, KSPCG, &cg));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ksp_norm_type", &set));
   if (cg && !set) PetscCall(KSPSetNormType(*ksp, KSP_NORM_UNPRECONDITIONED));
+  PetscCall(DefaultFactorSolver(*ksp));
   PetscCall(KSPSetInterruptible(*ksp, p->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
