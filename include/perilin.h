@@ -60,6 +60,16 @@ PETSC_EXTERN void           PeriListAppend(char[], size_t, const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneParseBool(PeriScene, PeriNode, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneParseRealArray(PeriScene, PeriNode, PetscInt, PetscInt, PetscReal[], PetscInt *);
 
+/* Options that name nothing (src/options.c; docs/scene.md): an option naming no scene key is an
+ * error before any computation, and an option nothing read is one after the analysis, both with a
+ * "did you mean"; -options_unused_ok makes them warnings. */
+PETSC_EXTERN PetscErrorCode PeriSceneOptionIsScene(const char[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneOptionNames(PeriScene, char ***);
+PETSC_EXTERN PetscErrorCode PeriSceneOptionExplain(PeriScene, const char[], char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriOptionsCheckScene(MPI_Comm, PeriScene);
+struct _p_PeriProblem; /* PeriProblem, below */
+PETSC_EXTERN PetscErrorCode PeriOptionsCheckUnused(struct _p_PeriProblem *);
+
 /* A user-input error that names the file, the line and the key. */
 #define PeriInputCheck(cond, scene, node, key, fmt, ...)                                      \
   do {                                                                                        \

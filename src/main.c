@@ -57,8 +57,10 @@ static PetscErrorCode Run(int argc, char **argv, int *status)
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
   p->write_output = PETSC_TRUE;
   PetscCall(PeriProblemLoad(p, argv[1]));
+  PetscCall(PeriOptionsCheckScene(p->comm, p->scene)); /* an option naming no scene key: before any work */
   PetscCall(PeriProblemSetUp(p));
   PetscCall(PeriProblemRun(p));
+  PetscCall(PeriOptionsCheckUnused(p)); /* an option nothing read: before anything is written */
   PetscCall(PeriProblemWriteOutput(p));
   PetscCall(Report(p));
   /* a run stopped by a signal says so in its exit status too: 128 + the signal, as shells do */

@@ -6,6 +6,7 @@
 #include <ctype.h>
 #include <errno.h>
 #include <libgen.h>
+#include <strings.h>
 
 /* The documented scalar keys: `perilin -help` lists them, and an option naming one that the
  * file lacks adds it (so -model_plane strain works on a scene that does not name the plane). */
@@ -149,22 +150,36 @@ static PetscErrorCode ReaderNext(Reader *r, yaml_event_t *ev)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Builds the node for the event ev (already read) and everything below it. */
-static PetscErrorCode ParseNode(Reader *r, yaml_event_t *ev, const char key[], const char parent_path[], PeriNode *node)
+/* Deeper nesting is an error: no scene needs more than a few levels, and the reader recurses once
+ * per level (a file nested thousands deep would overflow the stack). libyaml itself keeps its
+ * nesting on the heap, and stopping here also stops it from reading further. */
+#define PERI_SCENE_MAX_DEPTH 64
+
+/* Builds the node for the event ev (already read) and everything below it, each node appended to
+ * its parent (NULL for the root) as soon as it exists, so that the tree owns all of it whatever
+ * error stops the reading. depth counts the mappings and lists enclosing ev (the root mapping is
+ * at depth 1). */
+static PetscErrorCode ParseNode(Reader *r, yaml_event_t *ev, const char key[], PeriNode parent, int depth, PeriNode *node)
 {
-  int line = (int)ev->start_mark.line + 1;
+  int          line = (int)ev->start_mark.line + 1;
+  PeriNodeKind kind = ev->type == YAML_SEQUENCE_START_EVENT ? PERI_NODE_SEQ : ev->type == YAML_MAPPING_START_EVENT ? PERI_NODE_MAP
+                                                                                                                   : PERI_NODE_SCALAR;
 
   PetscFunctionBeginUser;
-  switch (ev->type) {
-  case YAML_SCALAR_EVENT:
-    PetscCall(NodeCreate(PERI_NODE_SCALAR, key, parent_path, line, node));
-    PetscCall(PetscStrallocpy((const char *)ev->data.scalar.value, &(*node)->value));
+  if (ev->type == YAML_ALIAS_EVENT || (kind == PERI_NODE_SCALAR && ev->type != YAML_SCALAR_EVENT)) {
+    PetscBool alias = (PetscBool)(ev->type == YAML_ALIAS_EVENT);
     yaml_event_delete(ev);
-    break;
-  case YAML_SEQUENCE_START_EVENT: {
-    PetscInt k = 0;
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: %s", r->file, line, alias ? "YAML aliases are not supported in scene files" : "unexpected YAML content");
+  }
+  if (kind != PERI_NODE_SCALAR && depth > PERI_SCENE_MAX_DEPTH) {
     yaml_event_delete(ev);
-    PetscCall(NodeCreate(PERI_NODE_SEQ, key, parent_path, line, node));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: nested more than %d levels deep", r->file, line, PERI_SCENE_MAX_DEPTH);
+  }
+  PetscCall(NodeCreate(kind, key, parent ? parent->path : "", line, node));
+  if (parent) PetscCall(NodeAppend(parent, *node));
+  if (kind == PERI_NODE_SCALAR) PetscCall(PetscStrallocpy((const char *)ev->data.scalar.value, &(*node)->value));
+  yaml_event_delete(ev);
+  if (kind == PERI_NODE_SEQ) {
     while (PETSC_TRUE) {
       yaml_event_t item;
       PeriNode     child;
@@ -174,44 +189,35 @@ static PetscErrorCode ParseNode(Reader *r, yaml_event_t *ev, const char key[], c
         yaml_event_delete(&item);
         break;
       }
-      PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, k++));
-      PetscCall(ParseNode(r, &item, idx, (*node)->path, &child));
-      PetscCall(NodeAppend(*node, child));
+      PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, (*node)->n));
+      PetscCall(ParseNode(r, &item, idx, *node, depth + 1, &child));
     }
-  } break;
-  case YAML_MAPPING_START_EVENT:
-    yaml_event_delete(ev);
-    PetscCall(NodeCreate(PERI_NODE_MAP, key, parent_path, line, node));
+  } else if (kind == PERI_NODE_MAP) {
     while (PETSC_TRUE) {
       yaml_event_t kev, vev;
       PeriNode     child, dup;
-      char        *k;
+      char         k[256];
       PetscCall(ReaderNext(r, &kev));
       if (kev.type == YAML_MAPPING_END_EVENT) {
         yaml_event_delete(&kev);
         break;
       }
-      PetscCheck(kev.type == YAML_SCALAR_EVENT, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: mapping keys must be plain words", r->file, (int)kev.start_mark.line + 1);
-      PetscCall(PetscStrallocpy((const char *)kev.data.scalar.value, &k));
       line = (int)kev.start_mark.line + 1;
+      if (kev.type != YAML_SCALAR_EVENT) {
+        yaml_event_delete(&kev);
+        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: mapping keys must be plain words", r->file, line);
+      }
+      if (strlen((const char *)kev.data.scalar.value) >= sizeof(k)) {
+        yaml_event_delete(&kev);
+        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: a key longer than %d characters", r->file, line, (int)sizeof(k) - 1);
+      }
+      PetscCall(PetscStrncpy(k, (const char *)kev.data.scalar.value, sizeof(k)));
       yaml_event_delete(&kev);
       PetscCall(PeriSceneGetNode(*node, k, &dup));
-      if (dup) {
-        PetscCall(PetscFree(k));
-        SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: key '%s' appears twice in '%s'", r->file, line, dup->path, (*node)->path[0] ? (*node)->path : "the scene");
-      }
+      PetscCheck(!dup, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: key '%s' appears twice in '%s'", r->file, line, dup->path, (*node)->path[0] ? (*node)->path : "the scene");
       PetscCall(ReaderNext(r, &vev));
-      PetscCall(ParseNode(r, &vev, k, (*node)->path, &child));
-      PetscCall(PetscFree(k));
-      PetscCall(NodeAppend(*node, child));
+      PetscCall(ParseNode(r, &vev, k, *node, depth + 1, &child));
     }
-    break;
-  case YAML_ALIAS_EVENT:
-    yaml_event_delete(ev);
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: YAML aliases are not supported in scene files", r->file, line);
-  default:
-    yaml_event_delete(ev);
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: unexpected YAML content", r->file, line);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -308,17 +314,164 @@ static PetscErrorCode AddOptionKeys(PeriNode root)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Options that name the scene (src/options.c checks them): a top-level key of the documented
+ * keys, alone or followed by '_'. Option names ignore case, as PETSc's do. */
+PetscErrorCode PeriSceneOptionIsScene(const char opt[], PetscBool *is)
+{
+  const char *o = opt[0] == '-' ? opt + 1 : opt;
+
+  PetscFunctionBeginUser;
+  *is = PETSC_FALSE;
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys) && !*is; k++) {
+    const char *path = scene_keys[k].path, *dot = strchr(path, '.');
+    size_t      len = dot ? (size_t)(dot - path) : strlen(path);
+    if (!strncasecmp(o, path, len) && (o[len] == 0 || o[len] == '_')) *is = PETSC_TRUE;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+typedef struct {
+  char   **name;
+  PetscInt n, cap;
+} NameList;
+
+static PetscErrorCode NameListAdd(NameList *l, const char path[])
+{
+  char opt[512];
+
+  PetscFunctionBeginUser;
+  OptionName(path, opt, sizeof(opt));
+  for (PetscInt k = 0; k < l->n; k++)
+    if (!strcasecmp(l->name[k], opt)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (l->n + 1 >= l->cap) {
+    char **more;
+    l->cap = 2 * l->cap + 64;
+    PetscCall(PetscCalloc1(l->cap, &more));
+    for (PetscInt k = 0; k < l->n; k++) more[k] = l->name[k];
+    PetscCall(PetscFree(l->name));
+    l->name = more;
+  }
+  PetscCall(PetscStrallocpy(opt, &l->name[l->n++]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The options ApplyOptions reads below node: its scalars, and its lists of scalars as a whole. */
+static PetscErrorCode NameListAddNodes(NameList *l, PeriNode node)
+{
+  PetscFunctionBeginUser;
+  if (node->kind == PERI_NODE_SCALAR || (node->kind == PERI_NODE_SEQ && node->n > 0 && node->child[0]->kind == PERI_NODE_SCALAR)) PetscCall(NameListAdd(l, node->path));
+  for (PetscInt k = 0; k < node->n; k++) PetscCall(NameListAddNodes(l, node->child[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSceneOptionNames - the options that set something in this scene ("-material_nu", ...): the
+  scalars and lists of scalars of the file (after the overrides) and the documented keys. A
+  NULL-terminated array; free it with PetscStrArrayDestroy(). Not collective.
+@*/
+PetscErrorCode PeriSceneOptionNames(PeriScene scene, char ***names)
+{
+  NameList l = {NULL, 0, 0};
+
+  PetscFunctionBeginUser;
+  PetscCall(NameListAddNodes(&l, scene->root));
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++)
+    if (!strchr(scene_keys[k].path, '<')) PetscCall(NameListAdd(&l, scene_keys[k].path));
+  if (!l.name) PetscCall(PetscCalloc1(1, &l.name));
+  *names = l.name;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The child of node whose key starts rest and is followed by '_' or the end; the longest such key
+ * wins (a key may contain '_' itself: boundary_layers, load_factor_max). */
+static PeriNode OptionChild(PeriNode node, const char rest[])
+{
+  PeriNode best = NULL;
+
+  for (PetscInt k = 0; k < node->n; k++) {
+    const char *key = node->child[k]->key;
+    size_t      len = strlen(key);
+    if (!strncasecmp(rest, key, len) && (rest[len] == 0 || rest[len] == '_') && (!best || len > strlen(best->key))) best = node->child[k];
+  }
+  return best;
+}
+
+/*@C
+  PeriSceneOptionExplain - why the scene option opt (which nothing read) sets nothing: the key it
+  names is missing from the file, is a mapping, or is an item of a list that an option replaced.
+  Not collective.
+@*/
+PetscErrorCode PeriSceneOptionExplain(PeriScene scene, const char opt[], char buf[], size_t len)
+{
+  PeriNode    node = scene->root, child;
+  const char *rest = opt[0] == '-' ? opt + 1 : opt;
+
+  PetscFunctionBeginUser;
+  while ((child = OptionChild(node, rest))) {
+    size_t klen = strlen(child->key);
+    if (rest[klen] == 0) {
+      if (child->kind == PERI_NODE_MAP)
+        PetscCall(PetscSNPrintf(buf, len, "'%s' is a mapping: set its keys one by one", child->path));
+      else if (node->kind == PERI_NODE_SEQ && node->line == 0)
+        PetscCall(PetscSNPrintf(buf, len, "the option for the whole list '%s' replaces it", node->path));
+      else if (child->kind == PERI_NODE_SEQ)
+        PetscCall(PetscSNPrintf(buf, len, "'%s' is %s: set its items one by one", child->path, child->n ? "a list of lists or mappings" : "an empty list"));
+      else
+        PetscCall(PetscSNPrintf(buf, len, "nothing reads '%s'", child->path));
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    node = child;
+    rest += klen + 1;
+  }
+  if (node->kind == PERI_NODE_SCALAR)
+    PetscCall(PetscSNPrintf(buf, len, "'%s' is a single value, with no key '%s'", node->path, rest));
+  else if (node->kind == PERI_NODE_SEQ && isdigit((unsigned char)rest[0]))
+    PetscCall(PetscSNPrintf(buf, len, "the list '%s' has no item %ld: its items are numbered from 0 to %" PetscInt_FMT, node->path, strtol(rest, NULL, 10), node->n - 1));
+  else if (node->kind == PERI_NODE_SEQ)
+    PetscCall(PetscSNPrintf(buf, len, "'%s' is a list: its items are numbered from 0, and it has no '%s'", node->path, rest));
+  else if (node == scene->root)
+    PetscCall(PetscSNPrintf(buf, len, "the scene file has no key '%s'", rest));
+  else
+    PetscCall(PetscSNPrintf(buf, len, "the scene file has no key '%s' in '%s'", rest, node->path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The stream start, the document start, then the root mapping and all below it. */
+static PetscErrorCode ReadDocument(Reader *r, PeriScene s)
+{
+  yaml_event_t ev;
+  int          line;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReaderNext(r, &ev));
+  yaml_event_delete(&ev);
+  PetscCall(ReaderNext(r, &ev));
+  if (ev.type == YAML_STREAM_END_EVENT) {
+    yaml_event_delete(&ev);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the scene file is empty (no YAML content, only blank lines or comments)", r->file);
+  }
+  yaml_event_delete(&ev);
+  PetscCall(ReaderNext(r, &ev));
+  line = (int)ev.start_mark.line + 1;
+  if (ev.type != YAML_MAPPING_START_EVENT) {
+    yaml_event_delete(&ev);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: a scene is a mapping of keys (dim, model, material, ...)", r->file, line);
+  }
+  PetscCall(ParseNode(r, &ev, "", NULL, 1, &s->root));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriSceneCreateFromFile - reads a YAML scene file and applies option overrides. Not collective:
   every rank reads the file.
 @*/
 PetscErrorCode PeriSceneCreateFromFile(const char file[], PeriScene *scene)
 {
-  PeriScene    s;
-  FILE        *fp;
-  Reader       r;
-  yaml_event_t ev;
-  char         tmp[PETSC_MAX_PATH_LEN];
+  PeriScene      s;
+  FILE          *fp;
+  Reader         r;
+  char           tmp[PETSC_MAX_PATH_LEN];
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&s));
@@ -335,22 +488,11 @@ PetscErrorCode PeriSceneCreateFromFile(const char file[], PeriScene *scene)
   PetscCheck(yaml_parser_initialize(&r.parser), PETSC_COMM_SELF, PETSC_ERR_LIB, "libyaml could not initialize");
   yaml_parser_set_input_file(&r.parser, fp);
   *scene = s;
-  /* stream start, document start, then the root mapping */
-  PetscCall(ReaderNext(&r, &ev));
-  yaml_event_delete(&ev);
-  PetscCall(ReaderNext(&r, &ev));
-  if (ev.type == YAML_STREAM_END_EVENT) {
-    yaml_event_delete(&ev);
-    yaml_parser_delete(&r.parser);
-    fclose(fp);
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the scene file is empty", file);
-  }
-  yaml_event_delete(&ev);
-  PetscCall(ReaderNext(&r, &ev));
-  PetscCheck(ev.type == YAML_MAPPING_START_EVENT, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: a scene is a mapping of keys (dim, model, material, ...)", file, (int)ev.start_mark.line + 1);
-  PetscCall(ParseNode(&r, &ev, "", "", &s->root));
+  /* the parser and the file are closed whatever the outcome; the tree read so far is the scene's */
+  ierr = ReadDocument(&r, s);
   yaml_parser_delete(&r.parser);
   fclose(fp);
+  PetscCall(ierr);
   PetscCall(ApplyOptions(s->root));
   PetscCall(AddOptionKeys(s->root));
   PetscFunctionReturn(PETSC_SUCCESS);
