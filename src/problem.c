@@ -81,6 +81,12 @@ static PetscErrorCode ReadHorizon(PeriProblem p)
     PeriInputCheck(m >= 1, s, h, "m", "must be at least 1 (the horizon may not be smaller than the spacing), got %g", (double)m);
     p->delta = m * p->particles.mean_spacing;
   }
+  {
+    /* beyond the body's diagonal every particle bonds with every other: N^2 bonds, no locality */
+    PetscReal diag2 = 0;
+    for (PetscInt d = 0; d < p->particles.dim; d++) diag2 += PetscSqr(p->particles.upper[d] - p->particles.lower[d]);
+    PeriInputCheck(p->delta <= PetscSqrtReal(diag2), s, h, hasm ? "m" : "delta", "the horizon %g exceeds the body's size (its diagonal %g): every particle would bond with every other; a horizon is a few spacings (m = 3 is usual)", (double)p->delta, (double)PetscSqrtReal(diag2));
+  }
   for (PetscInt k = 0; k < p->particles.n; k++) hmax = PetscMax(hmax, p->particles.spacing[k]);
   PeriInputCheck(p->delta >= hmax * (1 - 1e-10), s, h, hasm ? "m" : "delta", "the horizon %g is smaller than the particle spacing %g: particles would have no bonds", (double)p->delta, (double)hmax);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -200,12 +206,14 @@ static PetscErrorCode ReadSolver(PeriProblem p)
 
 /*@C
   PeriResidualTolerance - the largest true relative residual a solve run with relative tolerance
-  rtol may leave: solver.residual_tol, or by default max(100 rtol, 1e-6). The factor 100 leaves
-  room for the preconditioned norm that some KSPs monitor; the floor, for round-off in K.
+  rtol may leave: solver.residual_tol, or by default max(100 rtol, 1e-6), but never above 1e-3.
+  The factor 100 leaves room for the preconditioned norm that some KSPs monitor; the floor, for
+  round-off in K; the cap keeps a loose -ksp_rtol from passing a wrong answer (an answer that
+  crude must be asked for with solver.residual_tol).
 @*/
 PetscReal PeriResidualTolerance(PeriProblem p, PetscReal rtol)
 {
-  return p->residual_tol > 0 ? p->residual_tol : PetscMax(100 * rtol, 1e-6);
+  return p->residual_tol > 0 ? p->residual_tol : PetscMin(PetscMax(100 * rtol, 1e-6), 1e-3);
 }
 
 static PetscErrorCode CreateModel(PeriProblem p)

@@ -19,6 +19,22 @@ typedef struct {
   PeriProbe *control;
 } Settings;
 
+/* The load factor scales the loads, the prescribed values, the layers' values and the twist:
+ * with all of them zero every step is the unloaded body, and the loop would run to the end. */
+static PetscErrorCode CheckSomethingLoaded(PeriProblem p, PeriNode a)
+{
+  PetscReal fnorm, v = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecNorm(p->f, NORM_INFINITY, &fnorm));
+  for (PetscInt k = 0; k < p->nconstrained; k++) v = PetscMax(v, PetscAbsReal(p->constrained_value[k]));
+  for (PetscInt f = 0; f < 6; f++) v = PetscMax(v, p->layers.kind[f] ? PetscAbsReal(p->layers.value[f]) : 0);
+  if (p->torsion.active) v = PetscMax(v, PetscAbsReal(p->torsion.twist));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_REAL, MPI_MAX, p->comm));
+  PeriInputCheck(fnorm > 0 || v > 0, p->scene, a, "type", "a quasistatic analysis scales the loads and prescribed values, and this scene has none (no loads, every bc value 0): give loads or a bc value");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
 {
   static const char *const policies[] = {"all", "fraction", NULL};
@@ -65,6 +81,7 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
       if (!strcmp(p->probes[k].name, name)) st->control = &p->probes[k];
     PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", name);
   }
+  PetscCall(CheckSomethingLoaded(p, a));
   st->quiet = PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-quiet", &st->quiet, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -354,6 +371,8 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
       L->stale = PETSC_FALSE;
     }
     if (L->lost) {
+      /* cut off before any bond broke: the scene's own cracks did it, at every load */
+      PetscCheck(total > 0 || s->broken > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", p->scene->file, L->npieces);
       PetscCall(PetscSNPrintf(why, len, "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", L->npieces));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
@@ -413,7 +432,7 @@ static PetscErrorCode Failed(PeriProblem p, Equilibrium *eq, PetscReal trial, co
   q->failure_step         = q->nsteps + 1;
   q->failed_trial_broken  = s->broken;
   PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
-  if (p->vtk) PetscCall(WriteState(p, "failed_trial.vtu"));
+  if (p->vtk && p->u) PetscCall(WriteState(p, "failed_trial.vtu"));
   PetscCall(PeriDamage(p, &q->trial_damage)); /* where the failure went, for the caller */
   PetscCall(EquilibriumRestore(p, eq, PETSC_FALSE, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);

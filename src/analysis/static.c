@@ -60,7 +60,7 @@ static PetscErrorCode DefaultFactorSolver(KSP ksp)
 PetscErrorCode PeriStaticDefaultMatType(char type[], size_t len)
 {
   char      pc[64] = PCGAMG, solver[64] = "";
-  PetscBool gamg, cholesky, mumps;
+  PetscBool gamg, cholesky, mumps, aij;
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
@@ -69,7 +69,9 @@ PetscErrorCode PeriStaticDefaultMatType(char type[], size_t len)
   PetscCall(PetscStrcmp(pc, PCCHOLESKY, &cholesky));
   PetscCall(PetscStrcmp(solver, MATSOLVERMUMPS, &mumps));
   mumps = (PetscBool)(mumps || (!solver[0] && ParallelFactor()));
-  PetscCall(PetscStrncpy(type, gamg || (cholesky && mumps) ? MATAIJ : MATBAIJ, len));
+  /* other external factorizations (superlu_dist, umfpack, cholmod, ...) take AIJ only */
+  aij = (PetscBool)(gamg || (cholesky && mumps) || (solver[0] && !mumps && strcmp(solver, MATSOLVERPETSC)));
+  PetscCall(PetscStrncpy(type, aij ? MATAIJ : MATBAIJ, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -209,6 +211,20 @@ static PetscErrorCode KSPSetInterruptible(KSP ksp, MPI_Comm comm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Loads and prescribed values so large that K u_prescribed overflows make an inf right-hand
+ * side: say so, before KSP reports a breakdown that looks like a singular operator. */
+static PetscErrorCode CheckRightHandSide(PeriProblem p, Vec b)
+{
+  PetscReal norm, vmax = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecNorm(b, NORM_INFINITY, &norm));
+  if (!PetscIsInfOrNanReal(norm)) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < p->nconstrained; k++) vmax = PetscMax(vmax, PetscAbsReal(p->constrained_value[k]));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &vmax, 1, MPIU_REAL, MPI_MAX, p->comm));
+  SETERRQ(p->comm, PETSC_ERR_USER_INPUT, "%s: the loads and prescribed values overflow double precision (the right-hand side holds inf or NaN; largest prescribed value %g): give bc values and loads of a physical size", p->scene->file, (double)vmax);
+}
+
 /* CG (GMRES for an unsymmetric operator) + GAMG, rtol 1e-10, then the options. */
 static PetscErrorCode StaticKSPCreate(PeriProblem p, PetscBool symmetric, KSP *ksp)
 {
@@ -318,6 +334,7 @@ PetscErrorCode PeriStaticSolve(PeriProblem p, KSP *ksp, PetscReal lambda, PetscB
   }
   PetscCall(MatZeroRowsColumns(A, nrows, rows, diag, p->u, b));
   PetscCall(PetscFree2(rows, values));
+  PetscCall(CheckRightHandSide(p, b));
   PetscCall(HandleFreeMotions(p, A, p->u, b, diag, nhold, hold, &nfree, free));
 
   if (!*ksp) PetscCall(StaticKSPCreate(p, p->results.symmetric, ksp));
