@@ -9,6 +9,10 @@
 #   # exit: STATUS         the exact exit status expected
 #   # setup: COMMAND       run by bash before perilin, with $out the output directory
 #   # keep: FILE...        the outputs the case may leave (paths relative to $out, globs allowed)
+#   # signal: SIG DELAY [rank|group]   send SIG after DELAY s to perilin (or mpiexec), to one rank,
+#                          or to the process group; then the run must write summary.json marked
+#                          "complete": false, print no error, and the message is looked for in
+#                          stdout and stderr
 # Without setup and keep no output directory may be left; with setup it must be exactly as the
 # setup left it, apart from the files of keep. Every case runs with stdin from /dev/null and a
 # timeout of 60 s; the runner always passes -output_dir "$out".
@@ -53,6 +57,35 @@ allowed() {
   return 1
 }
 
+# run_signalled: runs the case in a session of its own and, after the delay of its "# signal:
+# SIG DELAY [rank|group]" line, sends SIG to the launched process (perilin, or mpiexec), to one
+# perilin rank, or to the whole process group (a terminal's Ctrl-C); sets code.
+run_signalled() {
+  local sig delay target pid victim waited=0
+  read -r sig delay target <<< "$signal"
+  # shellcheck disable=SC2086
+  setsid "${launcher[@]}" "$perilin" "$scene" -output_dir "$out" $args > "$tmp/stdout" 2> "$tmp/stderr" < /dev/null &
+  pid=$!
+  sleep "$delay"
+  case "$target" in
+    rank) victim=$(pgrep -x -s "$pid" perilin | head -n 1); kill -s "$sig" "$victim" ;;
+    group) kill -s "$sig" -- "-$pid" ;;
+    *) kill -s "$sig" "$pid" ;;
+  esac
+  while kill -0 "$pid" 2> /dev/null && [ "$waited" -lt "$timeout_s" ]; do
+    sleep 1
+    waited=$((waited + 1))
+  done
+  if kill -0 "$pid" 2> /dev/null; then
+    kill -s KILL -- "-$pid"
+    wait "$pid"
+    code=124
+  else
+    wait "$pid"
+    code=$?
+  fi
+}
+
 shopt -s nullglob
 scenes=("$dir/$category"/*.yaml)
 shopt -u nullglob
@@ -69,6 +102,7 @@ for scene in "${scenes[@]}"; do
   want_exit=$(header exit "$scene")
   setup=$(header setup "$scene")
   keep=$(header keep "$scene")
+  signal=$(header signal "$scene")
   out="$tmp/$name-out"
   rm -rf "$out"
   problem=""
@@ -86,10 +120,14 @@ for scene in "${scenes[@]}"; do
     if [ -n "$ranks" ]; then
       launcher=(env OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpiexec --oversubscribe -n "$ranks")
     fi
-    # shellcheck disable=SC2086
-    timeout -k 5 "$timeout_s" "${launcher[@]}" "$perilin" "$scene" -output_dir "$out" $args \
-      > "$tmp/stdout" 2> "$tmp/stderr" < /dev/null
-    code=$?
+    if [ -n "$signal" ]; then
+      run_signalled
+    else
+      # shellcheck disable=SC2086
+      timeout -k 5 "$timeout_s" "${launcher[@]}" "$perilin" "$scene" -output_dir "$out" $args \
+        > "$tmp/stdout" 2> "$tmp/stderr" < /dev/null
+      code=$?
+    fi
     after=$(snapshot "$out")
     changed=$(diff <(echo "$before") <(echo "$after") | sed -n 's/^[<>] [fdo] \([^ ]*\).*/\1/p' | LC_ALL=C sort -u)
     left=""
@@ -100,7 +138,15 @@ for scene in "${scenes[@]}"; do
     done <<< "$changed"
     if [ "$existed" = no ] && [ -z "$keep" ] && [ -e "$out" ]; then left=" (the directory itself)$left"; fi
     nerr=$(grep -c 'perilin: error:' "$tmp/stderr")
-    if [ "$code" -eq 124 ] || [ "$code" -eq 137 ]; then problem="hang: no exit within $timeout_s s"
+    if [ -n "$signal" ]; then
+      # an interrupted run is no error: it writes what it has, marked incomplete
+      [ "$nerr" -eq 0 ] && nerr=1 || nerr=2
+      cat "$tmp/stdout" >> "$tmp/stderr"
+      if [ "$code" -ne 124 ] && ! grep -q '"complete": false' "$out/summary.json" 2> /dev/null; then problem="summary.json is missing or not marked \"complete\": false"; fi
+      if compgen -G "$out.partial-*" > /dev/null; then problem="a staging directory was left behind: $(echo "$out".partial-*)"; fi
+    fi
+    if [ -n "$problem" ]; then :
+    elif [ "$code" -eq 124 ] || [ "$code" -eq 137 ]; then problem="hang: no exit within $timeout_s s"
     elif [ -n "$want_exit" ] && [ "$code" -ne "$want_exit" ]; then problem="exit status $code, expected $want_exit"
     elif [ -z "$want_exit" ] && [ "$code" -eq 0 ]; then problem="exit status 0"
     elif [ -z "$want_exit" ] && [ "$code" -gt 128 ]; then problem="killed by signal $((code - 128))"
