@@ -230,15 +230,14 @@ typedef struct {
 
 /* Resident size of PETSc, MPI and the libraries before the scene is read. */
 #define PERI_MEMORY_RUNTIME 45e6
-/* Peak memory over the assembled matrix in the static CG + GAMG solve (matrix, GAMG's graph and
- * coarse levels, Krylov vectors): docs/performance.md measured 2.5x at 1e6 particles including the
- * bonds and particles; without them the solver adds about 0.6x the matrix. */
-#define PERI_MEMORY_SOLVER 0.6
+/* What GAMG and CG add to the matrix, in units of its scalar graph (see Estimate). */
+#define PERI_MEMORY_SOLVER 2.4
 
-/* The grid's particle count and spacing, when the scene has a valid grid. */
-static PetscErrorCode GridSize(PeriScene s, PetscInt dim, PetscReal *n, PetscReal *h)
+/* The grid's particle count, spacing, cells per axis and periodic axes, when the scene has a valid
+ * grid (else n = 0). */
+static PetscErrorCode GridSize(PeriScene s, PetscInt dim, PetscReal *n, PetscReal *h, PetscReal cells[], PetscBool periodic[])
 {
-  PeriNode  grid;
+  PeriNode  grid, per;
   PetscReal lower[3], upper[3];
   PetscInt  nl, nu;
 
@@ -250,8 +249,16 @@ static PetscErrorCode GridSize(PeriScene s, PetscInt dim, PetscReal *n, PetscRea
   PetscCall(PeriSceneGetRealArray(s, grid, "upper", PETSC_TRUE, dim, dim, upper, &nu));
   PetscCall(PeriSceneGetReal(s, grid, "spacing", PETSC_TRUE, h, NULL));
   if (!(*h > 0)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetNode(grid, "periodic", &per));
+  for (PetscInt d = 0; d < dim; d++) {
+    periodic[d] = PETSC_FALSE;
+    if (per && per->kind == PERI_NODE_SEQ && per->n == dim) PetscCall(PeriSceneParseBool(s, per->child[d], &periodic[d]));
+  }
   *n = 1;
-  for (PetscInt d = 0; d < dim; d++) *n *= PetscMax(1, PetscFloorReal((upper[d] - lower[d]) / *h + 0.5));
+  for (PetscInt d = 0; d < dim; d++) {
+    cells[d] = PetscMax(1, PetscFloorReal((upper[d] - lower[d]) / *h + 0.5));
+    *n *= cells[d];
+  }
   /* beyond GridCreate's limit (or not a number) GridCreate's own message is the clearer one */
   if (!(*n <= 1e8)) *n = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -280,20 +287,42 @@ static PetscErrorCode SearchRadius(PeriScene s, PetscReal h, PetscReal *r)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* analysis.type, when given. */
+static PetscErrorCode AnalysisType(PeriScene s, char type[], size_t len)
+{
+  PeriNode a;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
+  if (a) PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, type, len, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Lattice points within r spacings of a particle, itself excluded. */
 static PetscReal BallCount(PetscInt dim, PetscReal r)
 {
   return (dim == 2 ? PETSC_PI * r * r : 4.0 / 3.0 * PETSC_PI * r * r * r) - 1;
 }
 
+/* The share of the lattice's pairs within r spacings that faces leave: a pair spans on average
+ * E|dx| = 4r/(3 pi) (2D) or 3r/8 (3D) along an axis, and a box of c cells keeps 1 - E|dx|/c of
+ * them along a non-periodic axis. */
+static PetscReal SurfaceShare(PetscInt dim, PetscReal r, const PetscReal cells[], const PetscBool periodic[])
+{
+  PetscReal share = 1, mean = r * (dim == 2 ? 4 / (3 * PETSC_PI) : 3.0 / 8.0);
+  for (PetscInt d = 0; d < dim; d++)
+    if (!periodic[d]) share *= PetscMax(0.1, 1 - mean / cells[d]);
+  return share;
+}
+
 /* Bytes of the bonds (include/perilin.h, PeriBonds), the matrix (AIJ for GAMG: 12 bytes per
- * nonzero; BAIJ: 8, and an index per block) and the solver, for n particles of dofs DOFs and a
- * search radius of r spacings. State-based models also list each family in full and couple
- * particles up to 2 delta apart. */
-static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscBool failure, MemoryEstimate *e)
+ * nonzero; BAIJ: 8, and an index per block) and the solver, for n particles of dofs DOFs, a
+ * search radius of r spacings and the share of pairs the faces leave. State-based models also list
+ * each family in full and couple particles up to 2 delta apart. */
+static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const char analysis[], MemoryEstimate *e)
 {
   const PetscReal dofs = m->dofs, ball = BallCount(m->dim, r);
-  PetscReal       per_bond, blocks, nnz, matrix;
+  PetscReal       reserved, per_bond, blocks, nnz, matrix;
   char            type[64];
   PetscBool       aij;
 
@@ -301,14 +330,22 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscBool 
   PetscCall(PeriStaticDefaultMatType(type, sizeof(type)));
   PetscCall(PetscStrcmp(type, MATAIJ, &aij));
   e->n      = n;
-  e->nbonds = n * ball / 2;
-  /* the search reserves 1.05 ball / 2 per particle of j, xi, length, alpha, live; then lambda,
-     and with failure the cause and the softening share */
-  per_bond  = 1.05 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1) + sizeof(PetscReal) + (failure ? 1 + sizeof(PetscReal) : 0);
-  blocks    = 1 + (m->ops.family_stiffness ? BallCount(m->dim, 2 * r) : ball);
-  nnz       = n * blocks * dofs * dofs;
-  matrix    = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
-  e->shared = e->nbonds * per_bond * (m->ops.family_stiffness ? 3 : 1) + matrix * (1 + PERI_MEMORY_SOLVER) + 10 * n * dofs * sizeof(PetscScalar);
+  e->nbonds = n * ball / 2 * share;
+  /* the search reserves 1.05 ball / 2 per particle of j, xi, length, alpha, live; every bond found
+     gets lambda, and with failure the cause and the softening share */
+  reserved = 1.05 * n * ball / 2 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1);
+  per_bond = sizeof(PetscReal) + (failure ? 1 + sizeof(PetscReal) : 0);
+  blocks   = 1 + share * (m->ops.family_stiffness ? BallCount(m->dim, 2 * r) : ball);
+  nnz      = n * blocks * dofs * dofs;
+  matrix   = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
+  /* GAMG's scalar graph (matrix / dofs^2), its coarse levels and prolongators and CG's vectors:
+     PERI_MEMORY_SOLVER graphs, fitted to the peaks of 2D plates (2 DOFs, 1e4-1e6 particles, where
+     the whole run peaks at 2.5x the matrix as in docs/performance.md) and 3D blocks (3 DOFs) */
+  e->shared = (reserved + e->nbonds * per_bond) * (m->ops.family_stiffness ? 3 : 1) + matrix * (1 + PERI_MEMORY_SOLVER / (dofs * dofs)) + 10 * n * dofs * sizeof(PetscScalar);
+  /* the quasi-static loop solves on a copy of K; the modal shift-and-invert factors K, whose
+     nested-dissection fill grew as 0.45 log2(n) matrices (2D lamina, 3,600 to 230,400 particles) */
+  if (!strcmp(analysis, "quasistatic")) e->shared += matrix;
+  if (!strcmp(analysis, "modal")) e->shared += matrix * 0.45 * PetscLog2Real(n);
   /* coordinates, volume, spacing, line, owner, family volume, neighbour count, the cell list, and
      the gathered displacements and energy densities */
   e->per_rank = PERI_MEMORY_RUNTIME + n * (8 * sizeof(PetscReal) + 6 * sizeof(PetscInt) + (2 * dofs + 1) * sizeof(PetscReal));
@@ -377,8 +414,9 @@ static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
 PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
 {
   MemoryEstimate e = {0};
-  PetscReal      h = 0, r = 0;
-  PetscBool      run = PETSC_TRUE, failure;
+  PetscReal      h = 0, r = 0, cells[3];
+  PetscBool      run                     = PETSC_TRUE, failure, periodic[3];
+  char           analysis[PERI_NAME_LEN] = "static";
   PeriNode       grid;
   PetscErrorCode ierr;
 
@@ -387,13 +425,14 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
   if (!run) PetscFunctionReturn(PETSC_SUCCESS);
   /* a bad grid or horizon is reported later, in the order of the other checks: quietly skip here */
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-  ierr = GridSize(s, m->dim, &e.n, &h);
+  ierr = GridSize(s, m->dim, &e.n, &h, cells, periodic);
   if (!ierr && e.n > 0) ierr = SearchRadius(s, h, &r);
+  if (!ierr && r > 0) ierr = AnalysisType(s, analysis, sizeof(analysis));
   PetscCall(PetscPopErrorHandler());
   if (ierr || !(e.n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
   failure = grid ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(Estimate(m, e.n, r, failure, &e));
+  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, analysis, &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));
