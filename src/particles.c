@@ -427,6 +427,12 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   ierr = GridSize(s, m->dim, &e.n, &h, cells, periodic);
   if (!ierr && e.n > 0) ierr = SearchRadius(s, h, &r);
+  if (!ierr && r > 0) {
+    /* a horizon beyond the body's diagonal is an input error of its own (ReadHorizon) */
+    PetscReal diag2 = 0;
+    for (PetscInt d = 0; d < m->dim; d++) diag2 += cells[d] * cells[d];
+    if (r - 0.5 > PetscSqrtReal(diag2)) r = 0;
+  }
   if (!ierr && r > 0) ierr = AnalysisType(s, analysis, sizeof(analysis));
   PetscCall(PetscPopErrorHandler());
   if (ierr || !(e.n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
