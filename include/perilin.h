@@ -65,7 +65,7 @@ PETSC_EXTERN PetscErrorCode PeriSceneParseRealArray(PeriScene, PeriNode, PetscIn
  * "did you mean"; -options_unused_ok makes them warnings. */
 PETSC_EXTERN PetscErrorCode PeriSceneOptionIsScene(const char[], PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneOptionNames(PeriScene, char ***);
-PETSC_EXTERN PetscErrorCode PeriSceneOptionExplain(PeriScene, const char[], char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriSceneOptionExplain(PeriScene, const char[], char[], size_t, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckScene(MPI_Comm, PeriScene);
 struct _p_PeriProblem; /* PeriProblem, below */
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckUnused(struct _p_PeriProblem *);

@@ -198,13 +198,14 @@ PetscErrorCode PeriOptionsCheckScene(MPI_Comm comm, PeriScene scene)
   PetscCall(PeriSceneOptionNames(scene, &scene_names));
   for (PetscInt k = 0; k < unread.n; k++) {
     char      why[256], hint[2 * PERI_OPTION_LEN];
-    PetscBool is, exact;
+    PetscBool is, exact, exists;
     PetscCall(PeriSceneOptionIsScene(unread.name[k], &is));
     if (!is) continue;
     PetscCall(NamesAdd(&bad, unread.name[k]));
     if (bad.n > PERI_OPTIONS_LISTED) continue;
-    PetscCall(PeriSceneOptionExplain(scene, unread.name[k], why, sizeof(why)));
+    PetscCall(PeriSceneOptionExplain(scene, unread.name[k], why, sizeof(why), &exists));
     Suggest(unread.name[k], scene_names, hint, sizeof(hint), &exact);
+    if (exists) hint[0] = 0; /* it names a key of the file: the explanation is the whole story */
     Append(msg, sizeof(msg), "%sunknown option %s (%s%s%s)", bad.n > 1 ? "; " : "", unread.name[k], why, hint[0] ? "; " : "", hint);
   }
   if (bad.n > PERI_OPTIONS_LISTED) Append(msg, sizeof(msg), "; and %" PetscInt_FMT " more", bad.n - PERI_OPTIONS_LISTED);

@@ -143,10 +143,27 @@ typedef struct {
   const char   *file;
 } Reader;
 
+/* The line of byte offset in the file: libyaml gives only the offset of an error found while it
+ * decodes the input (bad UTF-8, control characters). */
+static int LineAtOffset(const char file[], size_t offset)
+{
+  FILE *fp   = fopen(file, "rb");
+  int   line = 1, c;
+
+  if (!fp) return 0;
+  for (size_t k = 0; k < offset && (c = fgetc(fp)) != EOF; k++)
+    if (c == '\n') line++;
+  fclose(fp);
+  return line;
+}
+
 static PetscErrorCode ReaderNext(Reader *r, yaml_event_t *ev)
 {
   PetscFunctionBeginUser;
-  PetscCheck(yaml_parser_parse(&r->parser, ev), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: invalid YAML: %s", r->file, (int)r->parser.problem_mark.line + 1, r->parser.problem ? r->parser.problem : "syntax error");
+  if (PetscUnlikely(!yaml_parser_parse(&r->parser, ev))) {
+    int line = r->parser.error == YAML_READER_ERROR ? LineAtOffset(r->file, r->parser.problem_offset) : (int)r->parser.problem_mark.line + 1;
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: invalid YAML: %s", r->file, line, r->parser.problem ? r->parser.problem : "syntax error");
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -238,6 +255,25 @@ static void OptionName(const char path[], char opt[], size_t len)
   opt[k] = 0;
 }
 
+/* Whether the option for path may be looked up. PETSc looks an option that is not set up again
+ * without each of its inner numbers (-bc_0_region as -bc_region), recursively: the cost grows as
+ * the factorial of the numbers, and PETSc 3.18 keeps at most 16 of them. Names with more than a few
+ * numbers (lists of lists of lists, which no scene has) or too long for PETSc are not looked up. */
+static PetscBool OptionQueryable(const char opt[])
+{
+  PetscInt numbers = 0;
+
+  if (strlen(opt) >= 256) return PETSC_FALSE;
+  for (const char *c = opt; *c; c++)
+    if (c[0] == '_' && isdigit((unsigned char)c[1])) {
+      const char *e = c + 1;
+      while (isdigit((unsigned char)*e)) e++;
+      if (*e == '_') numbers++;
+      c = e - 1;
+    }
+  return numbers <= 4 ? PETSC_TRUE : PETSC_FALSE;
+}
+
 /* Every scalar whose option -path_joined_by_underscores is set takes the option's value; a list of
  * scalars takes a comma-separated one (-grid_upper 1,0.5). */
 static PetscErrorCode ApplyOptions(PeriNode node)
@@ -247,7 +283,8 @@ static PetscErrorCode ApplyOptions(PeriNode node)
     char      opt[512], val[PETSC_MAX_PATH_LEN], *tok, *save;
     PetscBool set;
     OptionName(node->path, opt, sizeof(opt));
-    PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
+    set = PETSC_FALSE;
+    if (OptionQueryable(opt)) PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
     if (set) {
       for (PetscInt k = 0; k < node->n; k++) PetscCall(NodeDestroy(&node->child[k]));
       node->n = 0;
@@ -267,7 +304,8 @@ static PetscErrorCode ApplyOptions(PeriNode node)
     char      opt[512], val[PETSC_MAX_PATH_LEN];
     PetscBool set;
     OptionName(node->path, opt, sizeof(opt));
-    PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
+    set = PETSC_FALSE;
+    if (OptionQueryable(opt)) PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
     if (set) {
       PetscCall(PetscFree(node->value));
       PetscCall(PetscStrallocpy(val, &node->value));
@@ -399,17 +437,19 @@ static PeriNode OptionChild(PeriNode node, const char rest[])
 /*@C
   PeriSceneOptionExplain - why the scene option opt (which nothing read) sets nothing: the key it
   names is missing from the file, is a mapping, or is an item of a list that an option replaced.
-  Not collective.
+  *exists says whether it names a node of the scene (then other names are no better). Not collective.
 @*/
-PetscErrorCode PeriSceneOptionExplain(PeriScene scene, const char opt[], char buf[], size_t len)
+PetscErrorCode PeriSceneOptionExplain(PeriScene scene, const char opt[], char buf[], size_t len, PetscBool *exists)
 {
   PeriNode    node = scene->root, child;
   const char *rest = opt[0] == '-' ? opt + 1 : opt;
 
   PetscFunctionBeginUser;
+  *exists = PETSC_FALSE;
   while ((child = OptionChild(node, rest))) {
     size_t klen = strlen(child->key);
     if (rest[klen] == 0) {
+      *exists = PETSC_TRUE;
       if (child->kind == PERI_NODE_MAP)
         PetscCall(PetscSNPrintf(buf, len, "'%s' is a mapping: set its keys one by one", child->path));
       else if (node->kind == PERI_NODE_SEQ && node->line == 0)
