@@ -188,12 +188,10 @@ static PetscErrorCode UnreadHere(Names *unread)
 @*/
 PetscErrorCode PeriOptionsCheckScene(MPI_Comm comm, PeriScene scene)
 {
-  Names     unread = {NULL, 0, 0}, bad = {NULL, 0, 0};
-  char    **scene_names, msg[1600]     = "";
-  PetscBool ok = PETSC_FALSE;
+  Names  unread = {NULL, 0, 0}, bad = {NULL, 0, 0};
+  char **scene_names, msg[1600]     = "";
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-options_unused_ok", &ok, NULL));
   PetscCall(UnreadHere(&unread));
   PetscCall(PeriSceneOptionNames(scene, &scene_names));
   for (PetscInt k = 0; k < unread.n; k++) {
@@ -415,7 +413,7 @@ PetscErrorCode PeriOptionsCheckUnused(PeriProblem p)
   PetscBool ok = PETSC_FALSE, said = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-options_unused_ok", &ok, NULL));
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-options_unused_ok", &ok, NULL)); /* read: not unread itself */
   PetscCall(UnreadEverywhere(p->comm, &unread));
   if (!unread.n) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscNames(p, &cand));
