@@ -256,6 +256,9 @@ PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);
 PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
 PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
 
+PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel);
+PETSC_EXTERN PetscBool      PeriModelRegisterAllCalled;
+
 PETSC_EXTERN PetscErrorCode PeriModelCreate_PMB(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriModelCreate_NPMB(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriModelCreate_PDS(PeriModel);

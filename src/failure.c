@@ -132,6 +132,7 @@ PetscErrorCode PeriCracksApply(PeriProblem p)
   }
   cut = CutBonds(&p->particles, &p->bonds, list->n, seg);
   if (p->family.offset) CutBonds(&p->particles, &p->family, list->n, seg);
+  PetscCall(PetscFree(seg));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, p->comm));
   p->results.precracked_bonds = cut;
   PetscFunctionReturn(PETSC_SUCCESS);

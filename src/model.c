@@ -4,7 +4,6 @@
 #include "perilin.h"
 
 static PetscFunctionList PeriModelList = NULL;
-PETSC_EXTERN PetscBool   PeriModelRegisterAllCalled; /* models/registry.c */
 
 /* Run by PetscFinalize: frees the list and forgets it was filled, as PETSc's own packages do. */
 static PetscErrorCode PeriModelFinalizePackage(void)

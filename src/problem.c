@@ -367,6 +367,8 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
   PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &thickness, NULL));
   PeriInputCheck(thickness > 0, s, mat, "thickness", "must be positive, got %g", (double)thickness);
+  /* before any large allocation: a scene that cannot fit is refused with its size */
+  PetscCall(PeriParticlesCheckMemory(p->comm, s, p->model));
   PetscCall(PeriParticlesCreateFromScene(s, p->model->dim, thickness, &p->particles));
   PetscCall(ReadHorizon(p));
   PetscCall(PeriModelSetFromScene(p->model, s, p->delta));

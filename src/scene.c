@@ -686,8 +686,11 @@ PetscErrorCode PeriSceneGetInt(PeriScene scene, PeriNode map, const char key[], 
   PetscCall(GetScalar(scene, map, key, required, &node));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
-  l = strtol(node->value, &end, 10);
+  errno = 0;
+  l     = strtol(node->value, &end, 10);
   PeriInputCheck(end != node->value && !*end, scene, node, NULL, "expected a whole number, got '%s'", node->value);
+  /* strtol saturates, and PetscInt may be 32 bits: an overflow must not become another number */
+  PeriInputCheck(errno != ERANGE && l >= PETSC_MIN_INT && l <= PETSC_MAX_INT, scene, node, NULL, "the whole number %s is out of range (at most %" PetscInt_FMT ")", node->value, (PetscInt)PETSC_MAX_INT);
   *v = (PetscInt)l;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -211,6 +211,37 @@ static PetscErrorCode KSPSetInterruptible(KSP ksp, MPI_Comm comm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* GAMG and its coarse LU hold absolute thresholds (a pivot below 2.2e-14 is zero; the
+ * eigen-estimates of the smoothed prolongators collapse for K ~ 1e40), so the result depended on
+ * the units of E. Solving A/diag u = b/diag gives the same u with O(1) matrix entries; what no
+ * scaling can help (a stiffness or a displacement scale beyond double precision) is refused. */
+static PetscErrorCode ScaleToUnits(PeriProblem p, Mat A, Vec b, PetscReal *diag)
+{
+  PeriNode mat;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(p->scene->root, "material", &mat));
+  PeriInputCheck(*diag > 0 && PetscIsNormalReal(*diag) && *diag < 1e250 && *diag > 1e-250, p->scene, mat, "E", "the stiffness (mean diagonal of K: %g) is beyond what double precision can solve with: give the moduli, thickness and spacing in units that keep them within about 1e-100 to 1e100", (double)*diag);
+  PetscCall(MatScale(A, 1 / *diag));
+  PetscCall(VecScale(b, 1 / *diag));
+  *diag = 1;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After scaling, b is of the order of the displacements: beyond 1e+-150 the squared norms of CG
+ * overflow or underflow. */
+static PetscErrorCode CheckDisplacementScale(PeriProblem p, Vec b)
+{
+  PetscReal norm, vmax = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecNorm(b, NORM_INFINITY, &norm));
+  if (norm == 0 || (norm < 1e150 && norm > 1e-150)) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < p->nconstrained; k++) vmax = PetscMax(vmax, PetscAbsReal(p->constrained_value[k]));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &vmax, 1, MPIU_REAL, MPI_MAX, p->comm));
+  SETERRQ(p->comm, PETSC_ERR_USER_INPUT, "%s: the displacements would be of the order of %g (largest prescribed value %g), beyond what double precision can solve for (1e-150 to 1e150): check the units of the moduli, the loads and the bc values", p->scene->file, (double)norm, (double)vmax);
+}
+
 /* Loads and prescribed values so large that K u_prescribed overflows make an inf right-hand
  * side: say so, before KSP reports a breakdown that looks like a singular operator. */
 static PetscErrorCode CheckRightHandSide(PeriProblem p, Vec b)
@@ -236,7 +267,9 @@ static PetscErrorCode StaticKSPCreate(PeriProblem p, PetscBool symmetric, KSP *k
   PetscCall(KSPSetType(*ksp, symmetric ? KSPCG : KSPGMRES));
   PetscCall(KSPGetPC(*ksp, &pc));
   PetscCall(PCSetType(pc, PCGAMG));
-  PetscCall(KSPSetTolerances(*ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
+  /* no absolute tolerance: the system is scaled to O(1) numbers (ScaleToUnits), and atol = 1e-50
+     would stop CG at once on a tiny right-hand side */
+  PetscCall(KSPSetTolerances(*ksp, 1e-10, 0.0, PETSC_DEFAULT, 10000));
   PetscCall(KSPSetFromOptions(*ksp));
   /* CG monitors the preconditioned residual by default, which GAMG lets sit 10-30x above the true
    * one: make -ksp_rtol bound the true relative residual unless the user chose a norm */
@@ -327,6 +360,7 @@ PetscErrorCode PeriStaticSolve(PeriProblem p, KSP *ksp, PetscReal lambda, PetscB
   PetscCall(VecNorm(r, NORM_1, &diag));
   PetscCall(VecGetSize(r, &N));
   diag /= N;
+  PetscCall(ScaleToUnits(p, A, b, &diag));
   {
     PetscBool mpisbaij;
     PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPISBAIJ, &mpisbaij));
@@ -335,6 +369,7 @@ PetscErrorCode PeriStaticSolve(PeriProblem p, KSP *ksp, PetscReal lambda, PetscB
   PetscCall(MatZeroRowsColumns(A, nrows, rows, diag, p->u, b));
   PetscCall(PetscFree2(rows, values));
   PetscCall(CheckRightHandSide(p, b));
+  PetscCall(CheckDisplacementScale(p, b));
   PetscCall(HandleFreeMotions(p, A, p->u, b, diag, nhold, hold, &nfree, free));
 
   if (!*ksp) PetscCall(StaticKSPCreate(p, p->results.symmetric, ksp));
