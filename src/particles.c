@@ -327,7 +327,10 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   PetscBool       aij;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriStaticDefaultMatType(type, sizeof(type)));
+  /* a modal K is AIJ; asking the static default would read -pc_type, which must stay unread in a
+     modal run so that the unknown-option check reports it */
+  PetscCall(PetscStrncpy(type, MATAIJ, sizeof(type)));
+  if (strcmp(analysis, "modal")) PetscCall(PeriStaticDefaultMatType(type, sizeof(type)));
   PetscCall(PetscStrcmp(type, MATAIJ, &aij));
   e->n      = n;
   e->nbonds = n * ball / 2 * share;
