@@ -5,18 +5,27 @@
  * (Open MPI: odls_base_sigkill_timeout, 1 s by default), so the work after the signal is small. */
 #include "perilin.h"
 #include <signal.h>
+#include <time.h>
 
 static volatile sig_atomic_t peri_signal = 0;
+static volatile time_t       peri_signal_time;
 
 static void OnSignal(int sig)
 {
-  /* a second signal means "now": the default action ends the process */
+  time_t now = time(NULL); /* async-signal-safe */
+
+  /* A signal again, some seconds after the first, means "now": the default action ends the
+     process. Copies of one signal arrive together (timeout(1) and a terminal signal the process
+     group as well as the process; mpiexec forwards what the ranks already got) and are ignored. */
   if (peri_signal) {
-    signal(sig, SIG_DFL);
-    raise(sig);
+    if (now - peri_signal_time >= 3) {
+      signal(sig, SIG_DFL);
+      raise(sig);
+    }
     return;
   }
-  peri_signal = sig;
+  peri_signal_time = now;
+  peri_signal      = sig;
 }
 
 /*@C
