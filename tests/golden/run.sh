@@ -66,7 +66,7 @@ for entry in "${scenes[@]}"; do
   code=$?
   secs=$(since "$s0")
   if [ "$code" -ne 0 ]; then
-    echo "FAIL: $name: perilin $scene $opts exited $code"
+    echo "FAIL: $name: perilin $scene${opts:+ $opts} exited $code"
     tail -n 20 "$tmp/$name.log"
     fail=1
     continue
@@ -74,9 +74,9 @@ for entry in "${scenes[@]}"; do
   python3 "$py" normalize "$out" "$tmp/$name-norm" || { echo "FAIL: $name: cannot read the output"; fail=1; continue; }
   if python3 "$py" compare "$tmp/$name-norm" "$expected/$name" $update > "$tmp/$name.cmp" 2>&1; then
     [ -n "$update" ] && cat "$tmp/$name.cmp"
-    echo "ok: $name ($scene $opts, ${secs} s)"
+    echo "ok: $name ($scene${opts:+ $opts}, ${secs} s)"
   else
-    echo "FAIL: $name ($scene $opts) differs from tests/golden/expected/$name:"
+    echo "FAIL: $name ($scene${opts:+ $opts}) differs from tests/golden/expected/$name:"
     cat "$tmp/$name.cmp"
     fail=1
   fi
@@ -102,5 +102,9 @@ else
 fi
 
 total=$(since "$t0")
+if [ -n "$update" ] && [ "$fail" -eq 0 ]; then
+  echo "golden: expectations updated where they differed (${total} s); review git diff tests/golden/expected"
+  exit 0
+fi
 [ "$fail" -eq 0 ] && echo "golden: all outputs as expected (${total} s)" || echo "golden: differences found (${total} s); if intended, rerun with --update and review git diff tests/golden/expected"
 exit "$fail"
