@@ -257,15 +257,19 @@ PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscRe
 PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
 
 PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel);
-PETSC_EXTERN PetscBool      PeriModelRegisterAllCalled;
 
-PETSC_EXTERN PetscErrorCode PeriModelCreate_PMB(PeriModel);
-PETSC_EXTERN PetscErrorCode PeriModelCreate_NPMB(PeriModel);
-PETSC_EXTERN PetscErrorCode PeriModelCreate_PDS(PeriModel);
-PETSC_EXTERN PetscErrorCode PeriModelCreate_MPPD(PeriModel);
-PETSC_EXTERN PetscErrorCode PeriModelCreate_Gerstle(PeriModel);
-PETSC_EXTERN PetscErrorCode PeriModelCreate_Antiplane(PeriModel);
-PETSC_EXTERN PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel);
+/* The scene keys a plug-in owns. Declared only: until the scene sections declare their keys, every
+ * type's schema is NULL. */
+typedef struct _PeriSchema PeriSchema;
+
+/* A built-in model type. Each model file (models/) ends with its descriptor(s) PeriModel_<id>,
+ * whose create function stays static; models/list.h names them and models/registry.c registers
+ * them. */
+typedef struct {
+  const char       *name; /* model.type */
+  const PeriSchema *schema;
+  PetscErrorCode (*create)(PeriModel);
+} PeriModelType;
 
 /* ------------------------------------------------------------------ the problem (src/problem.c) */
 typedef struct {
@@ -478,12 +482,18 @@ PETSC_EXTERN PetscErrorCode PeriReferenceSetUp(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriReferenceEvaluate(PeriProblem);
 PETSC_EXTERN void           PeriReferenceDisplacement(PeriProblem, const PetscReal[], PetscReal[]);
 
-/* analyses (src/analysis/) */
+/* analyses (src/analysis/). A built-in analysis type: each analysis file ends with its descriptor
+ * PeriAnalysis_<id>, whose run function stays static; src/analysis/list.h names them and
+ * src/analysis/registry.c registers them. */
+typedef struct {
+  const char       *name; /* analysis.type */
+  const PeriSchema *schema;
+  PetscErrorCode (*run)(PeriProblem);
+} PeriAnalysisType;
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegister(const char[], PetscErrorCode (*)(PeriProblem));
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
-PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Static(PeriProblem);
-PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Modal(PeriProblem);
-PETSC_EXTERN PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem);
+PETSC_EXTERN PetscErrorCode PeriAnalysisFind(const char[], PetscErrorCode (**)(PeriProblem));
+PETSC_EXTERN PetscErrorCode PeriAnalysisListTypes(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriStaticSolve(PeriProblem, KSP *, PetscReal, PetscBool, PetscInt, const PetscInt[], const PetscReal[], KSPConvergedReason *);
 PETSC_EXTERN PetscErrorCode PeriStaticCheckConverged(PeriProblem, KSPConvergedReason);
 PETSC_EXTERN PetscErrorCode PeriStaticConverged(PeriProblem, KSP, KSPConvergedReason, PetscBool *);

@@ -292,7 +292,7 @@ static PetscErrorCode Create(PeriModel m)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PeriModelCreate_Antiplane(PeriModel m)
+static PetscErrorCode PeriModelCreate_Antiplane(PeriModel m)
 {
   PetscFunctionBeginUser;
   PetscCall(Create(m));
@@ -302,7 +302,7 @@ PetscErrorCode PeriModelCreate_Antiplane(PeriModel m)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel m)
+static PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel m)
 {
   PetscFunctionBeginUser;
   PetscCall(Create(m));
@@ -313,3 +313,6 @@ PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel m)
   m->ops.family_stiffness = FamilyStiffness;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriModelType PeriModel_Antiplane   = {"antiplane", NULL, PeriModelCreate_Antiplane};
+const PeriModelType PeriModel_AntiplaneOS = {"antiplane_os", NULL, PeriModelCreate_AntiplaneOS};

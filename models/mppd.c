@@ -153,16 +153,19 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PeriModelCreate_MPPD(PeriModel m)
+static PetscErrorCode PeriModelCreate_MPPD(PeriModel m)
 {
   PetscFunctionBeginUser;
   PetscCall(Create(m, PETSC_FALSE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PeriModelCreate_Gerstle(PeriModel m)
+static PetscErrorCode PeriModelCreate_Gerstle(PeriModel m)
 {
   PetscFunctionBeginUser;
   PetscCall(Create(m, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriModelType PeriModel_MPPD    = {"mppd", NULL, PeriModelCreate_MPPD};
+const PeriModelType PeriModel_Gerstle = {"gerstle", NULL, PeriModelCreate_Gerstle};

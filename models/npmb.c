@@ -55,7 +55,7 @@ static PetscErrorCode Destroy(PeriModel m)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
+static PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
 {
   NPMB *np;
 
@@ -71,3 +71,5 @@ PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
   m->ops.critical_from_G       = CriticalFromG;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriModelType PeriModel_NPMB = {"npmb", NULL, PeriModelCreate_NPMB};

@@ -66,7 +66,7 @@ static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal
   }
 }
 
-PetscErrorCode PeriModelCreate_PDS(PeriModel m)
+static PetscErrorCode PeriModelCreate_PDS(PeriModel m)
 {
   PDS *pds;
 
@@ -87,3 +87,5 @@ PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   m->ops.rigid_modes = PeriTranslationalRigidModes;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriModelType PeriModel_PDS = {"pds", NULL, PeriModelCreate_PDS};

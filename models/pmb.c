@@ -31,7 +31,7 @@ static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal
   return PeriCriticalStretchSpring(m, ((const PMB *)m->data)->c, G);
 }
 
-PetscErrorCode PeriModelCreate_PMB(PeriModel m)
+static PetscErrorCode PeriModelCreate_PMB(PeriModel m)
 {
   PMB *pmb;
 
@@ -44,3 +44,5 @@ PetscErrorCode PeriModelCreate_PMB(PeriModel m)
   m->ops.critical_from_G = CriticalFromG;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriModelType PeriModel_PMB = {"pmb", NULL, PeriModelCreate_PMB};

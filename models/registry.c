@@ -1,21 +1,33 @@
-/* The one place models are listed. */
+/* Registers the built-in models of models/list.h. Only PeriInitializePackage calls this;
+ * src/model.c holds the list it fills and never calls back here. */
 #include "perilin.h"
 
-/* Global, not static: the registry's finalizer (src/model.c) resets it, so that a second
- * PetscInitialize in one process registers the models again. */
-PetscBool PeriModelRegisterAllCalled = PETSC_FALSE;
+#define PERI_MODEL(id) extern const PeriModelType PeriModel_##id;
+#include "list.h"
+#undef PERI_MODEL
+
+static const PeriModelType *const builtin[] = {
+#define PERI_MODEL(id) &PeriModel_##id,
+#include "list.h"
+#undef PERI_MODEL
+};
+
+static PetscBool registered = PETSC_FALSE;
+
+/* Run by PetscFinalize: a second PetscInitialize in one process registers the models again. */
+static PetscErrorCode PeriModelRegisterAllFinalize(void)
+{
+  PetscFunctionBeginUser;
+  registered = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 PetscErrorCode PeriModelRegisterAll(void)
 {
   PetscFunctionBeginUser;
-  if (PeriModelRegisterAllCalled) PetscFunctionReturn(PETSC_SUCCESS);
-  PeriModelRegisterAllCalled = PETSC_TRUE;
-  PetscCall(PeriModelRegister("pmb", PeriModelCreate_PMB));
-  PetscCall(PeriModelRegister("npmb", PeriModelCreate_NPMB));
-  PetscCall(PeriModelRegister("pds", PeriModelCreate_PDS));
-  PetscCall(PeriModelRegister("mppd", PeriModelCreate_MPPD));
-  PetscCall(PeriModelRegister("gerstle", PeriModelCreate_Gerstle));
-  PetscCall(PeriModelRegister("antiplane", PeriModelCreate_Antiplane));
-  PetscCall(PeriModelRegister("antiplane_os", PeriModelCreate_AntiplaneOS));
+  if (registered) PetscFunctionReturn(PETSC_SUCCESS);
+  registered = PETSC_TRUE;
+  PetscCall(PetscRegisterFinalize(PeriModelRegisterAllFinalize));
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(builtin); k++) PetscCall(PeriModelRegister(builtin[k]->name, builtin[k]->create));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

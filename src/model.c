@@ -5,12 +5,12 @@
 
 static PetscFunctionList PeriModelList = NULL;
 
-/* Run by PetscFinalize: frees the list and forgets it was filled, as PETSc's own packages do. */
+/* Run by PetscFinalize: frees the list, as PETSc's own packages do (models/registry.c forgets on
+ * its own that it filled it). */
 static PetscErrorCode PeriModelFinalizePackage(void)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscFunctionListDestroy(&PeriModelList));
-  PeriModelRegisterAllCalled = PETSC_FALSE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -23,13 +23,24 @@ PetscErrorCode PeriModelRegister(const char name[], PetscErrorCode (*create)(Per
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The list is filled by PeriInitializePackage (PeriModelRegisterAll), never from here: the
+ * registry calls this file, not the other way round. An empty list means the package was not
+ * initialized, which the "unknown model" message would hide. */
+static PetscErrorCode ModelFind(const char type[], PetscErrorCode (**create)(PeriModel))
+{
+  PetscFunctionBeginUser;
+  PetscCheck(PeriModelList, PETSC_COMM_SELF, PETSC_ERR_ORDER, "no model is registered: call PeriInitializePackage() first");
+  *create = NULL;
+  PetscCall(PetscFunctionListFind(PeriModelList, type, create));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriModelTypeRegistered(const char type[], PetscBool *found)
 {
   PetscErrorCode (*create)(PeriModel) = NULL;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriModelRegisterAll());
-  PetscCall(PetscFunctionListFind(PeriModelList, type, &create));
+  PetscCall(ModelFind(type, &create));
   *found = create ? PETSC_TRUE : PETSC_FALSE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -40,7 +51,6 @@ PetscErrorCode PeriModelListTypes(char buf[], size_t len)
   int          n;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriModelRegisterAll());
   PetscCall(PetscFunctionListGet(PeriModelList, &names, &n));
   buf[0] = 0;
   for (int k = 0; k < n; k++)
@@ -51,7 +61,8 @@ PetscErrorCode PeriModelListTypes(char buf[], size_t len)
 
 /*@C
   PeriModelCreate - creates the model registered as type for dim (2, 3) and plane kind. Not
-  collective. Errors name the registered types when type is unknown.
+  collective. Errors name the registered types when type is unknown. PeriInitializePackage must
+  have run (PeriProblemCreate runs it).
 @*/
 PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_strain, PeriModel *model)
 {
@@ -60,8 +71,7 @@ PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_
   PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriModelRegisterAll());
-  PetscCall(PetscFunctionListFind(PeriModelList, type, &create));
+  PetscCall(ModelFind(type, &create));
   if (!create) {
     char list[256];
     PetscCall(PeriModelListTypes(list, sizeof(list)));

@@ -32,6 +32,7 @@ PetscErrorCode PeriInitializePackage(void)
   PetscCall(PetscLogStageRegister("Peri assembly", &PERI_STAGE_Assembly));
   PetscCall(PetscLogStageRegister("Peri solve", &PERI_STAGE_Solve));
   PetscCall(PetscLogStageRegister("Peri output", &PERI_STAGE_Output));
+  /* the registries are filled here, once, so that neither calls back into the package */
   PetscCall(PeriModelRegisterAll());
   PetscCall(PeriAnalysisRegisterAll());
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -478,37 +479,6 @@ PetscErrorCode PeriProblemAssemble(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscFunctionList PeriAnalysisList              = NULL;
-static PetscBool         PeriAnalysisRegisterAllCalled = PETSC_FALSE;
-
-/* Run by PetscFinalize: frees the list and forgets it was filled, as PETSc's own packages do. */
-static PetscErrorCode PeriAnalysisFinalizePackage(void)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFunctionListDestroy(&PeriAnalysisList));
-  PeriAnalysisRegisterAllCalled = PETSC_FALSE;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-PetscErrorCode PeriAnalysisRegister(const char name[], PetscErrorCode (*run)(PeriProblem))
-{
-  PetscFunctionBeginUser;
-  if (!PeriAnalysisList) PetscCall(PetscRegisterFinalize(PeriAnalysisFinalizePackage));
-  PetscCall(PetscFunctionListAdd(&PeriAnalysisList, name, run));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-PetscErrorCode PeriAnalysisRegisterAll(void)
-{
-  PetscFunctionBeginUser;
-  if (PeriAnalysisRegisterAllCalled) PetscFunctionReturn(PETSC_SUCCESS);
-  PeriAnalysisRegisterAllCalled = PETSC_TRUE;
-  PetscCall(PeriAnalysisRegister("static", PeriAnalysisRun_Static));
-  PetscCall(PeriAnalysisRegister("modal", PeriAnalysisRun_Modal));
-  PetscCall(PeriAnalysisRegister("quasistatic", PeriAnalysisRun_Quasistatic));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /*@C
   PeriProblemRun - runs the scene's analysis (analysis.type), found by name. Collective.
 @*/
@@ -520,17 +490,12 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   PetscLogDouble t;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscFunctionListFind(PeriAnalysisList, p->analysis, &run));
+  PetscCall(PeriAnalysisFind(p->analysis, &run));
   if (!run) {
     PeriNode a;
+    char     list[256];
     PetscCall(PeriSceneGetNode(p->scene->root, "analysis", &a));
-    const char **names;
-    char         list[256] = "";
-    int          n;
-    PetscCall(PetscFunctionListGet(PeriAnalysisList, &names, &n));
-    for (int k = 0; k < n; k++)
-      if (names[k]) PeriListAppend(list, sizeof(list), names[k]);
-    PetscCall(PetscFree(names));
+    PetscCall(PeriAnalysisListTypes(list, sizeof(list)));
     PeriInputCheck(PETSC_FALSE, p->scene, a, "type", "unknown analysis '%s'; available: %s", p->analysis, list);
   }
   /* a signal during the set-up: no analysis, only the summary saying so */

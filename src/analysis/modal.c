@@ -608,7 +608,7 @@ static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_h
   the run fails with PETSC_ERR_NOT_CONVERGED. Options: every -eps_* and -st_* option (e.g.
   -st_pc_factor_mat_solver_type, -eps_tol). SLEPc must be initialized. Collective.
 @*/
-PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
+static PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
 {
   PetscInt       nev;
   PetscReal      target_hz;
@@ -654,3 +654,5 @@ PetscErrorCode PeriWriteModesCSV(PeriProblem p, const char path[])
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriAnalysisType PeriAnalysis_Modal = {"modal", NULL, PeriAnalysisRun_Modal};

@@ -480,7 +480,7 @@ static PetscErrorCode Finish(PeriProblem p, const Settings *st)
   probes, energies, damage) describe the last equilibrium; a failed trial is written apart as
   failed_trial.vtu. Collective.
 @*/
-PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
+static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
 {
   Settings       st;
   Loop           L      = {0};
@@ -584,3 +584,5 @@ PetscErrorCode PeriWriteSnapshotsPVD(PeriProblem p, const char path[])
   PetscCall(PetscFree2(times, files));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriAnalysisType PeriAnalysis_Quasistatic = {"quasistatic", NULL, PeriAnalysisRun_Quasistatic};

@@ -443,7 +443,7 @@ PetscErrorCode PeriStaticCheckConverged(PeriProblem p, KSPConvergedReason reason
   PeriAnalysisRun_Static - solves the linear static problem once and evaluates energies and probes.
   Options: every KSP/PC option (-ksp_type, -pc_type, -ksp_rtol, ...). Collective.
 @*/
-PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
+static PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
 {
   KSP                ksp = NULL;
   PetscInt           nc;
@@ -499,3 +499,5 @@ PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscCall(PeriReferenceEvaluate(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+const PeriAnalysisType PeriAnalysis_Static = {"static", NULL, PeriAnalysisRun_Static};
