@@ -47,15 +47,8 @@ PetscErrorCode PeriModelTypeRegistered(const char type[], PetscBool *found)
 
 PetscErrorCode PeriModelListTypes(char buf[], size_t len)
 {
-  const char **names;
-  int          n;
-
   PetscFunctionBeginUser;
-  PetscCall(PetscFunctionListGet(PeriModelList, &names, &n));
-  buf[0] = 0;
-  for (int k = 0; k < n; k++)
-    if (names[k]) PeriListAppend(buf, len, names[k]);
-  PetscCall(PetscFree(names));
+  PetscCall(PeriFunctionListNames(PeriModelList, buf, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

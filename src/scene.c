@@ -247,6 +247,22 @@ void PeriListAppend(char buf[], size_t len, const char item[])
   if (used + 1 < len) snprintf(buf + used, len - used, "%s%s", used ? ", " : "", item);
 }
 
+/* The names registered in a function list, comma-separated, in the order of registration (for
+ * "unknown type; registered: ..." messages). */
+PetscErrorCode PeriFunctionListNames(PetscFunctionList list, char buf[], size_t len)
+{
+  const char **names;
+  int          n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFunctionListGet(list, &names, &n));
+  buf[0] = 0;
+  for (int k = 0; k < n; k++)
+    if (names[k]) PeriListAppend(buf, len, names[k]);
+  PetscCall(PetscFree(names));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static void OptionName(const char path[], char opt[], size_t len)
 {
   size_t k = 0;

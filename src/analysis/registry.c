@@ -53,14 +53,7 @@ PetscErrorCode PeriAnalysisFind(const char name[], PetscErrorCode (**run)(PeriPr
 /* the registered names, comma-separated, in the order of registration */
 PetscErrorCode PeriAnalysisListTypes(char buf[], size_t len)
 {
-  const char **names;
-  int          n;
-
   PetscFunctionBeginUser;
-  PetscCall(PetscFunctionListGet(PeriAnalysisList, &names, &n));
-  buf[0] = 0;
-  for (int k = 0; k < n; k++)
-    if (names[k]) PeriListAppend(buf, len, names[k]);
-  PetscCall(PetscFree(names));
+  PetscCall(PeriFunctionListNames(PeriAnalysisList, buf, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
