@@ -228,9 +228,11 @@ static PetscErrorCode ScaleToUnits(PeriProblem p, Mat A, Vec b, PetscReal *diag)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* After scaling, b is of the order of the displacements: beyond 1e+-150 the squared norms of CG
- * overflow or underflow. */
-static PetscErrorCode CheckDisplacementScale(PeriProblem p, Vec b)
+/* After ScaleToUnits, b is of the order of the displacements: inf or NaN (loads or prescribed
+ * values that overflow with K), or beyond 1e+-150 (where the squared norms of CG overflow or
+ * underflow), is no problem a solver can help with; say so before KSP reports a breakdown that
+ * looks like a singular operator. */
+static PetscErrorCode CheckRightHandSide(PeriProblem p, Vec b)
 {
   PetscReal norm, vmax = 0;
 
@@ -239,21 +241,8 @@ static PetscErrorCode CheckDisplacementScale(PeriProblem p, Vec b)
   if (norm == 0 || (norm < 1e150 && norm > 1e-150)) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt k = 0; k < p->nconstrained; k++) vmax = PetscMax(vmax, PetscAbsReal(p->constrained_value[k]));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &vmax, 1, MPIU_REAL, MPI_MAX, p->comm));
+  PetscCheck(!PetscIsInfOrNanReal(norm), p->comm, PETSC_ERR_USER_INPUT, "%s: the loads and prescribed values overflow double precision (the right-hand side holds inf or NaN; largest prescribed value %g): give bc values and loads of a physical size", p->scene->file, (double)vmax);
   SETERRQ(p->comm, PETSC_ERR_USER_INPUT, "%s: the displacements would be of the order of %g (largest prescribed value %g), beyond what double precision can solve for (1e-150 to 1e150): check the units of the moduli, the loads and the bc values", p->scene->file, (double)norm, (double)vmax);
-}
-
-/* Loads and prescribed values so large that K u_prescribed overflows make an inf right-hand
- * side: say so, before KSP reports a breakdown that looks like a singular operator. */
-static PetscErrorCode CheckRightHandSide(PeriProblem p, Vec b)
-{
-  PetscReal norm, vmax = 0;
-
-  PetscFunctionBeginUser;
-  PetscCall(VecNorm(b, NORM_INFINITY, &norm));
-  if (!PetscIsInfOrNanReal(norm)) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt k = 0; k < p->nconstrained; k++) vmax = PetscMax(vmax, PetscAbsReal(p->constrained_value[k]));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &vmax, 1, MPIU_REAL, MPI_MAX, p->comm));
-  SETERRQ(p->comm, PETSC_ERR_USER_INPUT, "%s: the loads and prescribed values overflow double precision (the right-hand side holds inf or NaN; largest prescribed value %g): give bc values and loads of a physical size", p->scene->file, (double)vmax);
 }
 
 /* CG (GMRES for an unsymmetric operator) + GAMG, rtol 1e-10, then the options. */
@@ -369,7 +358,6 @@ PetscErrorCode PeriStaticSolve(PeriProblem p, KSP *ksp, PetscReal lambda, PetscB
   PetscCall(MatZeroRowsColumns(A, nrows, rows, diag, p->u, b));
   PetscCall(PetscFree2(rows, values));
   PetscCall(CheckRightHandSide(p, b));
-  PetscCall(CheckDisplacementScale(p, b));
   PetscCall(HandleFreeMotions(p, A, p->u, b, diag, nhold, hold, &nfree, free));
 
   if (!*ksp) PetscCall(StaticKSPCreate(p, p->results.symmetric, ksp));
