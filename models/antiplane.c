@@ -11,7 +11,7 @@
  * W_k V_k = mu_k |r_k|^2 V_k / 2 with the shear angles r_k = b g_k sum_j w_kj (u_j - u_k) n_kj V_j,
  * w = delta/|xi|, n the bond direction, b = 2/(pi l delta^3) and g_k = (g_xz, g_yz) of eq. 53.
  * The energy couples every pair of k's family, so the stiffness reaches 2 delta (docs/models/antiplane.md). */
-#include "perilin.h"
+#include <perilin/model.h>
 
 static const char *const components[]       = {"uz"};
 static const char *const measures[]         = {"shear_angle"};

@@ -12,7 +12,7 @@
  *   mppd:    k_n = c, k_t = g (eqs. 7, 21), k_theta = f c delta^2 / (36 |xi|), f = model.k_theta_factor
  *            (default 1: Gerstle's rotational spring at nu = 0), or k_theta = model.k_theta.
  *   gerstle: k_n = c, k_t = 12 d / |xi|^2, k_theta = d / |xi| (eqs. 42-43), d = g delta^2 / 36. */
-#include "perilin.h"
+#include <perilin/model.h>
 
 typedef struct {
   PetscBool gerstle;

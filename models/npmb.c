@@ -3,7 +3,7 @@
  * energy density of u = X, 9K/2 in 3D: c_i = 18K / sum_j V_j, eq. 14) and c_ij = (c_i + c_j)/2
  * (eq. 15). The discrete energy density of any isotropic expansion is then exact wherever the
  * family is uniform, at surfaces too, and particle volumes may differ. */
-#include "perilin.h"
+#include <perilin/model.h>
 
 typedef struct {
   PetscInt   n;

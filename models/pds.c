@@ -4,7 +4,7 @@
  * 21, so any Poisson ratio in (-1, 1/2) is reached; g = 0 at nu = 1/3 (plane stress) or 1/4
  * (plane strain), where pds is pmb. The sliding does not subtract the rotation of the bond, so a
  * rigid rotation stores energy when g != 0: the defect Diana & Casolo demonstrate (docs/models/pds.md). */
-#include "perilin.h"
+#include <perilin/model.h>
 
 typedef struct {
   PetscReal c, g;

@@ -2,7 +2,7 @@
  * Micropotential w = c s^2 |xi| / 2; c from equating the energy density of u = s X over the
  * continuous horizon with the elastic one: c = 18K/(pi delta^4) in 3D, 9E/(pi t delta^3) in plane
  * stress, 48E/(5 pi t delta^3) in plane strain (docs/models/pmb.md). */
-#include "perilin.h"
+#include <perilin/model.h>
 
 typedef struct {
   PetscReal c;

@@ -1,6 +1,6 @@
 /* perilin SCENE.yaml [PETSc options]: run a scene, write summary.json and particles.vtu. */
 #include "perilin.h"
-#include <slepcsys.h>
+#include "perilin/private/output.h" /* PeriOutputSetDiscard: the error path */
 #include <signal.h>
 #include <unistd.h>
 
@@ -23,25 +23,6 @@ static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, con
   return n;
 }
 
-/* The one-paragraph report on stdout: what ran, what it cost, the main results. */
-static PetscErrorCode Report(PeriProblem p)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis, p->model->type, p->particles.n, p->results.nbonds_total, p->particles.n * p->model->dofs, p->size));
-  PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", p->results.neighbors_s, p->results.assembly_s, p->results.solve_s, p->results.ksp_type, p->results.pc_type, p->results.iterations, p->results.converged_reason, (double)p->results.residual_norm, p->results.memory_mb));
-  if (p->interrupted) {
-    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", p->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", p->u_all ? "the last complete state was written" : "no result was reached", p->output_dir));
-  } else if (p->modal) {
-    PetscCall(PetscPrintf(p->comm, "perilin: %" PetscInt_FMT " modes (Hz):", p->modal->nmodes));
-    for (PetscInt k = 0; k < p->modal->nmodes; k++) PetscCall(PetscPrintf(p->comm, " %.6g (%s)", (double)p->modal->modes[k].f_hz, p->modal->modes[k].kind));
-    PetscCall(PetscPrintf(p->comm, "; results in %s/\n", p->output_dir));
-  } else {
-    if (p->torsion.active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)p->torsion.torque, (double)p->torsion.J, (double)p->torsion.J_rectangle, 100 * (double)(p->torsion.J / p->torsion.J_rectangle - 1), (double)p->torsion.max_stress, (double)p->torsion.max_at[0], (double)p->torsion.max_at[1]));
-    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", p->results.strain_energy, p->output_dir));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 static PetscErrorCode Run(int argc, char **argv, PeriProblem *problem, int *status)
 {
   PeriProblem p;
@@ -50,22 +31,23 @@ static PetscErrorCode Run(int argc, char **argv, PeriProblem *problem, int *stat
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsHasHelp(NULL, &help_asked));
   if (help_asked) {
-    PetscCall(PeriSceneHelp(PETSC_COMM_WORLD));
+    PetscCall(PeriPrintHelp(PETSC_COMM_WORLD));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCheck(argc >= 2 && argv[1][0] != '-', PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "usage: perilin SCENE.yaml [options]; perilin -help lists the scene keys");
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, problem));
-  p               = *problem;
-  p->write_output = PETSC_TRUE;
+  p = *problem;
+  PetscCall(PeriProblemSetWriteOutput(p, PETSC_TRUE));
   PetscCall(PeriProblemLoad(p, argv[1]));
-  PetscCall(PeriOptionsCheckScene(p->comm, p->scene)); /* an option naming no scene key: before any work */
+  PetscCall(PeriProblemCheckOptions(p)); /* an option naming no scene key: before any work */
   PetscCall(PeriProblemSetUp(p));
   PetscCall(PeriProblemRun(p));
-  PetscCall(PeriOptionsCheckUnused(p)); /* an option nothing read: before anything is written */
+  PetscCall(PeriProblemCheckUnusedOptions(p)); /* an option nothing read: before anything is written */
   PetscCall(PeriProblemWriteOutput(p));
-  PetscCall(Report(p));
+  PetscCall(PeriProblemReport(p));
   /* a run stopped by a signal says so in its exit status too: 128 + the signal, as shells do */
-  *status = p->interrupted ? 128 + p->interrupted : 0;
+  PetscCall(PeriProblemInterrupted(p, status));
+  if (*status) *status += 128;
   PetscCall(PeriProblemDestroy(problem));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -94,9 +76,7 @@ int main(int argc, char **argv)
   int            status = 0;
   PeriProblem    p      = NULL;
 
-  /* SLEPc once for the whole run (it initializes PETSc): the modal analysis needs it */
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
-  PetscCall(PeriSignalsInstall());
+  PetscCall(PeriInitialize(&argc, &argv, help));
   PetscCall(PetscPushErrorHandler(CaptureError, NULL));
   ierr = Run(argc, argv, &p, &status);
   PetscCall(PetscPopErrorHandler());
@@ -112,9 +92,9 @@ int main(int argc, char **argv)
     PetscCall(PetscPushErrorHandler(PetscIgnoreErrorHandler, NULL));
     (void)PeriProblemDestroy(&p);
     PetscCall(PetscPopErrorHandler());
-    PetscCall(SlepcFinalize());
+    PetscCall(PeriFinalize());
     return 1;
   }
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return status;
 }

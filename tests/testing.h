@@ -1,6 +1,6 @@
 /* Helpers for perilin's tests: run a scene through the library and assert numbers. */
 #pragma once
-#include "perilin.h"
+#include "perilin/private/problem.h"
 
 /* Fails the test with the expected value, the tolerance and what was measured. */
 #define PeriTestClose(what, got, expected, tol)                                                                                                                                                                                   \

@@ -2,7 +2,7 @@
  * shift-and-invert around a target with a direct factorization, on the free DOFs only (prescribed
  * DOFs are removed, so they give no spurious eigenvalues). M is lumped: rho V_i per translation,
  * rho V_i (dx^2 + dy^2)/12 per rotation (Diana & Casolo sec. 3.1, with r_i^2 for their r_i). */
-#include "perilin.h"
+#include "perilin/private/problem.h"
 #include <slepceps.h>
 
 /* The density of each owned particle: material.rho, or material.rho_by_region {region: rho}
@@ -10,22 +10,22 @@
 static PetscErrorCode Densities(PeriProblem p, PetscReal **rho)
 {
   PeriScene      s    = p->scene;
-  const PetscInt nloc = p->bonds.rend - p->bonds.rstart;
+  const PetscInt nloc = p->sys->bonds.rend - p->sys->bonds.rstart;
   PeriNode       mat, map;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(nloc, rho));
-  for (PetscInt i = 0; i < nloc; i++) (*rho)[i] = p->model->material.rho;
+  for (PetscInt i = 0; i < nloc; i++) (*rho)[i] = p->sys->model->material.rho;
   PetscCall(PeriSceneGetNode(s->root, "material", &mat));
   PetscCall(PeriSceneGetMap(s, mat, "rho_by_region", PETSC_FALSE, &map));
   for (PetscInt k = 0; map && k < map->n; k++) {
     PeriRegion *r;
     PetscReal   v;
-    PetscCall(PeriRegionFind(s, map->child[k], NULL, p->nregions, p->regions, &r));
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, p->sys->nregions, p->sys->regions, &r));
     PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &v, NULL));
     PeriInputCheck(v > 0, s, map, map->child[k]->key, "must be positive");
     for (PetscInt i = 0; i < nloc; i++)
-      if (PeriRegionContains(r, &p->particles.x[3 * (p->bonds.rstart + i)])) (*rho)[i] = v;
+      if (PeriRegionContains(r, &p->sys->particles.x[3 * (p->sys->bonds.rstart + i)])) (*rho)[i] = v;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -33,9 +33,9 @@ static PetscErrorCode Densities(PeriProblem p, PetscReal **rho)
 /*@C
   PeriAssembleMass - the lumped mass matrix, diagonal, in the layout of K. Collective.
 @*/
-PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
+static PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
 {
-  const PetscInt bs = p->model->dofs, nloc = p->bonds.rend - p->bonds.rstart;
+  const PetscInt bs = p->sys->model->dofs, nloc = p->sys->bonds.rend - p->sys->bonds.rstart;
   PetscReal     *rho;
   Vec            d;
   PetscScalar   *a;
@@ -48,12 +48,12 @@ PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
   PetscCall(MatXAIJSetPreallocation(*M, 1, NULL, NULL, NULL, NULL));
   PetscCall(MatSeqAIJSetPreallocation(*M, 1, NULL));
   PetscCall(MatMPIAIJSetPreallocation(*M, 1, NULL, 0, NULL));
-  PetscCall(PeriProblemCreateVec(p, &d));
+  PetscCall(PeriSystemCreateVec(p->sys, &d));
   PetscCall(Densities(p, &rho));
   PetscCall(VecGetArray(d, &a));
   for (PetscInt i = 0; i < nloc; i++) {
-    PetscReal V = p->particles.volume[p->bonds.rstart + i], h = p->particles.spacing[p->bonds.rstart + i];
-    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = p->model->rotational[c] ? rho[i] * V * (h * h + h * h) / 12 : rho[i] * V;
+    PetscReal V = p->sys->particles.volume[p->sys->bonds.rstart + i], h = p->sys->particles.spacing[p->sys->bonds.rstart + i];
+    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = p->sys->model->rotational[c] ? rho[i] * V * (h * h + h * h) / 12 : rho[i] * V;
   }
   PetscCall(VecRestoreArray(d, &a));
   PetscCall(PetscFree(rho));
@@ -68,13 +68,13 @@ PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
  * body, its longest extent. Components held at 0 because they are inactive do not count. */
 static PetscErrorCode MainAxis(PeriProblem p, PetscInt *axis)
 {
-  const PeriParticles *pt   = &p->particles;
+  const PeriParticles *pt   = &p->sys->particles;
   PetscReal            s[4] = {0, 0, 0, 0}, best = -1;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < p->nconstrained; k++) {
-    PetscInt i = p->constrained[k] / p->model->dofs;
-    if (p->model->inactive[p->constrained[k] % p->model->dofs]) continue;
+  for (PetscInt k = 0; k < p->sys->nconstrained; k++) {
+    PetscInt i = p->sys->constrained[k] / p->sys->model->dofs;
+    if (p->sys->model->inactive[p->sys->constrained[k] % p->sys->model->dofs]) continue;
     for (PetscInt d = 0; d < pt->dim; d++) s[d] += pt->x[3 * i + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
     s[3] += 1;
   }
@@ -104,22 +104,22 @@ static PetscErrorCode ReadSettings(PeriProblem p, PetscInt *nev, PetscReal *targ
   PeriInputCheck(*nev >= 1, s, a, "nev", "must be at least 1");
   PeriInputCheck(*target_hz >= 0, s, a, "target_hz", "must not be negative");
   PetscCall(PeriSceneGetNode(s->root, "material", &mat));
-  PeriInputCheck(p->model->material.rho > 0, s, mat, "rho", "a modal analysis needs the density (material.rho > 0)");
-  PeriInputCheck(!p->layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
+  PeriInputCheck(p->sys->model->material.rho > 0, s, mat, "rho", "a modal analysis needs the density (material.rho > 0)");
+  PeriInputCheck(!p->sys->layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The owned DOFs that are not prescribed. */
 static PetscErrorCode FreeDOFs(PeriProblem p, IS *is)
 {
-  const PetscInt bs = p->model->dofs, nloc = (p->bonds.rend - p->bonds.rstart) * bs, r0 = p->bonds.rstart * bs;
+  const PetscInt bs = p->sys->model->dofs, nloc = (p->sys->bonds.rend - p->sys->bonds.rstart) * bs, r0 = p->sys->bonds.rstart * bs;
   PetscInt      *idx, n = 0, c = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(nloc, &idx));
-  /* p->constrained is sorted: built by a loop over the owned DOFs */
+  /* p->sys->constrained is sorted: built by a loop over the owned DOFs */
   for (PetscInt k = 0; k < nloc; k++) {
-    if (c < p->nconstrained && p->constrained[c] == r0 + k) {
+    if (c < p->sys->nconstrained && p->sys->constrained[c] == r0 + k) {
       c++;
       continue;
     }
@@ -132,7 +132,7 @@ static PetscErrorCode FreeDOFs(PeriProblem p, IS *is)
 /* Shares of kinetic energy per component, effective modal masses per direction, and the kind. */
 static PetscErrorCode Classify(PeriProblem p, Vec x, Vec mdiag, PeriMode *mode, PetscInt axis)
 {
-  const PetscInt     bs = p->model->dofs, nloc = p->bonds.rend - p->bonds.rstart;
+  const PetscInt     bs = p->sys->model->dofs, nloc = p->sys->bonds.rend - p->sys->bonds.rstart;
   const PetscScalar *xa, *ma;
   PetscReal          e[PERI_MAX_DOF + 4] = {0}, tot = 0, trans = 0, rot = 0, along = 0;
   PetscInt           comp[3];
@@ -140,7 +140,7 @@ static PetscErrorCode Classify(PeriProblem p, Vec x, Vec mdiag, PeriMode *mode, 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) {
     static const char *const names[] = {"ux", "uy", "uz"};
-    PetscCall(PeriModelComponentIndex(p->model, names[d], &comp[d]));
+    PetscCall(PeriModelComponentIndex(p->sys->model, names[d], &comp[d]));
   }
   PetscCall(VecGetArrayRead(x, &xa));
   PetscCall(VecGetArrayRead(mdiag, &ma));
@@ -157,7 +157,7 @@ static PetscErrorCode Classify(PeriProblem p, Vec x, Vec mdiag, PeriMode *mode, 
   for (PetscInt c = 0; c < bs; c++) tot += e[c];
   for (PetscInt c = 0; c < bs; c++) {
     mode->energy_share[c] = e[c] / tot;
-    if (p->model->rotational[c])
+    if (p->sys->model->rotational[c])
       rot += e[c] / tot;
     else
       trans += e[c] / tot;
@@ -170,14 +170,14 @@ static PetscErrorCode Classify(PeriProblem p, Vec x, Vec mdiag, PeriMode *mode, 
    * where their kinetic energy is. */
   {
     PetscReal maxis = mode->effective_mass[axis], macross = 0;
-    for (PetscInt d = 0; d < p->particles.dim; d++)
+    for (PetscInt d = 0; d < p->sys->particles.dim; d++)
       if (d != axis) macross = PetscMax(macross, mode->effective_mass[d]);
     if (rot > 0.5)
       PetscCall(PetscStrncpy(mode->kind, "rotational", sizeof(mode->kind)));
     else if (PetscMax(maxis, macross) > 1e-3 ? maxis > macross : along > 0.5 * trans)
-      PetscCall(PetscStrncpy(mode->kind, p->particles.dim == 2 ? "axial" : "longitudinal", sizeof(mode->kind)));
+      PetscCall(PetscStrncpy(mode->kind, p->sys->particles.dim == 2 ? "axial" : "longitudinal", sizeof(mode->kind)));
     else
-      PetscCall(PetscStrncpy(mode->kind, p->particles.dim == 2 ? "flexural" : "transverse", sizeof(mode->kind)));
+      PetscCall(PetscStrncpy(mode->kind, p->sys->particles.dim == 2 ? "flexural" : "transverse", sizeof(mode->kind)));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -188,7 +188,7 @@ static PetscErrorCode StoreShape(PeriProblem p, Vec full, PetscInt k)
   VecScatter         sc;
   Vec                all;
   const PetscScalar *a;
-  const PetscInt     nd = p->particles.n * p->model->dofs;
+  const PetscInt     nd = p->sys->particles.n * p->sys->model->dofs;
 
   PetscFunctionBeginUser;
   PetscCall(VecScatterCreateToZero(full, &sc, &all));
@@ -197,11 +197,11 @@ static PetscErrorCode StoreShape(PeriProblem p, Vec full, PetscInt k)
   if (p->rank == 0) {
     PetscReal amax = 0, *s = &p->modal->shapes[k * nd];
     PetscBool trans = PETSC_FALSE;
-    for (PetscInt c = 0; c < p->model->dofs; c++) trans = (PetscBool)(trans || !p->model->rotational[c]);
+    for (PetscInt c = 0; c < p->sys->model->dofs; c++) trans = (PetscBool)(trans || !p->sys->model->rotational[c]);
     PetscCall(VecGetArrayRead(all, &a));
     /* the largest displacement is 1 (rotations, in radians, do not set the scale) */
     for (PetscInt i = 0; i < nd; i++)
-      if (!trans || !p->model->rotational[i % p->model->dofs]) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
+      if (!trans || !p->sys->model->rotational[i % p->sys->model->dofs]) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
     for (PetscInt i = 0; i < nd; i++) s[i] = PetscRealPart(a[i]) / (amax > 0 ? amax : 1);
     PetscCall(VecRestoreArrayRead(all, &a));
   }
@@ -239,7 +239,7 @@ static PetscErrorCode InnerSolveCheck(KSP ksp, Vec b, Vec y, void *ctx)
   c->nsolves++;
   if (rel > c->worst || PetscIsNanReal(rel)) c->worst = rel;
   PetscCall(KSPGetTolerances(ksp, &rtol, NULL, NULL, NULL));
-  tol = PeriResidualTolerance(c->p, rtol);
+  tol = PeriResidualTolerance(c->p->sys, rtol);
   if (PetscUnlikely(!(rel <= tol))) {
     KSPType            kt;
     PCType             pt;
@@ -413,7 +413,7 @@ static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal
 static PetscErrorCode CheckModes(PeriProblem p, PetscReal eps_tol)
 {
   const PeriModal *md   = p->modal;
-  const PetscReal  tol  = PeriResidualTolerance(p, eps_tol);
+  const PetscReal  tol  = PeriResidualTolerance(p->sys, eps_tol);
   PetscInt         nbad = 0, first = -1;
 
   PetscFunctionBeginUser;
@@ -444,7 +444,7 @@ static PetscErrorCode SetUpModal(PeriProblem p, PetscReal target_hz, Mat *M, Vec
   p->modal = md;
   /* rotations carry inertia, not mass: the total mass is that of the particles */
   PetscCall(Densities(p, &rho));
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) md->total_mass += rho[i - p->bonds.rstart] * p->particles.volume[i];
+  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++) md->total_mass += rho[i - p->sys->bonds.rstart] * p->sys->particles.volume[i];
   PetscCall(PetscFree(rho));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, p->comm));
   md->target_hz = target_hz;
@@ -452,7 +452,7 @@ static PetscErrorCode SetUpModal(PeriProblem p, PetscReal target_hz, Mat *M, Vec
   PetscCall(FreeDOFs(p, isfree));
   PetscCall(ISGetSize(*isfree, &md->nfree_dofs));
   PetscCheck(md->nfree_dofs > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", p->scene->file);
-  PetscCall(MatCreateSubMatrix(p->K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
+  PetscCall(MatCreateSubMatrix(p->sys->K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
   PetscCall(MatCreateSubMatrix(*M, *isfree, *isfree, MAT_INITIAL_MATRIX, Mff));
   PetscCall(MatSetOption(*Kff, MAT_SYMMETRIC, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -463,12 +463,12 @@ static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS 
 {
   PeriModal *md = p->modal;
   Vec        x, r, y, full;
-  PetscInt   nd = p->particles.n * p->model->dofs;
+  PetscInt   nd = p->sys->particles.n * p->sys->model->dofs;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(Kff, &x, &r));
   PetscCall(VecDuplicate(r, &y));
-  PetscCall(PeriProblemCreateVec(p, &full));
+  PetscCall(PeriSystemCreateVec(p->sys, &full));
   /* no more modes than free DOFs, whatever nev asks for */
   PetscCall(PetscCalloc1(PetscMin(nev, md->nfree_dofs), &md->modes));
   md->nshapes = PetscMin(PetscMin(nev, md->nfree_dofs), PERI_MAX_VTU_MODES);
@@ -513,14 +513,14 @@ static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, PetscInt nev, const I
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pt));
-  PetscCall(PetscStrncpy(p->results.ksp_type, kt, sizeof(p->results.ksp_type)));
-  PetscCall(PetscStrncpy(p->results.pc_type, pt, sizeof(p->results.pc_type)));
+  PetscCall(PetscStrncpy(p->sys->results.ksp_type, kt, sizeof(p->sys->results.ksp_type)));
+  PetscCall(PetscStrncpy(p->sys->results.pc_type, pt, sizeof(p->sys->results.pc_type)));
   PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &nconv));
   partial = (PetscBool)(nconv < asked || p->modal->nmodes < PetscMin(nev, p->modal->nfree_dofs - p->modal->nrigid));
-  PetscCall(PetscStrncpy(p->results.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(p->results.converged_reason)));
-  PetscCall(EPSGetIterationNumber(eps, &p->results.iterations));
-  p->results.residual_norm = inner->worst;
+  PetscCall(PetscStrncpy(p->sys->results.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(p->sys->results.converged_reason)));
+  PetscCall(EPSGetIterationNumber(eps, &p->sys->results.iterations));
+  p->sys->results.residual_norm = inner->worst;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -560,7 +560,7 @@ static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_h
   PetscCall(PetscTime(&t0));
   PetscCall(SetUpModal(p, target_hz, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff));
   md = p->modal;
-  PetscCall(PeriRigidMotionFree(p, &nfree, what, sizeof(what), NULL));
+  PetscCall(PeriRigidMotionFree(p->sys, &nfree, what, sizeof(what), NULL));
   md->nrigid = 0;
 
   /* the scale of the largest omega^2 */
@@ -576,9 +576,9 @@ static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_h
   PetscCall(PetscTime(&t1));
   PetscCall(SolveModes(p, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
   PetscCall(PetscTime(&t2));
-  md->factor_s       = t1 - t0;
-  md->solve_s        = t2 - t1;
-  p->results.solve_s = t2 - t0;
+  md->factor_s            = t1 - t0;
+  md->solve_s             = t2 - t1;
+  p->sys->results.solve_s = t2 - t0;
   PetscCheck(npairs + md->nrigid > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", p->scene->file);
   PetscCall(CollectModes(p, w->eps, w->Kff, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
   PetscCall(EPSGetTolerances(w->eps, &eps_tol, NULL));
@@ -587,9 +587,9 @@ static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_h
   if (nfree)
     for (PetscInt k = 0; k < md->nmodes; k++)
       if (!strcmp(md->modes[k].kind, "longitudinal") || !strcmp(md->modes[k].kind, "axial")) {
-        PetscReal L            = p->particles.upper[md->axis] - p->particles.lower[md->axis];
+        PetscReal L            = p->sys->particles.upper[md->axis] - p->sys->particles.lower[md->axis];
         md->longitudinal_speed = 2 * L * md->modes[k].f_hz;
-        if (p->particles.dim == 3) md->theory_speed = PetscSqrtReal((p->model->material.K + 4 * p->model->material.G / 3) / p->model->material.rho);
+        if (p->sys->particles.dim == 3) md->theory_speed = PetscSqrtReal((p->sys->model->material.K + 4 * p->sys->model->material.G / 3) / p->sys->model->material.rho);
         break;
       }
   PetscCall(RecordSolver(p, w->eps, nev, &w->inner));
@@ -617,8 +617,8 @@ static PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
 
   PetscFunctionBeginUser;
   PetscCall(ReadSettings(p, &nev, &target_hz));
-  PetscCall(PetscStrncpy(p->mat_type, MATAIJ, sizeof(p->mat_type)));
-  if (!p->K) PetscCall(PeriProblemAssemble(p));
+  PetscCall(PetscStrncpy(p->sys->mat_type, MATAIJ, sizeof(p->sys->mat_type)));
+  if (!p->sys->K) PetscCall(PeriSystemAssemble(p->sys));
   PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   /* a failed check may return from deep inside SLEPc: free everything, then pass the error on */
@@ -643,16 +643,132 @@ PetscErrorCode PeriWriteModesCSV(PeriProblem p, const char path[])
   if (p->rank || !p->modal) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "mode,f_hz,omega2,residual,kind") < 0;
-  for (PetscInt c = 0; c < p->model->dofs; c++) bad |= fprintf(fp, ",share_%s", p->model->components[c]) < 0;
+  for (PetscInt c = 0; c < p->sys->model->dofs; c++) bad |= fprintf(fp, ",share_%s", p->sys->model->components[c]) < 0;
   bad |= fprintf(fp, ",meff_x,meff_y,meff_z\n") < 0;
   for (PetscInt k = 0; k < p->modal->nmodes; k++) {
     const PeriMode *m = &p->modal->modes[k];
     bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%.3g,%s", k + 1, (double)m->f_hz, (double)m->omega2, (double)m->residual, m->kind) < 0;
-    for (PetscInt c = 0; c < p->model->dofs; c++) bad |= fprintf(fp, ",%.6f", (double)m->energy_share[c]) < 0;
+    for (PetscInt c = 0; c < p->sys->model->dofs; c++) bad |= fprintf(fp, ",%.6f", (double)m->energy_share[c]) < 0;
     bad |= fprintf(fp, ",%.6f,%.6f,%.6f\n", (double)m->effective_mass[0], (double)m->effective_mass[1], (double)m->effective_mass[2]) < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriAnalysisType PeriAnalysis_Modal = {"modal", NULL, PeriAnalysisRun_Modal};
+/* The stored mode shapes as fields of particles.vtu: mode_1, mode_1_theta, ... */
+static PetscErrorCode ModalAddFields(PeriProblem p, PeriFieldList fl)
+{
+  const PeriModal *md = p->modal;
+  const PetscInt   nd = p->sys->particles.n * p->sys->model->dofs;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; md && k < md->nshapes; k++) {
+    char prefix[32];
+    PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "mode_%" PetscInt_FMT, k + 1));
+    PetscCall(PeriFieldListAddSolution(fl, prefix, p->sys->model->dofs, p->sys->model->components, &md->shapes[k * nd]));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  WriteModeShapes - mode_NN.vtu, one file per stored mode shape with the shape as its
+  "displacement", and modes.pvd listing them by mode number (ParaView steps through the modes
+  like time steps). Collective; rank 0 writes.
+@*/
+static PetscErrorCode WriteModeShapes(PeriProblem p, const char dir[])
+{
+  PeriModal     *md = p->modal;
+  PetscReal     *times;
+  char         **files, path[PETSC_MAX_PATH_LEN];
+  const PetscInt nd = p->sys->particles.n * p->sys->model->dofs;
+
+  PetscFunctionBeginUser;
+  if (p->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc2(md->nshapes, &times, md->nshapes, &files));
+  /* each file is particles.vtu's layout with the mode as the displacement field */
+  for (PetscInt k = 0; k < md->nshapes; k++) {
+    times[k] = (PetscReal)(k + 1);
+    PetscCall(PetscMalloc1(32, &files[k]));
+    PetscCall(PetscSNPrintf(files[k], 32, "mode_%02" PetscInt_FMT ".vtu", k + 1));
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", dir, files[k]));
+    PetscCall(PeriSystemWriteVTU(p->sys, &md->shapes[k * nd], path));
+  }
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
+  PetscCall(PeriWritePVD(path, md->nshapes, times, (const char *const *)files));
+  for (PetscInt k = 0; k < md->nshapes; k++) PetscCall(PetscFree(files[k]));
+  PetscCall(PetscFree2(times, files));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* summary.json's "modal" object: frequencies, masses, and per mode its residual, kind, energy
+ * shares and effective masses. */
+static PetscErrorCode ModalSummary(PeriProblem p, PeriJSON j)
+{
+  const PetscInt bs = p->sys->model->dofs;
+
+  PetscFunctionBeginUser;
+  if (!p->modal) PetscFunctionReturn(PETSC_SUCCESS);
+  const PeriModal *md = p->modal;
+  PetscReal        f[256];
+  PetscCall(PeriJSONBeginObject(j, "modal"));
+  for (PetscInt k = 0; k < PetscMin(md->nmodes, 256); k++) f[k] = md->modes[k].f_hz;
+  PetscCall(PeriJSONRealArray(j, "frequencies_hz", PetscMin(md->nmodes, 256), f));
+  PetscCall(PeriJSONInt(j, "rigid_modes", md->nrigid));
+  PetscCall(PeriJSONInt(j, "free_dofs", md->nfree_dofs));
+  PetscCall(PeriJSONReal(j, "total_mass", md->total_mass));
+  PetscCall(PeriJSONString(j, "axis", (const char *[]){"x", "y", "z"}[md->axis]));
+  PetscCall(PeriJSONReal(j, "factorization_s", md->factor_s));
+  PetscCall(PeriJSONReal(j, "eigensolve_s", md->solve_s));
+  if (md->longitudinal_speed > 0) PetscCall(PeriJSONReal(j, "longitudinal_speed", md->longitudinal_speed));
+  if (md->theory_speed > 0) PetscCall(PeriJSONReal(j, "theory_speed", md->theory_speed));
+  PetscCall(PeriJSONBeginArray(j, "modes"));
+  for (PetscInt k = 0; k < md->nmodes; k++) {
+    const PeriMode *m = &md->modes[k];
+    PetscCall(PeriJSONBeginObject(j, NULL));
+    PetscCall(PeriJSONReal(j, "f_hz", m->f_hz));
+    PetscCall(PeriJSONReal(j, "residual", m->residual));
+    PetscCall(PeriJSONString(j, "kind", m->kind));
+    PetscCall(PeriJSONBeginObject(j, "energy_share"));
+    for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, p->sys->model->components[c], m->energy_share[c]));
+    PetscCall(PeriJSONEndObject(j));
+    PetscCall(PeriJSONRealArray(j, "effective_mass", p->sys->particles.dim, m->effective_mass));
+    PetscCall(PeriJSONEndObject(j));
+  }
+  PetscCall(PeriJSONEndArray(j));
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ModalReport(PeriProblem p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(p->comm, "perilin: %" PetscInt_FMT " modes (Hz):", p->modal->nmodes));
+  for (PetscInt k = 0; k < p->modal->nmodes; k++) PetscCall(PetscPrintf(p->comm, " %.6g (%s)", (double)p->modal->modes[k].f_hz, p->modal->modes[k].kind));
+  PetscCall(PetscPrintf(p->comm, "; results in %s/\n", p->output_dir));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* modes.csv, and with output.vtk the shapes mode_NN.vtu and modes.pvd. */
+static PetscErrorCode ModalFiles(PeriProblem p, const char dir[])
+{
+  char path[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  if (!p->modal) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", dir));
+  PetscCall(PeriWriteModesCSV(p, path));
+  if (p->vtk) PetscCall(WriteModeShapes(p, dir));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ModalDestroy(PeriProblem p)
+{
+  PetscFunctionBeginUser;
+  if (!p->modal) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscFree(p->modal->modes));
+  PetscCall(PetscFree(p->modal->shapes));
+  PetscCall(PetscFree(p->modal));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+const PeriAnalysisType PeriAnalysis_Modal = {"modal", "natural frequencies and mode shapes (SLEPc, shift-and-invert)", NULL, PETSC_TRUE, {PeriAnalysisRun_Modal, ModalAddFields, ModalFiles, ModalSummary, ModalReport, ModalDestroy}};

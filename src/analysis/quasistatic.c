@@ -5,7 +5,7 @@
  * from the constraints are held where they are; when a loaded piece is cut off, the solve fails,
  * or no equilibrium is found, the body has failed: with adaptive steps the step is halved from the
  * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
-#include "perilin.h"
+#include "perilin/private/problem.h"
 #include <signal.h>
 #include <unistd.h>
 
@@ -26,10 +26,10 @@ static PetscErrorCode CheckSomethingLoaded(PeriProblem p, PeriNode a)
   PetscReal fnorm, v = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecNorm(p->f, NORM_INFINITY, &fnorm));
-  for (PetscInt k = 0; k < p->nconstrained; k++) v = PetscMax(v, PetscAbsReal(p->constrained_value[k]));
-  for (PetscInt f = 0; f < 6; f++) v = PetscMax(v, p->layers.kind[f] ? PetscAbsReal(p->layers.value[f]) : 0);
-  if (p->torsion.active) v = PetscMax(v, PetscAbsReal(p->torsion.twist));
+  PetscCall(VecNorm(p->sys->f, NORM_INFINITY, &fnorm));
+  for (PetscInt k = 0; k < p->sys->nconstrained; k++) v = PetscMax(v, PetscAbsReal(p->sys->constrained_value[k]));
+  for (PetscInt f = 0; f < 6; f++) v = PetscMax(v, p->sys->layers.kind[f] ? PetscAbsReal(p->sys->layers.value[f]) : 0);
+  if (p->sys->torsion.active) v = PetscMax(v, PetscAbsReal(p->sys->torsion.twist));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_REAL, MPI_MAX, p->comm));
   PeriInputCheck(fnorm > 0 || v > 0, p->scene, a, "type", "a quasistatic analysis scales the loads and prescribed values, and this scene has none (no loads, every bc value 0): give loads or a bc value");
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -46,7 +46,7 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
-  PeriInputCheck(p->failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
+  PeriInputCheck(p->sys->failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
   PetscCall(PeriSceneGetReal(s, a, "load_factor_max", PETSC_TRUE, &st->max, NULL));
   PetscCall(PeriSceneGetReal(s, a, "load_factor_step", PETSC_TRUE, &st->step, NULL));
   PeriInputCheck(st->max > 0, s, a, "load_factor_max", "must be positive, got %g", (double)st->max);
@@ -73,12 +73,12 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
   PeriInputCheck(st->max_iterations >= 1, s, a, "max_iterations", "must be at least 1");
   st->reuse = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));
-  st->control = p->nprobes ? &p->probes[0] : NULL;
+  st->control = p->sys->nprobes ? &p->sys->probes[0] : NULL;
   PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, name, sizeof(name), &has));
   if (has) {
     st->control = NULL;
-    for (PetscInt k = 0; k < p->nprobes; k++)
-      if (!strcmp(p->probes[k].name, name)) st->control = &p->probes[k];
+    for (PetscInt k = 0; k < p->sys->nprobes; k++)
+      if (!strcmp(p->sys->probes[k].name, name)) st->control = &p->sys->probes[k];
     PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", name);
   }
   PetscCall(CheckSomethingLoaded(p, a));
@@ -93,8 +93,8 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
  * softened by more than 1 %. */
 static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nbroken)
 {
-  PeriBonds         *b  = &p->bonds;
-  PeriModel          m  = p->model;
+  PeriBonds         *b  = &p->sys->bonds;
+  PeriModel          m  = p->sys->model;
   const PetscInt     bs = m->dofs, nb = 2 * bs;
   VecScatter         scatter;
   Vec                all;
@@ -104,9 +104,9 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   PetscInt           mine = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecScatterCreateToAll(p->u, &scatter, &all));
-  PetscCall(VecScatterBegin(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(scatter, p->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterCreateToAll(p->sys->u, &scatter, &all));
+  PetscCall(VecScatterBegin(scatter, p->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(scatter, p->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(all, &u));
   PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
   for (PetscInt i = b->rstart; i < b->rend; i++)
@@ -115,14 +115,14 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       PetscReal        ui[PERI_MAX_DOF], uj[PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
       index[k] = 0;
       if (!b->live[k] || b->j[k] == i) continue;
-      PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+      PetscCall(PeriSystemBondGeometry(p->sys, i, k, &g));
       for (PetscInt c = 0; c < bs; c++) {
         ui[c] = PetscRealPart(u[i * bs + c]);
         uj[c] = PetscRealPart(u[g.j * bs + c]);
       }
       m->ops.bond_measures(m, &g, ui, uj, meas);
-      index[k] = PeriBondFailureIndex(p, &g, meas, &cause[k]);
-      soft[k]  = b->intact ? PeriBondSoftening(p, meas) : 1;
+      index[k] = PeriBondFailureIndex(p->sys, &g, meas, &cause[k]);
+      soft[k]  = b->intact ? PeriBondSoftening(p->sys, meas) : 1;
       worst    = PetscMax(worst, index[k]);
     }
   PetscCall(VecRestoreArrayRead(all, &u));
@@ -142,13 +142,13 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       /* K changes by (new share / old share - 1) times the bond's present block (state-based
          models: K is reassembled from the synchronized families below) */
       if (m->ops.bond_stiffness) {
-        PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+        PetscCall(PeriSystemBondGeometry(p->sys, i, k, &g));
         m->ops.bond_stiffness(m, &g, Ke);
         scale = breaks ? -1 : soft[k] / b->intact[k] - 1;
         for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
         idx[0] = i;
         idx[1] = g.j;
-        PetscCall(MatSetValuesBlocked(p->K, 2, idx, 2, idx, Ke, ADD_VALUES));
+        PetscCall(MatSetValuesBlocked(p->sys->K, 2, idx, 2, idx, Ke, ADD_VALUES));
       }
       if (breaks || soft[k] <= 0) {
         b->live[k]  = 0;
@@ -162,12 +162,12 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       }
     }
   PetscCall(PetscFree3(index, soft, cause));
-  PetscCall(MatAssemblyBegin(p->K, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(p->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(p->sys->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(p->sys->K, MAT_FINAL_ASSEMBLY));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, p->comm));
   if (*nbroken && !m->ops.bond_stiffness) {
-    PetscCall(PeriFamilySync(p));
-    PetscCall(PeriProblemAssemble(p));
+    PetscCall(PeriFamilySync(p->sys));
+    PetscCall(PeriSystemAssemble(p->sys));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -195,10 +195,10 @@ static PetscErrorCode ControlValue(PeriProblem p, PeriProbe *probe, PetscReal *v
   PetscFunctionBeginUser;
   *v = 0;
   if (!probe) PetscFunctionReturn(PETSC_SUCCESS);
-  row = probe->particle * p->model->dofs;
-  if (p->owner[probe->particle] == p->rank) {
+  row = probe->particle * p->sys->model->dofs;
+  if (p->sys->owner[probe->particle] == p->rank) {
     PetscScalar x;
-    PetscCall(VecGetValues(p->u, 1, &row, &x));
+    PetscCall(VecGetValues(p->sys->u, 1, &row, &x));
     *v = PetscRealPart(x);
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, v, 1, MPIU_REAL, MPI_SUM, p->comm));
@@ -232,13 +232,13 @@ typedef struct {
 static PetscErrorCode EquilibriumCreate(PeriProblem p, Equilibrium *e)
 {
   PetscFunctionBeginUser;
-  PetscCall(MatCreateVecs(p->K, &e->u, NULL)); /* lambda = 0: no displacement */
-  PetscCall(PetscMalloc1(p->bonds.nbonds, &e->live));
-  PetscCall(PetscArraycpy(e->live, p->bonds.live, p->bonds.nbonds));
+  PetscCall(MatCreateVecs(p->sys->K, &e->u, NULL)); /* lambda = 0: no displacement */
+  PetscCall(PetscMalloc1(p->sys->bonds.nbonds, &e->live));
+  PetscCall(PetscArraycpy(e->live, p->sys->bonds.live, p->sys->bonds.nbonds));
   e->intact = NULL;
-  if (p->bonds.intact) {
-    PetscCall(PetscMalloc1(p->bonds.nbonds, &e->intact));
-    PetscCall(PetscArraycpy(e->intact, p->bonds.intact, p->bonds.nbonds));
+  if (p->sys->bonds.intact) {
+    PetscCall(PetscMalloc1(p->sys->bonds.nbonds, &e->intact));
+    PetscCall(PetscArraycpy(e->intact, p->sys->bonds.intact, p->sys->bonds.nbonds));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -246,10 +246,10 @@ static PetscErrorCode EquilibriumCreate(PeriProblem p, Equilibrium *e)
 static PetscErrorCode EquilibriumSave(PeriProblem p, Equilibrium *e)
 {
   PetscFunctionBeginUser;
-  PetscCall(VecCopy(p->u, e->u));
-  e->solve = p->results;
-  PetscCall(PetscArraycpy(e->live, p->bonds.live, p->bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(e->intact, p->bonds.intact, p->bonds.nbonds));
+  PetscCall(VecCopy(p->sys->u, e->u));
+  e->solve = p->sys->results;
+  PetscCall(PetscArraycpy(e->live, p->sys->bonds.live, p->sys->bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(e->intact, p->sys->bonds.intact, p->sys->bonds.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -258,17 +258,17 @@ static PetscErrorCode EquilibriumSave(PeriProblem p, Equilibrium *e)
 static PetscErrorCode EquilibriumRestore(PeriProblem p, Equilibrium *e, PetscBool reassemble, PetscBool restore_u)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscArraycpy(p->bonds.live, e->live, p->bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(p->bonds.intact, e->intact, p->bonds.nbonds));
-  PetscCall(PeriFamilySync(p));
+  PetscCall(PetscArraycpy(p->sys->bonds.live, e->live, p->sys->bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(p->sys->bonds.intact, e->intact, p->sys->bonds.nbonds));
+  PetscCall(PeriFamilySync(p->sys));
   if (reassemble) {
-    PetscCall(PeriProblemAssemble(p));
-    if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
+    PetscCall(PeriSystemAssemble(p->sys));
+    if (p->sys->torsion.active && !p->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(p->sys, p->sys->f));
   }
   if (restore_u) {
-    PeriResults *r = &p->results;
-    if (!p->u) PetscCall(VecDuplicate(e->u, &p->u));
-    PetscCall(VecCopy(e->u, p->u));
+    PeriResults *r = &p->sys->results;
+    if (!p->sys->u) PetscCall(VecDuplicate(e->u, &p->sys->u));
+    PetscCall(VecCopy(e->u, p->sys->u));
     /* summary.json's solver section describes the solve of this state, not the abandoned one */
     if (e->solve.ksp_type[0]) {
       PetscCall(PetscStrncpy(r->ksp_type, e->solve.ksp_type, sizeof(r->ksp_type)));
@@ -297,11 +297,11 @@ static PetscErrorCode WriteState(PeriProblem p, const char name[])
   char path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriProblemEvaluateEnergy(p));
-  PetscCall(PeriDamage(p, &p->damage));
+  PetscCall(PeriSystemEvaluateEnergy(p->sys));
+  PetscCall(PeriDamage(p->sys, &p->sys->damage));
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", p->staging_dir, name));
-  PetscCall(PeriWriteVTU(p, path));
+  PetscCall(PeriSystemWriteVTU(p->sys, p->sys->u_all, path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -317,14 +317,14 @@ static PetscErrorCode WriteSnapshot(PeriProblem p)
 
 static PetscErrorCode PrintCriteria(PeriProblem p, const Settings *st)
 {
-  const PeriFailure *F = &p->failure;
+  const PeriFailure *F = &p->sys->failure;
 
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
   PetscCall(PetscPrintf(p->comm, "perilin: failure:"));
   if (F->stretch > 0) PetscCall(PetscPrintf(p->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
-  if (F->G > 0) PetscCall(PetscPrintf(p->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, p->model->type));
+  if (F->G > 0) PetscCall(PetscPrintf(p->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, p->sys->model->type));
   if (F->compressive > 0) PetscCall(PetscPrintf(p->comm, " -s > %g", (double)F->compressive));
   if (F->sliding > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g", (double)F->sliding));
   if (F->friction_angle > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g - s tan(%g deg)", (double)F->cohesion, (double)F->friction_angle));
@@ -359,15 +359,15 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
     KSPConvergedReason reason;
     PetscInt           nb;
     PetscBool          ok;
-    PetscCall(PeriSignalReceived(p->comm, &p->interrupted));
-    if (p->interrupted) {
+    PetscCall(PeriSignalReceived(p->comm, &p->sys->interrupted));
+    if (p->sys->interrupted) {
       *end = TRIAL_INTERRUPTED;
       PetscFunctionReturn(PETSC_SUCCESS);
     }
     /* the pieces change only when bonds do */
     if (L->stale) {
       PetscCall(PetscFree2(L->hold, L->held));
-      PetscCall(PeriPieces(p, &L->nhold, &L->hold, &L->held, &L->npieces, &L->lost));
+      PetscCall(PeriPieces(p->sys, &L->nhold, &L->hold, &L->held, &L->npieces, &L->lost));
       L->stale = PETSC_FALSE;
     }
     if (L->lost) {
@@ -382,22 +382,22 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
       q->pc_setups++;
       L->since_setup = 0;
     }
-    PetscCall(PeriStaticSolve(p, &L->ksp, trial, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
+    PetscCall(PeriStaticSolve(p->sys, &L->ksp, trial, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
     /* later solves start from the last solution: few bonds change between them */
     PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
     q->solves++;
-    s->ksp_iterations += p->results.iterations;
-    PetscCall(PeriStaticConverged(p, L->ksp, reason, &ok));
-    PetscCall(PeriSignalReceived(p->comm, &p->interrupted));
-    if (p->interrupted) {
+    s->ksp_iterations += p->sys->results.iterations;
+    PetscCall(PeriStaticConverged(p->sys, L->ksp, reason, &ok));
+    PetscCall(PeriSignalReceived(p->comm, &p->sys->interrupted));
+    if (p->sys->interrupted) {
       *end = TRIAL_INTERRUPTED;
       PetscFunctionReturn(PETSC_SUCCESS);
     }
     if (!ok) {
       /* the body as set up is linear: a solve that fails before any bond broke fails at every
          load, so it is the solver's failure, not the body's */
-      if (total == 0 && s->broken == 0) PetscCall(PeriStaticCheckConverged(p, reason));
-      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)p->results.residual_norm));
+      if (total == 0 && s->broken == 0) PetscCall(PeriStaticCheckConverged(p->sys, reason));
+      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)p->sys->results.residual_norm));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
     PetscCall(BreakBonds(p, st, &nb));
@@ -409,7 +409,7 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
     s->broken += nb;
     L->since_setup += nb;
     /* a twist carried by the bonds themselves loses the broken bonds' share */
-    if (p->torsion.active && !p->layers.nfaces) PetscCall(PeriLoadsAssemble(p, p->f));
+    if (p->sys->torsion.active && !p->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(p->sys, p->sys->f));
     if (st->adaptive && s->broken > st->runaway * L->nbonds) {
       /* a crack running away at this load: a smaller step tells whether it would settle */
       PetscCall(PetscSNPrintf(why, len, "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s->broken, (double)st->runaway));
@@ -432,8 +432,8 @@ static PetscErrorCode Failed(PeriProblem p, Equilibrium *eq, PetscReal trial, co
   q->failure_step         = q->nsteps + 1;
   q->failed_trial_broken  = s->broken;
   PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
-  if (p->vtk && p->u) PetscCall(WriteState(p, "failed_trial.vtu"));
-  PetscCall(PeriDamage(p, &q->trial_damage)); /* where the failure went, for the caller */
+  if (p->vtk && p->sys->u) PetscCall(WriteState(p, "failed_trial.vtu"));
+  PetscCall(PeriDamage(p->sys, &q->trial_damage)); /* where the failure went, for the caller */
   PetscCall(EquilibriumRestore(p, eq, PETSC_FALSE, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -462,13 +462,13 @@ static PetscErrorCode Finish(PeriProblem p, const Settings *st)
   PeriQuasistatic *q = p->quasistatic;
 
   PetscFunctionBeginUser;
-  q->complete = p->interrupted ? PETSC_FALSE : PETSC_TRUE;
-  if (p->interrupted)
-    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", p->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  q->complete = p->sys->interrupted ? PETSC_FALSE : PETSC_TRUE;
+  if (p->sys->interrupted)
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", p->sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
   else if (!q->failed)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st->max));
-  PetscCall(PeriProblemEvaluateEnergy(p));
-  PetscCall(PeriDamage(p, &p->damage));
+  PetscCall(PeriSystemEvaluateEnergy(p->sys));
+  PetscCall(PeriDamage(p->sys, &p->sys->damage));
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(p->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
   if (q->failed) PetscCall(PetscPrintf(p->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
@@ -492,10 +492,10 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   PetscCall(ReadSettings(p, &st));
   PetscCall(PetscNew(&p->quasistatic));
   PetscCall(PetscStrncpy(p->quasistatic->control, st.control ? st.control->name : "", sizeof(p->quasistatic->control)));
-  PetscCall(PeriStaticDefaultMatType(p->mat_type, sizeof(p->mat_type)));
-  PetscCall(PeriProblemAssemble(p));
+  PetscCall(PeriStaticDefaultMatType(p->sys->mat_type, sizeof(p->sys->mat_type)));
+  PetscCall(PeriSystemAssemble(p->sys));
   PetscCall(EquilibriumCreate(p, &eq));
-  PetscCallMPI(MPI_Allreduce(&p->bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(&p->sys->bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, p->comm));
   L.stale = PETSC_TRUE;
   PetscCall(PetscTime(&t0));
   dl = st.step;
@@ -534,7 +534,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   PetscCall(PetscFree2(L.hold, L.held));
   PetscCall(EquilibriumDestroy(&eq));
   PetscCall(PetscTime(&t));
-  p->results.solve_s = t - t0;
+  p->sys->results.solve_s = t - t0;
   PetscCall(Finish(p, &st));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -561,10 +561,10 @@ PetscErrorCode PeriWriteStepsCSV(PeriProblem p, const char path[])
 }
 
 /*@C
-  PeriWriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
+  WriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
   (output.every) by load factor. Rank 0 writes. Collective.
 @*/
-PetscErrorCode PeriWriteSnapshotsPVD(PeriProblem p, const char path[])
+static PetscErrorCode WriteSnapshotsPVD(PeriProblem p, const char path[])
 {
   PeriQuasistatic *q = p->quasistatic;
   PetscReal       *times;
@@ -585,4 +585,57 @@ PetscErrorCode PeriWriteSnapshotsPVD(PeriProblem p, const char path[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriAnalysisType PeriAnalysis_Quasistatic = {"quasistatic", NULL, PeriAnalysisRun_Quasistatic};
+/* summary.json's "quasistatic" object: the path's end, the critical load, what broke. */
+static PetscErrorCode QSSummary(PeriProblem p, PeriJSON j)
+{
+  const PeriResults *r = &p->sys->results;
+
+  PetscFunctionBeginUser;
+  if (!p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
+  const PeriQuasistatic *q = p->quasistatic;
+  PetscCall(PeriJSONBeginObject(j, "quasistatic"));
+  PetscCall(PeriJSONInt(j, "steps", q->nsteps));
+  PetscCall(PeriJSONString(j, "state", "last equilibrium"));
+  PetscCall(PeriJSONReal(j, "peak_load_factor", q->peak_load_factor));
+  if (q->failed) {
+    PetscCall(PeriJSONReal(j, "critical_load_factor", q->critical_load_factor));
+    PetscCall(PeriJSONInt(j, "failure_step", q->failure_step));
+    PetscCall(PeriJSONInt(j, "failed_trial_broken_bonds", q->failed_trial_broken));
+  }
+  PetscCall(PeriJSONInt(j, "broken_bonds", q->broken_bonds));
+  PetscCall(PeriJSONInt(j, "precracked_bonds", r->precracked_bonds));
+  PetscCall(PeriJSONBool(j, "failed", q->failed));
+  PetscCall(PeriJSONBool(j, "complete", q->complete));
+  PetscCall(PeriJSONString(j, "ending", q->ending));
+  PetscCall(PeriJSONInt(j, "solves", q->solves));
+  PetscCall(PeriJSONInt(j, "preconditioner_setups", q->pc_setups));
+  if (q->control[0]) PetscCall(PeriJSONString(j, "control_probe", q->control));
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* steps.csv and the snapshot series particles.pvd. */
+static PetscErrorCode QSFiles(PeriProblem p, const char dir[])
+{
+  char path[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  if (!p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/steps.csv", dir));
+  PetscCall(PeriWriteStepsCSV(p, path));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.pvd", dir));
+  PetscCall(WriteSnapshotsPVD(p, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode QSDestroy(PeriProblem p)
+{
+  PetscFunctionBeginUser;
+  if (!p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscFree(p->quasistatic->steps));
+  PetscCall(PetscFree(p->quasistatic->trial_damage));
+  PetscCall(PetscFree(p->quasistatic));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+const PeriAnalysisType PeriAnalysis_Quasistatic = {"quasistatic", "load stepping with bond failure to the critical load", NULL, PETSC_FALSE, {PeriAnalysisRun_Quasistatic, NULL, QSFiles, QSSummary, NULL, QSDestroy}};

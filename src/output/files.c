@@ -4,7 +4,7 @@
  * succeeded, removing the tmp on failure, so a crashed or failed run never leaves a half-written
  * file under the final name (rename() replaces the target atomically on POSIX). */
 #define _GNU_SOURCE /* renameat2 */
-#include "perilin.h"
+#include "perilin/private/output.h"
 
 #include <dirent.h>
 #include <errno.h>

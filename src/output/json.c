@@ -4,7 +4,7 @@
  * Any error (a write failure, a non-finite value, misuse) abandons the writer at once: the tmp file
  * is closed and removed, so even a caller that simply propagates the error with PetscCall() leaves
  * no partial file behind. Later calls on an abandoned writer fail; PeriJSONClose() still frees it. */
-#include "perilin.h"
+#include "perilin/private/output.h"
 
 #include <errno.h>
 #include <stdarg.h>

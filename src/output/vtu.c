@@ -3,7 +3,7 @@
  * Layout of <AppendedData encoding="raw">_...: for each DataArray, in the order they are declared,
  * a UInt64 byte count followed by the bytes. A DataArray's offset counts from the byte after '_'
  * and includes the 8-byte counts of all earlier blocks. */
-#include "perilin.h"
+#include "perilin/private/output.h"
 
 #include <errno.h>
 #include <inttypes.h>
@@ -12,8 +12,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#define VTU_MAX_ARRAYS (8 + PERI_MAX_DOF * (1 + PERI_MAX_VTU_MODES))
-#define VTK_VERTEX     1
+#define VTK_VERTEX 1
 
 typedef enum {
   VTU_POINT_DATA,
@@ -32,7 +31,7 @@ typedef enum {
    when map[c] < 0 (e.g. uz of a 2D model). */
 typedef struct {
   VTUSection       section;
-  const char      *name;
+  char            *name;
   VTUKind          kind;
   PetscInt         ncomp;
   const PetscReal *real;
@@ -46,129 +45,115 @@ typedef struct {
 static const char *const VTUTypeNames[] = {"Float64", "Int32", "Int64", "UInt8"};
 static const size_t      VTUTypeSizes[] = {8, 4, 8, 1};
 
-static PetscErrorCode VTUAddReal(VTUArray a[], PetscInt *na, VTUSection section, const char name[], PetscInt ncomp, const PetscReal *real, PetscInt stride, const PetscInt map[])
-{
-  PetscInt c;
+/* The arrays of one file: per-particle fields (PointData), then the points and the cells. */
+struct _p_PeriFieldList {
+  PetscInt         n;
+  const PetscReal *x;
+  PetscInt         na, cap;
+  VTUArray        *a;
+};
 
-  PetscFunctionBeginUser;
-  PetscCheck(*na < VTU_MAX_ARRAYS, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Too many VTU arrays");
-  PetscCheck(real, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write VTU array %s: no data", name);
-  PetscCall(PetscMemzero(&a[*na], sizeof(a[*na])));
-  a[*na].section = section;
-  a[*na].name    = name;
-  a[*na].kind    = VTU_FLOAT64;
-  a[*na].ncomp   = ncomp;
-  a[*na].real    = real;
-  a[*na].stride  = stride;
-  for (c = 0; c < ncomp; c++) a[*na].map[c] = map ? map[c] : c;
-  (*na)++;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode VTUAddInt(VTUArray a[], PetscInt *na, VTUSection section, const char name[], VTUKind kind, const PetscInt *ints, int64_t first, uint8_t byte)
+static PetscErrorCode FieldListPush(PeriFieldList fl, VTUSection section, const char name[], VTUKind kind, PetscInt ncomp, VTUArray **a)
 {
   PetscFunctionBeginUser;
-  PetscCheck(*na < VTU_MAX_ARRAYS, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Too many VTU arrays");
-  PetscCheck(kind != VTU_INT32 || ints, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write VTU array %s: no data", name);
-  PetscCall(PetscMemzero(&a[*na], sizeof(a[*na])));
-  a[*na].section = section;
-  a[*na].name    = name;
-  a[*na].kind    = kind;
-  a[*na].ncomp   = 1;
-  a[*na].ints    = ints;
-  a[*na].first   = first;
-  a[*na].byte    = byte;
-  (*na)++;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Which arrays to write, from the problem's data. Done before the file is opened, so that a
-   missing field fails without creating anything. */
-static PetscErrorCode VTUDescribe(PeriProblem p, VTUArray a[], PetscInt *na)
-{
-  PeriModel model  = p->model;
-  PetscInt  map[3] = {-1, -1, -1}, c, axis, ntrans = 0;
-
-  PetscFunctionBeginUser;
-  *na = 0;
-  if (p->u_all) {
-    PetscCheck(model && model->components, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write displacements to VTU: the model has no component names");
-    PetscCheck(model->dofs >= 1 && model->dofs <= PERI_MAX_DOF, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Model %s has %" PetscInt_FMT " DOFs per particle", model->type, model->dofs);
-    for (c = 0; c < model->dofs; c++) {
-      const char *name = model->components[c];
-
-      axis = -1;
-      if (!strcmp(name, "ux"))
-        axis = 0;
-      else if (!strcmp(name, "uy"))
-        axis = 1;
-      else if (!strcmp(name, "uz"))
-        axis = 2;
-      if (axis < 0) continue;
-      PetscCheck(map[axis] < 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Model %s names component %s twice", model->type, name);
-      map[axis] = c;
-      ntrans++;
-    }
-    /* No vector when the model has no translations: a zero "displacement" would be misleading. */
-    if (ntrans) PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "displacement", 3, p->u_all, model->dofs, map));
-    for (c = 0; c < model->dofs; c++) {
-      if (c == map[0] || c == map[1] || c == map[2]) continue;
-      PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, model->components[c], 1, p->u_all, model->dofs, &c));
-    }
+  if (fl->na == fl->cap) {
+    VTUArray *grown;
+    PetscCall(PetscCalloc1(2 * fl->cap + 8, &grown));
+    if (fl->na) PetscCall(PetscArraycpy(grown, fl->a, fl->na));
+    PetscCall(PetscFree(fl->a));
+    fl->a   = grown;
+    fl->cap = 2 * fl->cap + 8;
   }
-  if (p->modal) {
-    /* one array per mode: its displacement vector, and each other component on its own */
-    static char    names[PERI_MAX_VTU_MODES][PERI_MAX_DOF][PERI_NAME_LEN + 16];
-    const PetscInt nd = p->particles.n * model->dofs;
-    for (c = 0; c < model->dofs; c++) {
-      axis = -1;
-      if (!strcmp(model->components[c], "ux"))
-        axis = 0;
-      else if (!strcmp(model->components[c], "uy"))
-        axis = 1;
-      else if (!strcmp(model->components[c], "uz"))
-        axis = 2;
-      if (axis >= 0) map[axis] = c;
-    }
-    for (PetscInt k = 0; k < p->modal->nshapes; k++) {
-      PetscCall(PetscSNPrintf(names[k][0], sizeof(names[k][0]), "mode_%" PetscInt_FMT, k + 1));
-      PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, names[k][0], 3, &p->modal->shapes[k * nd], model->dofs, map));
-      for (c = 0; c < model->dofs; c++) {
-        if (c == map[0] || c == map[1] || c == map[2]) continue;
-        PetscCall(PetscSNPrintf(names[k][c], sizeof(names[k][c]), "mode_%" PetscInt_FMT "_%s", k + 1, model->components[c]));
-        PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, names[k][c], 1, &p->modal->shapes[k * nd], model->dofs, &c));
+  *a = &fl->a[fl->na++];
+  PetscCall(PetscMemzero(*a, sizeof(**a)));
+  (*a)->section = section;
+  (*a)->kind    = kind;
+  (*a)->ncomp   = ncomp;
+  PetscCall(PetscStrallocpy(name, &(*a)->name));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriFieldListCreate - an empty list of per-particle fields over n points x (3 per point). The
+  arrays are referenced, not copied: they must live until the list is written.
+@*/
+PetscErrorCode PeriFieldListCreate(PetscInt n, const PetscReal x[], PeriFieldList *list)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Negative number of particles %" PetscInt_FMT, n);
+  PetscCall(PetscNew(list));
+  (*list)->n = n;
+  (*list)->x = x;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriFieldListDestroy(PeriFieldList *list)
+{
+  PetscFunctionBeginUser;
+  if (!*list) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < (*list)->na; k++) PetscCall(PetscFree((*list)->a[k].name));
+  PetscCall(PetscFree((*list)->a));
+  PetscCall(PetscFree(*list));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriFieldListAddReal - a field of ncomp components: component c of particle i is
+  real[i * stride + map[c]] (map NULL: c), or 0 where map[c] < 0 (uz of a 2D model).
+@*/
+PetscErrorCode PeriFieldListAddReal(PeriFieldList fl, const char name[], PetscInt ncomp, const PetscReal *real, PetscInt stride, const PetscInt map[])
+{
+  VTUArray *a = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCheck(real, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write field %s: no data", name);
+  PetscCheck(ncomp >= 1 && ncomp <= 3, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Field %s: %" PetscInt_FMT " components (1 to 3)", name, ncomp);
+  PetscCall(FieldListPush(fl, VTU_POINT_DATA, name, VTU_FLOAT64, ncomp, &a));
+  a->real   = real;
+  a->stride = stride;
+  for (PetscInt c = 0; c < ncomp; c++) a->map[c] = map ? map[c] : c;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* An integer field (Int32, with an overflow check when written). */
+PetscErrorCode PeriFieldListAddInt(PeriFieldList fl, const char name[], const PetscInt *ints)
+{
+  VTUArray *a = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCheck(ints, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write field %s: no data", name);
+  PetscCall(FieldListPush(fl, VTU_POINT_DATA, name, VTU_INT32, 1, &a));
+  a->ints = ints;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriFieldListAddSolution - the DOFs u (dofs per particle, named components[]) as fields: ux, uy,
+  uz as one vector "displacement" (none when the model has no translation: a zero vector would
+  mislead), every other component as its own field ("theta"). With a prefix ("mode_3") the vector
+  is named by the prefix and the others "mode_3_theta".
+@*/
+PetscErrorCode PeriFieldListAddSolution(PeriFieldList fl, const char prefix[], PetscInt dofs, const char *const components[], const PetscReal *u)
+{
+  static const char *const axes[] = {"ux", "uy", "uz"};
+  PetscInt                 map[3] = {-1, -1, -1}, ntrans = 0;
+  char                     name[PERI_NAME_LEN + 32];
+
+  PetscFunctionBeginUser;
+  PetscCheck(components && dofs >= 1 && dofs <= PERI_MAX_DOF, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Cannot write a solution of %" PetscInt_FMT " named DOFs per particle", dofs);
+  for (PetscInt c = 0; c < dofs; c++)
+    for (PetscInt d = 0; d < 3; d++)
+      if (!strcmp(components[c], axes[d])) {
+        PetscCheck(map[d] < 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Component %s named twice", components[c]);
+        map[d] = c;
+        ntrans++;
       }
-    }
+  if (ntrans) PetscCall(PeriFieldListAddReal(fl, prefix[0] ? prefix : "displacement", 3, u, dofs, map));
+  for (PetscInt c = 0; c < dofs; c++) {
+    if (c == map[0] || c == map[1] || c == map[2]) continue;
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s%s%s", prefix, prefix[0] ? "_" : "", components[c]));
+    PetscCall(PeriFieldListAddReal(fl, name, 1, u, dofs, &c));
   }
-  PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "volume", 1, p->particles.volume, 1, NULL));
-  PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "neighbors", VTU_INT32, p->neighbor_count, 0, 0));
-  PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "rank", VTU_INT32, p->owner, 0, 0));
-  if (p->W) PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "strain_energy_density", 1, p->W, 1, NULL));
-  if (p->tau) {
-    static const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
-    PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress", 3, p->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
-    PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "shear_stress_norm", 1, p->tau, 3, &nmap));
-  }
-  if (p->damage) {
-    /* the total, and the share lost to each criterion the scene uses (Diana & Casolo eqs. 47, 48, 51) */
-    static char           names[PERI_NCAUSES][32];
-    static const PetscInt map0 = 0;
-    static PetscInt       maps[PERI_NCAUSES];
-    const PeriFailure    *F      = &p->failure;
-    const PetscBool       used[] = {(PetscBool)(p->results.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
-    PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, "damage", 1, p->damage, PERI_NCAUSES + 1, &map0));
-    for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
-      if (!used[c]) continue;
-      maps[c] = 1 + c;
-      PetscCall(PetscSNPrintf(names[c], sizeof(names[c]), "damage_%s", PeriFailureCauses[c]));
-      PetscCall(VTUAddReal(a, na, VTU_POINT_DATA, names[c], 1, p->damage, PERI_NCAUSES + 1, &maps[c]));
-    }
-  }
-  if (p->particles.image) PetscCall(VTUAddInt(a, na, VTU_POINT_DATA, "mirror_of", VTU_INT32, p->particles.image, 0, 0)); /* -1: a body particle */
-  PetscCall(VTUAddReal(a, na, VTU_POINTS, "Points", 3, p->particles.x, 3, NULL));
-  PetscCall(VTUAddInt(a, na, VTU_CELLS, "connectivity", VTU_INT64, NULL, 0, 0));
-  PetscCall(VTUAddInt(a, na, VTU_CELLS, "offsets", VTU_INT64, NULL, 1, 0)); /* one point per cell */
-  PetscCall(VTUAddInt(a, na, VTU_CELLS, "types", VTU_UINT8, NULL, 0, VTK_VERTEX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -254,11 +239,36 @@ static PetscErrorCode VTUWriteFile(FILE *fp, const char file[], PetscInt n, Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Collective on p->comm; only rank 0, which holds every particle's data, writes. */
-PetscErrorCode PeriWriteVTU(PeriProblem p, const char path[])
+/* The points and the cells (one vertex per point), after the fields; once per list. */
+static PetscErrorCode PeriFieldListAddGeometry(PeriFieldList fl)
 {
-  VTUArray       a[VTU_MAX_ARRAYS];
-  PetscInt       na, k, n;
+  VTUArray *a = NULL;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < fl->na; k++)
+    if (fl->a[k].section == VTU_POINTS) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(fl->x, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write VTU: no points");
+  PetscCall(FieldListPush(fl, VTU_POINTS, "Points", VTU_FLOAT64, 3, &a));
+  a->real   = fl->x;
+  a->stride = 3;
+  for (PetscInt c = 0; c < 3; c++) a->map[c] = c;
+  PetscCall(FieldListPush(fl, VTU_CELLS, "connectivity", VTU_INT64, 1, &a));
+  PetscCall(FieldListPush(fl, VTU_CELLS, "offsets", VTU_INT64, 1, &a));
+  a->first = 1; /* one point per cell */
+  PetscCall(FieldListPush(fl, VTU_CELLS, "types", VTU_UINT8, 1, &a));
+  a->byte = VTK_VERTEX;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteVTU - the fields of the list, the points and one vertex cell per point, written to
+  path through a temporary file (nothing is left behind on failure). Not collective: the rank that
+  holds every particle's data calls it.
+@*/
+PetscErrorCode PeriWriteVTU(PeriFieldList fl, const char path[])
+{
+  VTUArray      *a;
+  PetscInt       na, n = fl->n;
   uint64_t       offset = 0, maxbytes = 0;
   char           tmp[PETSC_MAX_PATH_LEN];
   FILE          *fp;
@@ -267,13 +277,12 @@ PetscErrorCode PeriWriteVTU(PeriProblem p, const char path[])
   int            rc, err;
 
   PetscFunctionBeginUser;
-  if (p->rank != 0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(path && path[0], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Empty VTU file name");
   PetscCheck(strlen(path) + sizeof(".tmp") <= sizeof(tmp), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "VTU file name is too long: %s", path);
-  n = p->particles.n;
-  PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Negative number of particles %" PetscInt_FMT, n);
-  PetscCall(VTUDescribe(p, a, &na));
-  for (k = 0; k < na; k++) {
+  PetscCall(PeriFieldListAddGeometry(fl));
+  a  = fl->a;
+  na = fl->na;
+  for (PetscInt k = 0; k < na; k++) {
     a[k].nbytes = (uint64_t)n * (uint64_t)a[k].ncomp * VTUTypeSizes[a[k].kind];
     a[k].offset = offset;
     offset += sizeof(uint64_t) + a[k].nbytes;
@@ -318,39 +327,5 @@ PetscErrorCode PeriWritePVD(const char path[], PetscInt n, const PetscReal times
   for (PetscInt k = 0; k < n; k++) bad |= fprintf(fp, "    <DataSet timestep=\"%.10g\" group=\"\" part=\"0\" file=\"%s\"/>\n", (double)times[k], files[k]) < 0;
   bad |= fprintf(fp, "  </Collection>\n</VTKFile>\n") < 0;
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriWriteModeShapes - mode_NN.vtu, one file per stored mode shape with the shape as its
-  "displacement", and modes.pvd listing them by mode number (ParaView steps through the modes
-  like time steps). Collective; rank 0 writes.
-@*/
-PetscErrorCode PeriWriteModeShapes(PeriProblem p, const char dir[])
-{
-  PeriModal     *md    = p->modal;
-  PetscReal     *u_all = p->u_all, *times;
-  char         **files, path[PETSC_MAX_PATH_LEN];
-  const PetscInt nd = p->particles.n * p->model->dofs;
-
-  PetscFunctionBeginUser;
-  if (p->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc2(md->nshapes, &times, md->nshapes, &files));
-  /* each file is particles.vtu's layout with the mode as the displacement field */
-  p->modal = NULL;
-  for (PetscInt k = 0; k < md->nshapes; k++) {
-    times[k] = (PetscReal)(k + 1);
-    PetscCall(PetscMalloc1(32, &files[k]));
-    PetscCall(PetscSNPrintf(files[k], 32, "mode_%02" PetscInt_FMT ".vtu", k + 1));
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", dir, files[k]));
-    p->u_all = &md->shapes[k * nd];
-    PetscCall(PeriWriteVTU(p, path));
-  }
-  p->u_all = u_all;
-  p->modal = md;
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
-  PetscCall(PeriWritePVD(path, md->nshapes, times, (const char *const *)files));
-  for (PetscInt k = 0; k < md->nshapes; k++) PetscCall(PetscFree(files[k]));
-  PetscCall(PetscFree2(times, files));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -67,7 +67,7 @@ static PetscReal TorsionWarping(const PetscReal X[])
 /* Relative l2 error of u_z over the body's particles (rank 0 holds the fields; broadcast). */
 static PetscErrorCode FieldError(PeriProblem p, PetscReal (*exact)(const PetscReal[]), PetscReal *err)
 {
-  const PeriParticles *pt  = &p->particles;
+  const PeriParticles *pt  = &p->sys->particles;
   PetscReal            num = 0, den = 0;
 
   PetscFunctionBeginUser;
@@ -76,7 +76,7 @@ static PetscErrorCode FieldError(PeriProblem p, PetscReal (*exact)(const PetscRe
       PetscReal ue;
       if (PeriParticleIsFictitious(pt, i)) continue;
       ue = exact(&pt->x[3 * i]);
-      num += PetscSqr(p->u_all[i] - ue) * pt->volume[i];
+      num += PetscSqr(p->sys->u_all[i] - ue) * pt->volume[i];
       den += ue * ue * pt->volume[i];
     }
   *err = PetscSqrtReal(num / den);
@@ -86,7 +86,7 @@ static PetscErrorCode FieldError(PeriProblem p, PetscReal (*exact)(const PetscRe
 
 static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
 {
-  const PeriParticles *pt  = &p->particles;
+  const PeriParticles *pt  = &p->sys->particles;
   PetscReal            num = 0, den = 0;
 
   PetscFunctionBeginUser;
@@ -95,7 +95,7 @@ static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
       PetscReal w, txz, tyz;
       if (PeriParticleIsFictitious(pt, i)) continue;
       Torsion(&pt->x[3 * i], &w, &txz, &tyz);
-      num += (PetscSqr(p->tau[3 * i] - txz) + PetscSqr(p->tau[3 * i + 1] - tyz)) * pt->volume[i];
+      num += (PetscSqr(p->sys->tau[3 * i] - txz) + PetscSqr(p->sys->tau[3 * i + 1] - tyz)) * pt->volume[i];
       den += (txz * txz + tyz * tyz) * pt->volume[i];
     }
   *err = PetscSqrtReal(num / den);
@@ -106,13 +106,13 @@ static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
 /* The interior strain of the bar without layers, mu du/dy / S over |y| < 1/4 (least squares) */
 static PetscErrorCode InteriorSlope(PeriProblem p, PetscReal *slope)
 {
-  const PeriParticles *pt = &p->particles;
+  const PeriParticles *pt = &p->sys->particles;
   PetscReal            n = 0, sy = 0, su = 0, syy = 0, syu = 0;
 
   PetscFunctionBeginUser;
   if (p->rank == 0)
     for (PetscInt i = 0; i < pt->n; i++) {
-      PetscReal y = pt->x[3 * i + 1], u = p->u_all[i];
+      PetscReal y = pt->x[3 * i + 1], u = p->sys->u_all[i];
       if (PetscAbsReal(y) > 0.25) continue;
       n += 1;
       sy += y;
@@ -202,9 +202,9 @@ int main(int argc, char **argv)
     /* Timoshenko's table: J = beta (2a)^3 (2b), beta = 0.229 at b/a = 2 */
     PeriTestClose("exact J of the 1 x 2 rectangle vs Timoshenko's beta = 0.229", J, 0.229 * 2, 0.0005 * 2);
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s torsion J / J_exact - 1 at dx = 0.02", models[k]));
-    PeriTestClose(what, q->torsion.J / J - 1, 0, 0.001);
+    PeriTestClose(what, q->sys->torsion.J / J - 1, 0, 0.001);
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s torsion |J error| shrinks with dx", models[k]));
-    PeriTestClose(what, PetscAbsReal(q->torsion.J / J - 1) / PetscAbsReal(p->torsion.J / J - 1), 0.5, 0.5 - 1e-3);
+    PeriTestClose(what, PetscAbsReal(q->sys->torsion.J / J - 1) / PetscAbsReal(p->sys->torsion.J / J - 1), 0.5, 0.5 - 1e-3);
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
   }
@@ -274,7 +274,7 @@ int main(int argc, char **argv)
       PetscCall(PeriTestSetOption("-horizon_m", ms[q]));
       PetscCall(Run(argv[3], models[k], "0.04", &p));
       PetscCall(PetscSNPrintf(what, sizeof(what), "%s torsion m = %s, dx = 0.04: J / 0.45733 - 1", models[k], ms[q]));
-      PeriTestClose(what, p->torsion.J / 0.4573300474 - 1, 0, 0.01);
+      PeriTestClose(what, p->sys->torsion.J / 0.4573300474 - 1, 0, 0.01);
       PetscCall(PeriProblemDestroy(&p));
     }
     PetscCall(PeriTestSetOption("-horizon_m", NULL));

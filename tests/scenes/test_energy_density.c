@@ -40,11 +40,11 @@ int main(int argc, char **argv)
     PetscCall(PeriTestSetOption("-model_type", "npmb"));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
     if (p->rank == 0) {
-      PetscCall(PeriProblemFindProbe(p, "center", &c));
+      PetscCall(PeriSystemFindProbe(p->sys, "center", &c));
       PetscCall(PetscSNPrintf(what, sizeof(what), "npmb m=%" PetscInt_FMT ": centre W / (9 K s^2/2)", m));
       PeriTestClose(what, c->W / Wexact, 1.0, 1e-10);
       PetscCall(PetscSNPrintf(what, sizeof(what), "m=%" PetscInt_FMT ": neighbours of the centre (lattice count)", m));
-      PeriTestClose(what, (PetscReal)p->neighbor_count[c->particle], (PetscReal)count, 0);
+      PeriTestClose(what, (PetscReal)p->sys->neighbor_count[c->particle], (PetscReal)count, 0);
       if (m == 2) PeriTestClose("m=2: neighbours of the centre (paper: 32)", (PetscReal)count, 32, 0);
       if (m == 6) PeriTestClose("m=6: neighbours of the centre (paper: 924)", (PetscReal)count, 924, 0);
     }
@@ -54,7 +54,7 @@ int main(int argc, char **argv)
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
     if (p->rank == 0) {
       PetscReal predicted = sum1 / (PETSC_PI * PetscPowReal((PetscReal)m, 4));
-      PetscCall(PeriProblemFindProbe(p, "center", &c));
+      PetscCall(PeriSystemFindProbe(p->sys, "center", &c));
       PetscCall(PetscSNPrintf(what, sizeof(what), "pmb m=%" PetscInt_FMT ": centre W / (9 K s^2/2), error %+.2f %%", m, (double)(100 * (c->W / Wexact - 1))));
       PeriTestClose(what, c->W / Wexact, predicted, 1e-10 * predicted);
     }

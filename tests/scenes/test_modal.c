@@ -159,9 +159,9 @@ static PetscErrorCode Extremes(const char lamina[], const char tiny[])
     slash = strrchr(file, '/');
     PetscCall(PetscStrncpy(slash + 1, "heavy_tip_static.yaml", sizeof(file) - (size_t)(slash + 1 - file)));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, file, &s));
-    k = 1000.0 * 1000.0 / (2 * s->results.strain_energy);
-    for (PetscInt r = 0; r < s->nregions; r++)
-      if (!strcmp(s->regions[r].name, "tip")) M = 2.5e9 * s->regions[r].volume;
+    k = 1000.0 * 1000.0 / (2 * s->sys->results.strain_energy);
+    for (PetscInt r = 0; r < s->sys->nregions; r++)
+      if (!strcmp(s->sys->regions[r].name, "tip")) M = 2.5e9 * s->sys->regions[r].volume;
     f = PetscSqrtReal(k / M) / (2 * PETSC_PI);
     PetscCall(PetscStrncpy(slash + 1, "heavy_tip_modal.yaml", sizeof(file) - (size_t)(slash + 1 - file)));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, file, &p));
@@ -321,9 +321,9 @@ static PetscErrorCode Checks(const char lamina[])
   PetscCall(PeriTestSetOption("-grid_spacing", "0.02"));
   /* the default (preonly + Cholesky): accepted, its inner residual recorded */
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &a));
-  PetscCheck(a->results.residual_norm > 0 && a->results.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "direct inner solve: worst true residual %g, expected in (0, 1e-6]", (double)a->results.residual_norm);
+  PetscCheck(a->sys->results.residual_norm > 0 && a->sys->results.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "direct inner solve: worst true residual %g, expected in (0, 1e-6]", (double)a->sys->results.residual_norm);
   for (PetscInt m = 0; m < a->modal->nmodes; m++) PetscCheck(a->modal->modes[m].residual <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "mode %" PetscInt_FMT " residual %g", m + 1, (double)a->modal->modes[m].residual);
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: direct inner solve: worst true residual %.2g <= 1e-6, the %" PetscInt_FMT " modes' residuals <= 1e-6\n", (double)a->results.residual_norm, a->modal->nmodes));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: direct inner solve: worst true residual %.2g <= 1e-6, the %" PetscInt_FMT " modes' residuals <= 1e-6\n", (double)a->sys->results.residual_norm, a->modal->nmodes));
   /* a preconditioner alone as the inner solve: refused at its first solve */
   PetscCall(ExpectRefused(lamina, jacobi, "inner solve 1 of the spectral transform", "-st_ksp_type preonly -st_pc_type cholesky"));
   /* CG to 1e-3: each inner solve within its own tolerance (100 rtol), the modes not: refused by the
@@ -338,7 +338,7 @@ static PetscErrorCode Checks(const char lamina[])
   PetscCall(PeriTestSetOption("-st_pc_type", NULL));
   PetscCall(PeriTestSetOption("-st_ksp_rtol", NULL));
   PetscCheck(b->modal->nmodes == a->modal->nmodes, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: %" PetscInt_FMT " modes, direct %" PetscInt_FMT, b->modal->nmodes, a->modal->nmodes);
-  PetscCheck(b->results.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: worst true residual %g", (double)b->results.residual_norm);
+  PetscCheck(b->sys->results.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: worst true residual %g", (double)b->sys->results.residual_norm);
   for (PetscInt m = 0; m < a->modal->nmodes; m++) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "cg + jacobi to 1e-12 inner solves: mode %" PetscInt_FMT " f / f with Cholesky", m + 1));
     PeriTestClose(what, b->modal->modes[m].f_hz / a->modal->modes[m].f_hz, 1.0, 1e-8);

@@ -42,12 +42,12 @@ static PetscErrorCode FarField(PeriProblem p, PetscReal sigma, PetscReal *exx, P
   PeriProbe *a, *b, *c, *d;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriProblemFindProbe(p, "a", &a));
-  PetscCall(PeriProblemFindProbe(p, "b", &b));
-  PetscCall(PeriProblemFindProbe(p, "c", &c));
-  PetscCall(PeriProblemFindProbe(p, "d", &d));
-  *exx = (b->u[0] - a->u[0]) / (b->x[0] - a->x[0]) / (sigma / p->model->material.E);
-  *nu  = -((d->u[1] - c->u[1]) / (d->x[1] - c->x[1])) / (*exx * sigma / p->model->material.E);
+  PetscCall(PeriSystemFindProbe(p->sys, "a", &a));
+  PetscCall(PeriSystemFindProbe(p->sys, "b", &b));
+  PetscCall(PeriSystemFindProbe(p->sys, "c", &c));
+  PetscCall(PeriSystemFindProbe(p->sys, "d", &d));
+  *exx = (b->u[0] - a->u[0]) / (b->x[0] - a->x[0]) / (sigma / p->sys->model->material.E);
+  *nu  = -((d->u[1] - c->u[1]) / (d->x[1] - c->x[1])) / (*exx * sigma / p->sys->model->material.E);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -85,12 +85,12 @@ int main(int argc, char **argv)
       PeriProblem q;
       PetscCall(PeriTestRunScene(PETSC_COMM_SELF, argv[1], &q));
       if (rank == 0) {
-        for (PetscInt i = 0; i < p->nprobes; i++)
+        for (PetscInt i = 0; i < p->sys->nprobes; i++)
           for (PetscInt c = 0; c < 2; c++) {
-            PetscCall(PetscSNPrintf(what, sizeof(what), "surface %s: probe %s u[%" PetscInt_FMT "], %d ranks vs 1", surfaces[k], p->probes[i].name, c, size));
-            PeriTestClose(what, p->probes[i].u[c], q->probes[i].u[c], 1e-7 * p->results.max_abs_u[c]);
+            PetscCall(PetscSNPrintf(what, sizeof(what), "surface %s: probe %s u[%" PetscInt_FMT "], %d ranks vs 1", surfaces[k], p->sys->probes[i].name, c, size));
+            PeriTestClose(what, p->sys->probes[i].u[c], q->sys->probes[i].u[c], 1e-7 * p->sys->results.max_abs_u[c]);
           }
-        PeriTestClose("strain energy, ranks vs 1", p->results.strain_energy, q->results.strain_energy, 1e-8 * q->results.strain_energy);
+        PeriTestClose("strain energy, ranks vs 1", p->sys->results.strain_energy, q->sys->results.strain_energy, 1e-8 * q->sys->results.strain_energy);
       }
       PetscCall(PeriProblemDestroy(&q));
     }

@@ -18,7 +18,7 @@ int main(int argc, char **argv)
   if (p->modal) {
     /* modes: the frequencies, which the eigensolver converges to 1e-10 */
     for (PetscInt k = 0; k < p->modal->nmodes; k++) {
-      PetscCall(PetscSNPrintf(what, sizeof(what), "%s: mode %" PetscInt_FMT " frequency on %d ranks vs 1", p->model->type, k + 1, size));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "%s: mode %" PetscInt_FMT " frequency on %d ranks vs 1", p->sys->model->type, k + 1, size));
       PeriTestClose(what, p->modal->modes[k].f_hz, q->modal->modes[k].f_hz, 1e-7 * q->modal->modes[k].f_hz);
     }
     PetscCall(PeriProblemDestroy(&p));
@@ -28,24 +28,24 @@ int main(int argc, char **argv)
   }
   if (p->quasistatic) {
     /* the same bonds break at the same loads: the bracket of the critical load is identical */
-    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: last equilibrium load factor on %d ranks vs 1", p->model->type, size));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: last equilibrium load factor on %d ranks vs 1", p->sys->model->type, size));
     PeriTestClose(what, p->quasistatic->peak_load_factor, q->quasistatic->peak_load_factor, 1e-12 * q->quasistatic->peak_load_factor);
-    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: load steps on %d ranks vs 1", p->model->type, size));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: load steps on %d ranks vs 1", p->sys->model->type, size));
     PeriTestClose(what, (PetscReal)p->quasistatic->nsteps, (PetscReal)q->quasistatic->nsteps, 0);
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
     PetscCall(SlepcFinalize());
     return 0;
   }
-  PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %d ranks vs 1", p->model->type, size));
-  PeriTestClose(what, p->results.strain_energy, q->results.strain_energy, 1e-8 * q->results.strain_energy);
-  for (PetscInt c = 0; c < p->model->dofs; c++) {
-    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s| on %d ranks vs 1", p->model->type, p->model->components[c], size));
-    PeriTestClose(what, p->results.max_abs_u[c], q->results.max_abs_u[c], 1e-7 * q->results.max_abs_u[c] + 1e-300);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %d ranks vs 1", p->sys->model->type, size));
+  PeriTestClose(what, p->sys->results.strain_energy, q->sys->results.strain_energy, 1e-8 * q->sys->results.strain_energy);
+  for (PetscInt c = 0; c < p->sys->model->dofs; c++) {
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s| on %d ranks vs 1", p->sys->model->type, p->sys->model->components[c], size));
+    PeriTestClose(what, p->sys->results.max_abs_u[c], q->sys->results.max_abs_u[c], 1e-7 * q->sys->results.max_abs_u[c] + 1e-300);
   }
-  if (p->torsion.active) {
-    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: torsion constant J on %d ranks vs 1", p->model->type, size));
-    PeriTestClose(what, p->torsion.J, q->torsion.J, 1e-8 * q->torsion.J);
+  if (p->sys->torsion.active) {
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: torsion constant J on %d ranks vs 1", p->sys->model->type, size));
+    PeriTestClose(what, p->sys->torsion.J, q->sys->torsion.J, 1e-8 * q->sys->torsion.J);
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));

@@ -19,45 +19,45 @@ static PetscErrorCode CheckAffine(const char file[])
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
   PetscCall(PeriProblemLoad(p, file));
   PetscCall(PeriProblemSetUp(p));
-  PetscCall(PeriProblemAssemble(p));
-  PetscCall(MatCreateVecs(p->K, &u, &f));
+  PetscCall(PeriSystemAssemble(p->sys));
+  PetscCall(MatCreateVecs(p->sys->K, &u, &f));
   PetscCall(VecGetArray(u, &a));
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
-    for (PetscInt c = 0; c < p->particles.dim; c++) {
+  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++)
+    for (PetscInt c = 0; c < p->sys->particles.dim; c++) {
       PetscReal v = b[c];
-      for (PetscInt d = 0; d < p->particles.dim; d++) v += A[c][d] * p->particles.x[3 * i + d];
-      a[(i - p->bonds.rstart) * p->model->dofs + c] = v;
+      for (PetscInt d = 0; d < p->sys->particles.dim; d++) v += A[c][d] * p->sys->particles.x[3 * i + d];
+      a[(i - p->sys->bonds.rstart) * p->sys->model->dofs + c] = v;
       /* micropolar models: the particles turn with the field's rotation */
-      if (p->model->dofs == 3 && p->particles.dim == 2) a[(i - p->bonds.rstart) * 3 + 2] = 0.5 * (A[1][0] - A[0][1]);
+      if (p->sys->model->dofs == 3 && p->sys->particles.dim == 2) a[(i - p->sys->bonds.rstart) * 3 + 2] = 0.5 * (A[1][0] - A[0][1]);
     }
   PetscCall(VecRestoreArray(u, &a));
-  PetscCall(MatMult(p->K, u, f));
+  PetscCall(MatMult(p->sys->K, u, f));
   /* the scale of the force from the strain alone: the diagonal block times the strain times dx */
   {
     Vec dg;
-    PetscCall(MatCreateVecs(p->K, &dg, NULL));
-    PetscCall(MatGetDiagonal(p->K, dg));
+    PetscCall(MatCreateVecs(p->sys->K, &dg, NULL));
+    PetscCall(MatGetDiagonal(p->sys->K, dg));
     PetscCall(VecNorm(dg, NORM_INFINITY, &scale));
     PetscCall(VecDestroy(&dg));
-    scale *= 2e-3 * p->particles.mean_spacing;
+    scale *= 2e-3 * p->sys->particles.mean_spacing;
   }
-  reach = 2 * PeriSearchRadius(p->partial_volume, p->delta, p->particles.mean_spacing);
+  reach = 2 * PeriSearchRadius(p->sys->partial_volume, p->sys->delta, p->sys->particles.mean_spacing);
   PetscCall(VecGetArrayRead(f, &fa));
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
+  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++) {
     PetscBool inner = PETSC_TRUE;
-    for (PetscInt d = 0; d < p->particles.dim; d++) {
-      PetscReal x = p->particles.x[3 * i + d];
-      if (!p->particles.periodic[d] && (x - p->particles.lower[d] < reach || p->particles.upper[d] - x < reach)) inner = PETSC_FALSE;
+    for (PetscInt d = 0; d < p->sys->particles.dim; d++) {
+      PetscReal x = p->sys->particles.x[3 * i + d];
+      if (!p->sys->particles.periodic[d] && (x - p->sys->particles.lower[d] < reach || p->sys->particles.upper[d] - x < reach)) inner = PETSC_FALSE;
     }
     if (!inner) continue;
     checked++;
-    for (PetscInt c = 0; c < p->model->dofs; c++) fmax = PetscMax(fmax, PetscAbsReal(PetscRealPart(fa[(i - p->bonds.rstart) * p->model->dofs + c])));
+    for (PetscInt c = 0; c < p->sys->model->dofs; c++) fmax = PetscMax(fmax, PetscAbsReal(PetscRealPart(fa[(i - p->sys->bonds.rstart) * p->sys->model->dofs + c])));
   }
   PetscCall(VecRestoreArrayRead(f, &fa));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &fmax, 1, MPIU_REAL, MPI_MAX, p->comm));
   PetscCallMPI(MPI_Allreduce(&checked, &total, 1, MPIU_INT, MPI_SUM, p->comm));
   PetscCheck(total > 0, p->comm, PETSC_ERR_PLIB, "no particle with a full horizon: enlarge the scene");
-  PetscCall(PetscPrintf(p->comm, "%s, model %s: %" PetscInt_FMT " interior particles, max |K u| / force scale = %g\n", file, p->model->type, total, (double)(fmax / scale)));
+  PetscCall(PetscPrintf(p->comm, "%s, model %s: %" PetscInt_FMT " interior particles, max |K u| / force scale = %g\n", file, p->sys->model->type, total, (double)(fmax / scale)));
   PeriTestClose("interior residual force of an affine field (relative)", fmax / scale, 0.0, 1e-11);
   PetscCall(VecDestroy(&u));
   PetscCall(VecDestroy(&f));

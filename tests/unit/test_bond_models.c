@@ -16,7 +16,7 @@ static PetscErrorCode Setup(const char file[], const char model[], const char nu
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, p));
   PetscCall(PeriProblemLoad(*p, file));
   PetscCall(PeriProblemSetUp(*p));
-  PetscCall(PeriProblemAssemble(*p));
+  PetscCall(PeriSystemAssemble((*p)->sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -25,20 +25,20 @@ static PetscErrorCode Energy(PeriProblem p, const PetscReal A[2][2], PetscReal t
 {
   Vec          u, Ku;
   PetscScalar *a, e;
-  PetscInt     bs = p->model->dofs;
+  PetscInt     bs = p->sys->model->dofs;
 
   PetscFunctionBeginUser;
-  PetscCall(MatCreateVecs(p->K, &u, &Ku));
+  PetscCall(MatCreateVecs(p->sys->K, &u, &Ku));
   PetscCall(VecGetArray(u, &a));
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
-    PetscReal x                       = p->particles.x[3 * i] - 0.5 * (p->particles.lower[0] + p->particles.upper[0]);
-    PetscReal y                       = p->particles.x[3 * i + 1] - 0.5 * (p->particles.lower[1] + p->particles.upper[1]);
-    a[(i - p->bonds.rstart) * bs + 0] = A[0][0] * x + A[0][1] * y;
-    a[(i - p->bonds.rstart) * bs + 1] = A[1][0] * x + A[1][1] * y;
-    if (bs == 3) a[(i - p->bonds.rstart) * bs + 2] = th;
+  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++) {
+    PetscReal x                            = p->sys->particles.x[3 * i] - 0.5 * (p->sys->particles.lower[0] + p->sys->particles.upper[0]);
+    PetscReal y                            = p->sys->particles.x[3 * i + 1] - 0.5 * (p->sys->particles.lower[1] + p->sys->particles.upper[1]);
+    a[(i - p->sys->bonds.rstart) * bs + 0] = A[0][0] * x + A[0][1] * y;
+    a[(i - p->sys->bonds.rstart) * bs + 1] = A[1][0] * x + A[1][1] * y;
+    if (bs == 3) a[(i - p->sys->bonds.rstart) * bs + 2] = th;
   }
   PetscCall(VecRestoreArray(u, &a));
-  PetscCall(MatMult(p->K, u, Ku));
+  PetscCall(MatMult(p->sys->K, u, Ku));
   PetscCall(VecDot(u, Ku, &e));
   *E = 0.5 * PetscRealPart(e);
   PetscCall(VecDestroy(&u));
@@ -60,9 +60,9 @@ int main(int argc, char **argv)
     PetscReal diff, norm;
     PetscCall(Setup(argv[1], "pds", nus[k], planes[k], &p));
     PetscCall(Setup(argv[1], "pmb", nus[k], planes[k], &q));
-    PetscCall(MatNorm(q->K, NORM_FROBENIUS, &norm));
-    PetscCall(MatAXPY(p->K, -1, q->K, SAME_NONZERO_PATTERN));
-    PetscCall(MatNorm(p->K, NORM_FROBENIUS, &diff));
+    PetscCall(MatNorm(q->sys->K, NORM_FROBENIUS, &norm));
+    PetscCall(MatAXPY(p->sys->K, -1, q->sys->K, SAME_NONZERO_PATTERN));
+    PetscCall(MatNorm(p->sys->K, NORM_FROBENIUS, &diff));
     PetscCall(PetscSNPrintf(what, sizeof(what), "plane %s, nu = %s: |K_pds - K_pmb| / |K_pmb|", planes[k], nus[k]));
     PeriTestClose(what, diff / norm, 0, 1e-13);
     PetscCall(PeriProblemDestroy(&p));
@@ -80,14 +80,14 @@ int main(int argc, char **argv)
         PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu = %s: rigid rotation energy / dilatation energy", models[mo], nuv[k]));
         PeriTestClose(what, Erot / Edil, 0, 1e-12);
       } else {
-        const PeriParticles *pt = &p->particles;
-        const PetscReal      E = p->model->material.E, t = pt->thickness, d3 = PetscPowReal(p->delta, 3);
+        const PeriParticles *pt = &p->sys->particles;
+        const PetscReal      E = p->sys->model->material.E, t = pt->thickness, d3 = PetscPowReal(p->sys->delta, 3);
         const PetscReal      g      = 6 * E * (1 - 3 * nu) / (PETSC_PI * t * d3 * (1 - nu * nu));
         PetscReal            expect = 0;
-        for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
-          for (PetscInt b = p->bonds.offset[i - p->bonds.rstart]; b < p->bonds.offset[i - p->bonds.rstart + 1]; b++) {
-            PetscInt j = p->bonds.j[b];
-            expect += 0.5 * p->bonds.alpha[b] * p->bonds.lambda[b] * pt->volume[i] * pt->volume[j] * g * p->bonds.length[b] * w * w;
+        for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++)
+          for (PetscInt b = p->sys->bonds.offset[i - p->sys->bonds.rstart]; b < p->sys->bonds.offset[i - p->sys->bonds.rstart + 1]; b++) {
+            PetscInt j = p->sys->bonds.j[b];
+            expect += 0.5 * p->sys->bonds.alpha[b] * p->sys->bonds.lambda[b] * pt->volume[i] * pt->volume[j] * g * p->sys->bonds.length[b] * w * w;
           }
         PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &expect, 1, MPIU_REAL, MPI_SUM, p->comm));
         PetscCall(PetscSNPrintf(what, sizeof(what), "pds nu = %s: rigid rotation energy / sum of (1/2) W g |xi| w^2 (nonzero: the defect)", nuv[k]));

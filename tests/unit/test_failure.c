@@ -18,25 +18,25 @@ int main(int argc, char **argv)
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   /* the scene: s_c = 0.01, compressive 0.02 */
   meas[0] = 0.005;
-  PeriTestClose("tension index s/s_c", PeriBondFailureIndex(p, &g, meas, NULL), 0.5, 1e-14);
+  PeriTestClose("tension index s/s_c", PeriBondFailureIndex(p->sys, &g, meas, NULL), 0.5, 1e-14);
   meas[0] = 0.012;
-  PeriTestClose("tension index past s_c", PeriBondFailureIndex(p, &g, meas, NULL), 1.2, 1e-14);
+  PeriTestClose("tension index past s_c", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1.2, 1e-14);
   meas[0] = -0.03;
-  PeriTestClose("compression index -s/s_cc", PeriBondFailureIndex(p, &g, meas, NULL), 1.5, 1e-14);
+  PeriTestClose("compression index -s/s_cc", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1.5, 1e-14);
   /* the cut-off piece: held, the rest loaded and solved */
-  PeriTestClose("static solve converged with a held piece", (PetscReal)(p->results.residual_norm < 1e-8), 1, 0);
-  PetscCall(PeriDamage(p, &p->damage));
+  PeriTestClose("static solve converged with a held piece", (PetscReal)(p->sys->results.residual_norm < 1e-8), 1, 0);
+  PetscCall(PeriDamage(p->sys, &p->sys->damage));
   if (p->rank == 0) {
     PetscReal dmax = 0;
-    for (PetscInt i = 0; i < p->particles.n; i++) dmax = PetscMax(dmax, p->damage[(PERI_NCAUSES + 1) * i]);
+    for (PetscInt i = 0; i < p->sys->particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
     PeriTestClose("largest damage of the cut particles in (0, 1)", (PetscReal)(dmax > 0.2 && dmax < 1), 1, 0);
   }
-  PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->results.precracked_bonds > 0), 1, 0);
+  PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->sys->results.precracked_bonds > 0), 1, 0);
   /* G: pmb, plane stress: s_c = sqrt(4 pi G / (9 E delta)) */
-  p->failure.stretch = 0;
-  p->failure.G       = 100;
-  meas[0]            = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->delta));
-  PeriTestClose("pmb plane stress: s at s_c from G gives index 1", PeriBondFailureIndex(p, &g, meas, NULL), 1, 1e-12);
+  p->sys->failure.stretch = 0;
+  p->sys->failure.G       = 100;
+  meas[0]                 = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->sys->delta));
+  PeriTestClose("pmb plane stress: s at s_c from G gives index 1", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1, 1e-12);
   PetscCall(PeriProblemDestroy(&p));
 
   /* sliding and friction (pds): gamma_0 = 0.01; friction 30 degrees, cohesion 0.005 */
@@ -46,15 +46,15 @@ int main(int argc, char **argv)
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   meas[0] = 0;
   meas[1] = -0.008;
-  PeriTestClose("pds sliding index |gamma|/gamma_0", PeriBondFailureIndex(p, &g, meas, NULL), 0.8, 1e-14);
-  p->failure.sliding        = 0;
-  p->failure.friction_angle = 30;
-  p->failure.cohesion       = 0.005;
-  meas[0]                   = -0.004; /* compression raises the limit to a - s tan(beta) */
-  meas[1]                   = 0.006;
-  PeriTestClose("frictional sliding index", PeriBondFailureIndex(p, &g, meas, NULL), 0.006 / (0.005 + 0.004 * PetscTanReal(PETSC_PI / 6)), 1e-14);
+  PeriTestClose("pds sliding index |gamma|/gamma_0", PeriBondFailureIndex(p->sys, &g, meas, NULL), 0.8, 1e-14);
+  p->sys->failure.sliding        = 0;
+  p->sys->failure.friction_angle = 30;
+  p->sys->failure.cohesion       = 0.005;
+  meas[0]                        = -0.004; /* compression raises the limit to a - s tan(beta) */
+  meas[1]                        = 0.006;
+  PeriTestClose("frictional sliding index", PeriBondFailureIndex(p->sys, &g, meas, NULL), 0.006 / (0.005 + 0.004 * PetscTanReal(PETSC_PI / 6)), 1e-14);
   meas[0] = 0.01; /* tension beyond a / tan(beta): no sliding strength left */
-  PeriTestClose("frictional sliding in tension breaks", (PetscReal)(PeriBondFailureIndex(p, &g, meas, NULL) >= 1), 1, 0);
+  PeriTestClose("frictional sliding in tension breaks", (PetscReal)(PeriBondFailureIndex(p->sys, &g, meas, NULL) >= 1), 1, 0);
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriTestSetOption("-model_type", NULL));
   PetscCall(PeriTestSetOption("-material_nu", NULL));
@@ -67,14 +67,14 @@ int main(int argc, char **argv)
     PetscCall(PeriTestSetOption("-analysis_load_factor_max", "0.5"));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
     meas[0] = 2e-3;
-    PeriTestClose("softening share at (s_0 + s_u)/2", PeriBondSoftening(p, meas), 0.5, 1e-14);
-    E1 = p->results.strain_energy;
+    PeriTestClose("softening share at (s_0 + s_u)/2", PeriBondSoftening(p->sys, meas), 0.5, 1e-14);
+    E1 = p->sys->results.strain_energy;
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriTestSetOption("-analysis_load_factor_max", "4"));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
-    E2 = p->results.strain_energy;
+    E2 = p->sys->results.strain_energy;
     if (p->rank == 0)
-      for (PetscInt i = 0; i < p->particles.n; i++) dmax = PetscMax(dmax, p->damage[(PERI_NCAUSES + 1) * i]);
+      for (PetscInt i = 0; i < p->sys->particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
     PetscCallMPI(MPI_Bcast(&dmax, 1, MPIU_REAL, 0, PETSC_COMM_WORLD));
     PeriTestClose("strip below s_0 at load 0.5: nothing softened", (PetscReal)(E1 > 0), 1, 0);
     PeriTestClose("softened strip: energy at load 4 / (64 x energy at load 0.5) below 0.95", (PetscReal)(E2 / (64 * E1) < 0.95), 1, 0);

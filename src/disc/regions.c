@@ -1,5 +1,5 @@
 /* Named regions: boxes, and boundary layers of a given depth along a face of the body. */
-#include "perilin.h"
+#include "perilin/private/disc.h"
 
 static const char *const sides[] = {"x-", "x+", "y-", "y+", "z-", "z+", NULL};
 

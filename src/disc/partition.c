@@ -3,7 +3,7 @@
  * to 1.5 spacings): a horizon of m spacings only adds edges between particles that graph already
  * links through short paths, so it gives the same parts for a fraction of the graph size and search
  * time (docs/performance.md measures both). */
-#include "perilin.h"
+#include "perilin/private/disc.h"
 #include <metis.h>
 
 static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, PetscMPIInt nparts, PetscInt part[])

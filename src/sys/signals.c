@@ -3,7 +3,7 @@
  * KSP convergence test), stop, and write what they have marked "complete": false. mpiexec
  * forwards both signals to every rank as SIGTERM, then kills the ranks after a grace period
  * (Open MPI: odls_base_sigkill_timeout, 1 s by default), so the work after the signal is small. */
-#include "perilin.h"
+#include "perilin/private/sys.h"
 #include <signal.h>
 #include <time.h>
 

@@ -1,6 +1,6 @@
 /* Boundary conditions (prescribed DOFs), loads, and the check that the constraints leave no
  * rigid-body motion free. */
-#include "perilin.h"
+#include "perilin/private/system.h"
 
 /* Translational component of axis a (ux, uy, uz), or -1 when the model has none. */
 static PetscErrorCode AxisComponent(PeriModel m, PetscInt a, PetscInt *c)
@@ -22,23 +22,23 @@ static PetscErrorCode ComponentList(PeriModel m, char buf[], size_t len)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ComponentFromNode(PeriProblem p, PeriNode node, const char name[], PetscInt *c)
+static PetscErrorCode ComponentFromNode(PeriSystem sys, PeriNode node, const char name[], PetscInt *c)
 {
   char list[128];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriModelComponentIndex(p->model, name, c));
-  PetscCall(ComponentList(p->model, list, sizeof(list)));
-  PeriInputCheck(*c >= 0, p->scene, node, NULL, "'%s' is not a component of model %s; its components are: %s", name, p->model->type, list);
+  PetscCall(PeriModelComponentIndex(sys->model, name, c));
+  PetscCall(ComponentList(sys->model, list, sizeof(list)));
+  PeriInputCheck(*c >= 0, sys->scene, node, NULL, "'%s' is not a component of model %s; its components are: %s", name, sys->model->type, list);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* {A: [[..], ..], b: [..]}: a field A X + b with dim rows (b optional). */
-static PetscErrorCode ParseAffine(PeriProblem p, PeriNode node, PetscReal A[3][3], PetscReal b[3])
+static PetscErrorCode ParseAffine(PeriSystem sys, PeriNode node, PetscReal A[3][3], PetscReal b[3])
 {
   static const char *const keys[] = {"A", "b", NULL};
-  PeriScene                s      = p->scene;
-  const PetscInt           dim    = p->particles.dim;
+  PeriScene                s      = sys->scene;
+  const PetscInt           dim    = sys->particles.dim;
   PeriNode                 Anode;
   PetscInt                 n;
 
@@ -53,12 +53,12 @@ static PetscErrorCode ParseAffine(PeriProblem p, PeriNode node, PetscReal A[3][3
 }
 
 /* value[] and set[] over the owned DOFs; later conditions override earlier ones. */
-static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal value[], PetscBool set[])
+static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal value[], PetscBool set[])
 {
   static const char *const keys[] = {"region", "fix", "value", "affine", "optional", NULL};
-  PeriScene                s      = p->scene;
-  PeriModel                m      = p->model;
-  const PetscInt           bs = m->dofs, dim = p->particles.dim;
+  PeriScene                s      = sys->scene;
+  PeriModel                m      = sys->model;
+  const PetscInt           bs = m->dofs, dim = sys->particles.dim;
   PeriRegion              *r;
   PeriNode                 fix, val, aff;
   PetscReal                v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
@@ -69,7 +69,7 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
   PetscFunctionBeginUser;
   PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a boundary condition is a mapping {region: name, fix: [..] | value: {..} | affine: {..}}");
   PetscCall(PeriSceneCheckKeys(s, item, keys));
-  PetscCall(PeriRegionFind(s, item, "region", p->nregions, p->regions, &r));
+  PetscCall(PeriRegionFind(s, item, "region", sys->nregions, sys->regions, &r));
   PetscCall(PeriSceneGetBool(s, item, "optional", &optional, NULL));
   PetscCall(PeriSceneGetNode(item, "fix", &fix));
   PetscCall(PeriSceneGetNode(item, "value", &val));
@@ -82,7 +82,7 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
       PeriInputCheck(fix->child[k]->kind == PERI_NODE_SCALAR, s, fix->child[k], NULL, "must be a component name");
       PetscCall(PeriModelComponentIndex(m, fix->child[k]->value, &c));
       if (c < 0 && optional) continue;
-      PetscCall(ComponentFromNode(p, fix->child[k], fix->child[k]->value, &c));
+      PetscCall(ComponentFromNode(sys, fix->child[k], fix->child[k]->value, &c));
       use[c] = PETSC_TRUE;
       v[c]   = 0;
     }
@@ -92,20 +92,20 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
       PetscInt c;
       PetscCall(PeriModelComponentIndex(m, val->child[k]->key, &c));
       if (c < 0 && optional) continue;
-      PetscCall(ComponentFromNode(p, val->child[k], val->child[k]->key, &c));
+      PetscCall(ComponentFromNode(sys, val->child[k], val->child[k]->key, &c));
       PetscCall(PeriSceneGetReal(s, val, val->child[k]->key, PETSC_TRUE, &v[c], NULL));
       use[c] = PETSC_TRUE;
     }
   } else {
-    PetscCall(ParseAffine(p, aff, A, b0));
+    PetscCall(ParseAffine(sys, aff, A, b0));
     for (PetscInt a = 0; a < dim; a++) {
       PetscCall(AxisComponent(m, a, &axis_comp[a]));
       PeriInputCheck(axis_comp[a] >= 0, s, aff, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + a));
       use[axis_comp[a]] = PETSC_TRUE;
     }
   }
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
-    const PetscReal *X = &p->particles.x[3 * i];
+  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
+    const PetscReal *X = &sys->particles.x[3 * i];
     if (!PeriRegionContains(r, X)) continue;
     if (aff)
       for (PetscInt a = 0; a < dim; a++) {
@@ -114,8 +114,8 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
       }
     for (PetscInt c = 0; c < bs; c++)
       if (use[c]) {
-        value[(i - p->bonds.rstart) * bs + c] = v[c];
-        set[(i - p->bonds.rstart) * bs + c]   = PETSC_TRUE;
+        value[(i - sys->bonds.rstart) * bs + c] = v[c];
+        set[(i - sys->bonds.rstart) * bs + c]   = PETSC_TRUE;
       }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -124,10 +124,10 @@ static PetscErrorCode ApplyCondition(PeriProblem p, PeriNode item, PetscReal val
 /*@C
   PeriBoundarySetUp - reads bc: the owned constrained DOFs (global rows) and their values. Collective.
 @*/
-PetscErrorCode PeriBoundarySetUp(PeriProblem p)
+PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
 {
-  PeriScene      s  = p->scene;
-  const PetscInt bs = p->model->dofs, nloc = (p->bonds.rend - p->bonds.rstart) * bs;
+  PeriScene      s  = sys->scene;
+  const PetscInt bs = sys->model->dofs, nloc = (sys->bonds.rend - sys->bonds.rstart) * bs;
   PeriNode       bc;
   PetscReal     *value;
   PetscBool     *set;
@@ -139,26 +139,26 @@ PetscErrorCode PeriBoundarySetUp(PeriProblem p)
   PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
   PetscCall(PetscCalloc2(nloc, &value, nloc, &set));
   /* a bad condition is an input error, not an exit: free the work arrays before passing it on */
-  for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(p, bc->child[k], value, set);
+  for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(sys, bc->child[k], value, set);
   if (ierr) PetscCall(PetscFree2(value, set));
   PetscCall(ierr);
   for (PetscInt c = 0; c < bs; c++) {
-    if (!p->model->inactive[c]) continue;
-    PetscCall(PetscPrintf(p->comm, "perilin: note: in model %s at nu = %g the shear springs vanish and %s no longer acts on the displacements: it is held at 0\n", p->model->type, (double)p->model->material.nu, p->model->components[c]));
+    if (!sys->model->inactive[c]) continue;
+    PetscCall(PetscPrintf(sys->comm, "perilin: note: in model %s at nu = %g the shear springs vanish and %s no longer acts on the displacements: it is held at 0\n", sys->model->type, (double)sys->model->material.nu, sys->model->components[c]));
     for (PetscInt i = 0; i < nloc / bs; i++) {
       value[i * bs + c] = 0;
       set[i * bs + c]   = PETSC_TRUE;
     }
   }
   for (PetscInt k = 0; k < nloc; k++) n += set[k] ? 1 : 0;
-  p->nconstrained = n;
-  PetscCall(PetscMalloc1(n, &p->constrained));
-  PetscCall(PetscMalloc1(n, &p->constrained_value));
+  sys->nconstrained = n;
+  PetscCall(PetscMalloc1(n, &sys->constrained));
+  PetscCall(PetscMalloc1(n, &sys->constrained_value));
   n = 0;
   for (PetscInt k = 0; k < nloc; k++)
     if (set[k]) {
-      p->constrained[n]       = p->bonds.rstart * bs + k;
-      p->constrained_value[n] = value[k];
+      sys->constrained[n]       = sys->bonds.rstart * bs + k;
+      sys->constrained_value[n] = value[k];
       n++;
     }
   PetscCall(PetscFree2(value, set));
@@ -169,12 +169,12 @@ PetscErrorCode PeriBoundarySetUp(PeriProblem p)
   PeriLoadsAssemble - the load vector from loads: total forces and tractions spread over a
   region's particles in proportion to their volume, and body forces. Collective.
 @*/
-PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
+PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
 {
   static const char *const keys[] = {"region", "force", "traction", "body_force", "traction_field", NULL};
-  PeriScene                s      = p->scene;
-  PeriModel                m      = p->model;
-  const PetscInt           bs = m->dofs, dim = p->particles.dim;
+  PeriScene                s      = sys->scene;
+  PeriModel                m      = sys->model;
+  const PetscInt           bs = m->dofs, dim = sys->particles.dim;
   PeriNode                 loads;
   PetscScalar             *a;
   PetscInt                 ncomp, uz;
@@ -185,7 +185,7 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
   PetscCall(PeriModelComponentIndex(m, "uz", &uz));
   ncomp = dim == 2 && uz >= 0 ? 3 : dim;
   PetscCall(VecSet(f, 0));
-  PetscCall(PeriTorsionLoads(p, f));
+  PetscCall(PeriTorsionLoads(sys, f));
   PetscCall(PeriSceneGetNode(s->root, "loads", &loads));
   if (!loads) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(loads->kind == PERI_NODE_SEQ, s, loads, NULL, "must be a list of loads, each {region: .., force: [..]}");
@@ -197,14 +197,14 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
     PetscInt    n, comp[3]            = {-1, -1, -1};
     PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force | traction_field: ..}");
     PetscCall(PeriSceneCheckKeys(s, item, keys));
-    PetscCall(PeriRegionFind(s, item, "region", p->nregions, p->regions, &r));
+    PetscCall(PeriRegionFind(s, item, "region", sys->nregions, sys->regions, &r));
     PetscCall(PeriSceneGetNode(item, "force", &force));
     PetscCall(PeriSceneGetNode(item, "traction", &traction));
     PetscCall(PeriSceneGetNode(item, "body_force", &body));
     PetscCall(PeriSceneGetNode(item, "traction_field", &field));
     PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) + (field ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force, traction_field");
     if (field)
-      PetscCall(ParseAffine(p, field, A, F));
+      PetscCall(ParseAffine(sys, field, A, F));
     else
       PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
                                                                           : "body_force",
@@ -217,25 +217,25 @@ PetscErrorCode PeriLoadsAssemble(PeriProblem p, Vec f)
       PeriInputCheck(comp[d] >= 0 || (F[d] == 0 && A[d][0] == 0 && A[d][1] == 0 && A[d][2] == 0), s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
     }
     largest = 0;
-    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
-      const PetscReal *X = &p->particles.x[3 * i];
+    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
+      const PetscReal *X = &sys->particles.x[3 * i];
       if (!PeriRegionContains(r, X)) continue;
       for (PetscInt d = 0; d < ncomp; d++) {
         PetscReal v = F[d];
         for (PetscInt e = 0; e < dim; e++) v += A[d][e] * X[e];
         if (comp[d] < 0) continue;
-        v *= scale * p->particles.volume[i];
-        a[(i - p->bonds.rstart) * bs + comp[d]] += v;
+        v *= scale * sys->particles.volume[i];
+        a[(i - sys->bonds.rstart) * bs + comp[d]] += v;
         /* NaN must fail the check below, so it counts as infinitely large */
         largest = PetscIsInfOrNanReal(v) ? PETSC_INFINITY : PetscMax(largest, PetscAbsReal(v));
       }
     }
     /* Finite but huge values (1e308) overflow the solver's inner products, which then stops with
        a NaN residual that blames the operator; say here that the load is at fault. */
-    PetscCallMPI(MPIU_Allreduce(MPI_IN_PLACE, &largest, 1, MPIU_REAL, MPIU_MAX, p->comm));
-    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(p->particles.n * bs)), s, item, field ? "traction_field" : force  ? "force"
-                                                                                                                               : traction ? "traction"
-                                                                                                                                          : "body_force",
+    PetscCallMPI(MPIU_Allreduce(MPI_IN_PLACE, &largest, 1, MPIU_REAL, MPIU_MAX, sys->comm));
+    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(sys->particles.n * bs)), s, item, field ? "traction_field" : force  ? "force"
+                                                                                                                                 : traction ? "traction"
+                                                                                                                                            : "body_force",
                    "the load is too large for double precision: a particle force of %g overflows the solver's inner products (keep particle forces below about 1e150)", (double)largest);
   }
   PetscCall(VecRestoreArray(f, &a));
@@ -285,13 +285,13 @@ static void SymmetricEigen(PetscInt n, PetscReal A[PERI_MAX_MODES][PERI_MAX_MODE
   fictitious layers leave free (K is singular when any is), the main motion of the first, named,
   and (when free is not NULL) those combinations as orthonormal vectors, created here. Collective.
 @*/
-PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], size_t len, Vec free[])
+PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[], size_t len, Vec free[])
 {
   static const char *const names1[] = {"translation along z"};
   static const char *const names2[] = {"translation along x", "translation along y", "rotation about z"};
   static const char *const names3[] = {"translation along x", "translation along y", "translation along z", "rotation about x", "rotation about y", "rotation about z"};
-  const PeriParticles     *pt       = &p->particles;
-  PeriModel                m        = p->model;
+  const PeriParticles     *pt       = &sys->particles;
+  PeriModel                m        = sys->model;
   Vec                      modes[PERI_MAX_MODES];
   PetscInt                 nm;
   PetscReal                G[PERI_MAX_MODES][PERI_MAX_MODES] = {{0}}, V[PERI_MAX_MODES][PERI_MAX_MODES], w[PERI_MAX_MODES], norm[PERI_MAX_MODES];
@@ -299,28 +299,28 @@ PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], 
   PetscInt                 rstart;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriRigidModes(p, &nm, modes, norm));
+  PetscCall(PeriRigidModes(sys, &nm, modes, norm));
   PetscCall(VecGetOwnershipRange(modes[0], &rstart, NULL));
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecGetArrayRead(modes[k], &a[k]));
-  for (PetscInt c = 0; c < p->nconstrained; c++) {
-    PetscInt row = p->constrained[c] - rstart;
+  for (PetscInt c = 0; c < sys->nconstrained; c++) {
+    PetscInt row = sys->constrained[c] - rstart;
     for (PetscInt k = 0; k < nm; k++)
       for (PetscInt l = 0; l < nm; l++) G[k][l] += PetscRealPart(a[k][row] * a[l][row]);
   }
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecRestoreArrayRead(modes[k], &a[k]));
-  if (p->layers.T) {
+  if (sys->layers.T) {
     /* a fictitious particle's relation u_f = s u_m + o holds a mode v unless v_f = s v_m */
     PetscReal centre[3], X[3], vf[PERI_MAX_MODES][PERI_MAX_DOF], vm[PERI_MAX_MODES][PERI_MAX_DOF];
     for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
-    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++) {
+    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
       PetscInt           mi = pt->image ? pt->image[i] : -1, ncols;
       const PetscInt    *cols;
       const PetscScalar *vals;
       PetscReal          sign;
       if (mi < 0) continue;
-      PetscCall(MatGetRow(p->layers.T, i, &ncols, &cols, &vals));
+      PetscCall(MatGetRow(sys->layers.T, i, &ncols, &cols, &vals));
       sign = PetscRealPart(vals[0]);
-      PetscCall(MatRestoreRow(p->layers.T, i, &ncols, &cols, &vals));
+      PetscCall(MatRestoreRow(sys->layers.T, i, &ncols, &cols, &vals));
       for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
       m->ops.rigid_modes(m, X, vf);
       for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * mi + d] - centre[d];
@@ -330,7 +330,7 @@ PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], 
           for (PetscInt l = 0; l < nm; l++) G[k][l] += (vf[k][c] - sign * vm[k][c]) * (vf[l][c] - sign * vm[l][c]) / (norm[k] * norm[l]);
     }
   }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, G, PERI_MAX_MODES * PERI_MAX_MODES, MPIU_REAL, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, G, PERI_MAX_MODES * PERI_MAX_MODES, MPIU_REAL, MPI_SUM, sys->comm));
   /* G holds sums of squares of unit vectors' entries: a free motion gives an eigenvalue of about
    * round-off; one constrained particle already gives ~1/N */
   SymmetricEigen(nm, G, w, V);
@@ -338,7 +338,7 @@ PetscErrorCode PeriRigidMotionFree(PeriProblem p, PetscInt *nfree, char what[], 
   if (what) what[0] = 0;
   for (PetscInt k = 0; k < nm; k++) {
     PetscInt best = 0;
-    if (w[k] > 1e-12 / p->particles.n) continue;
+    if (w[k] > 1e-12 / sys->particles.n) continue;
     if (free) {
       PetscCall(VecDuplicate(modes[0], &free[*nfree]));
       PetscCall(VecZeroEntries(free[*nfree]));

@@ -1,6 +1,6 @@
 /* Neighbour search with cell lists: O(N), periodic axes by explicit images (a short periodic
  * axis gives several bonds to images of the same particle, as the continuum would). */
-#include "perilin.h"
+#include "perilin/private/disc.h"
 
 const char *const PeriPartialVolumes[] = {"none", "linear", "linear_continued", NULL};
 

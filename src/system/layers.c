@@ -9,14 +9,14 @@
  * the traction-free conditions tau_xz = mu (u_z,x - psi (y - y0)) = 0, tau_yz = mu (u_z,y + psi (x - x0)) = 0.
  * The relations u = T u_body + g are eliminated from the static system: A = R K T (R keeps the
  * body's rows), which is symmetric for mirror images on a uniform grid (checked at run time). */
-#include "perilin.h"
+#include "perilin/private/system.h"
 
 const char *const PeriLayerKinds[] = {"none", "displacement", "shear_stress", "free", NULL};
 
-static PetscErrorCode ReadTorsion(PeriProblem p)
+static PetscErrorCode ReadTorsion(PeriSystem sys)
 {
   static const char *const keys[] = {"twist", "center", NULL};
-  PeriScene                s      = p->scene;
+  PeriScene                s      = sys->scene;
   PeriNode                 t;
   PetscInt                 n;
 
@@ -24,23 +24,23 @@ static PetscErrorCode ReadTorsion(PeriProblem p)
   PetscCall(PeriSceneGetMap(s, s->root, "torsion", PETSC_FALSE, &t));
   if (!t) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckKeys(s, t, keys));
-  PeriInputCheck(p->model->antiplane, s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", p->model->type);
-  PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &p->torsion.twist, NULL));
-  PeriInputCheck(p->torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
-  p->torsion.center[0] = 0.5 * (p->particles.lower[0] + p->particles.upper[0]);
-  p->torsion.center[1] = 0.5 * (p->particles.lower[1] + p->particles.upper[1]);
-  PetscCall(PeriSceneGetRealArray(s, t, "center", PETSC_FALSE, 2, 2, p->torsion.center, &n));
-  p->torsion.active = PETSC_TRUE;
+  PeriInputCheck(sys->model->antiplane, s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", sys->model->type);
+  PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &sys->torsion.twist, NULL));
+  PeriInputCheck(sys->torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
+  sys->torsion.center[0] = 0.5 * (sys->particles.lower[0] + sys->particles.upper[0]);
+  sys->torsion.center[1] = 0.5 * (sys->particles.lower[1] + sys->particles.upper[1]);
+  PetscCall(PeriSceneGetRealArray(s, t, "center", PETSC_FALSE, 2, 2, sys->torsion.center, &n));
+  sys->torsion.active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Fictitious cells beyond a face: those a body particle can bond to. A state-based particle's
  * force also involves its neighbours' shear angles, so there the layer is twice as deep: every
  * fictitious particle that a body particle bonds to has a complete family. */
-static PetscInt LayerCells(PeriProblem p, PetscReal h)
+static PetscInt LayerCells(PeriSystem sys, PetscReal h)
 {
-  PetscReal R = PeriSearchRadius(p->partial_volume, p->delta, h);
-  return (p->model->ops.family_stiffness ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
+  PetscReal R = PeriSearchRadius(sys->partial_volume, sys->delta, h);
+  return (sys->model->ops.family_stiffness ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
 }
 
 /*@C
@@ -48,28 +48,28 @@ static PetscInt LayerCells(PeriProblem p, PetscReal h)
   (with their mirror images) to the grid's particles. Call after the horizon and the corrections
   are known, before partitioning. Not collective.
 @*/
-PetscErrorCode PeriLayersAddParticles(PeriProblem p)
+PetscErrorCode PeriLayersAddParticles(PeriSystem sys)
 {
   static const char *const keys[]  = {"side", "condition", "value", NULL};
   static const char *const sides[] = {"x-", "x+", "y-", "y+", NULL};
-  PeriScene                s       = p->scene;
-  PeriParticles           *pt      = &p->particles;
-  PeriLayers              *L       = &p->layers;
+  PeriScene                s       = sys->scene;
+  PeriParticles           *pt      = &sys->particles;
+  PeriLayers              *L       = &sys->layers;
   PeriNode                 list, grid;
   PetscInt                 cells[2], lo[2] = {0, 0}, hi[2] = {0, 0}, nl, n, k;
   PetscReal                h;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadTorsion(p));
+  PetscCall(ReadTorsion(sys));
   PetscCall(PeriSceneGetNode(s->root, "boundary_layers", &list));
   if (!list) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(list->kind == PERI_NODE_SEQ && list->n > 0, s, list, NULL, "must be a list of layers, each {side: x-|x+|y-|y+, condition: displacement|shear_stress|free, value: ..}");
-  PeriInputCheck(p->model->antiplane, s, list, NULL, "fictitious layers carry the conditions of the cross-section models (antiplane, antiplane_os); for model %s use bc and loads", p->model->type);
+  PeriInputCheck(sys->model->antiplane, s, list, NULL, "fictitious layers carry the conditions of the cross-section models (antiplane, antiplane_os); for model %s use bc and loads", sys->model->type);
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(grid, s, list, NULL, "need a grid body (grid:), whose faces the layers mirror; particles.file is not supported");
   h = pt->mean_spacing;
   for (PetscInt d = 0; d < 2; d++) cells[d] = (PetscInt)PetscFloorReal((pt->upper[d] - pt->lower[d]) / h + 0.5);
-  nl = LayerCells(p, h);
+  nl = LayerCells(sys, h);
   for (PetscInt i = 0; i < list->n; i++) {
     PeriNode  item = list->child[i];
     PetscInt  side = 0, kind = 0, face;
@@ -147,9 +147,9 @@ PetscErrorCode PeriLayersAddParticles(PeriProblem p)
 }
 
 /* The relation u(X) = sign u(Y) + offset across one face: Y is X mirrored through it. */
-static void FaceRelation(PeriProblem p, PetscInt face, const PetscReal X[], const PetscReal Y[], PetscReal mu, PetscReal *sign, PetscReal *offset)
+static void FaceRelation(PeriSystem sys, PetscInt face, const PetscReal X[], const PetscReal Y[], PetscReal mu, PetscReal *sign, PetscReal *offset)
 {
-  const PeriLayers *L    = &p->layers;
+  const PeriLayers *L    = &sys->layers;
   const PetscInt    a    = face / 2;
   PetscReal         grad = 0;
 
@@ -159,7 +159,7 @@ static void FaceRelation(PeriProblem p, PetscInt face, const PetscReal X[], cons
     return;
   }
   if (L->kind[face] == PERI_LAYER_SHEAR_STRESS) grad = L->value[face] / mu;
-  if (p->torsion.active) grad += a == 0 ? p->torsion.twist * (X[1] - p->torsion.center[1]) : -p->torsion.twist * (X[0] - p->torsion.center[0]);
+  if (sys->torsion.active) grad += a == 0 ? sys->torsion.twist * (X[1] - sys->torsion.center[1]) : -sys->torsion.twist * (X[0] - sys->torsion.center[0]);
   *sign   = 1;
   *offset = grad * (X[a] - Y[a]);
 }
@@ -169,16 +169,16 @@ static void FaceRelation(PeriProblem p, PetscInt face, const PetscReal X[], cons
   matrix T and the offsets g of u = T u_body + g. Call after calibration (the shear moduli).
   Collective.
 @*/
-PetscErrorCode PeriLayersSetUp(PeriProblem p)
+PetscErrorCode PeriLayersSetUp(PeriSystem sys)
 {
-  const PeriParticles *pt     = &p->particles;
-  PeriLayers          *L      = &p->layers;
-  const PetscInt       rstart = p->bonds.rstart, rend = p->bonds.rend;
+  const PeriParticles *pt     = &sys->particles;
+  PeriLayers          *L      = &sys->layers;
+  const PetscInt       rstart = sys->bonds.rstart, rend = sys->bonds.rend;
 
   PetscFunctionBeginUser;
   if (!L->nfaces) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(MatCreateAIJ(p->comm, rend - rstart, rend - rstart, pt->n, pt->n, 1, NULL, 1, NULL, &L->T));
-  PetscCall(PeriProblemCreateVec(p, &L->g));
+  PetscCall(MatCreateAIJ(sys->comm, rend - rstart, rend - rstart, pt->n, pt->n, 1, NULL, 1, NULL, &L->T));
+  PetscCall(PeriSystemCreateVec(sys, &L->g));
   for (PetscInt i = rstart; i < rend; i++) {
     PetscInt    m = pt->image[i], faces[2], nf = 0;
     PetscReal   sign = 1, offset = 0, mu;
@@ -187,11 +187,11 @@ PetscErrorCode PeriLayersSetUp(PeriProblem p)
       PetscCall(MatSetValue(L->T, i, i, 1.0, INSERT_VALUES));
       continue;
     }
-    mu = p->mu ? p->mu[m] : p->model->material.G;
+    mu = sys->mu ? sys->mu[m] : sys->model->material.G;
     for (PetscInt f = 0; f < 4; f++)
       if (pt->crossed[i] & (1 << f)) faces[nf++] = f;
     if (nf == 1)
-      FaceRelation(p, faces[0], &pt->x[3 * i], &pt->x[3 * m], mu, &sign, &offset);
+      FaceRelation(sys, faces[0], &pt->x[3 * i], &pt->x[3 * m], mu, &sign, &offset);
     else {
       /* a corner: through one face to an intermediate image, then through the other; the two
          orders differ in the twist term, so take their mean */
@@ -200,8 +200,8 @@ PetscErrorCode PeriLayersSetUp(PeriProblem p)
         PetscReal Y[3], s1, o1, s2, o2;
         for (PetscInt d = 0; d < 3; d++) Y[d] = pt->x[3 * i + d];
         Y[a1] = pt->x[3 * m + a1];
-        FaceRelation(p, f1, &pt->x[3 * i], Y, mu, &s1, &o1);
-        FaceRelation(p, f2, Y, &pt->x[3 * m], mu, &s2, &o2);
+        FaceRelation(sys, f1, &pt->x[3 * i], Y, mu, &s1, &o1);
+        FaceRelation(sys, f2, Y, &pt->x[3 * m], mu, &s2, &o2);
         sign = s1 * s2;
         offset += 0.5 * (o1 + s1 * o2);
       }
@@ -222,11 +222,11 @@ PetscErrorCode PeriLayersSetUp(PeriProblem p)
   DOFs (scaled by the mean diagonal), f <- R (f - lambda K g) (lambda scales the conditions). Sets MAT_SYMMETRIC from a check of A.
   Collective.
 @*/
-PetscErrorCode PeriLayersApply(PeriProblem p, PetscReal lambda, Mat *A, Vec f)
+PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
 {
-  const PeriParticles *pt = &p->particles;
-  PeriLayers          *L  = &p->layers;
-  Mat                  K = p->K, Kaij = NULL;
+  const PeriParticles *pt = &sys->particles;
+  PeriLayers          *L  = &sys->layers;
+  Mat                  K = sys->K, Kaij = NULL;
   Vec                  w;
   PetscInt            *rows, nf = 0, N;
   PetscReal            diag, kmax;
@@ -248,8 +248,8 @@ PetscErrorCode PeriLayersApply(PeriProblem p, PetscReal lambda, Mat *A, Vec f)
   diag /= N;
   PetscCall(VecDestroy(&w));
   PetscCall(MatDestroy(&Kaij));
-  PetscCall(PetscMalloc1(p->bonds.rend - p->bonds.rstart, &rows));
-  for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
+  PetscCall(PetscMalloc1(sys->bonds.rend - sys->bonds.rstart, &rows));
+  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
     if (PeriParticleIsFictitious(pt, i)) rows[nf++] = i;
   PetscCall(MatZeroRows(*A, nf, rows, diag, NULL, NULL));
   for (PetscInt k = 0; k < nf; k++) PetscCall(VecSetValue(f, rows[k], 0.0, INSERT_VALUES));
@@ -259,20 +259,20 @@ PetscErrorCode PeriLayersApply(PeriProblem p, PetscReal lambda, Mat *A, Vec f)
   PetscCall(MatNorm(*A, NORM_INFINITY, &kmax));
   PetscCall(MatIsSymmetric(*A, 1e-12 * kmax, &sym));
   PetscCall(MatSetOption(*A, MAT_SYMMETRIC, sym));
-  p->results.symmetric = sym;
+  sys->results.symmetric = sym;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* u <- T u + lambda g: the fictitious DOFs from their images. Collective. */
-PetscErrorCode PeriLayersComplete(PeriProblem p, PetscReal lambda, Vec u)
+PetscErrorCode PeriLayersComplete(PeriSystem sys, PetscReal lambda, Vec u)
 {
   Vec t;
 
   PetscFunctionBeginUser;
-  if (!p->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecDuplicate(u, &t));
-  PetscCall(MatMult(p->layers.T, u, t));
-  PetscCall(VecWAXPY(u, lambda, p->layers.g, t));
+  PetscCall(MatMult(sys->layers.T, u, t));
+  PetscCall(VecWAXPY(u, lambda, sys->layers.g, t));
   PetscCall(VecDestroy(&t));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -292,22 +292,22 @@ PetscErrorCode PeriLayersDestroy(PeriLayers *L)
   family for state-based models. Free faces and crack faces are then natural PD free surfaces,
   traction-free with the twist. Adds to f (owned rows, and others through the stash). Collective.
 @*/
-PetscErrorCode PeriTorsionLoads(PeriProblem p, Vec f)
+PetscErrorCode PeriTorsionLoads(PeriSystem sys, Vec f)
 {
-  const PeriParticles *pt  = &p->particles;
-  PeriModel            m   = p->model;
-  const PetscReal      psi = p->torsion.twist, *c = p->torsion.center;
+  const PeriParticles *pt  = &sys->particles;
+  PeriModel            m   = sys->model;
+  const PetscReal      psi = sys->torsion.twist, *c = sys->torsion.center;
 
   PetscFunctionBeginUser;
-  if (!p->torsion.active || p->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->torsion.active || sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
   if (m->ops.family_stiffness) {
-    PetscInt          nmax = PeriProblemMaxFamily(p), n;
+    PetscInt          nmax = PeriSystemMaxFamily(sys), n;
     PeriBondGeometry *fam;
     PetscReal        *Ke, *e, *fe;
     PetscInt         *idx;
     PetscCall(PetscMalloc5(nmax, &fam, PetscSqr(nmax + 1), &Ke, nmax + 1, &e, nmax + 1, &fe, nmax + 1, &idx));
-    for (PetscInt i = p->family.rstart; i < p->family.rend; i++) {
-      PetscCall(PeriProblemFamilyGeometry(p, i, &n, fam));
+    for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
+      PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
       PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
       e[0]   = 0;
       idx[0] = i;
@@ -324,13 +324,13 @@ PetscErrorCode PeriTorsionLoads(PeriProblem p, Vec f)
     }
     PetscCall(PetscFree5(fam, Ke, e, fe, idx));
   } else {
-    for (PetscInt i = p->bonds.rstart; i < p->bonds.rend; i++)
-      for (PetscInt k = p->bonds.offset[i - p->bonds.rstart]; k < p->bonds.offset[i - p->bonds.rstart + 1]; k++) {
+    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
+      for (PetscInt k = sys->bonds.offset[i - sys->bonds.rstart]; k < sys->bonds.offset[i - sys->bonds.rstart + 1]; k++) {
         PeriBondGeometry g;
         PetscReal        Ke[4], e0, fe[2];
         PetscInt         idx[2];
-        if (!p->bonds.live[k] || p->bonds.j[k] == i) continue;
-        PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+        if (!sys->bonds.live[k] || sys->bonds.j[k] == i) continue;
+        PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
         m->ops.bond_stiffness(m, &g, Ke);
         e0     = psi * ((pt->x[3 * i] - c[0]) * (pt->x[3 * g.j + 1] - c[1]) - (pt->x[3 * g.j] - c[0]) * (pt->x[3 * i + 1] - c[1]));
         fe[0]  = -Ke[1] * e0;
@@ -354,30 +354,30 @@ static PetscReal RectangleTorsionConstant(PetscReal A, PetscReal B)
 }
 
 /*@C
-  PeriTorsionEvaluate - from the shear stresses p->tau (rank 0): the torque per unit length
+  PeriTorsionEvaluate - from the shear stresses sys->tau (rank 0): the torque per unit length
   T = sum (x tau_yz - y tau_xz) A over the body's particles (A = V / l), the torsion constant
   J = T / (mu psi), the largest stress |tau| and where. Not collective (rank 0 has the fields).
 @*/
-PetscErrorCode PeriTorsionEvaluate(PeriProblem p)
+PetscErrorCode PeriTorsionEvaluate(PeriSystem sys)
 {
-  const PeriParticles *pt = &p->particles;
-  PeriTorsion         *t  = &p->torsion;
+  const PeriParticles *pt = &sys->particles;
+  PeriTorsion         *t  = &sys->torsion;
 
   PetscFunctionBeginUser;
-  if (!t->active || !p->tau) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!t->active || !sys->tau) PetscFunctionReturn(PETSC_SUCCESS);
   t->torque = t->max_stress = 0;
   for (PetscInt i = 0; i < pt->n; i++) {
     PetscReal x = pt->x[3 * i] - t->center[0], y = pt->x[3 * i + 1] - t->center[1], tau;
     if (PeriParticleIsFictitious(pt, i)) continue;
-    t->torque += (x * p->tau[3 * i + 1] - y * p->tau[3 * i]) * pt->volume[i] / pt->thickness;
-    tau = p->tau[3 * i + 2];
+    t->torque += (x * sys->tau[3 * i + 1] - y * sys->tau[3 * i]) * pt->volume[i] / pt->thickness;
+    tau = sys->tau[3 * i + 2];
     if (tau > t->max_stress) {
       t->max_stress = tau;
       t->max_at[0]  = pt->x[3 * i];
       t->max_at[1]  = pt->x[3 * i + 1];
     }
   }
-  t->J           = t->torque / (p->model->material.G * t->twist);
+  t->J           = t->torque / (sys->model->material.G * t->twist);
   t->J_rectangle = RectangleTorsionConstant(pt->upper[0] - pt->lower[0], pt->upper[1] - pt->lower[1]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

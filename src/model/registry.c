@@ -1,14 +1,14 @@
 /* Registers the built-in models of models/list.h. Only PeriInitializePackage calls this;
  * src/model.c holds the list it fills and never calls back here. */
-#include "perilin.h"
+#include "perilin/private/model.h"
 
 #define PERI_MODEL(id) extern const PeriModelType PeriModel_##id;
-#include "list.h"
+#include "../../models/list.h"
 #undef PERI_MODEL
 
 static const PeriModelType *const builtin[] = {
 #define PERI_MODEL(id) &PeriModel_##id,
-#include "list.h"
+#include "../../models/list.h"
 #undef PERI_MODEL
 };
 

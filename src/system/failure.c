@@ -2,7 +2,7 @@
  * particle and the connected pieces of the body. Sources: Ganzenmueller sec. 3.2 and Diehl &
  * Schweitzer (critical stretch from G), Diana & Casolo eqs. 44-58 (tension, compression, sliding,
  * friction), Oterkus & Madenci eqs. 70, 78-79 (critical shear angle, damage). docs/failure.md. */
-#include "perilin.h"
+#include "perilin/private/system.h"
 
 const char *const PeriFailureCauses[] = {"crack", "tension", "compression", "sliding", "shear_angle", NULL};
 
@@ -10,12 +10,12 @@ const char *const PeriFailureCauses[] = {"crack", "tension", "compression", "sli
   PeriFailureSetUp - reads failure: and checks each criterion against the model's measures.
   Not collective.
 @*/
-PetscErrorCode PeriFailureSetUp(PeriProblem p)
+PetscErrorCode PeriFailureSetUp(PeriSystem sys)
 {
   static const char *const keys[] = {"critical_stretch", "G", "compressive_stretch", "sliding", "friction_angle", "cohesion", "shear_angle", "ultimate_stretch", "ultimate_compressive_stretch", NULL};
-  PeriScene                s      = p->scene;
-  PeriFailure             *F      = &p->failure;
-  PeriModel                m      = p->model;
+  PeriScene                s      = sys->scene;
+  PeriFailure             *F      = &sys->failure;
+  PeriModel                m      = sys->model;
   PeriNode                 node;
   PetscBool                has[9];
   PetscReal               *val[9] = {&F->stretch, &F->G, &F->compressive, &F->sliding, &F->friction_angle, &F->cohesion, &F->shear_angle, &F->ultimate, &F->ultimate_compressive};
@@ -46,10 +46,10 @@ PetscErrorCode PeriFailureSetUp(PeriProblem p)
   PeriInputCheck(!has[4] || F->friction_angle < 90, s, node, "friction_angle", "must lie in (0, 90) degrees, got %g", (double)F->friction_angle);
   PeriInputCheck(!has[7] || (has[0] && F->ultimate > F->stretch), s, node, "ultimate_stretch", "softening needs critical_stretch (where it starts) below ultimate_stretch (where the bond is gone)");
   PeriInputCheck(!has[8] || (has[2] && F->ultimate_compressive > F->compressive), s, node, "ultimate_compressive_stretch", "softening needs compressive_stretch below ultimate_compressive_stretch");
-  PetscCall(PetscCalloc1(p->bonds.nbonds, &p->bonds.cause));
+  PetscCall(PetscCalloc1(sys->bonds.nbonds, &sys->bonds.cause));
   if (has[7] || has[8]) {
-    PetscCall(PetscMalloc1(p->bonds.nbonds, &p->bonds.intact));
-    for (PetscInt k = 0; k < p->bonds.nbonds; k++) p->bonds.intact[k] = 1;
+    PetscCall(PetscMalloc1(sys->bonds.nbonds, &sys->bonds.intact));
+    for (PetscInt k = 0; k < sys->bonds.nbonds; k++) sys->bonds.intact[k] = 1;
   }
   F->active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -107,10 +107,10 @@ static PetscBool SegmentMeetsBox(const PetscReal s[], const PetscReal lo[], cons
   PeriCracksApply - reads cracks: (2D segments {from: [x, y], to: [x, y]}) and removes every bond
   that crosses one, before the family volumes and the calibration see the body. Collective.
 @*/
-PetscErrorCode PeriCracksApply(PeriProblem p)
+PetscErrorCode PeriCracksApply(PeriSystem sys)
 {
   static const char *const keys[] = {"from", "to", NULL};
-  PeriScene                s      = p->scene;
+  PeriScene                s      = sys->scene;
   PeriNode                 list;
   PetscReal               *seg;
   PetscInt                 cut, n;
@@ -119,7 +119,7 @@ PetscErrorCode PeriCracksApply(PeriProblem p)
   PetscCall(PeriSceneGetNode(s->root, "cracks", &list));
   if (!list) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(list->kind == PERI_NODE_SEQ, s, list, NULL, "must be a list of segments, each {from: [x, y], to: [x, y]}");
-  PeriInputCheck(p->particles.dim == 2, s, list, NULL, "cracks are 2D segments; 3D scenes cannot have them yet");
+  PeriInputCheck(sys->particles.dim == 2, s, list, NULL, "cracks are 2D segments; 3D scenes cannot have them yet");
   PetscCall(PetscMalloc1(4 * list->n, &seg));
   for (PetscInt c = 0; c < list->n; c++) {
     PeriNode item = list->child[c];
@@ -128,13 +128,13 @@ PetscErrorCode PeriCracksApply(PeriProblem p)
     PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
     PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
     PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");
-    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], p->particles.lower, p->particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)p->particles.lower[0], (double)p->particles.upper[0], (double)p->particles.lower[1], (double)p->particles.upper[1]);
+    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], sys->particles.lower, sys->particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)sys->particles.lower[0], (double)sys->particles.upper[0], (double)sys->particles.lower[1], (double)sys->particles.upper[1]);
   }
-  cut = CutBonds(&p->particles, &p->bonds, list->n, seg);
-  if (p->family.offset) CutBonds(&p->particles, &p->family, list->n, seg);
+  cut = CutBonds(&sys->particles, &sys->bonds, list->n, seg);
+  if (sys->family.offset) CutBonds(&sys->particles, &sys->family, list->n, seg);
   PetscCall(PetscFree(seg));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, p->comm));
-  p->results.precracked_bonds = cut;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, sys->comm));
+  sys->results.precracked_bonds = cut;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -144,13 +144,13 @@ PetscErrorCode PeriCracksApply(PeriProblem p)
   |r|/r_c; the bond breaks when it reaches 1. meas[] are the model's measures; cause (may be NULL)
   gets the criterion that gave the index. Not collective.
 @*/
-PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause)
+PetscReal PeriBondFailureIndex(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause)
 {
-  const PeriFailure *F   = &p->failure;
+  const PeriFailure *F   = &sys->failure;
   PetscReal          idx = 0, crit = 0;
   PeriFailureCause   c = PERI_CAUSE_CRACK;
 
-  if (F->G > 0) crit = p->model->ops.critical_from_G(p->model, g, F->G);
+  if (F->G > 0) crit = sys->model->ops.critical_from_G(sys->model, g, F->G);
   if (F->istretch >= 0) {
     /* with softening the bond is gone at the ultimate stretch; before, PeriBondSoftening weakens it */
     PetscReal s = meas[F->istretch], sc = F->ultimate > 0 ? F->ultimate : F->stretch > 0 ? F->stretch
@@ -194,9 +194,9 @@ PetscReal PeriBondFailureIndex(PeriProblem p, const PeriBondGeometry *g, const P
   45-46): 1 below the critical stretch, falling linearly to 0 at the ultimate stretch, in tension
   and (when given) in compression. Not collective.
 @*/
-PetscReal PeriBondSoftening(PeriProblem p, const PetscReal meas[])
+PetscReal PeriBondSoftening(PeriSystem sys, const PetscReal meas[])
 {
-  const PeriFailure *F = &p->failure;
+  const PeriFailure *F = &sys->failure;
   PetscReal          s = F->istretch >= 0 ? meas[F->istretch] : 0, mu = 1;
 
   if (F->ultimate > 0 && s > F->stretch) mu = PetscMax(0, (F->ultimate - s) / (F->ultimate - F->stretch));
@@ -210,10 +210,10 @@ PetscReal PeriBondSoftening(PeriProblem p, const PetscReal meas[])
   criterion (Diana & Casolo eqs. 47, 48, 51) the share of the family lost to it. Rank 0 gets
   PERI_NCAUSES + 1 values per particle: the total, then one per PeriFailureCause. Collective.
 @*/
-PetscErrorCode PeriDamage(PeriProblem p, PetscReal **damage)
+PetscErrorCode PeriDamage(PeriSystem sys, PetscReal **damage)
 {
-  const PeriBonds     *b  = &p->bonds;
-  const PeriParticles *pt = &p->particles;
+  const PeriBonds     *b  = &sys->bonds;
+  const PeriParticles *pt = &sys->particles;
   const PetscInt       w  = PERI_NCAUSES + 2; /* all, live, then the lost share per cause */
   PetscReal           *acc;
 
@@ -230,9 +230,9 @@ PetscErrorCode PeriDamage(PeriProblem p, PetscReal **damage)
         a[2 + (b->cause ? b->cause[k] : 0)] += (1 - left) * V;
       }
     }
-  PetscCallMPI(MPI_Reduce(p->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(w * pt->n), MPIU_REAL, MPI_SUM, 0, p->comm));
+  PetscCallMPI(MPI_Reduce(sys->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(w * pt->n), MPIU_REAL, MPI_SUM, 0, sys->comm));
   PetscCall(PetscFree(*damage));
-  if (p->rank == 0) {
+  if (sys->rank == 0) {
     PetscCall(PetscMalloc1((PERI_NCAUSES + 1) * pt->n, damage));
     for (PetscInt i = 0; i < pt->n; i++) {
       const PetscReal *a                = &acc[w * i];
@@ -252,15 +252,15 @@ static int ComparePair(const void *a, const void *b)
 }
 
 /*@C
-  PeriFamilySync - state-based models keep each particle's whole family (p->family, both
-  directions); this marks dead every family entry whose bond is dead in p->bonds (stored once, at
+  PeriFamilySync - state-based models keep each particle's whole family (sys->family, both
+  directions); this marks dead every family entry whose bond is dead in sys->bonds (stored once, at
   the smaller index, possibly on another rank): the dead pairs are gathered on every rank.
   Collective.
 @*/
-PetscErrorCode PeriFamilySync(PeriProblem p)
+PetscErrorCode PeriFamilySync(PeriSystem sys)
 {
-  const PeriBonds *b = &p->bonds;
-  PeriBonds       *F = &p->family;
+  const PeriBonds *b = &sys->bonds;
+  PeriBonds       *F = &sys->family;
   PetscInt        *mine, *all, nmine = 0, nall;
   PetscMPIInt      n2, *counts, *displs;
 
@@ -275,14 +275,14 @@ PetscErrorCode PeriFamilySync(PeriProblem p)
         mine[2 * nmine]       = i;
         mine[2 * nmine++ + 1] = b->j[k];
       }
-  PetscCall(PetscMalloc2(p->size, &counts, p->size, &displs));
+  PetscCall(PetscMalloc2(sys->size, &counts, sys->size, &displs));
   PetscCall(PetscMPIIntCast(2 * nmine, &n2));
-  PetscCallMPI(MPI_Allgather(&n2, 1, MPI_INT, counts, 1, MPI_INT, p->comm));
+  PetscCallMPI(MPI_Allgather(&n2, 1, MPI_INT, counts, 1, MPI_INT, sys->comm));
   displs[0] = 0;
-  for (PetscMPIInt r = 1; r < p->size; r++) displs[r] = displs[r - 1] + counts[r - 1];
-  nall = (displs[p->size - 1] + counts[p->size - 1]) / 2;
+  for (PetscMPIInt r = 1; r < sys->size; r++) displs[r] = displs[r - 1] + counts[r - 1];
+  nall = (displs[sys->size - 1] + counts[sys->size - 1]) / 2;
   PetscCall(PetscMalloc1(2 * nall + 1, &all));
-  PetscCallMPI(MPI_Allgatherv(mine, n2, MPIU_INT, all, counts, displs, MPIU_INT, p->comm));
+  PetscCallMPI(MPI_Allgatherv(mine, n2, MPIU_INT, all, counts, displs, MPIU_INT, sys->comm));
   qsort(all, (size_t)nall, 2 * sizeof(PetscInt), ComparePair);
   for (PetscInt i = F->rstart; i < F->rend; i++)
     for (PetscInt k = F->offset[i - F->rstart]; k < F->offset[i - F->rstart + 1]; k++) {
@@ -316,10 +316,10 @@ static void Union(PetscInt parent[], PetscInt a, PetscInt b)
   smallest particle index of i's piece, on every rank. Each rank joins its bonds (union-find),
   rank 0 merges the ranks' forests. Collective.
 @*/
-PetscErrorCode PeriComponents(PeriProblem p, PetscInt label[])
+PetscErrorCode PeriComponents(PeriSystem sys, PetscInt label[])
 {
-  const PeriBonds *b   = &p->bonds;
-  const PetscInt   n   = p->particles.n;
+  const PeriBonds *b   = &sys->bonds;
+  const PetscInt   n   = sys->particles.n;
   PetscInt        *all = NULL;
 
   PetscFunctionBeginUser;
@@ -328,16 +328,16 @@ PetscErrorCode PeriComponents(PeriProblem p, PetscInt label[])
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
       if (b->live[k]) Union(label, i, b->j[k]);
   for (PetscInt i = 0; i < n; i++) label[i] = Find(label, i);
-  if (p->size > 1) {
-    if (p->rank == 0) PetscCall(PetscMalloc1(n * p->size, &all));
-    PetscCallMPI(MPI_Gather(label, (PetscMPIInt)n, MPIU_INT, all, (PetscMPIInt)n, MPIU_INT, 0, p->comm));
-    if (p->rank == 0) {
-      for (PetscMPIInt r = 1; r < p->size; r++)
+  if (sys->size > 1) {
+    if (sys->rank == 0) PetscCall(PetscMalloc1(n * sys->size, &all));
+    PetscCallMPI(MPI_Gather(label, (PetscMPIInt)n, MPIU_INT, all, (PetscMPIInt)n, MPIU_INT, 0, sys->comm));
+    if (sys->rank == 0) {
+      for (PetscMPIInt r = 1; r < sys->size; r++)
         for (PetscInt i = 0; i < n; i++) Union(label, i, all[r * n + i]);
       for (PetscInt i = 0; i < n; i++) label[i] = Find(label, i);
     }
     PetscCall(PetscFree(all));
-    PetscCallMPI(MPI_Bcast(label, (PetscMPIInt)n, MPIU_INT, 0, p->comm));
+    PetscCallMPI(MPI_Bcast(label, (PetscMPIInt)n, MPIU_INT, 0, sys->comm));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -349,30 +349,30 @@ PetscErrorCode PeriComponents(PeriProblem p, PetscInt label[])
  * and their current values, freed by the caller with PetscFree2); *lost when a held piece carries
  * load. Collective.
 @*/
-PetscErrorCode PeriPieces(PeriProblem p, PetscInt *nhold, PetscInt **hold, PetscReal **held, PetscInt *npieces, PetscBool *lost)
+PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, PetscReal **held, PetscInt *npieces, PetscBool *lost)
 {
-  const PeriParticles *pt = &p->particles;
-  const PetscInt       n = pt->n, bs = p->model->dofs, rstart = p->bonds.rstart, rend = p->bonds.rend;
+  const PeriParticles *pt = &sys->particles;
+  const PetscInt       n = pt->n, bs = sys->model->dofs, rstart = sys->bonds.rstart, rend = sys->bonds.rend;
   PetscInt            *label, *anchored, *size, *loaded, main = -1, big = 0, lostl = 0;
   const PetscScalar   *f, *u = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(n, &label));
   PetscCall(PetscCalloc3(n, &anchored, n, &size, n, &loaded));
-  PetscCall(PeriComponents(p, label));
-  for (PetscInt k = 0; k < p->nconstrained; k++) anchored[label[p->constrained[k] / bs]] = 1;
-  PetscCall(VecGetArrayRead(p->f, &f));
+  PetscCall(PeriComponents(sys, label));
+  for (PetscInt k = 0; k < sys->nconstrained; k++) anchored[label[sys->constrained[k] / bs]] = 1;
+  PetscCall(VecGetArrayRead(sys->f, &f));
   for (PetscInt i = rstart; i < rend; i++) {
     if (PeriParticleIsFictitious(pt, i)) {
       for (PetscInt face = 0; face < 4; face++)
-        if ((pt->crossed[i] & (1 << face)) && p->layers.kind[face] == PERI_LAYER_DISPLACEMENT) anchored[label[i]] = 1;
+        if ((pt->crossed[i] & (1 << face)) && sys->layers.kind[face] == PERI_LAYER_DISPLACEMENT) anchored[label[i]] = 1;
     }
     for (PetscInt c = 0; c < bs; c++)
       if (f[(i - rstart) * bs + c] != 0) loaded[label[i]] = 1;
   }
-  PetscCall(VecRestoreArrayRead(p->f, &f));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, anchored, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, loaded, (PetscMPIInt)n, MPIU_INT, MPI_MAX, p->comm));
+  PetscCall(VecRestoreArrayRead(sys->f, &f));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, anchored, (PetscMPIInt)n, MPIU_INT, MPI_MAX, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, loaded, (PetscMPIInt)n, MPIU_INT, MPI_MAX, sys->comm));
   *npieces = 0;
   for (PetscInt i = 0; i < n; i++) {
     if (!size[label[i]]++) (*npieces)++;
@@ -389,7 +389,7 @@ PetscErrorCode PeriPieces(PeriProblem p, PetscInt *nhold, PetscInt **hold, Petsc
   }
   PetscCall(PetscMalloc2((rend - rstart) * bs, hold, (rend - rstart) * bs, held));
   *nhold = 0;
-  if (p->u) PetscCall(VecGetArrayRead(p->u, &u));
+  if (sys->u) PetscCall(VecGetArrayRead(sys->u, &u));
   for (PetscInt i = rstart; i < rend; i++) {
     PetscInt l = label[i];
     if (anchored[l] || l == main) continue;
@@ -399,8 +399,8 @@ PetscErrorCode PeriPieces(PeriProblem p, PetscInt *nhold, PetscInt **hold, Petsc
       (*held)[(*nhold)++] = u ? PetscRealPart(u[(i - rstart) * bs + c]) : 0;
     }
   }
-  if (p->u) PetscCall(VecRestoreArrayRead(p->u, &u));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lostl, 1, MPIU_INT, MPI_MAX, p->comm));
+  if (sys->u) PetscCall(VecRestoreArrayRead(sys->u, &u));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lostl, 1, MPIU_INT, MPI_MAX, sys->comm));
   *lost = lostl ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscFree(label));
   PetscCall(PetscFree3(anchored, size, loaded));

@@ -1,6 +1,6 @@
 /* Corrections of the discrete horizon: family volumes (for calibration and for the surface
  * correction) and the volume-method surface correction factor of Diana & Casolo eq. (16). */
-#include "perilin.h"
+#include "perilin/private/disc.h"
 
 const char *const PeriSurfaceCorrections[] = {"none", "volume", "energy", NULL};
 

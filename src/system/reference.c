@@ -1,17 +1,17 @@
 /* Exact plane elasticity fields a scene may name as its reference (reference: in the scene), and
  * the accuracy measures against them: the interior strain by least squares, the effective moduli
  * it implies, and the displacement error after removing the best-fit rigid motion. */
-#include "perilin.h"
+#include "perilin/private/system.h"
 
 const char *const PeriReferenceTypes[] = {"none", "uniaxial", "shear", "bending", NULL};
 
-static PetscBool Interior(PeriProblem, PetscInt);
+static PetscBool Interior(PeriSystem, PetscInt);
 
-PetscErrorCode PeriReferenceSetUp(PeriProblem p)
+PetscErrorCode PeriReferenceSetUp(PeriSystem sys)
 {
   static const char *const keys[] = {"type", "stress", "axis", "center", "E", "nu", NULL}, *const axes[] = {"x", "y", NULL};
-  PeriScene      s = p->scene;
-  PeriReference *r = &p->reference;
+  PeriScene      s = sys->scene;
+  PeriReference *r = &sys->reference;
   PeriNode       node;
   PetscInt       type = PERI_REFERENCE_NONE, n, ux, uy, ninterior = 0;
 
@@ -20,24 +20,24 @@ PetscErrorCode PeriReferenceSetUp(PeriProblem p)
   r->type = PERI_REFERENCE_NONE;
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckKeys(s, node, keys));
-  PeriInputCheck(p->particles.dim == 2, s, node, NULL, "reference fields are plane elasticity solutions: dim must be 2");
-  PetscCall(PeriModelComponentIndex(p->model, "ux", &ux));
-  PetscCall(PeriModelComponentIndex(p->model, "uy", &uy));
+  PeriInputCheck(sys->particles.dim == 2, s, node, NULL, "reference fields are plane elasticity solutions: dim must be 2");
+  PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
+  PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
   /* checked here, not only after the solve, so that a bad scene fails before any work */
-  PeriInputCheck(ux >= 0 && uy >= 0, s, node, NULL, "reference fields need the in-plane displacements ux, uy; model %s has none", p->model->type);
+  PeriInputCheck(ux >= 0 && uy >= 0, s, node, NULL, "reference fields need the in-plane displacements ux, uy; model %s has none", sys->model->type);
   PetscCall(PeriSceneGetChoice(s, node, "type", PeriReferenceTypes, &type, NULL));
   PeriInputCheck(type != PERI_REFERENCE_NONE, s, node, "type", "is required: uniaxial, shear or bending");
   r->type = (PeriReferenceType)type;
   PetscCall(PeriSceneGetReal(s, node, "stress", PETSC_TRUE, &r->stress, NULL));
   PeriInputCheck(r->stress != 0, s, node, "stress", "must not be 0: the reference field would vanish and there is nothing to compare with");
-  for (PetscInt i = 0; i < p->particles.n; i++) ninterior += Interior(p, i);
-  PeriInputCheck(ninterior >= 3, s, node, NULL, "only %" PetscInt_FMT " particles lie farther than 2 delta = %g from the edges: too few to measure the interior strain (enlarge the body or reduce the horizon)", ninterior, (double)(2 * p->delta));
+  for (PetscInt i = 0; i < sys->particles.n; i++) ninterior += Interior(sys, i);
+  PeriInputCheck(ninterior >= 3, s, node, NULL, "only %" PetscInt_FMT " particles lie farther than 2 delta = %g from the edges: too few to measure the interior strain (enlarge the body or reduce the horizon)", ninterior, (double)(2 * sys->delta));
   r->axis = 0;
   PetscCall(PeriSceneGetChoice(s, node, "axis", axes, &r->axis, NULL));
-  for (PetscInt d = 0; d < 3; d++) r->center[d] = 0.5 * (p->particles.lower[d] + p->particles.upper[d]);
+  for (PetscInt d = 0; d < 3; d++) r->center[d] = 0.5 * (sys->particles.lower[d] + sys->particles.upper[d]);
   PetscCall(PeriSceneGetRealArray(s, node, "center", PETSC_FALSE, 2, 2, r->center, &n));
-  r->E  = p->model->material.E;
-  r->nu = p->model->material.nu;
+  r->E  = sys->model->material.E;
+  r->nu = sys->model->material.nu;
   PetscCall(PeriSceneGetReal(s, node, "E", PETSC_FALSE, &r->E, NULL));
   PetscCall(PeriSceneGetReal(s, node, "nu", PETSC_FALSE, &r->nu, NULL));
   PeriInputCheck(r->E > 0, s, node, "E", "must be positive");
@@ -46,22 +46,22 @@ PetscErrorCode PeriReferenceSetUp(PeriProblem p)
 }
 
 /* Plane strain is plane stress with E' = E/(1-nu^2), nu' = nu/(1-nu). */
-static void PlaneConstants(PeriProblem p, PetscReal *E, PetscReal *nu)
+static void PlaneConstants(PeriSystem sys, PetscReal *E, PetscReal *nu)
 {
-  const PeriReference *r = &p->reference;
-  *E                     = p->model->plane_strain ? r->E / (1 - r->nu * r->nu) : r->E;
-  *nu                    = p->model->plane_strain ? r->nu / (1 - r->nu) : r->nu;
+  const PeriReference *r = &sys->reference;
+  *E                     = sys->model->plane_strain ? r->E / (1 - r->nu * r->nu) : r->E;
+  *nu                    = sys->model->plane_strain ? r->nu / (1 - r->nu) : r->nu;
 }
 
 /* The exact displacement at X (up to a rigid motion):
  *   uniaxial along a: e_aa = sigma/E, e_bb = -nu sigma/E;   shear: gamma_xy = tau/G, no rotation;
  *   bending by end moments on the x faces, fibre stress sigma at y' = +-h (h half the height):
  *   u_x = k x'y', u_y = -k (x'^2 + nu y'^2)/2, k = sigma/(E h). */
-void PeriReferenceDisplacement(PeriProblem p, const PetscReal X[], PetscReal u[])
+void PeriReferenceDisplacement(PeriSystem sys, const PetscReal X[], PetscReal u[])
 {
-  const PeriReference *r = &p->reference;
+  const PeriReference *r = &sys->reference;
   PetscReal            E, nu, x = X[0] - r->center[0], y = X[1] - r->center[1], e, k;
-  PlaneConstants(p, &E, &nu);
+  PlaneConstants(sys, &E, &nu);
   switch (r->type) {
   case PERI_REFERENCE_UNIAXIAL:
     e    = r->stress / E;
@@ -74,7 +74,7 @@ void PeriReferenceDisplacement(PeriProblem p, const PetscReal X[], PetscReal u[]
     u[1] = e * x;
     break;
   case PERI_REFERENCE_BENDING:
-    k    = r->stress / (E * 0.5 * (p->particles.upper[1] - p->particles.lower[1]));
+    k    = r->stress / (E * 0.5 * (sys->particles.upper[1] - sys->particles.lower[1]));
     u[0] = k * x * y;
     u[1] = -0.5 * k * (x * x + nu * y * y);
     break;
@@ -115,43 +115,43 @@ static PetscErrorCode SmallSolve(PetscInt n, PetscReal A[3][3], PetscReal b[3])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscBool Interior(PeriProblem p, PetscInt i)
+static PetscBool Interior(PeriSystem sys, PetscInt i)
 {
-  for (PetscInt d = 0; d < p->particles.dim; d++) {
-    PetscReal x = p->particles.x[3 * i + d];
-    if (!p->particles.periodic[d] && (x - p->particles.lower[d] < 2 * p->delta || p->particles.upper[d] - x < 2 * p->delta)) return PETSC_FALSE;
+  for (PetscInt d = 0; d < sys->particles.dim; d++) {
+    PetscReal x = sys->particles.x[3 * i + d];
+    if (!sys->particles.periodic[d] && (x - sys->particles.lower[d] < 2 * sys->delta || sys->particles.upper[d] - x < 2 * sys->delta)) return PETSC_FALSE;
   }
   return PETSC_TRUE;
 }
 
 /*@C
-  PeriReferenceEvaluate - on rank 0, from p->u_all: the interior strain (least-squares displacement
+  PeriReferenceEvaluate - on rank 0, from sys->u_all: the interior strain (least-squares displacement
   gradient over the particles farther than 2 delta from every edge), the effective moduli it
   implies for the reference's stress state, and the interior displacement error against the
   reference after removing the best-fit rigid motion. Not collective.
 @*/
-PetscErrorCode PeriReferenceEvaluate(PeriProblem p)
+PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
 {
-  PeriResults     *res     = &p->results;
-  const PetscInt   bs      = p->model->dofs;
-  const PetscReal *c       = p->reference.center;
+  PeriResults     *res     = &sys->results;
+  const PetscInt   bs      = sys->model->dofs;
+  const PetscReal *c       = sys->reference.center;
   PetscReal        A[3][3] = {{0}}, bx[3] = {0, 0, 0}, by[3] = {0, 0, 0}, R[3][3] = {{0}}, br[3] = {0, 0, 0};
   PetscReal        num = 0, den = 0, dmax = 0, umax = 0;
   PetscInt         n = 0, ux, uy;
 
   PetscFunctionBeginUser;
   res->has_reference = PETSC_FALSE;
-  if (p->rank || p->reference.type == PERI_REFERENCE_NONE) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriModelComponentIndex(p->model, "ux", &ux));
-  PetscCall(PeriModelComponentIndex(p->model, "uy", &uy));
-  PetscCheck(ux >= 0 && uy >= 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "reference fields need the in-plane displacements ux, uy; model %s has none", p->model->type);
+  if (sys->rank || sys->reference.type == PERI_REFERENCE_NONE) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
+  PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
+  PetscCheck(ux >= 0 && uy >= 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "reference fields need the in-plane displacements ux, uy; model %s has none", sys->model->type);
   /* least squares u = a + H x' for each component, and the rigid fit of the error */
-  for (PetscInt i = 0; i < p->particles.n; i++) {
-    const PetscReal *X = &p->particles.x[3 * i], *u = &p->u_all[i * bs];
+  for (PetscInt i = 0; i < sys->particles.n; i++) {
+    const PetscReal *X = &sys->particles.x[3 * i], *u = &sys->u_all[i * bs];
     PetscReal        phi[3] = {1, X[0] - c[0], X[1] - c[1]}, ref[2], d[2], rig[3][2];
-    if (!Interior(p, i)) continue;
+    if (!Interior(sys, i)) continue;
     n++;
-    PeriReferenceDisplacement(p, X, ref);
+    PeriReferenceDisplacement(sys, X, ref);
     d[0] = u[ux] - ref[0];
     d[1] = u[uy] - ref[1];
     /* rigid motion basis: (1,0), (0,1), (-y', x') */
@@ -166,7 +166,7 @@ PetscErrorCode PeriReferenceEvaluate(PeriProblem p)
       }
     }
   }
-  PetscCheck(n >= 3, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: only %" PetscInt_FMT " particles lie farther than 2 delta from the edges: too few to measure the interior strain", p->scene->file, n);
+  PetscCheck(n >= 3, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: only %" PetscInt_FMT " particles lie farther than 2 delta from the edges: too few to measure the interior strain", sys->scene->file, n);
   {
     PetscReal A2[3][3];
     PetscCall(PetscArraycpy(&A2[0][0], &A[0][0], 9));
@@ -178,11 +178,11 @@ PetscErrorCode PeriReferenceEvaluate(PeriProblem p)
   res->interior_strain[0] = bx[1];
   res->interior_strain[1] = by[2];
   res->interior_strain[2] = bx[2] + by[1];
-  for (PetscInt i = 0; i < p->particles.n; i++) {
-    const PetscReal *X = &p->particles.x[3 * i], *u = &p->u_all[i * bs];
+  for (PetscInt i = 0; i < sys->particles.n; i++) {
+    const PetscReal *X = &sys->particles.x[3 * i], *u = &sys->u_all[i * bs];
     PetscReal        ref[2], e[2];
-    if (!Interior(p, i)) continue;
-    PeriReferenceDisplacement(p, X, ref);
+    if (!Interior(sys, i)) continue;
+    PeriReferenceDisplacement(sys, X, ref);
     e[0] = u[ux] - ref[0] - (br[0] - br[2] * (X[1] - c[1]));
     e[1] = u[uy] - ref[1] - (br[1] + br[2] * (X[0] - c[0]));
     num += e[0] * e[0] + e[1] * e[1];
@@ -190,17 +190,17 @@ PetscErrorCode PeriReferenceEvaluate(PeriProblem p)
     dmax = PetscMax(dmax, PetscSqrtReal(e[0] * e[0] + e[1] * e[1]));
     umax = PetscMax(umax, PetscSqrtReal(ref[0] * ref[0] + ref[1] * ref[1]));
   }
-  PetscCheck(den > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the reference field vanishes on the interior particles (reference.stress = 0?)", p->scene->file);
+  PetscCheck(den > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the reference field vanishes on the interior particles (reference.stress = 0?)", sys->scene->file);
   res->error_l2_rel  = PetscSqrtReal(num / den);
   res->error_max_rel = dmax / umax;
   res->effective_E = res->effective_nu = res->effective_G = 0;
-  if (p->reference.type == PERI_REFERENCE_UNIAXIAL) {
-    PetscInt  a  = p->reference.axis;
+  if (sys->reference.type == PERI_REFERENCE_UNIAXIAL) {
+    PetscInt  a  = sys->reference.axis;
     PetscReal ea = res->interior_strain[a], eb = res->interior_strain[1 - a];
-    res->effective_E  = p->reference.stress / ea;
+    res->effective_E  = sys->reference.stress / ea;
     res->effective_nu = -eb / ea;
-  } else if (p->reference.type == PERI_REFERENCE_SHEAR)
-    res->effective_G = p->reference.stress / res->interior_strain[2];
+  } else if (sys->reference.type == PERI_REFERENCE_SHEAR)
+    res->effective_G = sys->reference.stress / res->interior_strain[2];
   res->has_reference = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -1,7 +1,7 @@
 /* Assembly of the linearized stiffness K from the model's bond blocks into a block matrix (BAIJ by
  * default, block size = DOFs per particle) with exact preallocation, and the rigid-body modes
  * that serve as AMG's near-null space and as the check for unconstrained motion. */
-#include "perilin.h"
+#include "perilin/private/system.h"
 
 /* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
 static PetscInt RowPartners(const PeriBonds *b, PetscInt i, PetscInt buf[])
@@ -18,10 +18,10 @@ static PetscInt RowPartners(const PeriBonds *b, PetscInt i, PetscInt buf[])
 /* Block counts per owned row: diagonal/off-diagonal part, and their upper-triangular share for
  * SBAIJ. Row i sees its stored partners (j > i, upper) and the particles that store a bond to i
  * (lower), which may live on other ranks: counts for those are summed with MPI_Reduce_scatter. */
-static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **onz, PetscInt **dnzu, PetscInt **onzu)
+static PetscErrorCode Preallocation(PeriSystem sys, PetscInt **dnz, PetscInt **onz, PetscInt **dnzu, PetscInt **onzu)
 {
-  const PeriBonds *b = &p->bonds;
-  const PetscInt   n = p->particles.n, nloc = b->rend - b->rstart;
+  const PeriBonds *b = &sys->bonds;
+  const PetscInt   n = sys->particles.n, nloc = b->rend - b->rstart;
   PetscInt        *cnt, *buf, maxrow = 0;
   PetscMPIInt     *recv;
 
@@ -34,7 +34,7 @@ static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **on
     PetscInt m = RowPartners(b, i, buf), du = 1, ou = 0;
     for (PetscInt k = 0; k < m; k++) {
       PetscInt  j    = buf[k];
-      PetscBool same = (PetscBool)(p->owner[j] == p->rank);
+      PetscBool same = (PetscBool)(sys->owner[j] == sys->rank);
       if (same)
         du++;
       else
@@ -48,8 +48,8 @@ static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **on
   }
   PetscCall(PetscFree(buf));
   /* owners hold contiguous ranges, so the rows in global order are already grouped by rank */
-  PetscCall(PetscCalloc1(p->size, &recv));
-  for (PetscInt i = 0; i < n; i++) recv[p->owner[i]] += 2;
+  PetscCall(PetscCalloc1(sys->size, &recv));
+  for (PetscInt i = 0; i < n; i++) recv[sys->owner[i]] += 2;
   {
     PetscInt *mine, *sendbuf;
     PetscCall(PetscMalloc2(2 * nloc, &mine, 2 * n, &sendbuf));
@@ -57,7 +57,7 @@ static PetscErrorCode Preallocation(PeriProblem p, PetscInt **dnz, PetscInt **on
       sendbuf[2 * i]     = cnt[i];
       sendbuf[2 * i + 1] = cnt[n + i];
     }
-    PetscCallMPI(MPI_Reduce_scatter(sendbuf, mine, recv, MPIU_INT, MPI_SUM, p->comm));
+    PetscCallMPI(MPI_Reduce_scatter(sendbuf, mine, recv, MPIU_INT, MPI_SUM, sys->comm));
     for (PetscInt i = 0; i < nloc; i++) {
       (*dnz)[i] = mine[2 * i];
       (*onz)[i] = mine[2 * i + 1];
@@ -84,19 +84,19 @@ static void RowAdd(PetscInt bs, PetscInt j, const PetscReal *B, PetscInt ld, Pet
 }
 
 /* Inserts every owned particle's family stiffness (state-based models) into K. */
-static PetscErrorCode InsertFamilies(PeriProblem p, Mat K)
+static PetscErrorCode InsertFamilies(PeriSystem sys, Mat K)
 {
-  PeriModel         m  = p->model;
-  const PetscInt    bs = m->dofs, nmax = PeriProblemMaxFamily(p);
+  PeriModel         m  = sys->model;
+  const PetscInt    bs = m->dofs, nmax = PeriSystemMaxFamily(sys);
   PeriBondGeometry *fam;
   PetscReal        *Ke;
   PetscInt         *idx;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc3(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, nmax + 1, &idx));
-  for (PetscInt i = p->family.rstart; i < p->family.rend; i++) {
+  for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
     PetscInt n;
-    PetscCall(PeriProblemFamilyGeometry(p, i, &n, fam));
+    PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
     PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
     idx[0] = i;
     for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
@@ -110,43 +110,43 @@ static PetscErrorCode InsertFamilies(PeriProblem p, Mat K)
 
 /* State-based models: particle i's energy couples every pair of its family, so K reaches 2 delta.
  * The pattern is exact from a first pass into PETSc's preallocator. */
-static PetscErrorCode AssembleFamilies(PeriProblem p, Mat *K)
+static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
 {
-  const PetscInt bs = p->model->dofs, nloc = p->bonds.rend - p->bonds.rstart;
+  const PetscInt bs = sys->model->dofs, nloc = sys->bonds.rend - sys->bonds.rstart;
   Mat            pre;
 
   PetscFunctionBeginUser;
-  PetscCall(MatCreate(p->comm, &pre));
-  PetscCall(MatSetSizes(pre, nloc * bs, nloc * bs, p->particles.n * bs, p->particles.n * bs));
+  PetscCall(MatCreate(sys->comm, &pre));
+  PetscCall(MatSetSizes(pre, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
   PetscCall(MatSetBlockSize(pre, bs));
   PetscCall(MatSetType(pre, MATPREALLOCATOR));
   PetscCall(MatSetUp(pre));
-  PetscCall(InsertFamilies(p, pre));
-  PetscCall(MatCreate(p->comm, K));
-  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, p->particles.n * bs, p->particles.n * bs));
+  PetscCall(InsertFamilies(sys, pre));
+  PetscCall(MatCreate(sys->comm, K));
+  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
   PetscCall(MatSetBlockSize(*K, bs));
-  PetscCall(MatSetType(*K, p->mat_type[0] ? p->mat_type : MATBAIJ));
+  PetscCall(MatSetType(*K, sys->mat_type[0] ? sys->mat_type : MATBAIJ));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *K));
   PetscCall(MatDestroy(&pre));
   PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  PetscCall(InsertFamilies(p, *K));
+  PetscCall(InsertFamilies(sys, *K));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
   PeriAssembleStiffness - assembles K = sum over live bonds of the model's bond blocks. The type is
-  p->mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
+  sys->mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
   only). Collective.
 
   Each owned block row is gathered in full (its stored bonds and the bonds other owned particles
   store towards it) and inserted with one call: inserting bond by bond costs a search per entry.
   Only rows owned by other ranks receive bond blocks through the stash.
 @*/
-PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
+PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 {
-  const PeriBonds *b  = &p->bonds;
-  PeriModel        m  = p->model;
+  const PeriBonds *b  = &sys->bonds;
+  PeriModel        m  = sys->model;
   const PetscInt   bs = m->dofs, nb = 2 * bs, nloc = b->rend - b->rstart, rstart = b->rstart;
   PetscInt        *dnz, *onz, *dnzu, *onzu, *tptr, *tbond, *trow, *slot, *col, *perm, maxcol = 1;
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], *blocks, *row;
@@ -155,18 +155,18 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
   if (m->ops.family_stiffness) {
-    PetscCall(AssembleFamilies(p, K));
+    PetscCall(AssembleFamilies(sys, K));
     PetscCall(MatSetOption(*K, MAT_SYMMETRIC, PETSC_TRUE));
     PetscCall(MatSetOption(*K, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
     PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(Preallocation(p, &dnz, &onz, &dnzu, &onzu));
+  PetscCall(Preallocation(sys, &dnz, &onz, &dnzu, &onzu));
   for (PetscInt i = 0; i < nloc; i++) maxcol = PetscMax(maxcol, dnz[i] + onz[i]);
-  PetscCall(MatCreate(p->comm, K));
-  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, p->particles.n * bs, p->particles.n * bs));
+  PetscCall(MatCreate(sys->comm, K));
+  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
   PetscCall(MatSetBlockSize(*K, bs));
-  PetscCall(MatSetType(*K, p->mat_type[0] ? p->mat_type : MATBAIJ));
+  PetscCall(MatSetType(*K, sys->mat_type[0] ? sys->mat_type : MATBAIJ));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatXAIJSetPreallocation(*K, bs, dnz, onz, dnzu, onzu));
   PetscCall(PetscFree4(dnz, onz, dnzu, onzu));
@@ -197,8 +197,8 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
     PetscCall(PetscFree(fill));
   }
 
-  PetscCall(PetscMalloc1(p->particles.n, &slot));
-  for (PetscInt i = 0; i < p->particles.n; i++) slot[i] = -1;
+  PetscCall(PetscMalloc1(sys->particles.n, &slot));
+  for (PetscInt i = 0; i < sys->particles.n; i++) slot[i] = -1;
   PetscCall(PetscMalloc4(maxcol, &col, maxcol, &perm, maxcol * bs * bs, &blocks, maxcol * bs * bs, &row));
   for (PetscInt i = rstart; i < b->rend; i++) {
     PetscInt         ncol = 0;
@@ -210,17 +210,17 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
       PetscInt j = b->j[k];
       /* a self-image bond moves both ends alike: its blocks cancel */
       if (!b->live[k] || j == i) continue;
-      PetscCall(PeriProblemBondGeometry(p, i, k, &g));
+      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
       RowAdd(bs, i, &Ke[0], nb, slot, col, blocks, &ncol);
       RowAdd(bs, j, &Ke[bs], nb, slot, col, blocks, &ncol);
-      if (p->owner[j] != p->rank) {
+      if (sys->owner[j] != sys->rank) {
         PetscInt idx[2] = {i, j};
         PetscCall(MatSetValuesBlocked(*K, 1, &j, 2, idx, &Ke[bs * nb], ADD_VALUES));
       }
     }
     for (PetscInt t = tptr[i - rstart]; t < tptr[i - rstart + 1]; t++) {
-      PetscCall(PeriProblemBondGeometry(p, trow[t], tbond[t], &g));
+      PetscCall(PeriSystemBondGeometry(sys, trow[t], tbond[t], &g));
       m->ops.bond_stiffness(m, &g, Ke);
       RowAdd(bs, i, &Ke[bs * nb + bs], nb, slot, col, blocks, &ncol);
       RowAdd(bs, trow[t], &Ke[bs * nb], nb, slot, col, blocks, &ncol);
@@ -254,23 +254,23 @@ PetscErrorCode PeriAssembleStiffness(PeriProblem p, Mat *K)
   norm that mode k had before scaling. Collective; modes[] must hold PERI_MAX_MODES vectors,
   created here.
 @*/
-PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[], PetscReal norm[])
+PetscErrorCode PeriRigidModes(PeriSystem sys, PetscInt *nmodes, Vec modes[], PetscReal norm[])
 {
-  const PeriParticles *pt = &p->particles;
-  PeriModel            m  = p->model;
+  const PeriParticles *pt = &sys->particles;
+  PeriModel            m  = sys->model;
   PetscReal            centre[3], vals[PERI_MAX_MODES][PERI_MAX_DOF], X[3];
   PetscScalar         *a[PERI_MAX_MODES];
-  PetscInt             nm = 0, rstart = p->bonds.rstart;
+  PetscInt             nm = 0, rstart = sys->bonds.rstart;
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
   X[0] = X[1] = X[2] = 0;
   nm                 = m->ops.rigid_modes(m, X, vals);
   for (PetscInt k = 0; k < nm; k++) {
-    PetscCall(PeriProblemCreateVec(p, &modes[k]));
+    PetscCall(PeriSystemCreateVec(sys, &modes[k]));
     PetscCall(VecGetArray(modes[k], &a[k]));
   }
-  for (PetscInt i = rstart; i < p->bonds.rend; i++) {
+  for (PetscInt i = rstart; i < sys->bonds.rend; i++) {
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
     m->ops.rigid_modes(m, X, vals);
     for (PetscInt k = 0; k < nm; k++)
@@ -288,14 +288,14 @@ PetscErrorCode PeriRigidModes(PeriProblem p, PetscInt *nmodes, Vec modes[], Pets
   PeriSetNearNullSpace - gives A the orthonormalized rigid-body modes, for algebraic multigrid.
   Collective.
 @*/
-PetscErrorCode PeriSetNearNullSpace(PeriProblem p, Mat A)
+PetscErrorCode PeriSetNearNullSpace(PeriSystem sys, Mat A)
 {
   Vec          modes[PERI_MAX_MODES];
   PetscInt     nm;
   MatNullSpace nsp;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriRigidModes(p, &nm, modes, NULL));
+  PetscCall(PeriRigidModes(sys, &nm, modes, NULL));
   /* Gram-Schmidt: MatNullSpaceCreate wants an orthonormal set */
   for (PetscInt k = 0; k < nm; k++) {
     for (PetscInt l = 0; l < k; l++) {
@@ -305,7 +305,7 @@ PetscErrorCode PeriSetNearNullSpace(PeriProblem p, Mat A)
     }
     PetscCall(VecNormalize(modes[k], NULL));
   }
-  PetscCall(MatNullSpaceCreate(p->comm, PETSC_FALSE, nm, modes, &nsp));
+  PetscCall(MatNullSpaceCreate(sys->comm, PETSC_FALSE, nm, modes, &nsp));
   PetscCall(MatSetNearNullSpace(A, nsp));
   PetscCall(MatNullSpaceDestroy(&nsp));
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));

@@ -6,7 +6,8 @@
  *   PeriOptionsCheckUnused, after the analysis and before any output: every other option that no
  *     rank read (PETSc's options-left machinery), which only the run itself can tell.
  * -options_unused_ok makes both warnings, for options meant for other tools (docs/scene.md). */
-#include "perilin.h"
+#include "perilin/private/scene.h"
+#include "perilin/private/sys.h"
 #include <slepceps.h>
 #include <ctype.h>
 #include <stdarg.h>
@@ -310,7 +311,7 @@ static PetscErrorCode KSPFromOptions(MPI_Comm comm, const char prefix[], const c
 
 /* Fresh objects of the kinds and types the run used, set from the options: under -help they print
  * every option they read. Collective. */
-static PetscErrorCode ObjectsFromOptions(PeriProblem p)
+static PetscErrorCode ObjectsFromOptions(const PeriRunSolvers *p)
 {
   Vec       v;
   Mat       A;
@@ -323,14 +324,10 @@ static PetscErrorCode ObjectsFromOptions(PeriProblem p)
   PetscCall(VecDestroy(&v));
   PetscCall(MatCreate(p->comm, &A));
   PetscCall(MatSetSizes(A, 1, 1, PETSC_DETERMINE, PETSC_DETERMINE));
-  if (p->K) {
-    MatType type;
-    PetscCall(MatGetType(p->K, &type));
-    PetscCall(MatSetType(A, type));
-  }
+  if (p->mat_type[0]) PetscCall(MatSetType(A, p->mat_type));
   PetscCall(MatSetFromOptions(A));
   PetscCall(MatDestroy(&A));
-  if (p->modal) { /* the spectral transformation's linear solver: shift-and-invert, as in modal.c */
+  if (p->eigen) { /* the spectral transformation's linear solver: shift-and-invert, as in modal.c */
     EPS eps;
     ST  st;
     KSP ksp;
@@ -339,17 +336,17 @@ static PetscErrorCode ObjectsFromOptions(PeriProblem p)
     PetscCall(EPSGetST(eps, &st));
     PetscCall(STSetType(st, STSINVERT));
     PetscCall(STGetKSP(st, &ksp));
-    if (p->results.ksp_type[0]) PetscCall(KSPSetType(ksp, p->results.ksp_type));
+    if (p->ksp_type[0]) PetscCall(KSPSetType(ksp, p->ksp_type));
     PetscCall(KSPGetPC(ksp, &pc));
-    if (p->results.pc_type[0]) PetscCall(PCSetType(pc, p->results.pc_type));
+    if (p->pc_type[0]) PetscCall(PCSetType(pc, p->pc_type));
     PetscCall(EPSSetFromOptions(eps));
     PetscCall(EPSDestroy(&eps));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(KSPFromOptions(p->comm, NULL, p->results.ksp_type, p->results.pc_type));
+  PetscCall(KSPFromOptions(p->comm, NULL, p->ksp_type, p->pc_type));
   /* multigrid levels exist only once set up: their solvers' options come from stand-ins */
-  PetscCall(PetscStrbeginswith(p->results.pc_type, PCMG, &mg));
-  if (!mg) PetscCall(PetscStrcmp(p->results.pc_type, PCGAMG, &mg));
+  PetscCall(PetscStrbeginswith(p->pc_type, PCMG, &mg));
+  if (!mg) PetscCall(PetscStrcmp(p->pc_type, PCGAMG, &mg));
   if (mg) {
     PetscCall(KSPFromOptions(p->comm, "mg_levels_", KSPCHEBYSHEV, PCJACOBI));
     PetscCall(KSPFromOptions(p->comm, "mg_coarse_", KSPPREONLY, PCBJACOBI));
@@ -361,7 +358,7 @@ static PetscErrorCode ObjectsFromOptions(PeriProblem p)
  * an object's options once per run (PetscOptionsHelpPrintedSingleton remembers): a fresh record
  * for these, then the run's is restored, with PetscHelpPrintf and the database as they were.
  * Collective; used on the error path only. */
-static PetscErrorCode PetscNames(PeriProblem p, Names *names)
+static PetscErrorCode PetscNames(const PeriRunSolvers *p, Names *names)
 {
   PetscErrorCode (*help)(MPI_Comm, const char[], ...)     = PetscHelpPrintf;
   PetscErrorCode (*vprint)(FILE *, const char[], va_list) = PetscVFPrintf;
@@ -406,7 +403,7 @@ static PetscErrorCode PetscNames(PeriProblem p, Names *names)
   among the scene's and those of the run's PETSc objects; the same error on every rank. With
   -options_unused_ok a warning printed by rank 0. Collective.
 @*/
-PetscErrorCode PeriOptionsCheckUnused(PeriProblem p)
+PetscErrorCode PeriOptionsCheckUnused(const PeriRunSolvers *p)
 {
   Names     unread = {NULL, 0, 0}, cand = {NULL, 0, 0};
   char    **scene_names, msg[1600]      = "";
@@ -430,7 +427,7 @@ PetscErrorCode PeriOptionsCheckUnused(PeriProblem p)
     else {
       Append(msg, sizeof(msg), "%soption %s was read by nothing in this run", k ? "; " : "", unread.name[k]);
       /* a real option for a solver the run did not use, or a misspelling: say what the run used */
-      if (!said && p->results.ksp_type[0]) Append(msg, sizeof(msg), p->modal ? " (its eigensolver's linear solves used -st_ksp_type %s -st_pc_type %s)" : " (its linear solves used -ksp_type %s -pc_type %s)", p->results.ksp_type, p->results.pc_type);
+      if (!said && p->ksp_type[0]) Append(msg, sizeof(msg), p->eigen ? " (its eigensolver's linear solves used -st_ksp_type %s -st_pc_type %s)" : " (its linear solves used -ksp_type %s -pc_type %s)", p->ksp_type, p->pc_type);
       said = PETSC_TRUE;
     }
   }

@@ -1,0 +1,86 @@
+/* The model-author API: what a bond model (models/) implements and the kernel helpers it may
+ * use. A model file includes this header only. */
+#pragma once
+
+#include <perilin/scene.h>
+
+/* What calibration may use besides the material: the discrete family volumes sum_j alpha_ij V_j. */
+typedef struct {
+  PetscInt              n;
+  const PetscReal      *family_volume;
+  const PetscReal      *mu; /* shear modulus per particle (material.mu_by_region), or NULL: uniform */
+  MPI_Comm              comm;
+  const PeriParticles  *particles;
+  const PeriBonds      *bonds; /* this rank's bonds, for corrections computed from the family */
+  PeriSurfaceCorrection surface;
+} PeriCalibrationData;
+
+typedef struct _p_PeriModel *PeriModel;
+typedef struct {
+  /* Reads the model's own scene keys (model.*); may be NULL. */
+  PetscErrorCode (*setfromscene)(PeriModel, PeriScene, PeriNode);
+  /* Admissible Poisson ratio range for this dimension / plane kind. */
+  void (*nu_range)(PeriModel, PetscReal *, PetscReal *);
+  PetscErrorCode (*calibrate)(PeriModel, const PeriCalibrationData *);
+  /* The (2 dofs)^2 linearized stiffness block of one bond, row-major, DOFs of i then of j. */
+  void (*bond_stiffness)(PeriModel, const PeriBondGeometry *, PetscReal[]);
+  /* The bond's strain measures (stretch, sliding, ...) from the two particles' DOFs. */
+  void (*bond_measures)(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
+  /* State-based models only (else NULL): the dense stiffness of particle i's energy, which depends
+     on its whole family fam[0..n-1] (all with fam[k].i == i): ((n+1) dofs)^2, row-major, the DOFs
+     of i first, then those of fam[0], fam[1], ... */
+  PetscErrorCode (*family_stiffness)(PeriModel, PetscInt, const PeriBondGeometry[], PetscReal[]);
+  /* The critical value of the first measure (stretch, shear angle) of this bond for the energy
+     release rate G: breaking every bond across a unit crack area releases G. May be NULL. */
+  PetscReal (*critical_from_G)(PeriModel, const PeriBondGeometry *, PetscReal);
+  /* Values of the rigid-body (zero-energy) modes at a point, nmodes x dofs; returns nmodes. */
+  PetscInt (*rigid_modes)(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
+  PetscErrorCode (*destroy)(PeriModel); /* frees what data points to; data itself is freed after; may be NULL */
+} PeriModelOps;
+
+struct _p_PeriModel {
+  char               type[PERI_NAME_LEN];
+  PeriModelOps       ops;
+  PetscInt           dim;
+  PetscBool          plane_strain;
+  PetscInt           dofs;
+  const char *const *components; /* dofs names, e.g. "ux", "uy" */
+  PetscInt           nmeasures;
+  const char *const *measure_names;
+  PetscBool          allows_surface_correction;
+  const char *const *surface_corrections;      /* allowed corrections.surface values; NULL: none, volume */
+  PetscBool          antiplane;                /* one DOF, the out-of-plane displacement uz: stresses tau_xz, tau_yz */
+  const char *const *keys;                     /* the model's own scene keys besides model.type and model.plane, or NULL */
+  PetscBool          inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
+  PetscBool          rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
+  char               warning[256];             /* set by calibration; printed once by the problem */
+  PeriMaterial       material;
+  PetscReal          delta;
+  void              *data;
+};
+
+PETSC_EXTERN PetscReal      PeriModelIsotropicEnergy(PeriModel);
+PETSC_EXTERN PetscReal      PeriModelHorizonMoment(PeriModel, PetscInt);
+PETSC_EXTERN void           PeriCentralBondBlock(PeriModel, const PeriBondGeometry *, PetscReal, PetscReal[]);
+PETSC_EXTERN void           PeriAddSpring(PetscInt, const PetscReal[], PetscReal, PetscReal[]);
+PETSC_EXTERN void           PeriPlaneMicromoduli(PeriModel, PetscReal *, PetscReal *);
+PETSC_EXTERN void           PeriShearBondNuRange(PeriModel, PetscReal *, PetscReal *);
+PETSC_EXTERN PetscReal      PeriCriticalStretchSpring(PeriModel, PetscReal, PetscReal);
+PETSC_EXTERN void           PeriBondStretch(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
+PETSC_EXTERN void           PeriBondBasedNuRange(PeriModel, PetscReal *, PetscReal *);
+PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);
+PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
+PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
+
+/* The scene keys a plug-in owns. Declared only: until the scene sections declare their keys, every
+ * type's schema is NULL. */
+typedef struct _PeriSchema PeriSchema;
+
+/* A built-in model type. Each model file (models/) ends with its descriptor(s) PeriModel_<id>,
+ * whose create function stays static; models/list.h names them and models/registry.c registers
+ * them. */
+typedef struct {
+  const char       *name; /* model.type */
+  const PeriSchema *schema;
+  PetscErrorCode (*create)(PeriModel);
+} PeriModelType;

@@ -1,0 +1,13 @@
+/* The model registry and life cycle (src/model/): create a model by name, list the types. */
+#pragma once
+
+#include <perilin/model.h>
+#include "perilin/private/sys.h"
+
+PETSC_EXTERN PetscErrorCode PeriModelRegister(const char[], PetscErrorCode (*)(PeriModel));
+PETSC_EXTERN PetscErrorCode PeriModelRegisterAll(void);
+PETSC_EXTERN PetscErrorCode PeriModelCreate(const char[], PetscInt, PetscBool, PeriModel *);
+PETSC_EXTERN PetscErrorCode PeriModelSetFromScene(PeriModel, PeriScene, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriModelListTypes(char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriModelTypeRegistered(const char[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriModelDestroy(PeriModel *);

@@ -1,0 +1,34 @@
+/* Writers (src/output/): streaming JSON, files written under a temporary name then committed,
+ * the output set. They know nothing of perilin's physics. */
+#pragma once
+
+#include <perilin/types.h>
+
+typedef struct _PeriJSON   *PeriJSON;
+PETSC_EXTERN PetscErrorCode PeriJSONOpen(const char[], PeriJSON *);
+PETSC_EXTERN PetscErrorCode PeriJSONClose(PeriJSON *, PetscBool);
+PETSC_EXTERN PetscErrorCode PeriJSONBeginObject(PeriJSON, const char[]);
+PETSC_EXTERN PetscErrorCode PeriJSONEndObject(PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriJSONBeginArray(PeriJSON, const char[]);
+PETSC_EXTERN PetscErrorCode PeriJSONEndArray(PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriJSONString(PeriJSON, const char[], const char[]);
+PETSC_EXTERN PetscErrorCode PeriJSONReal(PeriJSON, const char[], PetscReal);
+PETSC_EXTERN PetscErrorCode PeriJSONInt(PeriJSON, const char[], PetscInt);
+PETSC_EXTERN PetscErrorCode PeriJSONBool(PeriJSON, const char[], PetscBool);
+PETSC_EXTERN PetscErrorCode PeriJSONRealArray(PeriJSON, const char[], PetscInt, const PetscReal[]);
+/* Per-particle fields for a .vtu file: referenced arrays, named, written by PeriWriteVTU. */
+typedef struct _p_PeriFieldList *PeriFieldList;
+PETSC_EXTERN PetscErrorCode      PeriFieldListCreate(PetscInt, const PetscReal[], PeriFieldList *);
+PETSC_EXTERN PetscErrorCode      PeriFieldListAddReal(PeriFieldList, const char[], PetscInt, const PetscReal *, PetscInt, const PetscInt[]);
+PETSC_EXTERN PetscErrorCode      PeriFieldListAddInt(PeriFieldList, const char[], const PetscInt *);
+PETSC_EXTERN PetscErrorCode      PeriFieldListAddSolution(PeriFieldList, const char[], PetscInt, const char *const[], const PetscReal *);
+PETSC_EXTERN PetscErrorCode      PeriFieldListDestroy(PeriFieldList *);
+PETSC_EXTERN PetscErrorCode      PeriWriteVTU(PeriFieldList, const char[]);
+PETSC_EXTERN PetscErrorCode      PeriWritePVD(const char[], PetscInt, const PetscReal[], const char *const[]);
+PETSC_EXTERN PetscErrorCode      PeriOutputDirCreate(const char[]);
+PETSC_EXTERN PetscErrorCode      PeriFileCommit(const char[], const char[]);
+PETSC_EXTERN PetscErrorCode      PeriFileOpenTemporary(const char[], char[], size_t, FILE **);
+PETSC_EXTERN PetscErrorCode      PeriFileCloseCommit(FILE *, const char[], const char[], int);
+PETSC_EXTERN PetscErrorCode      PeriOutputSetOpen(MPI_Comm, char[], size_t, char[], size_t);
+PETSC_EXTERN PetscErrorCode      PeriOutputSetCommit(MPI_Comm, const char[], const char[]);
+PETSC_EXTERN void                PeriOutputSetDiscard(void);

@@ -1,0 +1,25 @@
+/* Scene files and option overrides (src/scene/): creation, -help, checks of the options. */
+#pragma once
+
+#include <perilin/scene.h>
+#include "perilin/private/sys.h"
+
+PETSC_EXTERN PetscErrorCode PeriSceneCreateFromFile(const char[], PeriScene *);
+PETSC_EXTERN PetscErrorCode PeriSceneDestroy(PeriScene *);
+PETSC_EXTERN PetscErrorCode PeriSceneHelp(MPI_Comm);
+
+/* Options that name nothing (src/options.c; docs/scene.md): an option naming no scene key is an
+ * error before any computation, and an option nothing read is one after the analysis, both with a
+ * "did you mean"; -options_unused_ok makes them warnings. */
+PETSC_EXTERN PetscErrorCode PeriSceneOptionIsScene(const char[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneOptionNames(PeriScene, char ***);
+PETSC_EXTERN PetscErrorCode PeriSceneOptionExplain(PeriScene, const char[], char[], size_t, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriOptionsCheckScene(MPI_Comm, PeriScene);
+/* What the run's solvers were, so that an unread option can be explained against them. */
+typedef struct {
+  MPI_Comm    comm;
+  PeriScene   scene;
+  const char *mat_type, *ksp_type, *pc_type; /* "" when the run had none */
+  PetscBool   eigen;                         /* the linear solves were an eigensolver's (-st_ prefix) */
+} PeriRunSolvers;
+PETSC_EXTERN PetscErrorCode PeriOptionsCheckUnused(const PeriRunSolvers *);

@@ -1,0 +1,206 @@
+/* PeriSystem (src/system/): the discretized physics of one scene, with no analysis-specific member:
+ * particles, bonds, model, conditions, layers, torsion, failure, the stiffness K and the fields of
+ * the last solve. Analyses drive it through these functions. */
+#pragma once
+
+#include <petscksp.h>
+#include "perilin/private/disc.h"
+#include "perilin/private/model.h"
+#include "perilin/private/output.h"
+#include "perilin/private/sys.h"
+
+typedef struct {
+  char      name[PERI_NAME_LEN];
+  PetscReal x[3];
+  PetscInt  particle; /* nearest particle (global index) */
+  PetscReal u[PERI_MAX_DOF];
+  PetscReal W;
+} PeriProbe;
+
+typedef struct {
+  PetscReal neighbors_s, assembly_s, solve_s, total_s;
+  PetscReal memory_mb, memory_mb_max_rank;
+  char      ksp_type[64], pc_type[64], converged_reason[64];
+  PetscInt  iterations;
+  PetscReal residual_norm; /* true relative residual of the last solve */
+  PetscReal residual_tol;  /* the largest accepted (solver.residual_tol or its default) */
+  PetscReal strain_energy;
+  PetscReal max_abs_u[PERI_MAX_DOF];
+  PetscInt  nbonds_total;
+  PetscBool symmetric;      /* the operator solved was symmetric */
+  PetscInt  free_modes;     /* rigid motions left free with balanced loads: solved orthogonal to them */
+  PetscReal load_imbalance; /* share of the load along those motions, removed */
+  PetscInt  precracked_bonds;
+  PetscBool free_modes_noted; /* the note on free motions is printed once per run */
+  PetscInt  edge_cut;         /* bonds between particles of different ranks */
+  /* against the scene's reference field (src/reference.c) */
+  PetscBool has_reference;
+  PetscInt  interior_particles;
+  PetscReal interior_strain[3];                     /* e_xx, e_yy, gamma_xy */
+  PetscReal effective_E, effective_nu, effective_G; /* 0 where the stress state does not define it */
+  PetscReal error_l2_rel, error_max_rel;
+} PeriResults;
+
+typedef enum {
+  PERI_REFERENCE_NONE,
+  PERI_REFERENCE_UNIAXIAL,
+  PERI_REFERENCE_SHEAR,
+  PERI_REFERENCE_BENDING
+} PeriReferenceType;
+PETSC_EXTERN const char *const PeriReferenceTypes[];
+
+typedef struct {
+  PeriReferenceType type;
+  PetscReal         stress; /* sigma (uniaxial), tau (shear), the extreme fibre stress (bending) */
+  PetscInt          axis;   /* uniaxial: the loaded axis */
+  PetscReal         center[3];
+  PetscReal         E, nu; /* elastic constants of the reference; default the material's */
+} PeriReference;
+
+/* Fictitious boundary layers outside the body's faces (Oterkus & Madenci sec. 6, src/layers.c):
+ * each fictitious particle copies its mirror image in the body, u_f = sign u_m + offset. */
+typedef enum {
+  PERI_LAYER_NONE,
+  PERI_LAYER_DISPLACEMENT,
+  PERI_LAYER_SHEAR_STRESS,
+  PERI_LAYER_FREE
+} PeriLayerKind;
+PETSC_EXTERN const char *const PeriLayerKinds[];
+
+typedef struct {
+  PetscInt      nfaces;
+  PeriLayerKind kind[6]; /* per face 2 axis + (upper face) */
+  PetscReal     value[6];
+  Mat           T; /* u = T u_body + g: identity on body DOFs, the mirror relation on fictitious ones */
+  Vec           g;
+} PeriLayers;
+
+/* Torsion of a bar (antiplane models): the twist psi enters the free-surface conditions. */
+typedef struct {
+  PetscBool active;
+  PetscReal twist, center[2];
+  PetscReal torque, J, J_rectangle, max_stress, max_at[2]; /* results, per unit length; kept contiguous (broadcast as 6 reals) */
+} PeriTorsion;
+
+/* Why a bond broke: a pre-existing crack, or the criterion that broke it. */
+typedef enum {
+  PERI_CAUSE_CRACK,
+  PERI_CAUSE_TENSION,
+  PERI_CAUSE_COMPRESSION,
+  PERI_CAUSE_SLIDING,
+  PERI_CAUSE_SHEAR_ANGLE,
+  PERI_NCAUSES
+} PeriFailureCause;
+PETSC_EXTERN const char *const PeriFailureCauses[];
+
+/* Bond failure criteria (failure:, src/failure.c); 0 = criterion not given. */
+typedef struct {
+  PetscBool active;
+  PetscReal stretch, G, compressive, sliding, friction_angle, cohesion, shear_angle;
+  PetscReal ultimate, ultimate_compressive; /* softening: the stretch where the stiffness is gone (0: brittle) */
+  PetscInt  istretch, isliding, ishear;     /* the model's measures, -1 when absent */
+} PeriFailure;
+
+typedef struct _p_PeriSystem *PeriSystem;
+struct _p_PeriSystem {
+  MPI_Comm              comm;
+  PetscMPIInt           rank, size;
+  PeriScene             scene;     /* borrowed from the problem: for reading sections and locating errors */
+  PetscReal             thickness; /* material.thickness (2D) */
+  PeriParticles         particles;
+  PetscInt              nregions;
+  PeriRegion           *regions;
+  PetscReal             delta;
+  PeriPartialVolume     partial_volume;
+  PeriSurfaceCorrection surface;
+  PeriBonds             bonds;
+  PetscReal            *family_volume;  /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
+  PetscInt             *neighbor_count; /* per particle (all ranks) */
+  PetscInt             *owner;          /* rank owning each particle (all ranks) */
+  PetscReal            *mu;             /* shear modulus per particle when material.mu_by_region is given, else NULL */
+  PetscReal            *bond_mu;        /* per local bond: the shear modulus across materials (eq. 60), or NULL */
+  PeriBonds             family;         /* state-based models: every bond of each owned particle (both directions) */
+  PeriLayers            layers;
+  PeriTorsion           torsion;
+  PetscReal            *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
+  PeriFailure           failure;
+  PetscReal            *damage; /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
+  PeriModel             model;
+  Mat                   K;                       /* stiffness */
+  char                  mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
+  Vec                   u, f;
+  PetscInt              nconstrained; /* owned constrained DOFs */
+  PetscInt             *constrained;  /* their global rows */
+  PetscReal            *constrained_value;
+  PetscInt              nprobes;
+  PeriProbe            *probes;
+  PetscReal            *W;     /* strain energy density per particle (rank 0, after the solve) */
+  PetscReal            *u_all; /* displacements of all particles (rank 0, after the solve) */
+  PeriResults           results;
+  PeriReference         reference;
+  int                   interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
+  PetscReal             residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
+};
+
+PETSC_EXTERN PetscErrorCode PeriSystemCreate(MPI_Comm, PeriScene, PeriSystem *);
+PETSC_EXTERN PetscErrorCode PeriSystemSetFromScene(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemSetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemDestroy(PeriSystem *);
+PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemCreateVec(PeriSystem, Vec *);
+PETSC_EXTERN PetscErrorCode PeriSystemBondGeometry(PeriSystem, PetscInt, PetscInt, PeriBondGeometry *);
+PETSC_EXTERN PetscErrorCode PeriSystemFamilyGeometry(PeriSystem, PetscInt, PetscInt *, PeriBondGeometry[]);
+PETSC_EXTERN PetscInt       PeriSystemMaxFamily(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemFindProbe(PeriSystem, const char[], PeriProbe **);
+PETSC_EXTERN PetscReal      PeriResidualTolerance(PeriSystem, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriReadProbes(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemAddFields(PeriSystem, PeriFieldList);
+PETSC_EXTERN PetscErrorCode PeriSystemWriteVTU(PeriSystem, const PetscReal *, const char[]);
+
+/* assembly (src/system/assembly.c) */
+PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat);
+
+/* boundary conditions and loads (src/system/boundary.c) */
+PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriLoadsAssemble(PeriSystem, Vec);
+
+/* reference solutions (src/system/reference.c) */
+PETSC_EXTERN PetscErrorCode PeriReferenceSetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriReferenceEvaluate(PeriSystem);
+PETSC_EXTERN void           PeriReferenceDisplacement(PeriSystem, const PetscReal[], PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriStaticSolve(PeriSystem, KSP *, PetscReal, PetscBool, PetscInt, const PetscInt[], const PetscReal[], KSPConvergedReason *);
+PETSC_EXTERN PetscErrorCode PeriStaticCheckConverged(PeriSystem, KSPConvergedReason);
+PETSC_EXTERN PetscErrorCode PeriStaticConverged(PeriSystem, KSP, KSPConvergedReason, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriStaticDefaultMatType(char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriSystem, PetscInt *, char[], size_t, Vec[]);
+/* failure, cracks, damage, pieces (src/system/failure.c) */
+PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
+PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
+PETSC_EXTERN PetscReal      PeriBondSoftening(PeriSystem, const PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriDamage(PeriSystem, PetscReal **);
+PETSC_EXTERN PetscErrorCode PeriComponents(PeriSystem, PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriFamilySync(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriPieces(PeriSystem, PetscInt *, PetscInt **, PetscReal **, PetscInt *, PetscBool *);
+/* fictitious boundary layers and torsion (src/system/layers.c) */
+PETSC_EXTERN PetscErrorCode PeriLayersAddParticles(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriLayersSetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriLayersApply(PeriSystem, PetscReal, Mat *, Vec);
+PETSC_EXTERN PetscErrorCode PeriLayersComplete(PeriSystem, PetscReal, Vec);
+PETSC_EXTERN PetscErrorCode PeriLayersDestroy(PeriLayers *);
+PETSC_EXTERN PetscErrorCode PeriTorsionEvaluate(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriTorsionLoads(PeriSystem, Vec);
+PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel);
+
+/* summary.json sections (src/system/summary.c) */
+PETSC_EXTERN PetscErrorCode PeriSystemSummaryModel(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriSystemSummaryCost(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriSystemSummarySolver(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriSystemSummaryTorsion(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriSystemSummaryFields(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriSystemSummaryReference(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriSystemSummaryProbes(PeriSystem, PeriJSON);

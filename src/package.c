@@ -1,0 +1,67 @@
+/* The perilin package: log events and stages, the registries, their finalizer. */
+#include "perilin.h"
+#include "perilin/private/sys.h"
+#include "perilin/private/scene.h"
+#include "perilin/private/model.h"
+#include "perilin/private/analysis.h"
+#include <slepcsys.h>
+
+static PetscBool PeriPackageInitialized = PETSC_FALSE;
+
+/* PetscFinalize drops the log events and stages: a second PetscInitialize must register them again. */
+static PetscErrorCode PeriFinalizePackage(void)
+{
+  PetscFunctionBeginUser;
+  PeriPackageInitialized = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriInitializePackage(void)
+{
+  PetscClassId id;
+
+  PetscFunctionBeginUser;
+  if (PeriPackageInitialized) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriPackageInitialized = PETSC_TRUE;
+  PetscCall(PetscRegisterFinalize(PeriFinalizePackage));
+  PetscCall(PetscClassIdRegister("perilin", &id));
+  PetscCall(PetscLogEventRegister("PeriPartition", id, &PERI_EVENT_Partition));
+  PetscCall(PetscLogEventRegister("PeriNeighbors", id, &PERI_EVENT_Neighbors));
+  PetscCall(PetscLogEventRegister("PeriAssembly", id, &PERI_EVENT_Assembly));
+  PetscCall(PetscLogEventRegister("PeriSolve", id, &PERI_EVENT_Solve));
+  PetscCall(PetscLogStageRegister("Peri setup", &PERI_STAGE_Setup));
+  PetscCall(PetscLogStageRegister("Peri assembly", &PERI_STAGE_Assembly));
+  PetscCall(PetscLogStageRegister("Peri solve", &PERI_STAGE_Solve));
+  PetscCall(PetscLogStageRegister("Peri output", &PERI_STAGE_Output));
+  /* the registries are filled here, once, so that neither calls back into the package */
+  PetscCall(PeriModelRegisterAll());
+  PetscCall(PeriAnalysisRegisterAll());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriInitialize - starts SLEPc (and with it PETSc) once for the process, installs the signal
+  handlers (SIGINT, SIGTERM end a run early with its last complete state) and fills the registries.
+@*/
+PetscErrorCode PeriInitialize(int *argc, char ***argv, const char help[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(SlepcInitialize(argc, argv, NULL, help));
+  PetscCall(PeriSignalsInstall());
+  PetscCall(PeriInitializePackage());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriFinalize(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SlepcFinalize());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriPrintHelp(MPI_Comm comm)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneHelp(comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

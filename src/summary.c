@@ -1,0 +1,44 @@
+/* summary.json: what the run was, what it cost, and its results (docs/summary.md lists the keys).
+ * One call per contributor: the system's sections, then the analysis' own (ops.summary). */
+#include "perilin/private/problem.h"
+#include <signal.h>
+
+static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
+{
+  PeriSystem sys = p->sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriJSONString(j, "scene", p->scene->file));
+  PetscCall(PeriSystemSummaryModel(sys, j));
+  PetscCall(PeriJSONString(j, "analysis", p->analysis));
+  /* false only for a run stopped by a signal: then the fields below describe the last complete
+     state (quasistatic), or there are none */
+  PetscCall(PeriJSONBool(j, "complete", sys->interrupted ? PETSC_FALSE : PETSC_TRUE));
+  if (sys->interrupted) PetscCall(PeriJSONString(j, "interrupted_by", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  PetscCall(PeriSystemSummaryDiscretization(sys, j));
+  PetscCall(PeriSystemSummaryCost(sys, j));
+  PetscCall(PeriSystemSummarySolver(sys, j));
+  if (p->atype && p->atype->ops.summary) PetscCall(p->atype->ops.summary(p, j));
+  PetscCall(PeriSystemSummaryTorsion(sys, j));
+  PetscCall(PeriSystemSummaryFields(sys, j));
+  PetscCall(PeriSystemSummaryReference(sys, j));
+  PetscCall(PeriSystemSummaryProbes(sys, j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteSummary - writes summary.json on rank 0 (temporary name, then rename). Collective.
+@*/
+PetscErrorCode PeriWriteSummary(PeriProblem p, const char path[])
+{
+  PeriJSON       j = NULL;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  if (p->rank) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriJSONOpen(path, &j));
+  ierr = WriteSummary(p, j);
+  PetscCall(PeriJSONClose(&j, ierr ? PETSC_FALSE : PETSC_TRUE));
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,261 @@
+/* Fields after a solve: strain energy density, antiplane shear stresses, probes. */
+#include "perilin/private/system.h"
+
+static PetscBool LexLess(const PetscReal a[], const PetscReal b[])
+{
+  for (PetscInt d = 0; d < 3; d++)
+    if (a[d] != b[d]) return a[d] < b[d] ? PETSC_TRUE : PETSC_FALSE;
+  return PETSC_FALSE;
+}
+
+PetscErrorCode PeriReadProbes(PeriSystem sys)
+{
+  PeriScene            s = sys->scene;
+  PeriNode             map;
+  const PeriParticles *pt = &sys->particles;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "probes", PETSC_FALSE, &map));
+  if (!map) PetscFunctionReturn(PETSC_SUCCESS);
+  sys->nprobes = map->n;
+  PetscCall(PetscCalloc1(map->n, &sys->probes));
+  for (PetscInt k = 0; k < map->n; k++) {
+    PeriProbe *pr   = &sys->probes[k];
+    PetscReal  best = PETSC_MAX_REAL;
+    PetscInt   n;
+    PetscCall(PetscStrncpy(pr->name, map->child[k]->key, sizeof(pr->name)));
+    PetscCall(PeriSceneGetRealArray(s, map, map->child[k]->key, PETSC_TRUE, pt->dim, pt->dim, pr->x, &n));
+    for (PetscInt i = 0; i < pt->n; i++) {
+      PetscReal d2 = 0;
+      if (PeriParticleIsFictitious(pt, i)) continue;
+      for (PetscInt d = 0; d < pt->dim; d++) d2 += PetscSqr(pt->x[3 * i + d] - pr->x[d]);
+      /* ties go to the lexicographically smallest position, whatever the numbering (ranks) */
+      if (d2 < best || (d2 == best && LexLess(&pt->x[3 * i], &pt->x[3 * pr->particle]))) {
+        best         = d2;
+        pr->particle = i;
+      }
+    }
+    /* inside the body: within the nearest particle's cell (its circumscribed ball) */
+    PeriInputCheck(PetscSqrtReal(best) <= 0.5 * PetscSqrtReal((PetscReal)pt->dim) * pt->spacing[pr->particle] * (1 + 1e-9), s, map, map->child[k]->key, "the point lies outside the body (nearest particle at distance %g)", (double)PetscSqrtReal(best));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Energy of the state-based particles' families: W_i V_i = u^T K_i u / 2 of each owned particle. */
+static PetscErrorCode FamilyEnergy(PeriSystem sys, const PetscScalar u[], PetscReal W[], PetscReal *energy)
+{
+  PeriModel         m  = sys->model;
+  const PetscInt    bs = m->dofs, nmax = PeriSystemMaxFamily(sys);
+  PeriBondGeometry *fam;
+  PetscReal        *Ke, *ue;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc3(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, (nmax + 1) * bs, &ue));
+  for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
+    PetscInt  n, N;
+    PetscReal e = 0;
+    PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
+    N = (n + 1) * bs;
+    PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
+    for (PetscInt c = 0; c < bs; c++) {
+      ue[c] = PetscRealPart(u[i * bs + c]);
+      for (PetscInt t = 0; t < n; t++) ue[(t + 1) * bs + c] = PetscRealPart(u[fam[t].j * bs + c]);
+    }
+    for (PetscInt a = 0; a < N; a++)
+      for (PetscInt c = 0; c < N; c++) e += 0.5 * ue[a] * Ke[a * N + c] * ue[c];
+    W[i] += e / sys->particles.volume[i];
+    if (!PeriParticleIsFictitious(&sys->particles, i)) *energy += e;
+  }
+  PetscCall(PetscFree3(fam, Ke, ue));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Antiplane models: the corrected shear angles grad uz = M^-1 R with M = sum w alpha xi xi^T V_j
+ * and R = sum w alpha (u_j - u_i) xi V_j (w = 1/|xi|^2), exact for every linear field (eq. 53 with
+ * the full 2x2 moment, so also at corners), and tau = mu (grad uz + twist terms). Rank 0 gets
+ * tau_xz, tau_yz and |tau| of every particle. */
+static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
+{
+  const PeriBonds     *b  = &sys->bonds;
+  const PeriParticles *pt = &sys->particles;
+  const PetscInt       n  = pt->n;
+  PetscReal           *acc; /* per particle: M00 M01 M11 R0 R1 */
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(5 * n, &acc));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscInt         j  = b->j[k];
+      const PetscReal *xi = &b->xi[3 * k];
+      PetscReal        w = b->alpha[k] / (b->length[k] * b->length[k]), e = PetscRealPart(u[j] - u[i]);
+      if (!b->live[k] || j == i) continue;
+      for (PetscInt end = 0; end < 2; end++) {
+        PetscReal *A = &acc[5 * (end ? j : i)], V = pt->volume[end ? i : j];
+        A[0] += w * xi[0] * xi[0] * V;
+        A[1] += w * xi[0] * xi[1] * V;
+        A[2] += w * xi[1] * xi[1] * V;
+        A[3] += w * e * xi[0] * V;
+        A[4] += w * e * xi[1] * V;
+      }
+    }
+  PetscCallMPI(MPI_Reduce(sys->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, 0, sys->comm));
+  PetscCall(PetscFree(sys->tau));
+  if (sys->rank == 0) {
+    PetscCall(PetscMalloc1(3 * n, &sys->tau));
+    for (PetscInt i = 0; i < n; i++) {
+      const PetscReal *A   = &acc[5 * i];
+      PetscReal        det = A[0] * A[2] - A[1] * A[1], gx = 0, gy = 0, mu = sys->mu ? sys->mu[i] : sys->model->material.G;
+      if (det > 1e-12 * PetscSqr(A[0] + A[2])) {
+        gx = (A[2] * A[3] - A[1] * A[4]) / det;
+        gy = (A[0] * A[4] - A[1] * A[3]) / det;
+      } else if (A[0] + A[2] > 0) { /* a one-dimensional family (a row of particles): along it only */
+        gx = A[0] > 0 ? A[3] / A[0] : 0;
+        gy = A[2] > 0 ? A[4] / A[2] : 0;
+      }
+      if (sys->torsion.active) {
+        gx -= sys->torsion.twist * (pt->x[3 * i + 1] - sys->torsion.center[1]);
+        gy += sys->torsion.twist * (pt->x[3 * i] - sys->torsion.center[0]);
+      }
+      sys->tau[3 * i]     = mu * gx;
+      sys->tau[3 * i + 1] = mu * gy;
+      sys->tau[3 * i + 2] = mu * PetscSqrtReal(gx * gx + gy * gy);
+    }
+  }
+  PetscCall(PetscFree(acc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemEvaluateEnergy - from the solution sys->u: the strain energy of the body, the energy
+  density W_i = (1/2) sum_j (pair energy) / V_i of every particle (rank 0), the displacements of
+  all particles (rank 0), the probes, the largest displacement per component, and for antiplane
+  models the shear stresses and the torsion results. Collective.
+@*/
+PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
+{
+  VecScatter           scatter;
+  Vec                  all;
+  const PetscScalar   *u;
+  PeriModel            m  = sys->model;
+  const PeriParticles *pt = &sys->particles;
+  const PetscInt       n = pt->n, bs = m->dofs, nb = 2 * bs;
+  PetscReal           *W, energy = 0, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], umax[PERI_MAX_DOF] = {0, 0, 0};
+
+  PetscFunctionBeginUser;
+  PetscCall(VecScatterCreateToAll(sys->u, &scatter, &all));
+  PetscCall(VecScatterBegin(scatter, sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(scatter, sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGetArrayRead(all, &u));
+  PetscCall(PetscCalloc1(n, &W));
+  if (m->ops.family_stiffness)
+    PetscCall(FamilyEnergy(sys, u, W, &energy));
+  else
+    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
+      for (PetscInt k = sys->bonds.offset[i - sys->bonds.rstart]; k < sys->bonds.offset[i - sys->bonds.rstart + 1]; k++) {
+        PeriBondGeometry g;
+        PetscReal        ue[2 * PERI_MAX_DOF], e = 0;
+        if (!sys->bonds.live[k] || sys->bonds.j[k] == i) continue;
+        PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+        m->ops.bond_stiffness(m, &g, Ke);
+        for (PetscInt c = 0; c < bs; c++) {
+          ue[c]      = PetscRealPart(u[i * bs + c]);
+          ue[bs + c] = PetscRealPart(u[g.j * bs + c]);
+        }
+        for (PetscInt a = 0; a < nb; a++)
+          for (PetscInt c = 0; c < nb; c++) e += 0.5 * ue[a] * Ke[a * nb + c] * ue[c];
+        /* each end owns half of the pair; fictitious particles are not part of the body */
+        if (!PeriParticleIsFictitious(pt, i)) energy += 0.5 * e;
+        if (!PeriParticleIsFictitious(pt, g.j)) energy += 0.5 * e;
+        W[i] += 0.5 * e / g.Vi;
+        W[g.j] += 0.5 * e / g.Vj;
+      }
+  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
+    for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(pt, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
+  PetscCallMPI(MPI_Allreduce(umax, sys->results.max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscCallMPI(MPI_Allreduce(&energy, &sys->results.strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Reduce(sys->rank ? W : MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, 0, sys->comm));
+  if (m->antiplane) PetscCall(ShearStresses(sys, u));
+  PetscCall(PetscFree(sys->W));
+  PetscCall(PetscFree(sys->u_all));
+  if (sys->rank == 0) {
+    sys->W = W;
+    PetscCall(PetscMalloc1(n * bs, &sys->u_all));
+    for (PetscInt k = 0; k < n * bs; k++) sys->u_all[k] = PetscRealPart(u[k]);
+    for (PetscInt k = 0; k < sys->nprobes; k++) {
+      PeriProbe *pr = &sys->probes[k];
+      for (PetscInt c = 0; c < bs; c++) pr->u[c] = sys->u_all[pr->particle * bs + c];
+      pr->W = W[pr->particle];
+    }
+    PetscCall(PeriTorsionEvaluate(sys));
+  } else
+    PetscCall(PetscFree(W));
+  if (sys->torsion.active) PetscCallMPI(MPI_Bcast(&sys->torsion.torque, 6, MPIU_REAL, 0, sys->comm));
+  PetscCall(VecRestoreArrayRead(all, &u));
+  PetscCall(VecDestroy(&all));
+  PetscCall(VecScatterDestroy(&scatter));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe **probe)
+{
+  PetscFunctionBeginUser;
+  *probe = NULL;
+  for (PetscInt k = 0; k < sys->nprobes; k++)
+    if (!strcmp(sys->probes[k].name, name)) *probe = &sys->probes[k];
+  PetscCheck(*probe, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "no probe named %s", name);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemAddFields - the system's per-particle fields besides the solution: volume, neighbours,
+  rank, and where they exist strain energy density, antiplane shear stresses, damage (the total
+  and the share of each criterion the scene uses, Diana & Casolo eqs. 47, 48, 51) and the mirror
+  images of fictitious layer particles. Rank 0, after the fields were gathered.
+@*/
+PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
+{
+  const PeriFailure *F = &sys->failure;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->particles.volume, 1, NULL));
+  PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->neighbor_count));
+  PetscCall(PeriFieldListAddInt(fl, "rank", sys->owner));
+  if (sys->W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->W, 1, NULL));
+  if (sys->tau) {
+    const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau, 3, &nmap));
+  }
+  if (sys->damage) {
+    const PetscBool used[] = {(PetscBool)(sys->results.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
+    const PetscInt  map0   = 0;
+    PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage, PERI_NCAUSES + 1, &map0));
+    for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
+      char           name[32];
+      const PetscInt map = 1 + c;
+      if (!used[c]) continue;
+      PetscCall(PetscSNPrintf(name, sizeof(name), "damage_%s", PeriFailureCauses[c]));
+      PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage, PERI_NCAUSES + 1, &map));
+    }
+  }
+  if (sys->particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->particles.image)); /* -1: a body particle */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemWriteVTU - path holds u (all particles' DOFs, or NULL: no solution) and the system's
+  fields. Collective; rank 0 writes.
+@*/
+PetscErrorCode PeriSystemWriteVTU(PeriSystem sys, const PetscReal *u, const char path[])
+{
+  PeriFieldList fl;
+
+  PetscFunctionBeginUser;
+  if (sys->rank) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriFieldListCreate(sys->particles.n, sys->particles.x, &fl));
+  if (u) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, u));
+  PetscCall(PeriSystemAddFields(sys, fl));
+  PetscCall(PeriWriteVTU(fl, path));
+  PetscCall(PeriFieldListDestroy(&fl));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,431 @@
+/* PeriSystem: the discretized physics of one scene (particles, bonds, model, conditions, K).
+ * Its set-up reads every scene section but analysis and output. */
+#include "perilin/private/system.h"
+#include "perilin/private/sys.h"
+#include "perilin/private/model.h"
+
+static PetscErrorCode ReadHorizon(PeriSystem sys)
+{
+  static const char *const keys[] = {"m", "delta", NULL};
+  PeriScene                s      = sys->scene;
+  PeriNode                 h;
+  PetscReal                m = 0, hmax = 0;
+  PetscBool                hasm, hasd;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "horizon", PETSC_TRUE, &h));
+  PetscCall(PeriSceneCheckKeys(s, h, keys));
+  PetscCall(PeriSceneGetReal(s, h, "m", PETSC_FALSE, &m, &hasm));
+  PetscCall(PeriSceneGetReal(s, h, "delta", PETSC_FALSE, &sys->delta, &hasd));
+  PeriInputCheck(hasm || hasd, s, h, "m", "is required (or give horizon.delta)");
+  PeriInputCheck(!(hasm && hasd), s, h, "delta", "give horizon.m or horizon.delta, not both");
+  if (hasm) {
+    PeriInputCheck(m >= 1, s, h, "m", "must be at least 1 (the horizon may not be smaller than the spacing), got %g", (double)m);
+    sys->delta = m * sys->particles.mean_spacing;
+  }
+  {
+    /* beyond the body's diagonal every particle bonds with every other: N^2 bonds, no locality */
+    PetscReal diag2 = 0;
+    for (PetscInt d = 0; d < sys->particles.dim; d++) diag2 += PetscSqr(sys->particles.upper[d] - sys->particles.lower[d]);
+    PeriInputCheck(sys->delta <= PetscSqrtReal(diag2), s, h, hasm ? "m" : "delta", "the horizon %g exceeds the body's size (its diagonal %g): every particle would bond with every other; a horizon is a few spacings (m = 3 is usual)", (double)sys->delta, (double)PetscSqrtReal(diag2));
+  }
+  for (PetscInt k = 0; k < sys->particles.n; k++) hmax = PetscMax(hmax, sys->particles.spacing[k]);
+  PeriInputCheck(sys->delta >= hmax * (1 - 1e-10), s, h, hasm ? "m" : "delta", "the horizon %g is smaller than the particle spacing %g: particles would have no bonds", (double)sys->delta, (double)hmax);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ReadCorrections(PeriSystem sys)
+{
+  static const char *const keys[] = {"partial_volume", "surface", NULL};
+  PeriScene                s      = sys->scene;
+  PeriNode                 c;
+  PetscInt                 pv = PERI_PARTIAL_VOLUME_LINEAR_CONTINUED, sc = PERI_SURFACE_NONE;
+  PetscBool                found;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "corrections", PETSC_FALSE, &c));
+  PetscCall(PeriSceneCheckKeys(s, c, keys));
+  PetscCall(PeriSceneGetChoice(s, c, "partial_volume", PeriPartialVolumes, &pv, NULL));
+  PetscCall(PeriSceneGetChoice(s, c, "surface", PeriSurfaceCorrections, &sc, &found));
+  PeriInputCheck(sc == PERI_SURFACE_NONE || sys->model->allows_surface_correction, s, c, "surface", "model %s normalizes each particle's micromodulus by its own family volume, which already corrects surfaces: use surface: none", sys->model->type);
+  {
+    static const char *const defaults[] = {"none", "volume", NULL};
+    const char *const       *allowed    = sys->model->surface_corrections ? sys->model->surface_corrections : defaults;
+    char                     list[128]  = "";
+    PetscBool                ok         = PETSC_FALSE;
+    for (PetscInt k = 0; allowed[k]; k++) {
+      ok = (PetscBool)(ok || !strcmp(allowed[k], PeriSurfaceCorrections[sc]));
+      PeriListAppend(list, sizeof(list), allowed[k]);
+    }
+    PeriInputCheck(ok, s, c, "surface", "model %s takes %s, not %s", sys->model->type, list, PeriSurfaceCorrections[sc]);
+  }
+  sys->partial_volume = (PeriPartialVolume)pv;
+  sys->surface        = (PeriSurfaceCorrection)sc;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* solver.residual_tol: every solve's true relative residual must lie below it. */
+static PetscErrorCode ReadSolver(PeriSystem sys)
+{
+  static const char *const keys[] = {"residual_tol", NULL};
+  PeriScene                s      = sys->scene;
+  PeriNode                 node;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &node));
+  PetscCall(PeriSceneCheckKeys(s, node, keys));
+  PetscCall(PeriSceneGetReal(s, node, "residual_tol", PETSC_FALSE, &sys->residual_tol, NULL));
+  PeriInputCheck(sys->residual_tol >= 0 && sys->residual_tol < 1, s, node, "residual_tol", "must lie in [0, 1) (0: the default, max(100 rtol, 1e-6)), got %g", (double)sys->residual_tol);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriResidualTolerance - the largest true relative residual a solve run with relative tolerance
+  rtol may leave: solver.residual_tol, or by default max(100 rtol, 1e-6), but never above 1e-3.
+  The factor 100 leaves room for the preconditioned norm that some KSPs monitor; the floor, for
+  round-off in K; the cap keeps a loose -ksp_rtol from passing a wrong answer (an answer that
+  crude must be asked for with solver.residual_tol).
+@*/
+PetscReal PeriResidualTolerance(PeriSystem sys, PetscReal rtol)
+{
+  return sys->residual_tol > 0 ? sys->residual_tol : PetscMin(PetscMax(100 * rtol, 1e-6), 1e-3);
+}
+
+static PetscErrorCode CreateModel(PeriSystem sys)
+{
+  static const char *const keys[] = {"type", "plane", NULL}, *const planes[] = {"stress", "strain", NULL};
+  PeriScene s = sys->scene;
+  PeriNode  m;
+  PetscInt  dim = 0, plane = 0;
+  char      type[PERI_NAME_LEN];
+  PetscBool found;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetInt(s, s->root, "dim", PETSC_TRUE, &dim, NULL));
+  PeriInputCheck(dim == 2 || dim == 3, s, s->root, "dim", "must be 2 or 3, got %" PetscInt_FMT, dim);
+  PetscCall(PeriSceneGetMap(s, s->root, "model", PETSC_TRUE, &m));
+  PetscCall(PeriSceneGetString(s, m, "type", PETSC_TRUE, type, sizeof(type), NULL));
+  PetscCall(PeriSceneGetChoice(s, m, "plane", planes, &plane, &found));
+  PeriInputCheck(!found || dim == 2, s, m, "plane", "applies to 2D scenes only");
+  PetscCall(PeriModelTypeRegistered(type, &found));
+  if (!found) {
+    char list[256];
+    PetscCall(PeriModelListTypes(list, sizeof(list)));
+    PeriInputCheck(PETSC_FALSE, s, m, "type", "unknown model '%s'; registered models: %s", type, list);
+  }
+  PetscCall(PeriModelCreate(type, dim, plane == 1 ? PETSC_TRUE : PETSC_FALSE, &sys->model));
+  {
+    const char *allowed[16];
+    PetscInt    n = 0;
+    for (PetscInt k = 0; keys[k]; k++) allowed[n++] = keys[k];
+    for (PetscInt k = 0; sys->model->keys && sys->model->keys[k] && n < 15; k++) allowed[n++] = sys->model->keys[k];
+    allowed[n] = NULL;
+    PetscCall(PeriSceneCheckKeys(s, m, allowed));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The point X folded back into the body's box through the faces it lies beyond: a fictitious
+ * layer particle has the material of its mirror image. */
+static void FoldIntoBody(const PeriParticles *pt, const PetscReal X[], PetscReal Y[])
+{
+  for (PetscInt d = 0; d < 3; d++) {
+    Y[d] = X[d];
+    if (d >= pt->dim) continue;
+    if (Y[d] < pt->lower[d]) Y[d] = 2 * pt->lower[d] - Y[d];
+    if (Y[d] > pt->upper[d]) Y[d] = 2 * pt->upper[d] - Y[d];
+  }
+}
+
+static PetscReal ShearModulusAt(PeriSystem sys, PetscInt nr, PeriRegion *const reg[], const PetscReal val[], const PetscReal X[])
+{
+  PetscReal Y[3], mu = sys->model->material.G;
+  FoldIntoBody(&sys->particles, X, Y);
+  for (PetscInt k = 0; k < nr; k++)
+    if (PeriRegionContains(reg[k], Y)) mu = val[k];
+  return mu;
+}
+
+static int CompareReal(const void *a, const void *b)
+{
+  PetscReal x = *(const PetscReal *)a, y = *(const PetscReal *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* material.mu_by_region: the shear modulus of every particle, and of every bond that crosses an
+ * interface, the harmonic mean over its length (Oterkus & Madenci eq. 60), exact for box regions:
+ * the bond is cut where it crosses a region's or the body's faces. */
+static PetscErrorCode ReadShearModuli(PeriSystem sys)
+{
+  PeriScene            s  = sys->scene;
+  const PeriParticles *pt = &sys->particles;
+  const PeriBonds     *b  = &sys->bonds;
+  PeriNode             mat, map;
+  PeriRegion         **reg;
+  PetscReal           *val, *cut;
+  PetscInt             nr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
+  PetscCall(PeriSceneGetMap(s, mat, "mu_by_region", PETSC_FALSE, &map));
+  if (!map) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(sys->model->antiplane, s, map, NULL, "applies to the cross-section models (antiplane, antiplane_os), not %s", sys->model->type);
+  nr = map->n;
+  PetscCall(PetscMalloc3(nr, &reg, nr, &val, 6 * (nr + 1) + 2, &cut));
+  for (PetscInt k = 0; k < nr; k++) {
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, sys->nregions, sys->regions, &reg[k]));
+    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &val[k], NULL));
+    PeriInputCheck(val[k] > 0, s, map, map->child[k]->key, "must be positive, got %g", (double)val[k]);
+  }
+  PetscCall(PetscMalloc1(pt->n, &sys->mu));
+  for (PetscInt i = 0; i < pt->n; i++) sys->mu[i] = ShearModulusAt(sys, nr, reg, val, &pt->x[3 * i]);
+  PetscCall(PetscMalloc1(b->nbonds, &sys->bond_mu));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      const PetscReal *X = &pt->x[3 * i], *xi = &b->xi[3 * k];
+      PetscInt         nc  = 0;
+      PetscReal        inv = 0;
+      /* the parameters t in (0, 1) where X + t xi crosses a face */
+      cut[nc++] = 0;
+      for (PetscInt r = 0; r <= nr; r++)
+        for (PetscInt d = 0; d < pt->dim; d++) {
+          PetscReal lo = r < nr ? reg[r]->lower[d] : pt->lower[d], hi = r < nr ? reg[r]->upper[d] : pt->upper[d];
+          if (xi[d] == 0) continue;
+          for (PetscInt e = 0; e < 2; e++) {
+            PetscReal t = ((e ? hi : lo) - X[d]) / xi[d];
+            if (t > 0 && t < 1) cut[nc++] = t;
+          }
+        }
+      cut[nc++] = 1;
+      qsort(cut, (size_t)nc, sizeof(PetscReal), CompareReal);
+      for (PetscInt c = 0; c + 1 < nc; c++) {
+        PetscReal Y[3], t = 0.5 * (cut[c] + cut[c + 1]);
+        for (PetscInt d = 0; d < 3; d++) Y[d] = X[d] + t * xi[d];
+        inv += (cut[c + 1] - cut[c]) / ShearModulusAt(sys, nr, reg, val, Y);
+      }
+      sys->bond_mu[k] = 1 / inv;
+    }
+  PetscCall(PetscFree3(reg, val, cut));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSystemCreate(MPI_Comm comm, PeriScene scene, PeriSystem *system)
+{
+  PeriSystem sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&sys));
+  sys->comm  = comm;
+  sys->scene = scene;
+  PetscCallMPI(MPI_Comm_rank(comm, &sys->rank));
+  PetscCallMPI(MPI_Comm_size(comm, &sys->size));
+  *system = sys;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemSetFromScene - the cheap part of the set-up: the model (dim, model.*), solver.* and
+  material.thickness, and the memory estimate, so that these errors come before any large
+  allocation. Collective.
+@*/
+PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
+{
+  PeriScene s = sys->scene;
+  PeriNode  mat;
+
+  PetscFunctionBeginUser;
+  PetscCall(CreateModel(sys));
+  PetscCall(ReadSolver(sys));
+  PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
+  sys->thickness = 1;
+  PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->thickness, NULL));
+  PeriInputCheck(sys->thickness > 0, s, mat, "thickness", "must be positive, got %g", (double)sys->thickness);
+  /* before any large allocation: a scene that cannot fit is refused with its size */
+  PetscCall(PeriParticlesCheckMemory(sys->comm, s, sys->model));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Partition, neighbour search (bonds, and families for state-based models), cracks, family
+ * volumes and the surface correction; counts of bonds and of bonds between ranks. */
+static PetscErrorCode SetUpBonds(PeriSystem sys)
+{
+  PetscInt      *perm, *range, cut = 0;
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t0));
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Partition, 0, 0, 0, 0));
+  PetscCall(PeriPartition(sys->comm, &sys->particles, sys->delta, &perm, &range));
+  if (sys->size > 1) PetscCall(PeriParticlesPermute(&sys->particles, perm));
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Partition, 0, 0, 0, 0));
+  PetscCall(PetscMalloc1(sys->particles.n, &sys->owner));
+  for (PetscMPIInt r = 0; r < sys->size; r++)
+    for (PetscInt i = range[r]; i < range[r + 1]; i++) sys->owner[i] = r;
+
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Neighbors, 0, 0, 0, 0));
+  PetscCall(PeriNeighborSearch(&sys->particles, sys->delta, sys->partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_TRUE, &sys->bonds));
+  /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
+  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&sys->particles, sys->delta, sys->partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_FALSE, &sys->family));
+  PetscCall(PetscMalloc2(sys->particles.n, &sys->family_volume, sys->particles.n, &sys->neighbor_count));
+  /* a crack is geometry: the family volumes, the surface correction and the calibration see it */
+  PetscCall(PeriCracksApply(sys));
+  PetscCall(PeriNeighborhoodVolumes(sys->comm, &sys->particles, &sys->bonds, sys->family_volume, sys->neighbor_count));
+  PetscCall(PeriSurfaceCorrectionApply(sys->surface, &sys->particles, sys->delta, sys->family_volume, &sys->bonds));
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Neighbors, 0, 0, 0, 0));
+  PetscCall(PetscTime(&t1));
+  sys->results.neighbors_s = t1 - t0;
+  PetscCallMPI(MPI_Allreduce(&sys->bonds.nbonds, &sys->results.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
+  for (PetscInt k = 0; k < sys->bonds.nbonds; k++) cut += sys->owner[sys->bonds.j[k]] != sys->rank;
+  PetscCallMPI(MPI_Allreduce(&cut, &sys->results.edge_cut, 1, MPIU_INT, MPI_SUM, sys->comm));
+  PetscCall(PetscFree(perm));
+  PetscCall(PetscFree(range));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The model's constants from the material and the discrete families. */
+static PetscErrorCode Calibrate(PeriSystem sys)
+{
+  PeriCalibrationData cal;
+
+  PetscFunctionBeginUser;
+  cal.n             = sys->particles.n;
+  cal.family_volume = sys->family_volume;
+  cal.mu            = sys->mu;
+  cal.comm          = sys->comm;
+  cal.particles     = &sys->particles;
+  cal.bonds         = &sys->bonds;
+  cal.surface       = sys->surface;
+  PetscCall(sys->model->ops.calibrate(sys->model, &cal));
+  if (sys->model->warning[0]) PetscCall(PetscPrintf(sys->comm, "perilin: warning: %s\n", sys->model->warning));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemSetUp - particles, partition, bonds, corrections, calibration, regions, probes and
+  boundary conditions, with every input check. After PeriSystemSetFromScene. Collective.
+@*/
+PetscErrorCode PeriSystemSetUp(PeriSystem sys)
+{
+  PeriScene            s  = sys->scene;
+  const PeriParticles *pt = &sys->particles;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriParticlesCreateFromScene(s, sys->model->dim, sys->thickness, &sys->particles));
+  PetscCall(ReadHorizon(sys));
+  PetscCall(PeriModelSetFromScene(sys->model, s, sys->delta));
+  PetscCall(ReadCorrections(sys));
+  PetscCall(PeriLayersAddParticles(sys));
+  PetscCall(SetUpBonds(sys));
+  for (PetscInt i = 0; i < pt->n; i++)
+    PetscCheck(sys->neighbor_count[i] > 0, sys->comm, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->delta, (double)pt->spacing[i]);
+  PetscCall(PeriRegionsCreateFromScene(s, &sys->particles, sys->delta, &sys->nregions, &sys->regions));
+  PetscCall(ReadShearModuli(sys));
+  PetscCall(Calibrate(sys));
+  PetscCall(PeriReadProbes(sys));
+  PetscCall(PeriFailureSetUp(sys));
+  PetscCall(PeriReferenceSetUp(sys));
+  PetscCall(PeriBoundarySetUp(sys));
+  PetscCall(PeriLayersSetUp(sys));
+  /* the loads too, so that a bad load is reported before any solve */
+  PetscCall(PeriSystemCreateVec(sys, &sys->f));
+  PetscCall(PeriLoadsAssemble(sys, sys->f));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSystemDestroy(PeriSystem *system)
+{
+  PeriSystem sys = *system;
+
+  PetscFunctionBeginUser;
+  if (!sys) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(MatDestroy(&sys->K));
+  PetscCall(VecDestroy(&sys->u));
+  PetscCall(VecDestroy(&sys->f));
+  PetscCall(PeriModelDestroy(&sys->model));
+  PetscCall(PeriBondsDestroy(&sys->bonds));
+  PetscCall(PeriBondsDestroy(&sys->family));
+  PetscCall(PeriLayersDestroy(&sys->layers));
+  PetscCall(PetscFree(sys->mu));
+  PetscCall(PetscFree(sys->bond_mu));
+  PetscCall(PetscFree(sys->tau));
+  PetscCall(PetscFree(sys->damage));
+  PetscCall(PeriParticlesDestroy(&sys->particles));
+  PetscCall(PetscFree(sys->regions));
+  PetscCall(PetscFree(sys->probes));
+  PetscCall(PetscFree2(sys->family_volume, sys->neighbor_count));
+  PetscCall(PetscFree(sys->owner));
+  PetscCall(PetscFree(sys->constrained));
+  PetscCall(PetscFree(sys->constrained_value));
+  PetscCall(PetscFree(sys->W));
+  PetscCall(PetscFree(sys->u_all));
+  PetscCall(PetscFree(sys));
+  *system = NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+/* A vector with one block of DOFs per owned particle. */
+PetscErrorCode PeriSystemCreateVec(PeriSystem sys, Vec *v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecCreate(sys->comm, v));
+  PetscCall(VecSetSizes(*v, (sys->bonds.rend - sys->bonds.rstart) * sys->model->dofs, PETSC_DETERMINE));
+  PetscCall(VecSetBlockSize(*v, sys->model->dofs));
+  PetscCall(VecSetFromOptions(*v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The kernel's view of bond k of owned particle i in the list b (bond_mu: per bond, or NULL). */
+static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const PetscReal bond_mu[], PetscInt i, PetscInt k, PeriBondGeometry *g)
+{
+  g->i = i;
+  g->j = b->j[k];
+  for (PetscInt d = 0; d < 3; d++) g->xi[d] = b->xi[3 * k + d];
+  g->length = b->length[k];
+  g->Vi     = pt->volume[i];
+  g->Vj     = pt->volume[g->j];
+  g->weight = b->alpha[k] * b->lambda[k] * (b->intact ? b->intact[k] : 1);
+  g->mu     = bond_mu ? bond_mu[k] : 0;
+}
+
+/* The kernel's view of local bond k of owned particle i. */
+PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, PeriBondGeometry *g)
+{
+  PetscFunctionBeginUser;
+  FillGeometry(&sys->particles, &sys->bonds, sys->bond_mu, i, k, g);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSystemAssemble(PeriSystem sys)
+{
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogStagePush(PERI_STAGE_Assembly));
+  PetscCall(PetscTime(&t0));
+  PetscCall(MatDestroy(&sys->K));
+  PetscCall(PeriAssembleStiffness(sys, &sys->K));
+  PetscCall(PetscTime(&t1));
+  sys->results.assembly_s = t1 - t0;
+  PetscCall(PetscLogStagePop());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Gathers the family of owned particle i from sys->family (state-based models). */
+PetscErrorCode PeriSystemFamilyGeometry(PeriSystem sys, PetscInt i, PetscInt *n, PeriBondGeometry fam[])
+{
+  const PeriBonds     *b  = &sys->family;
+  const PeriParticles *pt = &sys->particles;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+    if (b->live[k]) FillGeometry(pt, b, NULL, i, k, &fam[(*n)++]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Largest family in sys->family, for workspace. */
+PetscInt PeriSystemMaxFamily(PeriSystem sys)
+{
+  PetscInt nmax = 0;
+  for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) nmax = PetscMax(nmax, sys->family.offset[i - sys->family.rstart + 1] - sys->family.offset[i - sys->family.rstart]);
+  return nmax;
+}
