@@ -314,5 +314,7 @@ static PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel m)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriModelType PeriModel_Antiplane   = {"antiplane", NULL, PeriModelCreate_Antiplane};
-const PeriModelType PeriModel_AntiplaneOS = {"antiplane_os", NULL, PeriModelCreate_AntiplaneOS};
+/* the one rigid mode is the translation; the energy correction (eq. 53) makes every linear u_z
+ * exact (without it 2 % and 6 % off at m = 3) */
+const PeriModelType PeriModel_Antiplane   = {.name = "antiplane", .create = PeriModelCreate_Antiplane, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_HOMOGENEOUS};
+const PeriModelType PeriModel_AntiplaneOS = {.name = "antiplane_os", .create = PeriModelCreate_AntiplaneOS, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_HOMOGENEOUS};

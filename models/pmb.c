@@ -45,4 +45,6 @@ static PetscErrorCode PeriModelCreate_PMB(PeriModel m)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriModelType PeriModel_PMB = {"pmb", NULL, PeriModelCreate_PMB};
+/* c comes from the continuous horizon: the discrete family sums miss it by a few per cent on a grid
+ * (u = s X: 2 % at m = 3 in 2D; other strains 4 %), so no energy is exact */
+const PeriModelType PeriModel_PMB = {.name = "pmb", .create = PeriModelCreate_PMB, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_NONE};

@@ -79,8 +79,25 @@ typedef struct _PeriSchema PeriSchema;
 /* A built-in model type. Each model file (models/) ends with its descriptor(s) PeriModel_<id>,
  * whose create function stays static; models/list.h names them and models/registry.c registers
  * them. */
+/* What a model type promises about the energy of a homogeneous strain at a particle whose family
+ * and its neighbours' families lie inside the body, on a uniform grid: that it equals the energy
+ * density of the target elasticity (plane stress or strain as set up; antiplane models: the shear
+ * modulus), for the isotropic expansion u = s X only or for every strain. The promise holds with
+ * corrections.surface: energy where the model offers it (that correction calibrates the discrete
+ * energy of linear fields), otherwise with every correction the model takes.
+ * tests/unit/test_model_contract.c checks it. */
+typedef enum {
+  PERI_EXACT_NONE,
+  PERI_EXACT_EXPANSION,
+  PERI_EXACT_HOMOGENEOUS
+} PeriExactEnergy;
+
 typedef struct {
   const char       *name; /* model.type */
   const PeriSchema *schema;
   PetscErrorCode (*create)(PeriModel);
+  /* the modes of ops.rigid_modes that vary with position (rotations) store no energy; false when
+     they are listed only as AMG's near-null space */
+  PetscBool       rotation_invariant;
+  PeriExactEnergy exact_energy;
 } PeriModelType;

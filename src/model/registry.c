@@ -31,3 +31,14 @@ PetscErrorCode PeriModelRegisterAll(void)
   for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(builtin); k++) PetscCall(PeriModelRegister(builtin[k]->name, builtin[k]->create));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The descriptor of the built-in model type name, with its promises; NULL for a type registered
+ * with PeriModelRegister alone. Not collective. */
+PetscErrorCode PeriModelTypeGet(const char name[], const PeriModelType **type)
+{
+  PetscFunctionBeginUser;
+  *type = NULL;
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(builtin); k++)
+    if (!strcmp(builtin[k]->name, name)) *type = builtin[k];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

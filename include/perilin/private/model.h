@@ -11,3 +11,4 @@ PETSC_EXTERN PetscErrorCode PeriModelSetFromScene(PeriModel, PeriScene, PetscRea
 PETSC_EXTERN PetscErrorCode PeriModelListTypes(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriModelTypeRegistered(const char[], PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriModelDestroy(PeriModel *);
+PETSC_EXTERN PetscErrorCode PeriModelTypeGet(const char[], const PeriModelType **);
