@@ -153,7 +153,7 @@ int main(int argc, char **argv)
   const char *const models[] = {"antiplane", "antiplane_os"};
   char              what[256];
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 5, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_antiplane square_bar.yaml bimaterial.yaml rect_bar.yaml square_bar_inner.yaml");
   for (PetscInt k = 0; k < 2; k++) {
     PeriProblem p, q;
@@ -280,6 +280,6 @@ int main(int argc, char **argv)
     PetscCall(PeriTestSetOption("-horizon_m", NULL));
   }
   PetscCall(PeriTestSetOption("-model_type", NULL));
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

@@ -24,7 +24,7 @@ int main(int argc, char **argv)
 {
   const PetscReal K = 1e9, s = 0.01, Wexact = 4.5 * K * s * s;
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_energy_density examples/pmb/energy_density.yaml");
   for (PetscInt m = 2; m <= 6; m++) {
     char        val[8], what[128];
@@ -60,6 +60,6 @@ int main(int argc, char **argv)
     }
     PetscCall(PeriProblemDestroy(&p));
   }
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

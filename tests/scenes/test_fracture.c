@@ -30,7 +30,7 @@ int main(int argc, char **argv)
   PeriProblem        p;
   char               what[256];
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 5, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_fracture edge_crack.yaml cracked_bar.yaml micropolar_shear.yaml torsion_edge_crack.yaml");
   PeriTestClose("LEFM sigma_F plane stress [Pa]", lefm, 130.6, 0.05);
   for (PetscInt k = 0; k < 2; k++) {
@@ -114,6 +114,6 @@ int main(int argc, char **argv)
     PetscCall(PeriTestSetOption("-cracks_0_to_0", NULL));
   }
   PetscCall(PeriTestSetOption("-quiet", NULL));
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

@@ -175,7 +175,7 @@ int main(int argc, char **argv)
   PetscMPIInt       rank;
   char              what[160];
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_lamina examples/lamina");
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
 
@@ -236,6 +236,6 @@ int main(int argc, char **argv)
   }
   (void)sigma;
   PetscCall(Extremes(argv[1]));
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

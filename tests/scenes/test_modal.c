@@ -355,7 +355,7 @@ int main(int argc, char **argv)
 {
   PetscBool checks_only;
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_modal examples/lamina/modal.yaml examples/pmb/bar_modes.yaml tests/scenes/tiny_modal.yaml");
   /* -checks_only: the target and the refusals only (the 2-rank test) */
   PetscCall(PetscOptionsHasName(NULL, NULL, "-checks_only", &checks_only));
@@ -366,6 +366,6 @@ int main(int argc, char **argv)
   }
   PetscCall(Target(argv[1]));
   PetscCall(Checks(argv[1]));
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

@@ -58,7 +58,7 @@ int main(int argc, char **argv)
   PetscReal         lat_exx, lat_nu;
   PetscMPIInt       size, rank;
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_plate_traction examples/pmb/plate_traction.yaml");
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
@@ -96,6 +96,6 @@ int main(int argc, char **argv)
     }
     PetscCall(PeriProblemDestroy(&p));
   }
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

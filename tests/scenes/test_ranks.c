@@ -10,7 +10,7 @@ int main(int argc, char **argv)
   PetscMPIInt size;
   char        what[128];
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_ranks SCENE.yaml [options]");
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
@@ -23,7 +23,7 @@ int main(int argc, char **argv)
     }
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
-    PetscCall(SlepcFinalize());
+    PetscCall(PeriFinalize());
     return 0;
   }
   if (p->quasistatic) {
@@ -34,7 +34,7 @@ int main(int argc, char **argv)
     PeriTestClose(what, (PetscReal)p->quasistatic->nsteps, (PetscReal)q->quasistatic->nsteps, 0);
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
-    PetscCall(SlepcFinalize());
+    PetscCall(PeriFinalize());
     return 0;
   }
   PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %d ranks vs 1", p->sys->model->type, size));
@@ -49,6 +49,6 @@ int main(int argc, char **argv)
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

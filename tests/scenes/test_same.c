@@ -8,7 +8,7 @@ int main(int argc, char **argv)
   PeriProblem p, q;
   char        what[256];
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_same A.yaml B.yaml [options]");
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &q));
@@ -20,6 +20,6 @@ int main(int argc, char **argv)
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

@@ -53,7 +53,7 @@ int main(int argc, char **argv)
   PeriProblem     p, q;
   char            what[160];
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_bond_models tests/scenes/affine_2d.yaml");
 
   for (int k = 0; k < 2; k++) {
@@ -96,6 +96,6 @@ int main(int argc, char **argv)
       PetscCall(PeriProblemDestroy(&p));
     }
   }
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

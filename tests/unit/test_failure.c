@@ -13,7 +13,7 @@ int main(int argc, char **argv)
   PeriBondGeometry g = {0};
   PetscReal        meas[PERI_MAX_MEASURE];
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_failure fragment.yaml");
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   /* the scene: s_c = 0.01, compressive 0.02 */
@@ -83,6 +83,6 @@ int main(int argc, char **argv)
     PetscCall(PeriTestSetOption("-analysis_load_factor_max", NULL));
     PetscCall(PeriTestSetOption("-quiet", NULL));
   }
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }

@@ -299,7 +299,7 @@ int main(int argc, char **argv)
   int    ntypes;
   size_t len;
 
-  PetscCall(SlepcInitialize(&argc, &argv, NULL, NULL));
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_model_contract contract_2d.yaml contract_3d.yaml");
   PetscCall(PeriInitializePackage());
   PetscCall(PeriModelListTypes(list, sizeof(list)));
@@ -349,6 +349,6 @@ int main(int argc, char **argv)
   PetscCall(PeriTestSetOption("-model_plane", NULL));
   PetscCall(PeriTestSetOption("-material_nu", NULL));
   PetscCall(PeriTestSetOption("-corrections_surface", NULL));
-  PetscCall(SlepcFinalize());
+  PetscCall(PeriFinalize());
   return 0;
 }
