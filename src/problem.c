@@ -212,7 +212,10 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
 
   PetscFunctionBeginUser;
   PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis, sys->model->type, sys->particles.n, r->nbonds_total, sys->particles.n * sys->model->dofs, p->size));
-  PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", r->neighbors_s, r->assembly_s, r->solve_s, r->ksp_type, r->pc_type, r->iterations, r->converged_reason, (double)r->residual_norm, r->memory_mb));
+  if (r->ksp_type[0])
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", r->neighbors_s, r->assembly_s, r->solve_s, r->ksp_type, r->pc_type, r->iterations, r->converged_reason, (double)r->residual_norm, r->memory_mb));
+  else
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", r->neighbors_s, r->memory_mb));
   if (sys->interrupted) {
     PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->u_all ? "the last complete state was written" : "no result was reached", p->output_dir));
   } else if (p->atype && p->atype->ops.report) {

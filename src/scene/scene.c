@@ -83,7 +83,7 @@ static const PeriSceneKey scene_keys[] = {
     {"analysis.control_probe", "quasistatic: the probe whose displacement steps.csv reports (default the first)"},
     {"output.every", "quasistatic: write particles_NNNN.vtu every k steps (0: only the end)"},
     {"probes.<name>", "a point [x, y(, z)]: displacement and energy density of the nearest particle"},
-    {"analysis.type", "static | modal | quasistatic"},
+    {"analysis.type", "static | modal | quasistatic | setup (set up and stop: check a scene, size a run)"},
     {"analysis.nev", "modal: number of modes (default 6)"},
     {"analysis.target_hz", "modal: compute the modes nearest this frequency [1/time] (default 0: the lowest)"},
     {"solver.residual_tol", "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; default max(100 rtol, 1e-6)"},

@@ -64,12 +64,14 @@ PetscErrorCode PeriSystemSummaryCost(PeriSystem sys, PeriJSON j)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The last solve: KSP and PC, iterations, the true residual and its tolerance. */
+/* The last solve: KSP and PC, iterations, the true residual and its tolerance. None when no
+ * solver was used (analysis setup); an interrupted run always says whether it converged. */
 PetscErrorCode PeriSystemSummarySolver(PeriSystem sys, PeriJSON j)
 {
   const PeriResults *r = &sys->results;
 
   PetscFunctionBeginUser;
+  if (!r->ksp_type[0] && !sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONBeginObject(j, "solver"));
   PetscCall(PeriJSONString(j, "ksp_type", r->ksp_type));
   PetscCall(PeriJSONString(j, "pc_type", r->pc_type));

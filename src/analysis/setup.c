@@ -1,0 +1,24 @@
+/* analysis.type: setup. A dry run: the scene is read and the system set up (particles, partition,
+ * bonds, calibration, regions, conditions, loads: every input check), and nothing is assembled or
+ * solved. summary.json gives the sizes, the edge cut and the set-up cost, particles.vtu the
+ * volumes, neighbour counts and ranks: a scene is checked, or a large run sized, before it is paid
+ * for. Also the smallest example of an analysis (docs/design.md, "How to add an analysis"). */
+#include "perilin/private/problem.h"
+
+/* Nothing to run: no solver was used, so summary.json has no solver section and the report no
+ * solver line. */
+static PetscErrorCode Run_Setup(PeriProblem p)
+{
+  PetscFunctionBeginUser;
+  (void)p;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Report_Setup(PeriProblem p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(p->comm, "perilin: set-up only, nothing solved: %" PetscInt_FMT " bonds between ranks; results in %s/\n", p->sys->results.edge_cut, p->output_dir));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+const PeriAnalysisType PeriAnalysis_Setup = {"setup", "set up the system and stop: check a scene, size a run", NULL, PETSC_FALSE, {Run_Setup, NULL, NULL, NULL, Report_Setup, NULL}};
