@@ -1,6 +1,8 @@
 /* Ganzenmueller et al. sec. 3.1.1 (Fig. 3): energy density of u = s X at the centre of a cubic
  * lattice for m = 2..6. npmb must give 9 K s^2 / 2 to round-off; pmb's error must equal the
  * lattice sum sum_j |xi_j| V_j / (pi delta^4) - 1, computed here independently by brute force.
+ * cpmb (conical influence 1 - |xi|/delta) must equal sum_j (1 - |xi_j|/delta) |xi_j| V_j /
+ * (pi delta^4 / 5), the same brute-force sum with the weight.
  * The paper's neighbour counts (32 at m = 2, 924 at m = 6) are checked too. */
 #include "testing.h"
 #include <slepcsys.h>
@@ -28,12 +30,13 @@ int main(int argc, char **argv)
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_energy_density examples/pmb/energy_density.yaml");
   for (PetscInt m = 2; m <= 6; m++) {
     char        val[8], what[128];
-    PetscReal   sum1;
+    PetscReal   sum1, sum2;
     PetscInt    count;
     PeriProblem p;
     PeriProbe  *c;
 
     LatticeSum(m, 1, &sum1, &count);
+    LatticeSum(m, 2, &sum2, &count);
     PetscCall(PetscSNPrintf(val, sizeof(val), "%" PetscInt_FMT, m));
     PetscCall(PeriTestSetOption("-horizon_m", val));
 
@@ -56,6 +59,16 @@ int main(int argc, char **argv)
       PetscReal predicted = sum1 / (PETSC_PI * PetscPowReal((PetscReal)m, 4));
       PetscCall(PeriSystemFindProbe(p->sys, "center", &c));
       PetscCall(PetscSNPrintf(what, sizeof(what), "pmb m=%" PetscInt_FMT ": centre W / (9 K s^2/2), error %+.2f %%", m, (double)(100 * (c->W / Wexact - 1))));
+      PeriTestClose(what, c->W / Wexact, predicted, 1e-10 * predicted);
+    }
+    PetscCall(PeriProblemDestroy(&p));
+
+    PetscCall(PeriTestSetOption("-model_type", "cpmb"));
+    PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
+    if (p->rank == 0) {
+      PetscReal predicted = (sum1 - sum2 / m) / (PETSC_PI * PetscPowReal((PetscReal)m, 4) / 5);
+      PetscCall(PeriSystemFindProbe(p->sys, "center", &c));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "cpmb m=%" PetscInt_FMT ": centre W / (9 K s^2/2), error %+.2f %%", m, (double)(100 * (c->W / Wexact - 1))));
       PeriTestClose(what, c->W / Wexact, predicted, 1e-10 * predicted);
     }
     PetscCall(PeriProblemDestroy(&p));
