@@ -161,7 +161,7 @@ def document(res, notes):
     A("numbers are typed in from `../shared/papers/diana-casolo-micropolar-mppd.md` as printed. The")
     A("models: [models/pds.md](models/pds.md), [models/mppd.md](models/mppd.md) (mppd and gerstle).")
     A("")
-    A("How perilin measures (`src/reference.c`, [summary.md](summary.md)): `max|u|` is the largest")
+    A("How perilin measures (`src/system/reference.c`, [summary.md](summary.md)): `max|u|` is the largest")
     A("displacement component over all particles; the centre particle is pinned (u_x, u_y) and its")
     A("right-hand neighbour (u_y), so displacements are relative to the centre. `effective.nu`,")
     A("`effective.E`, `effective.G` come from the least-squares displacement gradient over the")
