@@ -57,81 +57,130 @@ static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* x, y[, z], volume[, material]: one particle per line; '#' comments and a header line allowed. */
-static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, PeriParticles *p)
+/* The particles file's path from the section's one key: absolute as given, else relative to the scene file's folder. */
+static PetscErrorCode CSVPath(PeriScene scene, PeriNode node, char path[], size_t size)
 {
   static const char *const keys[] = {"file", NULL};
-  char                     name[PETSC_MAX_PATH_LEN], path[PETSC_MAX_PATH_LEN], line[1024];
-  FILE                    *fp;
-  PetscInt                 cap = 1024, n = 0, lineno = 0;
-  PetscReal               *x, *vol, sum              = 0;
-  PetscInt                *src;
-  PetscBool                header = PETSC_FALSE;
+  char                     name[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckKeys(scene, node, keys));
   PetscCall(PeriSceneGetString(scene, node, "file", PETSC_TRUE, name, sizeof(name), NULL));
   if (name[0] == '/')
-    PetscCall(PetscStrncpy(path, name, sizeof(path)));
+    PetscCall(PetscStrncpy(path, name, size));
   else
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", scene->dir, name));
+    PetscCall(PetscSNPrintf(path, size, "%s/%s", scene->dir, name));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Splits one line into up to 5 numbers; *skip for comments and blank lines, *rest when text follows the numbers. */
+static PetscErrorCode CSVLineSplit(char line[], double v[5], int *nf, PetscBool *skip, PetscBool *rest)
+{
+  char *s = line, *end;
+
+  PetscFunctionBeginUser;
+  *nf   = 0;
+  *skip = PETSC_FALSE;
+  *rest = PETSC_FALSE;
+  while (*s == ' ' || *s == '\t') s++;
+  if (*s == '#' || *s == '\n' || *s == '\r' || !*s) {
+    *skip = PETSC_TRUE;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  while (*nf < 5) {
+    v[*nf] = strtod(s, &end);
+    if (end == s) break;
+    (*nf)++;
+    s = end;
+    while (*s == ' ' || *s == '\t') s++;
+    if (*s == ',') s++;
+  }
+  while (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') s++;
+  *rest = *s ? PETSC_TRUE : PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What is wrong with a particle line (NULL if nothing): its fields, then its volume; a non-finite value overrides both. */
+static PetscErrorCode CSVLineProblem(PetscInt dim, const double v[], int nf, PetscBool rest, const char **problem)
+{
+  PetscFunctionBeginUser;
+  *problem = NULL;
+  if (nf < dim + 1 || nf > dim + 2 || rest)
+    *problem = dim == 2 ? "expected x, y, volume[, material]" : "expected x, y, z, volume[, material]";
+  else if (!(v[dim] > 0))
+    *problem = "the volume must be positive";
+  for (int k = 0; k < nf; k++)
+    if (!PetscIsNormalReal((PetscReal)v[k]) && v[k] != 0) *problem = "every value must be a finite number";
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Doubles the capacity of the positions (3 per particle), volumes and source lines read so far. */
+static PetscErrorCode CSVGrow(PetscInt *cap, PetscReal **x, PetscReal **vol, PetscInt **src)
+{
+  PetscReal *x2, *v2;
+  PetscInt  *s2;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc3(6 * *cap, &x2, 2 * *cap, &v2, 2 * *cap, &s2));
+  PetscCall(PetscArraycpy(x2, *x, 3 * *cap));
+  PetscCall(PetscArraycpy(v2, *vol, *cap));
+  PetscCall(PetscArraycpy(s2, *src, *cap));
+  PetscCall(PetscFree3(*x, *vol, *src));
+  *x   = x2;
+  *vol = v2;
+  *src = s2;
+  *cap *= 2;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Reads the file's n particles into x, vol, src (allocated here, freed by the caller); stops at the first bad line. */
+static PetscErrorCode CSVRead(PeriScene scene, PeriNode node, const char path[], PetscInt dim, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt **src)
+{
+  char      line[1024];
+  FILE     *fp;
+  PetscInt  cap = 1024, lineno = 0;
+  PetscBool header = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  *n = 0;
   fp = fopen(path, "r");
   PeriInputCheck(fp, scene, node, "file", "cannot open %s: %s", path, strerror(errno));
-  PetscCall(PetscMalloc3(3 * cap, &x, cap, &vol, cap, &src));
+  PetscCall(PetscMalloc3(3 * cap, x, cap, vol, cap, src));
   while (fgets(line, sizeof(line), fp)) {
-    double         v[5];
-    int            nf   = 0;
-    char          *s    = line, *end;
-    PetscErrorCode ierr = PETSC_SUCCESS;
+    double      v[5];
+    int         nf;
+    PetscBool   skip, rest;
+    const char *problem;
 
     lineno++;
-    while (*s == ' ' || *s == '\t') s++;
-    if (*s == '#' || *s == '\n' || *s == '\r' || !*s) continue;
-    while (nf < 5) {
-      v[nf] = strtod(s, &end);
-      if (end == s) break;
-      nf++;
-      s = end;
-      while (*s == ' ' || *s == '\t') s++;
-      if (*s == ',') s++;
-    }
-    while (*s == ' ' || *s == '\t' || *s == '\r' || *s == '\n') s++;
-    if (nf == 0 && n == 0 && !header) { /* a header line before the first particle */
+    PetscCall(CSVLineSplit(line, v, &nf, &skip, &rest));
+    if (skip) continue;
+    if (nf == 0 && *n == 0 && !header) { /* a header line before the first particle */
       header = PETSC_TRUE;
       continue;
     }
-    if (nf < dim + 1 || nf > dim + 2 || *s)
-      ierr = PETSC_ERR_USER_INPUT;
-    else if (!(v[dim] > 0))
-      ierr = PETSC_ERR_USER_INPUT + 1;
-    for (int k = 0; k < nf; k++)
-      if (!PetscIsNormalReal((PetscReal)v[k]) && v[k] != 0) ierr = PETSC_ERR_USER_INPUT + 2;
-    if (ierr) {
+    PetscCall(CSVLineProblem(dim, v, nf, rest, &problem));
+    if (problem) {
       fclose(fp);
-      PetscCall(PetscFree3(x, vol, src));
-      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%" PetscInt_FMT ": %s (particles.file, referenced from %s)", path, lineno, ierr == PETSC_ERR_USER_INPUT ? (dim == 2 ? "expected x, y, volume[, material]" : "expected x, y, z, volume[, material]") : (ierr == PETSC_ERR_USER_INPUT + 1 ? "the volume must be positive" : "every value must be a finite number"), scene->file);
+      PetscCall(PetscFree3(*x, *vol, *src));
+      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%" PetscInt_FMT ": %s (particles.file, referenced from %s)", path, lineno, problem, scene->file);
     }
-    if (n == cap) {
-      PetscReal *x2, *v2;
-      PetscInt  *s2;
-      PetscCall(PetscMalloc3(6 * cap, &x2, 2 * cap, &v2, 2 * cap, &s2));
-      PetscCall(PetscArraycpy(x2, x, 3 * cap));
-      PetscCall(PetscArraycpy(v2, vol, cap));
-      PetscCall(PetscArraycpy(s2, src, cap));
-      PetscCall(PetscFree3(x, vol, src));
-      x   = x2;
-      vol = v2;
-      src = s2;
-      cap *= 2;
-    }
-    for (PetscInt d = 0; d < 3; d++) x[3 * n + d] = d < dim ? v[d] : 0;
-    vol[n] = v[dim];
-    src[n] = lineno;
-    n++;
+    if (*n == cap) PetscCall(CSVGrow(&cap, x, vol, src));
+    for (PetscInt d = 0; d < 3; d++) (*x)[3 * *n + d] = d < dim ? v[d] : 0;
+    (*vol)[*n] = v[dim];
+    (*src)[*n] = lineno;
+    (*n)++;
   }
   fclose(fp);
-  if (!n) PetscCall(PetscFree3(x, vol, src));
-  PeriInputCheck(n > 0, scene, node, "file", "%s holds no particles", path);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Fills p with the n particles read: each one's spacing from its volume, the bounding box from those spacings. */
+static PetscErrorCode CSVFill(PeriParticles *p, PetscInt dim, PetscInt n, const PetscReal x[], const PetscReal vol[], const PetscInt src[])
+{
+  PetscReal sum = 0;
+
+  PetscFunctionBeginUser;
   PetscCall(ParticlesAllocate(p, n));
   for (PetscInt d = 0; d < 3; d++) {
     p->lower[d] = PETSC_MAX_REAL;
@@ -151,6 +200,23 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
   }
   for (PetscInt d = dim; d < 3; d++) p->lower[d] = p->upper[d] = 0;
   p->mean_spacing = sum / n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* x, y[, z], volume[, material]: one particle per line; '#' comments and a header line allowed. */
+static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, PeriParticles *p)
+{
+  char       path[PETSC_MAX_PATH_LEN];
+  PetscInt   n;
+  PetscReal *x, *vol;
+  PetscInt  *src;
+
+  PetscFunctionBeginUser;
+  PetscCall(CSVPath(scene, node, path, sizeof(path)));
+  PetscCall(CSVRead(scene, node, path, dim, &n, &x, &vol, &src));
+  if (!n) PetscCall(PetscFree3(x, vol, src));
+  PeriInputCheck(n > 0, scene, node, "file", "%s holds no particles", path);
+  PetscCall(CSVFill(p, dim, n, x, vol, src));
   PetscCall(PetscFree3(x, vol, src));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

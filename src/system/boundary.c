@@ -280,26 +280,13 @@ static void SymmetricEigen(PetscInt n, PetscReal A[PERI_MAX_MODES][PERI_MAX_MODE
   for (PetscInt a = 0; a < n; a++) w[a] = A[a][a];
 }
 
-/*@C
-  PeriRigidMotionFree - how many combinations of the rigid-body modes the constrained DOFs and the
-  fictitious layers leave free (K is singular when any is), the main motion of the first, named,
-  and (when free is not NULL) those combinations as orthonormal vectors, created here. Collective.
-@*/
-PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[], size_t len, Vec free[])
+/* Adds to G the Gram matrix of the rigid modes restricted to this rank's constrained DOFs. */
+static PetscErrorCode RigidGramConstrained(PeriSystem sys, PetscInt nm, Vec modes[], PetscReal G[PERI_MAX_MODES][PERI_MAX_MODES])
 {
-  static const char *const names1[] = {"translation along z"};
-  static const char *const names2[] = {"translation along x", "translation along y", "rotation about z"};
-  static const char *const names3[] = {"translation along x", "translation along y", "translation along z", "rotation about x", "rotation about y", "rotation about z"};
-  const PeriParticles     *pt       = &sys->particles;
-  PeriModel                m        = sys->model;
-  Vec                      modes[PERI_MAX_MODES];
-  PetscInt                 nm;
-  PetscReal                G[PERI_MAX_MODES][PERI_MAX_MODES] = {{0}}, V[PERI_MAX_MODES][PERI_MAX_MODES], w[PERI_MAX_MODES], norm[PERI_MAX_MODES];
-  const PetscScalar       *a[PERI_MAX_MODES];
-  PetscInt                 rstart;
+  const PetscScalar *a[PERI_MAX_MODES];
+  PetscInt           rstart;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriRigidModes(sys, &nm, modes, norm));
   PetscCall(VecGetOwnershipRange(modes[0], &rstart, NULL));
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecGetArrayRead(modes[k], &a[k]));
   for (PetscInt c = 0; c < sys->nconstrained; c++) {
@@ -308,28 +295,113 @@ PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[],
       for (PetscInt l = 0; l < nm; l++) G[k][l] += PetscRealPart(a[k][row] * a[l][row]);
   }
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecRestoreArrayRead(modes[k], &a[k]));
-  if (sys->layers.T) {
-    /* a fictitious particle's relation u_f = s u_m + o holds a mode v unless v_f = s v_m */
-    PetscReal centre[3], X[3], vf[PERI_MAX_MODES][PERI_MAX_DOF], vm[PERI_MAX_MODES][PERI_MAX_DOF];
-    for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
-    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
-      PetscInt           mi = pt->image ? pt->image[i] : -1, ncols;
-      const PetscInt    *cols;
-      const PetscScalar *vals;
-      PetscReal          sign;
-      if (mi < 0) continue;
-      PetscCall(MatGetRow(sys->layers.T, i, &ncols, &cols, &vals));
-      sign = PetscRealPart(vals[0]);
-      PetscCall(MatRestoreRow(sys->layers.T, i, &ncols, &cols, &vals));
-      for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
-      m->ops.rigid_modes(m, X, vf);
-      for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * mi + d] - centre[d];
-      m->ops.rigid_modes(m, X, vm);
-      for (PetscInt c = 0; c < m->dofs; c++)
-        for (PetscInt k = 0; k < nm; k++)
-          for (PetscInt l = 0; l < nm; l++) G[k][l] += (vf[k][c] - sign * vm[k][c]) * (vf[l][c] - sign * vm[l][c]) / (norm[k] * norm[l]);
-    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Adds to G what this rank's fictitious particles hold of the (unit) rigid modes: a relation
+ * u_f = s u_m + o holds a mode v unless v_f = s v_m. */
+static PetscErrorCode RigidGramLayers(PeriSystem sys, PetscInt nm, const PetscReal norm[], PetscReal G[PERI_MAX_MODES][PERI_MAX_MODES])
+{
+  const PeriParticles *pt = &sys->particles;
+  PeriModel            m  = sys->model;
+  PetscReal            centre[3], X[3], vf[PERI_MAX_MODES][PERI_MAX_DOF], vm[PERI_MAX_MODES][PERI_MAX_DOF];
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
+  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
+    PetscInt           mi = pt->image ? pt->image[i] : -1, ncols;
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscReal          sign;
+    if (mi < 0) continue;
+    PetscCall(MatGetRow(sys->layers.T, i, &ncols, &cols, &vals));
+    sign = PetscRealPart(vals[0]);
+    PetscCall(MatRestoreRow(sys->layers.T, i, &ncols, &cols, &vals));
+    for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
+    m->ops.rigid_modes(m, X, vf);
+    for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * mi + d] - centre[d];
+    m->ops.rigid_modes(m, X, vm);
+    for (PetscInt c = 0; c < m->dofs; c++)
+      for (PetscInt k = 0; k < nm; k++)
+        for (PetscInt l = 0; l < nm; l++) G[k][l] += (vf[k][c] - sign * vm[k][c]) * (vf[l][c] - sign * vm[l][c]) / (norm[k] * norm[l]);
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Creates free[nfree], the free combination V[.][k] of the modes, orthonormalised against free[0..nfree-1]. */
+static PetscErrorCode RigidFreeVector(PetscInt nm, Vec modes[], PetscReal V[PERI_MAX_MODES][PERI_MAX_MODES], PetscInt k, PetscInt nfree, Vec free[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecDuplicate(modes[0], &free[nfree]));
+  PetscCall(VecZeroEntries(free[nfree]));
+  for (PetscInt l = 0; l < nm; l++) PetscCall(VecAXPY(free[nfree], V[l][k], modes[l]));
+  for (PetscInt q = 0; q < nfree; q++) {
+    PetscScalar dot;
+    PetscCall(VecDot(free[nfree], free[q], &dot));
+    PetscCall(VecAXPY(free[nfree], -dot, free[q]));
+  }
+  PetscCall(VecNormalize(free[nfree], NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Names the free combination V[.][k] of the modes in what: a rotation by its axis, else its largest mode. */
+static PetscErrorCode RigidMotionName(PeriSystem sys, PetscInt nm, const PetscReal norm[], PetscReal V[PERI_MAX_MODES][PERI_MAX_MODES], PetscInt k, char what[], size_t len)
+{
+  static const char *const names1[] = {"translation along z"};
+  static const char *const names2[] = {"translation along x", "translation along y", "rotation about z"};
+  static const char *const names3[] = {"translation along x", "translation along y", "translation along z", "rotation about x", "rotation about y", "rotation about z"};
+  const PeriParticles     *pt       = &sys->particles;
+  PetscInt                 best     = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt l = 0; l < nm; l++)
+    if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
+  if (nm == 3 && PetscAbsReal(V[2][k]) > 0.05) {
+    /* A rotation about a held point (a pin) is, about the box centre the modes use, a rotation
+       plus a translation that may be the larger part; naming the translation would point at
+       DOFs that are in fact held, so name the centre of rotation: u = w (-(y - Py), x - Px). */
+    PetscReal wz = V[2][k] / norm[2], P[2];
+    P[0]         = 0.5 * (pt->lower[0] + pt->upper[0]) - V[1][k] / norm[1] / wz;
+    P[1]         = 0.5 * (pt->lower[1] + pt->upper[1]) + V[0][k] / norm[0] / wz;
+    PetscCall(PetscSNPrintf(what, len, "rotation about z around (%g, %g)", (double)P[0], (double)P[1]));
+  } else if (nm == 6 && PetscSqrtReal(V[3][k] * V[3][k] + V[4][k] * V[4][k] + V[5][k] * V[5][k]) > 0.05) {
+    /* the same in 3D: u = t + w x (X - c) is a rotation about the axis along w through
+       P = c + (w x t) / |w|^2 (plus a slide along w, if any) */
+    PetscReal t[3], w[3], w2, P[3];
+    for (PetscInt d = 0; d < 3; d++) {
+      t[d] = V[d][k] / norm[d];
+      w[d] = V[3 + d][k] / norm[3 + d];
+    }
+    w2   = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+    P[0] = 0.5 * (pt->lower[0] + pt->upper[0]) + (w[1] * t[2] - w[2] * t[1]) / w2;
+    P[1] = 0.5 * (pt->lower[1] + pt->upper[1]) + (w[2] * t[0] - w[0] * t[2]) / w2;
+    P[2] = 0.5 * (pt->lower[2] + pt->upper[2]) + (w[0] * t[1] - w[1] * t[0]) / w2;
+    w2   = PetscSqrtReal(w2);
+    for (PetscInt d = 0; d < 3; d++) w[d] = PetscAbsReal(w[d]) < 1e-8 * w2 ? 0 : w[d]; /* no -1e-16 in the message */
+    PetscCall(PetscSNPrintf(what, len, "rotation about the axis along (%.3g, %.3g, %.3g) through (%g, %g, %g)", (double)(w[0] / w2), (double)(w[1] / w2), (double)(w[2] / w2), (double)P[0], (double)P[1], (double)P[2]));
+  } else if (nm == 1 || nm == 3 || nm == 6)
+    PetscCall(PetscSNPrintf(what, len, "%s", (nm == 1 ? names1 : nm == 3 ? names2
+                                                                         : names3)[best]));
+  else
+    PetscCall(PetscSNPrintf(what, len, "rigid mode %" PetscInt_FMT, best));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriRigidMotionFree - how many combinations of the rigid-body modes the constrained DOFs and the
+  fictitious layers leave free (K is singular when any is), the main motion of the first, named,
+  and (when free is not NULL) those combinations as orthonormal vectors, created here. Collective.
+@*/
+PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[], size_t len, Vec free[])
+{
+  Vec       modes[PERI_MAX_MODES];
+  PetscInt  nm;
+  PetscReal G[PERI_MAX_MODES][PERI_MAX_MODES] = {{0}}, V[PERI_MAX_MODES][PERI_MAX_MODES], w[PERI_MAX_MODES], norm[PERI_MAX_MODES];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriRigidModes(sys, &nm, modes, norm));
+  PetscCall(RigidGramConstrained(sys, nm, modes, G));
+  if (sys->layers.T) PetscCall(RigidGramLayers(sys, nm, norm, G));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, G, PERI_MAX_MODES * PERI_MAX_MODES, MPIU_REAL, MPI_SUM, sys->comm));
   /* G holds sums of squares of unit vectors' entries: a free motion gives an eigenvalue of about
    * round-off; one constrained particle already gives ~1/N */
@@ -337,50 +409,10 @@ PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[],
   *nfree = 0;
   if (what) what[0] = 0;
   for (PetscInt k = 0; k < nm; k++) {
-    PetscInt best = 0;
     if (w[k] > 1e-12 / sys->particles.n) continue;
-    if (free) {
-      PetscCall(VecDuplicate(modes[0], &free[*nfree]));
-      PetscCall(VecZeroEntries(free[*nfree]));
-      for (PetscInt l = 0; l < nm; l++) PetscCall(VecAXPY(free[*nfree], V[l][k], modes[l]));
-      for (PetscInt q = 0; q < *nfree; q++) {
-        PetscScalar dot;
-        PetscCall(VecDot(free[*nfree], free[q], &dot));
-        PetscCall(VecAXPY(free[*nfree], -dot, free[q]));
-      }
-      PetscCall(VecNormalize(free[*nfree], NULL));
-    }
+    if (free) PetscCall(RigidFreeVector(nm, modes, V, k, *nfree, free));
     if ((*nfree)++ || !what) continue;
-    for (PetscInt l = 0; l < nm; l++)
-      if (PetscAbsReal(V[l][k]) > PetscAbsReal(V[best][k])) best = l;
-    if (nm == 3 && PetscAbsReal(V[2][k]) > 0.05) {
-      /* A rotation about a held point (a pin) is, about the box centre the modes use, a rotation
-         plus a translation that may be the larger part; naming the translation would point at
-         DOFs that are in fact held, so name the centre of rotation: u = w (-(y - Py), x - Px). */
-      PetscReal wz = V[2][k] / norm[2], P[2];
-      P[0]         = 0.5 * (pt->lower[0] + pt->upper[0]) - V[1][k] / norm[1] / wz;
-      P[1]         = 0.5 * (pt->lower[1] + pt->upper[1]) + V[0][k] / norm[0] / wz;
-      PetscCall(PetscSNPrintf(what, len, "rotation about z around (%g, %g)", (double)P[0], (double)P[1]));
-    } else if (nm == 6 && PetscSqrtReal(V[3][k] * V[3][k] + V[4][k] * V[4][k] + V[5][k] * V[5][k]) > 0.05) {
-      /* the same in 3D: u = t + w x (X - c) is a rotation about the axis along w through
-         P = c + (w x t) / |w|^2 (plus a slide along w, if any) */
-      PetscReal t[3], w[3], w2, P[3];
-      for (PetscInt d = 0; d < 3; d++) {
-        t[d] = V[d][k] / norm[d];
-        w[d] = V[3 + d][k] / norm[3 + d];
-      }
-      w2   = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-      P[0] = 0.5 * (pt->lower[0] + pt->upper[0]) + (w[1] * t[2] - w[2] * t[1]) / w2;
-      P[1] = 0.5 * (pt->lower[1] + pt->upper[1]) + (w[2] * t[0] - w[0] * t[2]) / w2;
-      P[2] = 0.5 * (pt->lower[2] + pt->upper[2]) + (w[0] * t[1] - w[1] * t[0]) / w2;
-      w2   = PetscSqrtReal(w2);
-      for (PetscInt d = 0; d < 3; d++) w[d] = PetscAbsReal(w[d]) < 1e-8 * w2 ? 0 : w[d]; /* no -1e-16 in the message */
-      PetscCall(PetscSNPrintf(what, len, "rotation about the axis along (%.3g, %.3g, %.3g) through (%g, %g, %g)", (double)(w[0] / w2), (double)(w[1] / w2), (double)(w[2] / w2), (double)P[0], (double)P[1], (double)P[2]));
-    } else if (nm == 1 || nm == 3 || nm == 6)
-      PetscCall(PetscSNPrintf(what, len, "%s", (nm == 1 ? names1 : nm == 3 ? names2
-                                                                           : names3)[best]));
-    else
-      PetscCall(PetscSNPrintf(what, len, "rigid mode %" PetscInt_FMT, best));
+    PetscCall(RigidMotionName(sys, nm, norm, V, k, what, len));
   }
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
   PetscFunctionReturn(PETSC_SUCCESS);

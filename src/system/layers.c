@@ -43,6 +43,97 @@ static PetscInt LayerCells(PeriSystem sys, PetscReal h)
   return (sys->model->ops.family_stiffness ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
 }
 
+/* Reads one boundary_layers item into sys->layers and sets the depth nl of its face in lo or hi. */
+static PetscErrorCode LayerRead(PeriSystem sys, PeriNode item, const PetscInt cells[], PetscInt nl, PetscInt lo[], PetscInt hi[])
+{
+  static const char *const keys[]  = {"side", "condition", "value", NULL};
+  static const char *const sides[] = {"x-", "x+", "y-", "y+", NULL};
+  PeriScene                s       = sys->scene;
+  PeriLayers              *L       = &sys->layers;
+  PetscInt                 side = 0, kind = 0, face;
+  PetscBool                hasv;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a layer is a mapping {side: .., condition: .., value: ..}");
+  PetscCall(PeriSceneCheckKeys(s, item, keys));
+  PetscCall(PeriSceneGetChoice(s, item, "side", sides, &side, NULL));
+  PetscCall(PeriSceneGetChoice(s, item, "condition", PeriLayerKinds + 1, &kind, NULL));
+  kind++;
+  face = side;
+  PeriInputCheck(!sys->particles.periodic[face / 2], s, item, "side", "axis %c is periodic: it has no face", (char)('x' + face / 2));
+  PeriInputCheck(L->kind[face] == PERI_LAYER_NONE, s, item, "side", "face %s already has a layer", sides[face]);
+  L->kind[face] = (PeriLayerKind)kind;
+  PetscCall(PeriSceneGetReal(s, item, "value", kind != PERI_LAYER_FREE, &L->value[face], &hasv));
+  PeriInputCheck(kind != PERI_LAYER_FREE || !hasv, s, item, "value", "a free face takes no value");
+  /* the mirror of the deepest fictitious cell must lie in the body */
+  PeriInputCheck(cells[face / 2] >= nl, s, item, "side", "the body is %" PetscInt_FMT " particles across axis %c but the layer is %" PetscInt_FMT " deep (the horizon): the mirror images would fall outside the body; refine the grid or shorten the horizon", cells[face / 2], (char)('x' + face / 2), nl);
+  if (face % 2)
+    hi[face / 2] = nl;
+  else
+    lo[face / 2] = nl;
+  L->nfaces++;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Appends the fictitious cells lo/hi deep beyond the faces of the cells[0] x cells[1] body, each with
+ * its mirror image in the body and the faces it crossed. */
+static PetscErrorCode LayersAppendParticles(PeriSystem sys, const PetscInt cells[], const PetscInt lo[], const PetscInt hi[])
+{
+  PeriParticles *pt = &sys->particles;
+  PetscReal      h  = pt->mean_spacing;
+  PetscInt       n  = (cells[0] + lo[0] + hi[0]) * (cells[1] + lo[1] + hi[1]) - cells[0] * cells[1];
+  PetscInt       nb = pt->n, N = pt->n + n, k;
+  PetscReal     *x, *vol, *sp;
+  PetscInt      *src;
+  unsigned char *crossed;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(3 * N, &x));
+  PetscCall(PetscMalloc3(N, &vol, N, &sp, N, &src));
+  PetscCall(PetscMalloc2(N, &pt->image, N, &crossed));
+  PetscCall(PetscArraycpy(x, pt->x, 3 * nb));
+  PetscCall(PetscArraycpy(vol, pt->volume, nb));
+  PetscCall(PetscArraycpy(sp, pt->spacing, nb));
+  PetscCall(PetscArraycpy(src, pt->source_line, nb));
+  for (k = 0; k < nb; k++) {
+    pt->image[k] = -1;
+    crossed[k]   = 0;
+  }
+  for (PetscInt c1 = -lo[1]; c1 < cells[1] + hi[1]; c1++)
+    for (PetscInt c0 = -lo[0]; c0 < cells[0] + hi[0]; c0++) {
+      const PetscInt c[2] = {c0, c1};
+      PetscInt       m[2] = {c0, c1};
+      unsigned char  mask = 0;
+      for (PetscInt d = 0; d < 2; d++) {
+        if (c[d] < 0) {
+          mask |= (unsigned char)(1 << (2 * d));
+          m[d] = -1 - c[d];
+        } else if (c[d] >= cells[d]) {
+          mask |= (unsigned char)(1 << (2 * d + 1));
+          m[d] = 2 * cells[d] - 1 - c[d];
+        }
+      }
+      if (!mask) continue;
+      for (PetscInt d = 0; d < 2; d++) x[3 * k + d] = pt->lower[d] + (c[d] + 0.5) * h;
+      vol[k]       = pt->volume[0];
+      sp[k]        = h;
+      src[k]       = 0;
+      pt->image[k] = m[1] * cells[0] + m[0];
+      crossed[k]   = mask;
+      k++;
+    }
+  PetscCall(PetscFree(pt->x));
+  PetscCall(PetscFree3(pt->volume, pt->spacing, pt->source_line));
+  pt->x           = x;
+  pt->volume      = vol;
+  pt->spacing     = sp;
+  pt->source_line = src;
+  pt->crossed     = crossed;
+  pt->n           = N;
+  pt->nfictitious = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriLayersAddParticles - reads boundary_layers and torsion and appends the fictitious particles
   (with their mirror images) to the grid's particles. Call after the horizon and the corrections
@@ -50,14 +141,11 @@ static PetscInt LayerCells(PeriSystem sys, PetscReal h)
 @*/
 PetscErrorCode PeriLayersAddParticles(PeriSystem sys)
 {
-  static const char *const keys[]  = {"side", "condition", "value", NULL};
-  static const char *const sides[] = {"x-", "x+", "y-", "y+", NULL};
-  PeriScene                s       = sys->scene;
-  PeriParticles           *pt      = &sys->particles;
-  PeriLayers              *L       = &sys->layers;
-  PeriNode                 list, grid;
-  PetscInt                 cells[2], lo[2] = {0, 0}, hi[2] = {0, 0}, nl, n, k;
-  PetscReal                h;
+  PeriScene      s  = sys->scene;
+  PeriParticles *pt = &sys->particles;
+  PeriNode       list, grid;
+  PetscInt       cells[2], lo[2] = {0, 0}, hi[2] = {0, 0}, nl;
+  PetscReal      h;
 
   PetscFunctionBeginUser;
   PetscCall(ReadTorsion(sys));
@@ -70,79 +158,8 @@ PetscErrorCode PeriLayersAddParticles(PeriSystem sys)
   h = pt->mean_spacing;
   for (PetscInt d = 0; d < 2; d++) cells[d] = (PetscInt)PetscFloorReal((pt->upper[d] - pt->lower[d]) / h + 0.5);
   nl = LayerCells(sys, h);
-  for (PetscInt i = 0; i < list->n; i++) {
-    PeriNode  item = list->child[i];
-    PetscInt  side = 0, kind = 0, face;
-    PetscBool hasv;
-    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a layer is a mapping {side: .., condition: .., value: ..}");
-    PetscCall(PeriSceneCheckKeys(s, item, keys));
-    PetscCall(PeriSceneGetChoice(s, item, "side", sides, &side, NULL));
-    PetscCall(PeriSceneGetChoice(s, item, "condition", PeriLayerKinds + 1, &kind, NULL));
-    kind++;
-    face = side;
-    PeriInputCheck(!pt->periodic[face / 2], s, item, "side", "axis %c is periodic: it has no face", (char)('x' + face / 2));
-    PeriInputCheck(L->kind[face] == PERI_LAYER_NONE, s, item, "side", "face %s already has a layer", sides[face]);
-    L->kind[face] = (PeriLayerKind)kind;
-    PetscCall(PeriSceneGetReal(s, item, "value", kind != PERI_LAYER_FREE, &L->value[face], &hasv));
-    PeriInputCheck(kind != PERI_LAYER_FREE || !hasv, s, item, "value", "a free face takes no value");
-    /* the mirror of the deepest fictitious cell must lie in the body */
-    PeriInputCheck(cells[face / 2] >= nl, s, item, "side", "the body is %" PetscInt_FMT " particles across axis %c but the layer is %" PetscInt_FMT " deep (the horizon): the mirror images would fall outside the body; refine the grid or shorten the horizon", cells[face / 2], (char)('x' + face / 2), nl);
-    if (face % 2)
-      hi[face / 2] = nl;
-    else
-      lo[face / 2] = nl;
-    L->nfaces++;
-  }
-  n = (cells[0] + lo[0] + hi[0]) * (cells[1] + lo[1] + hi[1]) - cells[0] * cells[1];
-  {
-    PetscInt       nb = pt->n, N = pt->n + n;
-    PetscReal     *x, *vol, *sp;
-    PetscInt      *src;
-    unsigned char *crossed;
-    PetscCall(PetscCalloc1(3 * N, &x));
-    PetscCall(PetscMalloc3(N, &vol, N, &sp, N, &src));
-    PetscCall(PetscMalloc2(N, &pt->image, N, &crossed));
-    PetscCall(PetscArraycpy(x, pt->x, 3 * nb));
-    PetscCall(PetscArraycpy(vol, pt->volume, nb));
-    PetscCall(PetscArraycpy(sp, pt->spacing, nb));
-    PetscCall(PetscArraycpy(src, pt->source_line, nb));
-    for (k = 0; k < nb; k++) {
-      pt->image[k] = -1;
-      crossed[k]   = 0;
-    }
-    for (PetscInt c1 = -lo[1]; c1 < cells[1] + hi[1]; c1++)
-      for (PetscInt c0 = -lo[0]; c0 < cells[0] + hi[0]; c0++) {
-        const PetscInt c[2] = {c0, c1};
-        PetscInt       m[2] = {c0, c1};
-        unsigned char  mask = 0;
-        for (PetscInt d = 0; d < 2; d++) {
-          if (c[d] < 0) {
-            mask |= (unsigned char)(1 << (2 * d));
-            m[d] = -1 - c[d];
-          } else if (c[d] >= cells[d]) {
-            mask |= (unsigned char)(1 << (2 * d + 1));
-            m[d] = 2 * cells[d] - 1 - c[d];
-          }
-        }
-        if (!mask) continue;
-        for (PetscInt d = 0; d < 2; d++) x[3 * k + d] = pt->lower[d] + (c[d] + 0.5) * h;
-        vol[k]       = pt->volume[0];
-        sp[k]        = h;
-        src[k]       = 0;
-        pt->image[k] = m[1] * cells[0] + m[0];
-        crossed[k]   = mask;
-        k++;
-      }
-    PetscCall(PetscFree(pt->x));
-    PetscCall(PetscFree3(pt->volume, pt->spacing, pt->source_line));
-    pt->x           = x;
-    pt->volume      = vol;
-    pt->spacing     = sp;
-    pt->source_line = src;
-    pt->crossed     = crossed;
-    pt->n           = N;
-    pt->nfictitious = n;
-  }
+  for (PetscInt i = 0; i < list->n; i++) PetscCall(LayerRead(sys, list->child[i], cells, nl, lo, hi));
+  PetscCall(LayersAppendParticles(sys, cells, lo, hi));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
