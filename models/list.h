@@ -3,9 +3,9 @@
  * message lists them. Included by models/registry.c with PERI_MODEL defined; no include guard. */
 PERI_MODEL(PMB)
 PERI_MODEL(NPMB)
-PERI_MODEL(CPMB)
 PERI_MODEL(PDS)
 PERI_MODEL(MPPD)
 PERI_MODEL(Gerstle)
 PERI_MODEL(Antiplane)
 PERI_MODEL(AntiplaneOS)
+PERI_MODEL(CPMB)
