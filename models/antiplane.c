@@ -29,7 +29,12 @@ typedef struct {
   PetscInt   nwork;
 } Antiplane;
 
-static const char *const os_keys[] = {"stabilization", NULL};
+/* The model.* keys of antiplane_os (SetFromSceneState); antiplane has none. */
+static const PeriKey os_keys[] = {
+    {"stabilization", PERI_KEY_REAL, "1", "[0, inf)", NULL, NULL, "weight of the misfit energy that removes zero-energy modes"},
+    {NULL},
+};
+static const PeriSchema os_schema[] = {{"model", os_keys}, {NULL}};
 
 static PetscErrorCode SetFromSceneState(PeriModel m, PeriScene scene, PeriNode node)
 {
@@ -309,10 +314,9 @@ static PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel m)
   m->surface_corrections  = corrections_os;
   m->ops.calibrate        = CalibrateState;
   m->ops.setfromscene     = SetFromSceneState;
-  m->keys                 = os_keys;
   m->ops.family_stiffness = FamilyStiffness;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 const PeriModelType PeriModel_Antiplane   = {"antiplane", NULL, PeriModelCreate_Antiplane};
-const PeriModelType PeriModel_AntiplaneOS = {"antiplane_os", NULL, PeriModelCreate_AntiplaneOS};
+const PeriModelType PeriModel_AntiplaneOS = {"antiplane_os", os_schema, PeriModelCreate_AntiplaneOS};

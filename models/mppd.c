@@ -22,7 +22,6 @@ typedef struct {
 
 static const char *const components[] = {"ux", "uy", "theta"};
 static const char *const measures[]   = {"stretch", "sliding", "relative_rotation"};
-static const char *const mppd_keys[]  = {"k_theta", "k_theta_factor", NULL};
 
 static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
 {
@@ -141,7 +140,6 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->components          = components;
   m->nmeasures           = 3;
   m->measure_names       = measures;
-  m->keys                = gerstle ? NULL : mppd_keys;
   m->rotational[2]       = PETSC_TRUE;
   m->ops.setfromscene    = gerstle ? NULL : SetFromScene;
   m->ops.nu_range        = PeriShearBondNuRange;
@@ -167,5 +165,13 @@ static PetscErrorCode PeriModelCreate_Gerstle(PeriModel m)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriModelType PeriModel_MPPD    = {"mppd", NULL, PeriModelCreate_MPPD};
+/* The model.* keys SetFromScene reads (mppd only: gerstle's rotational spring is fixed). */
+static const PeriKey mppd_keys[] = {
+    {"k_theta", PERI_KEY_REAL, NULL, "[0, inf)", "[energy/volume^2]", NULL, "rotational spring k_theta, instead of the factor"},
+    {"k_theta_factor", PERI_KEY_REAL, "1", "[0, inf)", NULL, NULL, "k_theta = f c delta^2 / (36 |xi|); not with k_theta"},
+    {NULL},
+};
+static const PeriSchema mppd_schema[] = {{"model", mppd_keys}, {NULL}};
+
+const PeriModelType PeriModel_MPPD    = {"mppd", mppd_schema, PeriModelCreate_MPPD};
 const PeriModelType PeriModel_Gerstle = {"gerstle", NULL, PeriModelCreate_Gerstle};

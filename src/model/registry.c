@@ -31,3 +31,13 @@ PetscErrorCode PeriModelRegisterAll(void)
   for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(builtin); k++) PetscCall(PeriModelRegister(builtin[k]->name, builtin[k]->create));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The built-in types, in the order of models/list.h: their schemas for validation and -help. A
+ * model registered at run time (PeriModelRegister) has no descriptor here, hence no keys of its own. */
+PetscErrorCode PeriModelGetTypes(PetscInt *n, const PeriModelType *const **types)
+{
+  PetscFunctionBeginUser;
+  *n     = (PetscInt)PETSC_STATIC_ARRAY_LENGTH(builtin);
+  *types = builtin;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
