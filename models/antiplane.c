@@ -29,7 +29,12 @@ typedef struct {
   PetscInt   nwork;
 } Antiplane;
 
-static const char *const os_keys[] = {"stabilization", NULL};
+/* The model.* keys of antiplane_os (SetFromSceneState); antiplane has none. */
+static const PeriKey os_keys[] = {
+    {"stabilization", PERI_KEY_REAL, "1", "[0, inf)", NULL, NULL, "weight of the misfit energy that removes zero-energy modes"},
+    {NULL},
+};
+static const PeriSchema os_schema[] = {{"model", os_keys}, {NULL}};
 
 static PetscErrorCode SetFromSceneState(PeriModel m, PeriScene scene, PeriNode node)
 {
@@ -309,7 +314,6 @@ static PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel m)
   m->surface_corrections  = corrections_os;
   m->ops.calibrate        = CalibrateState;
   m->ops.setfromscene     = SetFromSceneState;
-  m->keys                 = os_keys;
   m->ops.family_stiffness = FamilyStiffness;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -317,4 +321,4 @@ static PetscErrorCode PeriModelCreate_AntiplaneOS(PeriModel m)
 /* the one rigid mode is the translation; the energy correction (eq. 53) makes every linear u_z
  * exact (without it 2 % and 6 % off at m = 3) */
 const PeriModelType PeriModel_Antiplane   = {.name = "antiplane", .create = PeriModelCreate_Antiplane, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_HOMOGENEOUS};
-const PeriModelType PeriModel_AntiplaneOS = {.name = "antiplane_os", .create = PeriModelCreate_AntiplaneOS, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_HOMOGENEOUS};
+const PeriModelType PeriModel_AntiplaneOS = {.name = "antiplane_os", .schema = os_schema, .create = PeriModelCreate_AntiplaneOS, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_HOMOGENEOUS};

@@ -22,7 +22,6 @@ typedef struct {
 
 static const char *const components[] = {"ux", "uy", "theta"};
 static const char *const measures[]   = {"stretch", "sliding", "relative_rotation"};
-static const char *const mppd_keys[]  = {"k_theta", "k_theta_factor", NULL};
 
 static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
 {
@@ -141,7 +140,6 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->components          = components;
   m->nmeasures           = 3;
   m->measure_names       = measures;
-  m->keys                = gerstle ? NULL : mppd_keys;
   m->rotational[2]       = PETSC_TRUE;
   m->ops.setfromscene    = gerstle ? NULL : SetFromScene;
   m->ops.nu_range        = PeriShearBondNuRange;
@@ -167,8 +165,16 @@ static PetscErrorCode PeriModelCreate_Gerstle(PeriModel m)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The model.* keys SetFromScene reads (mppd only: gerstle's rotational spring is fixed). */
+static const PeriKey mppd_keys[] = {
+    {"k_theta", PERI_KEY_REAL, NULL, "[0, inf)", "[energy/volume^2]", NULL, "rotational spring k_theta, instead of the factor"},
+    {"k_theta_factor", PERI_KEY_REAL, "1", "[0, inf)", NULL, NULL, "k_theta = f c delta^2 / (36 |xi|); not with k_theta"},
+    {NULL},
+};
+static const PeriSchema mppd_schema[] = {{"model", mppd_keys}, {NULL}};
+
 /* the micromoduli come from the continuous horizon, so no energy is exact on a grid: at m = 3 mppd
  * is 1 % off, as pds (theta is idle in a homogeneous strain), gerstle 16 % (its shear springs
  * weigh 1/|xi|, so the nearest bonds dominate) */
-const PeriModelType PeriModel_MPPD    = {.name = "mppd", .create = PeriModelCreate_MPPD, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_NONE};
+const PeriModelType PeriModel_MPPD    = {.name = "mppd", .schema = mppd_schema, .create = PeriModelCreate_MPPD, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_NONE};
 const PeriModelType PeriModel_Gerstle = {.name = "gerstle", .create = PeriModelCreate_Gerstle, .rotation_invariant = PETSC_TRUE, .exact_energy = PERI_EXACT_NONE};

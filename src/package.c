@@ -3,7 +3,7 @@
 #include "perilin/private/sys.h"
 #include "perilin/private/scene.h"
 #include "perilin/private/model.h"
-#include "perilin/private/analysis.h"
+#include "perilin/private/problem.h"
 #include <slepcsys.h>
 
 static PetscBool PeriPackageInitialized = PETSC_FALSE;
@@ -59,9 +59,34 @@ PetscErrorCode PeriFinalize(void)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriPluginSchemas - every built-in model's and analysis' schema, for the scene layer, which
+  cannot ask the registries itself: it validates, documents and adds from options the keys they
+  declare. At most max; not collective.
+@*/
+PetscErrorCode PeriPluginSchemas(PetscInt max, PeriSchemaOwner owners[], PetscInt *n)
+{
+  const PeriModelType *const    *models;
+  const PeriAnalysisType *const *analyses;
+  PetscInt                       nm, na;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriModelGetTypes(&nm, &models));
+  PetscCall(PeriAnalysisGetTypes(&na, &analyses));
+  PetscCheck(nm + na <= max, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%" PetscInt_FMT " plug-ins, more than PERI_MAX_PLUGINS = %" PetscInt_FMT, nm + na, max);
+  for (PetscInt k = 0; k < nm; k++) owners[k] = (PeriSchemaOwner){"model", models[k]->name, models[k]->schema};
+  for (PetscInt k = 0; k < na; k++) owners[nm + k] = (PeriSchemaOwner){"analysis", analyses[k]->name, analyses[k]->schema};
+  *n = nm + na;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriPrintHelp(MPI_Comm comm)
 {
+  PeriSchemaOwner owners[PERI_MAX_PLUGINS];
+  PetscInt        n;
+
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneHelp(comm));
+  PetscCall(PeriPluginSchemas(PERI_MAX_PLUGINS, owners, &n));
+  PetscCall(PeriSceneHelp(comm, n, owners));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

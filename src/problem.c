@@ -23,8 +23,32 @@ PetscErrorCode PeriProblemCreate(MPI_Comm comm, PeriProblem *problem)
 @*/
 PetscErrorCode PeriProblemLoad(PeriProblem p, const char file[])
 {
+  PeriSchemaOwner owners[PERI_MAX_PLUGINS];
+  PetscInt        n;
+
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneCreateFromFile(file, &p->scene));
+  PetscCall(PeriPluginSchemas(PERI_MAX_PLUGINS, owners, &n));
+  PetscCall(PeriSceneCreateFromFile(file, n, owners, &p->scene));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* analysis.type, and analysis.* against that analysis' schema (p->scene->owners holds every
+ * plug-in's). An unknown type allows every analysis' keys here: PeriProblemRun reports it with
+ * the list of types. */
+static PetscErrorCode ReadAnalysis(PeriProblem p)
+{
+  static const char *const base[] = {"type", NULL};
+  PeriScene                s      = p->scene;
+  const PeriSchemaOwner   *active = NULL;
+  PeriNode                 a;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(p->analysis, "static", sizeof(p->analysis)));
+  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
+  PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis, sizeof(p->analysis), NULL));
+  for (PetscInt o = 0; o < s->nowners; o++)
+    if (!strcmp(s->owners[o].kind, "analysis") && !strcmp(s->owners[o].name, p->analysis)) active = &s->owners[o];
+  PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", base, active));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -34,8 +58,6 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PeriScene                s      = p->scene;
   PeriNode                 o;
   char                     base[PETSC_MAX_PATH_LEN], *slash, *dot;
-  static const char *const akeys[] = {"type", "nev", "target_hz", "load_factor_max", "load_factor_step", "min_step", "adaptive", "break", "break_fraction", "max_iterations", "reuse_preconditioner", "control_probe", "runaway_fraction", NULL};
-  PeriNode                 a;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(base, (slash = strrchr(file, '/')) ? slash + 1 : file, sizeof(base)));
@@ -48,10 +70,7 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneGetBool(s, o, "vtk", &p->vtk, NULL));
   PetscCall(PeriSceneGetInt(s, o, "every", PETSC_FALSE, &p->output_every, NULL));
   PeriInputCheck(p->output_every >= 0, s, o, "every", "must not be negative (0: only the end), got %" PetscInt_FMT, p->output_every);
-  PetscCall(PetscStrncpy(p->analysis, "static", sizeof(p->analysis)));
-  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
-  PetscCall(PeriSceneCheckKeys(s, a, akeys));
-  PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis, sizeof(p->analysis), NULL));
+  PetscCall(ReadAnalysis(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

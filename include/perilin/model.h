@@ -50,7 +50,6 @@ struct _p_PeriModel {
   PetscBool          allows_surface_correction;
   const char *const *surface_corrections;      /* allowed corrections.surface values; NULL: none, volume */
   PetscBool          antiplane;                /* one DOF, the out-of-plane displacement uz: stresses tau_xz, tau_yz */
-  const char *const *keys;                     /* the model's own scene keys besides model.type and model.plane, or NULL */
   PetscBool          inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
   PetscBool          rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
   char               warning[256];             /* set by calibration; printed once by the problem */
@@ -72,10 +71,6 @@ PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);
 PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
 PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
 
-/* The scene keys a plug-in owns. Declared only: until the scene sections declare their keys, every
- * type's schema is NULL. */
-typedef struct _PeriSchema PeriSchema;
-
 /* A built-in model type. Each model file (models/) ends with its descriptor(s) PeriModel_<id>,
  * whose create function stays static; models/list.h names them and models/registry.c registers
  * them. */
@@ -93,8 +88,8 @@ typedef enum {
 } PeriExactEnergy;
 
 typedef struct {
-  const char       *name; /* model.type */
-  const PeriSchema *schema;
+  const char       *name;   /* model.type */
+  const PeriSchema *schema; /* its model.* keys besides type and plane, ended by {NULL}; NULL: none */
   PetscErrorCode (*create)(PeriModel);
   /* the modes of ops.rigid_modes that vary with position (rotations) store no energy; false when
      they are listed only as AMG's near-null space */

@@ -21,17 +21,57 @@ struct _PeriNode {
   PeriNode    *child;
 };
 
+/* A scene key, declared once next to the code that reads it: validation, -help and the options
+ * that add a missing key all come from the declaration. Today only the plug-ins (model types,
+ * analysis types) declare their keys this way; the core sections still list theirs in code. */
+typedef enum {
+  PERI_KEY_REAL,
+  PERI_KEY_INT,
+  PERI_KEY_BOOL,
+  PERI_KEY_STRING,
+  PERI_KEY_CHOICE,
+  PERI_KEY_REALS,
+  PERI_KEY_BOOLS,
+  PERI_KEY_MAP,
+  PERI_KEY_LIST
+} PeriKeyType;
+typedef struct {
+  const char        *name; /* "k_theta"; {NULL} ends a list */
+  PeriKeyType        type;
+  const char        *deflt;   /* "1", "required", or NULL: absent means not given */
+  const char        *range;   /* "[0, inf)", "(0, 1]" or NULL; printed verbatim */
+  const char        *units;   /* "[stress]" or NULL */
+  const char *const *choices; /* PERI_KEY_CHOICE: NULL-terminated; else NULL */
+  const char        *help;    /* one line */
+} PeriKey;
+/* The keys one owner declares in one section ("model", "analysis"). A plug-in's schema is an
+ * array of these ended by {NULL}, so that it may also own keys in other sections. */
+typedef struct _PeriSchema {
+  const char    *section;
+  const PeriKey *keys;
+} PeriSchema;
+/* A plug-in and its schema, as the core hands them to the scene layer: kind "model" or
+ * "analysis", name its type ("mppd"), schema NULL when it declares no key. */
+typedef struct {
+  const char       *kind, *name;
+  const PeriSchema *schema;
+} PeriSchemaOwner;
+
 typedef struct _p_PeriScene *PeriScene;
 struct _p_PeriScene {
-  char     file[PETSC_MAX_PATH_LEN];
-  char     dir[PETSC_MAX_PATH_LEN]; /* directory of the scene file, for relative paths */
-  PeriNode root;
+  char                   file[PETSC_MAX_PATH_LEN];
+  char                   dir[PETSC_MAX_PATH_LEN]; /* directory of the scene file, for relative paths */
+  PeriNode               root;
+  PetscInt               nowners;
+  const PeriSchemaOwner *owners; /* every plug-in's schema: options may add their keys */
 };
 
 PETSC_EXTERN PetscErrorCode PeriSceneWhere(PeriScene, PeriNode, const char[], char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriSceneGetNode(PeriNode, const char[], PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetMap(PeriScene, PeriNode, const char[], PetscBool, PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriSceneCheckKeys(PeriScene, PeriNode, const char *const[]);
+PETSC_EXTERN PetscErrorCode PeriSceneCheckKeysSchema(PeriScene, PeriNode, const char[], const char *const[], const PeriSchemaOwner *);
+PETSC_EXTERN const PeriKey *PeriSchemaFindKey(const PeriSchema *, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneGetReal(PeriScene, PeriNode, const char[], PetscBool, PetscReal *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetInt(PeriScene, PeriNode, const char[], PetscBool, PetscInt *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetBool(PeriScene, PeriNode, const char[], PetscBool *, PetscBool *);

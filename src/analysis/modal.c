@@ -771,4 +771,12 @@ static PetscErrorCode ModalDestroy(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriAnalysisType PeriAnalysis_Modal = {"modal", "natural frequencies and mode shapes (SLEPc, shift-and-invert)", NULL, PETSC_TRUE, {PeriAnalysisRun_Modal, ModalAddFields, ModalFiles, ModalSummary, ModalReport, ModalDestroy}};
+/* The analysis.* keys ReadSettings reads. */
+static const PeriKey modal_keys[] = {
+    {"nev", PERI_KEY_INT, "6", "[1, inf)", NULL, NULL, "number of modes"},
+    {"target_hz", PERI_KEY_REAL, "0", "[0, inf)", "[1/time]", NULL, "compute the modes nearest this frequency (0: the lowest)"},
+    {NULL},
+};
+static const PeriSchema modal_schema[] = {{"analysis", modal_keys}, {NULL}};
+
+const PeriAnalysisType PeriAnalysis_Modal = {"modal", "natural frequencies and mode shapes (SLEPc, shift-and-invert)", modal_schema, PETSC_TRUE, {PeriAnalysisRun_Modal, ModalAddFields, ModalFiles, ModalSummary, ModalReport, ModalDestroy}};

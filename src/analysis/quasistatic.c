@@ -638,4 +638,21 @@ static PetscErrorCode QSDestroy(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriAnalysisType PeriAnalysis_Quasistatic = {"quasistatic", "load stepping with bond failure to the critical load", NULL, PETSC_FALSE, {PeriAnalysisRun_Quasistatic, NULL, QSFiles, QSSummary, NULL, QSDestroy}};
+/* The analysis.* keys ReadSettings reads. */
+static const char *const qs_policies[] = {"all", "fraction", NULL};
+static const PeriKey     qs_keys[]     = {
+            {"load_factor_max", PERI_KEY_REAL, "required", "(0, inf)", NULL, NULL, "the largest load factor"},
+            {"load_factor_step", PERI_KEY_REAL, "required", "(0, load_factor_max]", NULL, NULL, "the load-factor step (the largest with adaptive steps)"},
+            {"min_step", PERI_KEY_REAL, "load_factor_step/64", "[load_factor_step/2^20, load_factor_step]", NULL, NULL, "the smallest step (adaptive)"},
+            {"adaptive", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "halve the step on failure or runaway"},
+            {"break", PERI_KEY_CHOICE, "all", NULL, NULL, qs_policies, "all | fraction: which violating bonds break per iteration"},
+            {"break_fraction", PERI_KEY_REAL, "0.1", "(0, 1]", NULL, NULL, "break: fraction: those within this top fraction of [1, worst index]"},
+            {"max_iterations", PERI_KEY_INT, "100", "[1, inf)", NULL, NULL, "equilibrium iterations per step"},
+            {"reuse_preconditioner", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "keep the preconditioner while few bonds changed"},
+            {"control_probe", PERI_KEY_STRING, "the first probe", NULL, NULL, NULL, "the probe whose displacement steps.csv reports"},
+            {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "adaptive: more bonds than this share breaking in one step is a runaway"},
+            {NULL},
+};
+static const PeriSchema qs_schema[] = {{"analysis", qs_keys}, {NULL}};
+
+const PeriAnalysisType PeriAnalysis_Quasistatic = {"quasistatic", "load stepping with bond failure to the critical load", qs_schema, PETSC_FALSE, {PeriAnalysisRun_Quasistatic, NULL, QSFiles, QSSummary, NULL, QSDestroy}};

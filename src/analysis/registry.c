@@ -30,6 +30,15 @@ PetscErrorCode PeriAnalysisFind(const char name[], const PeriAnalysisType **type
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The built-in types, in the order of src/analysis/list.h: their schemas for validation and -help. */
+PetscErrorCode PeriAnalysisGetTypes(PetscInt *n, const PeriAnalysisType *const **types)
+{
+  PetscFunctionBeginUser;
+  *n     = (PetscInt)PETSC_STATIC_ARRAY_LENGTH(builtin);
+  *types = builtin;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The names, comma-separated, in the order of src/analysis/list.h. */
 PetscErrorCode PeriAnalysisListTypes(char buf[], size_t len)
 {

@@ -21,4 +21,7 @@ static PetscErrorCode Report_Setup(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriAnalysisType PeriAnalysis_Setup = {"setup", "set up the system and stop: check a scene, size a run", NULL, PETSC_FALSE, {Run_Setup, NULL, NULL, NULL, Report_Setup, NULL}};
+/* no analysis.* key besides type: another analysis' key is an error */
+static const PeriKey    setup_keys[]       = {{NULL}};
+static const PeriSchema setup_schema[]     = {{"analysis", setup_keys}, {NULL}};
+const PeriAnalysisType  PeriAnalysis_Setup = {"setup", "set up the system and stop: check a scene, size a run", setup_schema, PETSC_FALSE, {Run_Setup, NULL, NULL, NULL, Report_Setup, NULL}};

@@ -63,4 +63,8 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-const PeriAnalysisType PeriAnalysis_Static = {"static", "one linear solve K u = f", NULL, PETSC_FALSE, {PeriAnalysisRun_Static, NULL, NULL, NULL, NULL, NULL}};
+/* The static analysis reads no analysis.* key besides type: the empty section says so, and makes
+ * another analysis' key (nev) an error naming its owner. */
+static const PeriKey    static_keys[]       = {{NULL}};
+static const PeriSchema static_schema[]     = {{"analysis", static_keys}, {NULL}};
+const PeriAnalysisType  PeriAnalysis_Static = {"static", "one linear solve K u = f", static_schema, PETSC_FALSE, {PeriAnalysisRun_Static, NULL, NULL, NULL, NULL, NULL}};

@@ -42,3 +42,13 @@ PetscErrorCode PeriModelTypeGet(const char name[], const PeriModelType **type)
     if (!strcmp(builtin[k]->name, name)) *type = builtin[k];
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The built-in types, in the order of models/list.h: their schemas for validation and -help. A
+ * model registered at run time (PeriModelRegister) has no descriptor here, hence no keys of its own. */
+PetscErrorCode PeriModelGetTypes(PetscInt *n, const PeriModelType *const **types)
+{
+  PetscFunctionBeginUser;
+  *n     = (PetscInt)PETSC_STATIC_ARRAY_LENGTH(builtin);
+  *types = builtin;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

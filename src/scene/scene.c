@@ -8,19 +8,18 @@
 #include <libgen.h>
 #include <strings.h>
 
-/* The documented scalar keys: `perilin -help` lists them, and an option naming one that the
- * file lacks adds it (so -model_plane strain works on a scene that does not name the plane). */
+/* The documented scalar keys of the core sections: `perilin -help` lists them, and an option
+ * naming one that the file lacks adds it (so -model_plane strain works on a scene that does not
+ * name the plane). The plug-ins' keys (model.k_theta, analysis.nev, ...) are not here: each model
+ * and analysis type declares them in its schema, which the scene receives as scene->owners. */
 typedef struct {
   const char *path, *meaning;
 } PeriSceneKey;
 
 static const PeriSceneKey scene_keys[] = {
     {"dim", "2 or 3"},
-    {"model.type", "bond model: pmb | npmb | pds | mppd | gerstle | antiplane | antiplane_os (see docs/models/)"},
-    {"model.k_theta", "mppd: rotational spring k_theta [energy/volume^2], instead of the factor"},
-    {"model.k_theta_factor", "mppd: k_theta = f c delta^2 / (36 |xi|); default 1"},
+    {"model.type", "bond model (docs/models/)"},
     {"model.plane", "2D only: stress | strain"},
-    {"model.stabilization", "antiplane_os: weight of the misfit energy that removes zero-energy modes; default 1"},
     {"material.E", "Young's modulus [stress]"},
     {"material.nu", "Poisson ratio: pmb/npmb only 1/3 (plane stress) or 1/4 (plane strain, 3D); pds/mppd/gerstle (-1, 1/2)"},
     {"material.K", "3D bulk modulus [stress], instead of E"},
@@ -71,21 +70,9 @@ static const PeriSceneKey scene_keys[] = {
     {"failure.ultimate_stretch", "softening (eq. 45): the stiffness falls linearly from critical_stretch to 0 here"},
     {"failure.ultimate_compressive_stretch", "softening in compression (eq. 46)"},
     {"cracks.<k>.from/to", "a pre-existing crack: 2D segment; bonds crossing it are removed before the first step"},
-    {"analysis.load_factor_max", "quasistatic: the largest load factor"},
-    {"analysis.load_factor_step", "quasistatic: the load-factor step (the largest with adaptive steps)"},
-    {"analysis.min_step", "quasistatic: the smallest step (adaptive); default step/64"},
-    {"analysis.adaptive", "quasistatic: true | false (default true): halve the step on failure or runaway"},
-    {"analysis.break", "quasistatic: all | fraction: which violating bonds break per iteration"},
-    {"analysis.break_fraction", "quasistatic, break: fraction: those within this top fraction of [1, worst index]"},
-    {"analysis.max_iterations", "quasistatic: equilibrium iterations per step (default 100)"},
-    {"analysis.reuse_preconditioner", "quasistatic: true | false (default true)"},
-    {"analysis.runaway_fraction", "quasistatic, adaptive: more bonds than this share breaking in one step is a runaway (default 0.01)"},
-    {"analysis.control_probe", "quasistatic: the probe whose displacement steps.csv reports (default the first)"},
     {"output.every", "quasistatic: write particles_NNNN.vtu every k steps (0: only the end)"},
     {"probes.<name>", "a point [x, y(, z)]: displacement and energy density of the nearest particle"},
-    {"analysis.type", "static | modal | quasistatic | setup (set up and stop: check a scene, size a run)"},
-    {"analysis.nev", "modal: number of modes (default 6)"},
-    {"analysis.target_hz", "modal: compute the modes nearest this frequency [1/time] (default 0: the lowest)"},
+    {"analysis.type", "the analysis (default static)"},
     {"solver.residual_tol", "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; default max(100 rtol, 1e-6)"},
     {"output.dir", "output directory; default <scene name>-out"},
     {"output.vtk", "true | false: write particles.vtu (default true)"},
@@ -332,39 +319,59 @@ static PetscErrorCode ApplyOptions(PeriNode node)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* A documented key missing from the file is added when its option is given. */
-static PetscErrorCode AddOptionKeys(PeriNode root)
+/* The key path (a documented one, "material.nu") missing from the file is added when its option
+ * is given. */
+static PetscErrorCode AddOptionKey(PeriNode root, const char path[])
 {
-  PetscFunctionBeginUser;
-  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) {
-    const char *path = scene_keys[k].path;
-    char        opt[512], val[PETSC_MAX_PATH_LEN], parent[256], leaf[128];
-    const char *dot;
-    PetscBool   set;
-    PeriNode    map = root, child;
+  char        opt[512], val[PETSC_MAX_PATH_LEN], parent[256], leaf[128];
+  const char *dot;
+  PetscBool   set;
+  PeriNode    map = root, child;
 
-    if (strchr(path, '<')) continue;
-    OptionName(path, opt, sizeof(opt));
-    PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
-    if (!set) continue;
-    dot = strrchr(path, '.');
-    if (dot) {
-      PetscCall(PetscStrncpy(parent, path, PetscMin((size_t)(dot - path + 1), sizeof(parent))));
-      PetscCall(PetscStrncpy(leaf, dot + 1, sizeof(leaf)));
-      PetscCall(PeriSceneGetNode(root, parent, &map));
-      if (!map) {
-        PetscCall(NodeCreate(PERI_NODE_MAP, parent, "", 0, &map));
-        PetscCall(NodeAppend(root, map));
+  PetscFunctionBeginUser;
+  if (strchr(path, '<')) PetscFunctionReturn(PETSC_SUCCESS);
+  OptionName(path, opt, sizeof(opt));
+  PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
+  if (!set) PetscFunctionReturn(PETSC_SUCCESS);
+  dot = strrchr(path, '.');
+  if (dot) {
+    PetscCall(PetscStrncpy(parent, path, PetscMin((size_t)(dot - path + 1), sizeof(parent))));
+    PetscCall(PetscStrncpy(leaf, dot + 1, sizeof(leaf)));
+    PetscCall(PeriSceneGetNode(root, parent, &map));
+    if (!map) {
+      PetscCall(NodeCreate(PERI_NODE_MAP, parent, "", 0, &map));
+      PetscCall(NodeAppend(root, map));
+    }
+    if (map->kind != PERI_NODE_MAP) PetscFunctionReturn(PETSC_SUCCESS); /* the reader reports the wrong type */
+  } else
+    PetscCall(PetscStrncpy(leaf, path, sizeof(leaf)));
+  PetscCall(PeriSceneGetNode(map, leaf, &child));
+  if (child) PetscFunctionReturn(PETSC_SUCCESS); /* ApplyOptions already set it */
+  PetscCall(NodeCreate(PERI_NODE_SCALAR, leaf, map->path, 0, &child));
+  PetscCall(PetscStrallocpy(val, &child->value));
+  PetscCall(NodeAppend(map, child));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* "section.key" of a schema key. */
+static void SchemaPath(const PeriSchema *sec, const PeriKey *key, char path[], size_t len)
+{
+  snprintf(path, len, "%s.%s", sec->section, key->name);
+}
+
+/* Every documented key, the core's and every plug-in's, that an option adds when the file lacks it. */
+static PetscErrorCode AddOptionKeys(PeriScene scene)
+{
+  char path[256];
+
+  PetscFunctionBeginUser;
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) PetscCall(AddOptionKey(scene->root, scene_keys[k].path));
+  for (PetscInt o = 0; o < scene->nowners; o++)
+    for (const PeriSchema *sec = scene->owners[o].schema; sec && sec->section; sec++)
+      for (const PeriKey *key = sec->keys; key->name; key++) {
+        SchemaPath(sec, key, path, sizeof(path));
+        PetscCall(AddOptionKey(scene->root, path));
       }
-      if (map->kind != PERI_NODE_MAP) continue; /* the reader reports the wrong type */
-    } else
-      PetscCall(PetscStrncpy(leaf, path, sizeof(leaf)));
-    PetscCall(PeriSceneGetNode(map, leaf, &child));
-    if (child) continue; /* ApplyOptions already set it */
-    PetscCall(NodeCreate(PERI_NODE_SCALAR, leaf, map->path, 0, &child));
-    PetscCall(PetscStrallocpy(val, &child->value));
-    PetscCall(NodeAppend(map, child));
-  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -431,6 +438,13 @@ PetscErrorCode PeriSceneOptionNames(PeriScene scene, char ***names)
   PetscCall(NameListAddNodes(&l, scene->root));
   for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++)
     if (!strchr(scene_keys[k].path, '<')) PetscCall(NameListAdd(&l, scene_keys[k].path));
+  for (PetscInt o = 0; o < scene->nowners; o++)
+    for (const PeriSchema *sec = scene->owners[o].schema; sec && sec->section; sec++)
+      for (const PeriKey *key = sec->keys; key->name; key++) {
+        char path[256];
+        SchemaPath(sec, key, path, sizeof(path));
+        PetscCall(NameListAdd(&l, path));
+      }
   if (!l.name) PetscCall(PetscCalloc1(1, &l.name));
   *names = l.name;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -492,6 +506,19 @@ PetscErrorCode PeriSceneOptionExplain(PeriScene scene, const char opt[], char bu
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscErrorCode CopyOwners(PeriScene s, PetscInt n, const PeriSchemaOwner owners[])
+{
+  PeriSchemaOwner *copy;
+
+  PetscFunctionBeginUser;
+  if (!n) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc1(n, &copy));
+  for (PetscInt k = 0; k < n; k++) copy[k] = owners[k];
+  s->owners  = copy;
+  s->nowners = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The stream start, the document start, then the root mapping and all below it. */
 static PetscErrorCode ReadDocument(Reader *r, PeriScene s)
 {
@@ -518,10 +545,11 @@ static PetscErrorCode ReadDocument(Reader *r, PeriScene s)
 }
 
 /*@C
-  PeriSceneCreateFromFile - reads a YAML scene file and applies option overrides. Not collective:
-  every rank reads the file.
+  PeriSceneCreateFromFile - reads a YAML scene file and applies option overrides. owners are the
+  plug-ins' schemas (copied; the schemas themselves must outlive the scene): an option adds their
+  keys as it adds the core's. Not collective: every rank reads the file.
 @*/
-PetscErrorCode PeriSceneCreateFromFile(const char file[], PeriScene *scene)
+PetscErrorCode PeriSceneCreateFromFile(const char file[], PetscInt nowners, const PeriSchemaOwner owners[], PeriScene *scene)
 {
   PeriScene      s;
   FILE          *fp;
@@ -531,13 +559,14 @@ PetscErrorCode PeriSceneCreateFromFile(const char file[], PeriScene *scene)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&s));
+  PetscCall(CopyOwners(s, nowners, owners));
   PetscCall(PetscStrncpy(s->file, file, sizeof(s->file)));
   PetscCall(PetscStrncpy(tmp, file, sizeof(tmp)));
   PetscCall(PetscStrncpy(s->dir, dirname(tmp), sizeof(s->dir)));
   fp = fopen(file, "r");
   if (!fp) {
     int err = errno;
-    PetscCall(PetscFree(s));
+    PetscCall(PeriSceneDestroy(&s));
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "cannot open scene file %s: %s", file, strerror(err));
   }
   r.file = s->file;
@@ -550,7 +579,7 @@ PetscErrorCode PeriSceneCreateFromFile(const char file[], PeriScene *scene)
   fclose(fp);
   PetscCall(ierr);
   PetscCall(ApplyOptions(s->root));
-  PetscCall(AddOptionKeys(s->root));
+  PetscCall(AddOptionKeys(s));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -559,18 +588,53 @@ PetscErrorCode PeriSceneDestroy(PeriScene *scene)
   PetscFunctionBeginUser;
   if (!*scene) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(NodeDestroy(&(*scene)->root));
+  PetscCall(PetscFree((*scene)->owners));
   PetscCall(PetscFree(*scene));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* One -help row per key the plug-ins declare in section, tagged with its owner: "(model mppd)". */
+static PetscErrorCode HelpSchemaRows(MPI_Comm comm, const char section[], PetscInt nowners, const PeriSchemaOwner owners[])
+{
+  char path[256], text[512];
+
+  PetscFunctionBeginUser;
+  for (PetscInt o = 0; o < nowners; o++)
+    for (const PeriSchema *sec = owners[o].schema; sec && sec->section; sec++) {
+      if (strcmp(sec->section, section)) continue;
+      for (const PeriKey *key = sec->keys; key->name; key++) {
+        SchemaPath(sec, key, path, sizeof(path));
+        PetscCall(PetscSNPrintf(text, sizeof(text), "(%s %s) %s", owners[o].kind, owners[o].name, key->help));
+        if (key->units) PetscCall(PetscSNPrintf(text + strlen(text), sizeof(text) - strlen(text), " %s", key->units));
+        if (key->range) PetscCall(PetscSNPrintf(text + strlen(text), sizeof(text) - strlen(text), "; in %s", key->range));
+        if (key->deflt) PetscCall(PetscSNPrintf(text + strlen(text), sizeof(text) - strlen(text), strcmp(key->deflt, "required") ? "; default %s" : "; %s", key->deflt));
+        PetscCall(PetscPrintf(comm, "  %-30s %s\n", path, text));
+      }
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriSceneHelp - prints the documented scene keys and their options. Collective.
+  PeriSceneHelp - prints the documented scene keys and their options: the core's, and after each
+  "<section>.type" row the keys the plug-ins (owners) declare in that section. Collective.
 @*/
-PetscErrorCode PeriSceneHelp(MPI_Comm comm)
+PetscErrorCode PeriSceneHelp(MPI_Comm comm, PetscInt nowners, const PeriSchemaOwner owners[])
 {
   PetscFunctionBeginUser;
   PetscCall(PetscPrintf(comm, "Scene keys (YAML; every scalar key is also an option: its path joined with '_', e.g. -material_nu 0.1):\n"));
-  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) PetscCall(PetscPrintf(comm, "  %-30s %s\n", scene_keys[k].path, scene_keys[k].meaning));
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) {
+    const char *path = scene_keys[k].path, *dot = strchr(path, '.');
+    if (dot && !strcmp(dot, ".type")) {
+      /* a plug-in selector: its values are the registered types, its keys their schemas */
+      char section[64], types[512] = "";
+      PetscCall(PetscStrncpy(section, path, PetscMin((size_t)(dot - path + 1), sizeof(section))));
+      for (PetscInt o = 0; o < nowners; o++)
+        if (!strcmp(owners[o].kind, section)) PeriListAppend(types, sizeof(types), owners[o].name);
+      PetscCall(PetscPrintf(comm, "  %-30s %s%s%s\n", path, scene_keys[k].meaning, types[0] ? ": " : "", types));
+      PetscCall(HelpSchemaRows(comm, section, nowners, owners));
+    } else
+      PetscCall(PetscPrintf(comm, "  %-30s %s\n", path, scene_keys[k].meaning));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -646,6 +710,57 @@ PetscErrorCode PeriSceneCheckKeys(PeriScene scene, PeriNode map, const char *con
       }
       PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s", list);
     }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSchemaFindKey - the key name that schema (a {NULL}-ended array, or NULL) declares in section,
+  or NULL.
+@*/
+const PeriKey *PeriSchemaFindKey(const PeriSchema *schema, const char section[], const char name[])
+{
+  for (const PeriSchema *sec = schema; sec && sec->section; sec++) {
+    if (strcmp(sec->section, section)) continue;
+    for (const PeriKey *key = sec->keys; key->name; key++)
+      if (!strcmp(key->name, name)) return key;
+  }
+  return NULL;
+}
+
+/* The plug-in other than active that declares name in section, or NULL. */
+static const PeriSchemaOwner *OtherOwner(PeriScene scene, const PeriSchemaOwner *active, const char section[], const char name[])
+{
+  for (PetscInt o = 0; o < scene->nowners; o++)
+    if ((!active || strcmp(scene->owners[o].name, active->name)) && PeriSchemaFindKey(scene->owners[o].schema, section, name)) return &scene->owners[o];
+  return NULL;
+}
+
+/*@C
+  PeriSceneCheckKeysSchema - checks the keys of map, the plug-in section named section
+  ("analysis", "model"): allowed are base (the core's keys there, e.g. type) and the keys the
+  active plug-in declares. A key another plug-in declares says which one owns it, so that a key
+  left from another analysis (load_factor_max in a modal scene) is not taken for a typo; the
+  message keeps the "unknown key; allowed here" start of any other unknown key. active NULL (the
+  type is unknown, reported later with the list of types) allows every plug-in's keys.
+@*/
+PetscErrorCode PeriSceneCheckKeysSchema(PeriScene scene, PeriNode map, const char section[], const char *const base[], const PeriSchemaOwner *active)
+{
+  PetscFunctionBeginUser;
+  if (!map) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < map->n; k++) {
+    const char            *name      = map->child[k]->key;
+    const PeriSchemaOwner *other     = OtherOwner(scene, active, section, name);
+    PetscBool              ok        = PETSC_FALSE;
+    char                   list[512] = "", owner[256] = "";
+
+    for (PetscInt a = 0; base[a]; a++) ok = (PetscBool)(ok || !strcmp(name, base[a]));
+    if (ok || (active ? PeriSchemaFindKey(active->schema, section, name) != NULL : other != NULL)) continue;
+    for (PetscInt a = 0; base[a]; a++) PeriListAppend(list, sizeof(list), base[a]);
+    for (const PeriSchema *sec = active ? active->schema : NULL; sec && sec->section; sec++)
+      for (const PeriKey *key = sec->keys; !strcmp(sec->section, section) && key->name; key++) PeriListAppend(list, sizeof(list), key->name);
+    if (other) PetscCall(PetscSNPrintf(owner, sizeof(owner), " (key '%s' belongs to %s %s, not %s)", name, other->kind, other->name, active->name));
+    PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s%s", list, owner);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

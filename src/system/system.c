@@ -91,6 +91,20 @@ PetscReal PeriResidualTolerance(PeriSystem sys, PetscReal rtol)
   return sys->residual_tol > 0 ? sys->residual_tol : PetscMin(PetscMax(100 * rtol, 1e-6), 1e-3);
 }
 
+/* model.* against the chosen model's schema (s->owners holds every plug-in's); a model registered
+ * at run time has no schema, and takes type and plane only. */
+static PetscErrorCode CheckModelKeys(PeriScene s, PeriNode m, const char type[], const char *const keys[])
+{
+  PeriSchemaOwner        none   = {"model", type, NULL};
+  const PeriSchemaOwner *active = &none;
+
+  PetscFunctionBeginUser;
+  for (PetscInt o = 0; o < s->nowners; o++)
+    if (!strcmp(s->owners[o].kind, "model") && !strcmp(s->owners[o].name, type)) active = &s->owners[o];
+  PetscCall(PeriSceneCheckKeysSchema(s, m, "model", keys, active));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode CreateModel(PeriSystem sys)
 {
   static const char *const keys[] = {"type", "plane", NULL}, *const planes[] = {"stress", "strain", NULL};
@@ -114,14 +128,7 @@ static PetscErrorCode CreateModel(PeriSystem sys)
     PeriInputCheck(PETSC_FALSE, s, m, "type", "unknown model '%s'; registered models: %s", type, list);
   }
   PetscCall(PeriModelCreate(type, dim, plane == 1 ? PETSC_TRUE : PETSC_FALSE, &sys->model));
-  {
-    const char *allowed[16];
-    PetscInt    n = 0;
-    for (PetscInt k = 0; keys[k]; k++) allowed[n++] = keys[k];
-    for (PetscInt k = 0; sys->model->keys && sys->model->keys[k] && n < 15; k++) allowed[n++] = sys->model->keys[k];
-    allowed[n] = NULL;
-    PetscCall(PeriSceneCheckKeys(s, m, allowed));
-  }
+  PetscCall(CheckModelKeys(s, m, type, keys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

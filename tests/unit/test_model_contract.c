@@ -314,7 +314,7 @@ int main(int argc, char **argv)
     for (int s = 1; s < 3; s++) {
       PeriScene scene;
       PetscInt  dim;
-      PetscCall(PeriSceneCreateFromFile(argv[s], &scene));
+      PetscCall(PeriSceneCreateFromFile(argv[s], 0, NULL, &scene));
       PetscCall(PeriSceneGetInt(scene, scene->root, "dim", PETSC_TRUE, &dim, NULL));
       PetscCall(PeriSceneDestroy(&scene));
       for (PetscInt k = 0; k < (dim == 2 ? 2 : 1); k++) {

@@ -61,12 +61,13 @@ typedef struct {
 } PeriAnalysisOps;
 
 typedef struct {
-  const char       *name; /* analysis.type */
-  const char       *help; /* one line, for -help and the "unknown analysis" message */
-  const PeriSchema *schema;
+  const char       *name;        /* analysis.type */
+  const char       *help;        /* one line, for -help and the "unknown analysis" message */
+  const PeriSchema *schema;      /* its analysis.* keys besides type, ended by {NULL}; NULL: none */
   PetscBool         eigensolver; /* its linear solves are an eigensolver's (options -st_ksp_type ...) */
   PeriAnalysisOps   ops;
 } PeriAnalysisType;
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisFind(const char[], const PeriAnalysisType **);
 PETSC_EXTERN PetscErrorCode PeriAnalysisListTypes(char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriAnalysisGetTypes(PetscInt *, const PeriAnalysisType *const **);

@@ -6,6 +6,7 @@
 
 PETSC_EXTERN PetscErrorCode PeriModelRegister(const char[], PetscErrorCode (*)(PeriModel));
 PETSC_EXTERN PetscErrorCode PeriModelRegisterAll(void);
+PETSC_EXTERN PetscErrorCode PeriModelGetTypes(PetscInt *, const PeriModelType *const **);
 PETSC_EXTERN PetscErrorCode PeriModelCreate(const char[], PetscInt, PetscBool, PeriModel *);
 PETSC_EXTERN PetscErrorCode PeriModelSetFromScene(PeriModel, PeriScene, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriModelListTypes(char[], size_t);

@@ -25,3 +25,7 @@ struct _p_PeriProblem {
 };
 
 PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
+
+/* Every built-in model's and analysis' schema (src/package.c), handed down to the scene layer. */
+#define PERI_MAX_PLUGINS 32
+PETSC_EXTERN PetscErrorCode PeriPluginSchemas(PetscInt, PeriSchemaOwner[], PetscInt *);

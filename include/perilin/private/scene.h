@@ -4,9 +4,9 @@
 #include <perilin/scene.h>
 #include "perilin/private/sys.h"
 
-PETSC_EXTERN PetscErrorCode PeriSceneCreateFromFile(const char[], PeriScene *);
+PETSC_EXTERN PetscErrorCode PeriSceneCreateFromFile(const char[], PetscInt, const PeriSchemaOwner[], PeriScene *);
 PETSC_EXTERN PetscErrorCode PeriSceneDestroy(PeriScene *);
-PETSC_EXTERN PetscErrorCode PeriSceneHelp(MPI_Comm);
+PETSC_EXTERN PetscErrorCode PeriSceneHelp(MPI_Comm, PetscInt, const PeriSchemaOwner[]);
 
 /* Options that name nothing (src/options.c; docs/scene.md): an option naming no scene key is an
  * error before any computation, and an option nothing read is one after the analysis, both with a
