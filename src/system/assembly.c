@@ -1,6 +1,7 @@
 /* Assembly of the linearized stiffness K from the model's bond blocks into a block matrix (BAIJ by
  * default, block size = DOFs per particle) with exact preallocation, and the rigid-body modes
- * that serve as AMG's near-null space and as the check for unconstrained motion. */
+ * that serve as AMG's near-null space and as the check for unconstrained motion; and the loop over
+ * the elements of the energy (bonds or families) that the energy and the torsion loads share. */
 #include "perilin/private/system.h"
 
 /* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
@@ -83,26 +84,90 @@ static void RowAdd(PetscInt bs, PetscInt j, const PetscReal *B, PetscInt ld, Pet
     for (PetscInt c = 0; c < bs; c++) dst[a * bs + c] += B[a * ld + c];
 }
 
-/* Inserts every owned particle's family stiffness (state-based models) into K. */
-static PetscErrorCode InsertFamilies(PeriSystem sys, Mat K)
+/* Visits the families of the owned particles (state-based models). */
+static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
 {
   PeriModel         m  = sys->model;
   const PetscInt    bs = m->dofs, nmax = PeriSystemMaxFamily(sys);
   PeriBondGeometry *fam;
-  PetscReal        *Ke;
+  PetscReal        *Ke, *work;
   PetscInt         *idx;
+  PeriElement       el;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc3(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, nmax + 1, &idx));
+  PetscCall(PetscMalloc4(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, 2 * (nmax + 1) * bs, &work, nmax + 1, &idx));
+  el.idx    = idx;
+  el.nshare = 1;
+  el.K      = Ke;
+  el.g      = fam;
+  el.work   = work;
   for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
     PetscInt n;
     PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
     PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
     idx[0] = i;
     for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
-    PetscCall(MatSetValuesBlocked(K, n + 1, idx, n + 1, idx, Ke, ADD_VALUES));
+    el.n = n + 1;
+    PetscCall((*fn)(sys, &el, ctx));
   }
-  PetscCall(PetscFree3(fam, Ke, idx));
+  PetscCall(PetscFree4(fam, Ke, work, idx));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Visits the live bonds of the owned particles (bond-based models); self-image bonds move both
+ * ends alike and carry no energy. */
+static PetscErrorCode BondsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
+{
+  const PeriBonds *b = &sys->bonds;
+  PeriModel        m = sys->model;
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], work[4 * PERI_MAX_DOF];
+  PetscInt         idx[2];
+  PeriBondGeometry g;
+  PeriElement      el = {2, idx, 2, Ke, &g, work};
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+      m->ops.bond_stiffness(m, &g, Ke);
+      idx[0] = i;
+      idx[1] = g.j;
+      PetscCall((*fn)(sys, &el, ctx));
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriElementsForEach - calls fn on every element of this rank's energy with its stiffness block:
+  each live bond of an owned particle (bond-based models), or each owned particle's family
+  (state-based models), in the order of the owned particles. Not collective.
+@*/
+PetscErrorCode PeriElementsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
+{
+  PetscFunctionBeginUser;
+  if (sys->model->ops.family_stiffness)
+    PetscCall(FamiliesForEach(sys, fn, ctx));
+  else
+    PetscCall(BondsForEach(sys, fn, ctx));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Adds an element's block to the matrix ctx. */
+static PetscErrorCode InsertElement(PeriSystem sys, const PeriElement *el, void *ctx)
+{
+  PetscFunctionBeginUser;
+  (void)sys;
+  PetscCall(MatSetValuesBlocked((Mat)ctx, el->n, el->idx, el->n, el->idx, el->K, ADD_VALUES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Inserts every element's block into K one by one: state-based models, whose families overlap too
+ * much for the row gathering of bond-based models. */
+static PetscErrorCode InsertElements(PeriSystem sys, Mat K)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriElementsForEach(sys, InsertElement, K));
   PetscCall(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -130,13 +195,13 @@ static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
   PetscFunctionBeginUser;
   PetscCall(CreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
   PetscCall(MatSetUp(pre));
-  PetscCall(InsertFamilies(sys, pre));
+  PetscCall(InsertElements(sys, pre));
   PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *K));
   PetscCall(MatDestroy(&pre));
   PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  PetscCall(InsertFamilies(sys, *K));
+  PetscCall(InsertElements(sys, *K));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
