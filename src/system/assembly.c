@@ -1,6 +1,7 @@
 /* Assembly of the linearized stiffness K from the model's bond blocks into a block matrix (BAIJ by
  * default, block size = DOFs per particle) with exact preallocation, and the rigid-body modes
- * that serve as AMG's near-null space and as the check for unconstrained motion. */
+ * that serve as AMG's near-null space and as the check for unconstrained motion; and the loop over
+ * the elements of the energy (bonds or families) that the energy and the torsion loads share. */
 #include "perilin/private/system.h"
 
 /* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
@@ -83,28 +84,105 @@ static void RowAdd(PetscInt bs, PetscInt j, const PetscReal *B, PetscInt ld, Pet
     for (PetscInt c = 0; c < bs; c++) dst[a * bs + c] += B[a * ld + c];
 }
 
-/* Inserts every owned particle's family stiffness (state-based models) into K. */
-static PetscErrorCode InsertFamilies(PeriSystem sys, Mat K)
+/* Visits the families of the owned particles (state-based models). */
+static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
 {
   PeriModel         m  = sys->model;
   const PetscInt    bs = m->dofs, nmax = PeriSystemMaxFamily(sys);
   PeriBondGeometry *fam;
-  PetscReal        *Ke;
+  PetscReal        *Ke, *work;
   PetscInt         *idx;
+  PeriElement       el;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc3(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, nmax + 1, &idx));
+  PetscCall(PetscMalloc4(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, 2 * (nmax + 1) * bs, &work, nmax + 1, &idx));
+  el.idx    = idx;
+  el.nshare = 1;
+  el.K      = Ke;
+  el.g      = fam;
+  el.work   = work;
   for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
     PetscInt n;
     PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
     PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
     idx[0] = i;
     for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
-    PetscCall(MatSetValuesBlocked(K, n + 1, idx, n + 1, idx, Ke, ADD_VALUES));
+    el.n = n + 1;
+    PetscCall((*fn)(sys, &el, ctx));
   }
-  PetscCall(PetscFree3(fam, Ke, idx));
+  PetscCall(PetscFree4(fam, Ke, work, idx));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Visits the live bonds of the owned particles (bond-based models); self-image bonds move both
+ * ends alike and carry no energy. */
+static PetscErrorCode BondsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
+{
+  const PeriBonds *b = &sys->bonds;
+  PeriModel        m = sys->model;
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], work[4 * PERI_MAX_DOF];
+  PetscInt         idx[2];
+  PeriBondGeometry g;
+  PeriElement      el = {2, idx, 2, Ke, &g, work};
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+      m->ops.bond_stiffness(m, &g, Ke);
+      idx[0] = i;
+      idx[1] = g.j;
+      PetscCall((*fn)(sys, &el, ctx));
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriElementsForEach - calls fn on every element of this rank's energy with its stiffness block:
+  each live bond of an owned particle (bond-based models), or each owned particle's family
+  (state-based models), in the order of the owned particles. Not collective.
+@*/
+PetscErrorCode PeriElementsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
+{
+  PetscFunctionBeginUser;
+  if (sys->model->ops.family_stiffness)
+    PetscCall(FamiliesForEach(sys, fn, ctx));
+  else
+    PetscCall(BondsForEach(sys, fn, ctx));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Adds an element's block to the matrix ctx. */
+static PetscErrorCode InsertElement(PeriSystem sys, const PeriElement *el, void *ctx)
+{
+  PetscFunctionBeginUser;
+  (void)sys;
+  PetscCall(MatSetValuesBlocked((Mat)ctx, el->n, el->idx, el->n, el->idx, el->K, ADD_VALUES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Inserts every element's block into K one by one: state-based models, whose families overlap too
+ * much for the row gathering of bond-based models. */
+static PetscErrorCode InsertElements(PeriSystem sys, Mat K)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriElementsForEach(sys, InsertElement, K));
   PetscCall(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* An empty block matrix of K's layout and the given type: the options and preallocation follow. */
+static PetscErrorCode CreateBlockMatrix(PeriSystem sys, MatType type, Mat *K)
+{
+  const PetscInt bs = sys->model->dofs, nloc = sys->bonds.rend - sys->bonds.rstart;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreate(sys->comm, K));
+  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
+  PetscCall(MatSetBlockSize(*K, bs));
+  PetscCall(MatSetType(*K, type));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -112,25 +190,169 @@ static PetscErrorCode InsertFamilies(PeriSystem sys, Mat K)
  * The pattern is exact from a first pass into PETSc's preallocator. */
 static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
 {
-  const PetscInt bs = sys->model->dofs, nloc = sys->bonds.rend - sys->bonds.rstart;
-  Mat            pre;
+  Mat pre;
 
   PetscFunctionBeginUser;
-  PetscCall(MatCreate(sys->comm, &pre));
-  PetscCall(MatSetSizes(pre, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
-  PetscCall(MatSetBlockSize(pre, bs));
-  PetscCall(MatSetType(pre, MATPREALLOCATOR));
+  PetscCall(CreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
   PetscCall(MatSetUp(pre));
-  PetscCall(InsertFamilies(sys, pre));
-  PetscCall(MatCreate(sys->comm, K));
-  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
-  PetscCall(MatSetBlockSize(*K, bs));
-  PetscCall(MatSetType(*K, sys->mat_type[0] ? sys->mat_type : MATBAIJ));
+  PetscCall(InsertElements(sys, pre));
+  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *K));
   PetscCall(MatDestroy(&pre));
   PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  PetscCall(InsertFamilies(sys, *K));
+  PetscCall(InsertElements(sys, *K));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Bond-based models: K of the default type or -mat_type, with the exact pattern from the bonds;
+ * *maxcol gets the most blocks of a row (the size of the row buffers). */
+static PetscErrorCode CreateBondStiffness(PeriSystem sys, Mat *K, PetscInt *maxcol)
+{
+  const PetscInt nloc = sys->bonds.rend - sys->bonds.rstart;
+  PetscInt      *dnz, *onz, *dnzu, *onzu;
+  PetscBool      sym;
+
+  PetscFunctionBeginUser;
+  PetscCall(Preallocation(sys, &dnz, &onz, &dnzu, &onzu));
+  *maxcol = 1;
+  for (PetscInt i = 0; i < nloc; i++) *maxcol = PetscMax(*maxcol, dnz[i] + onz[i]);
+  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
+  PetscCall(MatSetFromOptions(*K));
+  PetscCall(MatXAIJSetPreallocation(*K, sys->model->dofs, dnz, onz, dnzu, onzu));
+  PetscCall(PetscFree4(dnz, onz, dnzu, onzu));
+  PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)*K, &sym, MATSBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  if (sym) PetscCall(MatSetOption(*K, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether stored bond k of owned row r points to another owned particle: then that particle's row
+ * gathers the bond's lower blocks itself, without the stash. */
+static PetscBool IsIncoming(const PeriBonds *b, PetscInt r, PetscInt k)
+{
+  PetscInt j = b->j[k];
+  return (PetscBool)(b->live[k] && j != r && j >= b->rstart && j < b->rend);
+}
+
+/* The incoming bonds of every owned particle j as a CSR (ptr, bond, row): bond k stored at owned
+ * row r towards owned particle j, listed under j. */
+typedef struct {
+  PetscInt *ptr, *bond, *row;
+} Incoming;
+
+/* Builds the incoming-bond CSR (the transpose of the owned block of the bond list). */
+static PetscErrorCode IncomingBonds(const PeriBonds *b, Incoming *in)
+{
+  const PetscInt nloc = b->rend - b->rstart, rstart = b->rstart;
+  PetscInt      *fill;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(nloc + 1, &in->ptr));
+  for (PetscInt r = rstart; r < b->rend; r++)
+    for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++)
+      if (IsIncoming(b, r, k)) in->ptr[b->j[k] - rstart + 1]++;
+  for (PetscInt i = 0; i < nloc; i++) in->ptr[i + 1] += in->ptr[i];
+  PetscCall(PetscMalloc2(in->ptr[nloc], &in->bond, in->ptr[nloc], &in->row));
+  PetscCall(PetscMalloc1(nloc, &fill));
+  PetscCall(PetscArraycpy(fill, in->ptr, nloc));
+  for (PetscInt r = rstart; r < b->rend; r++)
+    for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++) {
+      PetscInt j = b->j[k];
+      if (!IsIncoming(b, r, k)) continue;
+      in->bond[fill[j - rstart]]  = k;
+      in->row[fill[j - rstart]++] = r;
+    }
+  PetscCall(PetscFree(fill));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* One block row being gathered: slot[j] is column j's place in col[] and blocks[] (-1: none yet). */
+typedef struct {
+  PetscInt   ncol, *slot, *col, *perm;
+  PetscReal *blocks, *row;
+} RowBuffer;
+
+/* Gathers owned row i in w: the blocks of its stored bonds and of the bonds other owned particles
+ * store towards it. Blocks of rows owned by other ranks go to K through the stash. */
+static PetscErrorCode GatherBondRow(PeriSystem sys, const Incoming *in, PetscInt i, RowBuffer *w, Mat K)
+{
+  const PeriBonds *b  = &sys->bonds;
+  PeriModel        m  = sys->model;
+  const PetscInt   bs = m->dofs, nb = 2 * bs, rstart = b->rstart;
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PeriBondGeometry g;
+
+  PetscFunctionBeginUser;
+  w->ncol    = 0;
+  w->slot[i] = w->ncol++; /* the diagonal block is always there */
+  w->col[0]  = i;
+  for (PetscInt a = 0; a < bs * bs; a++) w->blocks[a] = 0;
+  for (PetscInt k = b->offset[i - rstart]; k < b->offset[i - rstart + 1]; k++) {
+    PetscInt j = b->j[k];
+    /* a self-image bond moves both ends alike: its blocks cancel */
+    if (!b->live[k] || j == i) continue;
+    PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+    m->ops.bond_stiffness(m, &g, Ke);
+    RowAdd(bs, i, &Ke[0], nb, w->slot, w->col, w->blocks, &w->ncol);
+    RowAdd(bs, j, &Ke[bs], nb, w->slot, w->col, w->blocks, &w->ncol);
+    if (sys->owner[j] != sys->rank) {
+      PetscInt idx[2] = {i, j};
+      PetscCall(MatSetValuesBlocked(K, 1, &j, 2, idx, &Ke[bs * nb], ADD_VALUES));
+    }
+  }
+  for (PetscInt t = in->ptr[i - rstart]; t < in->ptr[i - rstart + 1]; t++) {
+    PetscCall(PeriSystemBondGeometry(sys, in->row[t], in->bond[t], &g));
+    m->ops.bond_stiffness(m, &g, Ke);
+    RowAdd(bs, i, &Ke[bs * nb + bs], nb, w->slot, w->col, w->blocks, &w->ncol);
+    RowAdd(bs, in->row[t], &Ke[bs * nb], nb, w->slot, w->col, w->blocks, &w->ncol);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Inserts the gathered row i with one call, its columns sorted (the insertion is then a merge),
+ * and clears the slots for the next row. */
+static PetscErrorCode InsertRow(PetscInt bs, PetscInt i, RowBuffer *w, Mat K)
+{
+  const PetscInt ncol = w->ncol;
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < ncol; c++) w->perm[c] = c;
+  PetscCall(PetscSortIntWithArray(ncol, w->col, w->perm));
+  for (PetscInt c = 0; c < ncol; c++) {
+    w->slot[w->col[c]] = -1;
+    for (PetscInt a = 0; a < bs; a++)
+      for (PetscInt e = 0; e < bs; e++) w->row[a * ncol * bs + c * bs + e] = w->blocks[w->perm[c] * bs * bs + a * bs + e];
+  }
+  PetscCall(MatSetValuesBlocked(K, 1, &i, ncol, w->col, w->row, ADD_VALUES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Bond-based models: each owned block row gathered in full and inserted with one call. */
+static PetscErrorCode AssembleBonds(PeriSystem sys, Mat *K)
+{
+  const PeriBonds *b  = &sys->bonds;
+  const PetscInt   bs = sys->model->dofs;
+  PetscInt         maxcol;
+  Incoming         in;
+  RowBuffer        w;
+
+  PetscFunctionBeginUser;
+  PetscCall(CreateBondStiffness(sys, K, &maxcol));
+  PetscCall(IncomingBonds(b, &in));
+  PetscCall(PetscMalloc1(sys->particles.n, &w.slot));
+  for (PetscInt i = 0; i < sys->particles.n; i++) w.slot[i] = -1;
+  PetscCall(PetscMalloc4(maxcol, &w.col, maxcol, &w.perm, maxcol * bs * bs, &w.blocks, maxcol * bs * bs, &w.row));
+  for (PetscInt i = b->rstart; i < b->rend; i++) {
+    PetscCall(GatherBondRow(sys, &in, i, &w, *K));
+    PetscCall(InsertRow(bs, i, &w, *K));
+  }
+  PetscCall(PetscFree4(w.col, w.perm, w.blocks, w.row));
+  PetscCall(PetscFree(w.slot));
+  PetscCall(PetscFree2(in.bond, in.row));
+  PetscCall(PetscFree(in.ptr));
+  PetscCall(MatAssemblyBegin(*K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*K, MAT_FINAL_ASSEMBLY));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -145,102 +367,12 @@ static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
 @*/
 PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 {
-  const PeriBonds *b  = &sys->bonds;
-  PeriModel        m  = sys->model;
-  const PetscInt   bs = m->dofs, nb = 2 * bs, nloc = b->rend - b->rstart, rstart = b->rstart;
-  PetscInt        *dnz, *onz, *dnzu, *onzu, *tptr, *tbond, *trow, *slot, *col, *perm, maxcol = 1;
-  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], *blocks, *row;
-  PetscBool        sym;
-
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
-  if (m->ops.family_stiffness) {
+  if (sys->model->ops.family_stiffness)
     PetscCall(AssembleFamilies(sys, K));
-    PetscCall(MatSetOption(*K, MAT_SYMMETRIC, PETSC_TRUE));
-    PetscCall(MatSetOption(*K, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
-    PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(Preallocation(sys, &dnz, &onz, &dnzu, &onzu));
-  for (PetscInt i = 0; i < nloc; i++) maxcol = PetscMax(maxcol, dnz[i] + onz[i]);
-  PetscCall(MatCreate(sys->comm, K));
-  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
-  PetscCall(MatSetBlockSize(*K, bs));
-  PetscCall(MatSetType(*K, sys->mat_type[0] ? sys->mat_type : MATBAIJ));
-  PetscCall(MatSetFromOptions(*K));
-  PetscCall(MatXAIJSetPreallocation(*K, bs, dnz, onz, dnzu, onzu));
-  PetscCall(PetscFree4(dnz, onz, dnzu, onzu));
-  PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)*K, &sym, MATSBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
-  if (sym) PetscCall(MatSetOption(*K, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
-
-  /* incoming bonds: stored at owned row r towards owned particle j > r, listed under j */
-  PetscCall(PetscCalloc1(nloc + 1, &tptr));
-  for (PetscInt r = rstart; r < b->rend; r++)
-    for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++) {
-      PetscInt j = b->j[k];
-      if (b->live[k] && j != r && j >= rstart && j < b->rend) tptr[j - rstart + 1]++;
-    }
-  for (PetscInt i = 0; i < nloc; i++) tptr[i + 1] += tptr[i];
-  PetscCall(PetscMalloc2(tptr[nloc], &tbond, tptr[nloc], &trow));
-  {
-    PetscInt *fill;
-    PetscCall(PetscMalloc1(nloc, &fill));
-    PetscCall(PetscArraycpy(fill, tptr, nloc));
-    for (PetscInt r = rstart; r < b->rend; r++)
-      for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++) {
-        PetscInt j = b->j[k];
-        if (!b->live[k] || j == r || j < rstart || j >= b->rend) continue;
-        tbond[fill[j - rstart]]  = k;
-        trow[fill[j - rstart]++] = r;
-      }
-    PetscCall(PetscFree(fill));
-  }
-
-  PetscCall(PetscMalloc1(sys->particles.n, &slot));
-  for (PetscInt i = 0; i < sys->particles.n; i++) slot[i] = -1;
-  PetscCall(PetscMalloc4(maxcol, &col, maxcol, &perm, maxcol * bs * bs, &blocks, maxcol * bs * bs, &row));
-  for (PetscInt i = rstart; i < b->rend; i++) {
-    PetscInt         ncol = 0;
-    PeriBondGeometry g;
-    slot[i] = ncol++; /* the diagonal block is always there */
-    col[0]  = i;
-    for (PetscInt a = 0; a < bs * bs; a++) blocks[a] = 0;
-    for (PetscInt k = b->offset[i - rstart]; k < b->offset[i - rstart + 1]; k++) {
-      PetscInt j = b->j[k];
-      /* a self-image bond moves both ends alike: its blocks cancel */
-      if (!b->live[k] || j == i) continue;
-      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
-      m->ops.bond_stiffness(m, &g, Ke);
-      RowAdd(bs, i, &Ke[0], nb, slot, col, blocks, &ncol);
-      RowAdd(bs, j, &Ke[bs], nb, slot, col, blocks, &ncol);
-      if (sys->owner[j] != sys->rank) {
-        PetscInt idx[2] = {i, j};
-        PetscCall(MatSetValuesBlocked(*K, 1, &j, 2, idx, &Ke[bs * nb], ADD_VALUES));
-      }
-    }
-    for (PetscInt t = tptr[i - rstart]; t < tptr[i - rstart + 1]; t++) {
-      PetscCall(PeriSystemBondGeometry(sys, trow[t], tbond[t], &g));
-      m->ops.bond_stiffness(m, &g, Ke);
-      RowAdd(bs, i, &Ke[bs * nb + bs], nb, slot, col, blocks, &ncol);
-      RowAdd(bs, trow[t], &Ke[bs * nb], nb, slot, col, blocks, &ncol);
-    }
-    /* sorted columns make the insertion a merge */
-    for (PetscInt c = 0; c < ncol; c++) perm[c] = c;
-    PetscCall(PetscSortIntWithArray(ncol, col, perm));
-    for (PetscInt c = 0; c < ncol; c++) {
-      slot[col[c]] = -1;
-      for (PetscInt a = 0; a < bs; a++)
-        for (PetscInt e = 0; e < bs; e++) row[a * ncol * bs + c * bs + e] = blocks[perm[c] * bs * bs + a * bs + e];
-    }
-    PetscCall(MatSetValuesBlocked(*K, 1, &i, ncol, col, row, ADD_VALUES));
-  }
-  PetscCall(PetscFree4(col, perm, blocks, row));
-  PetscCall(PetscFree(slot));
-  PetscCall(PetscFree2(tbond, trow));
-  PetscCall(PetscFree(tptr));
-  PetscCall(MatAssemblyBegin(*K, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(*K, MAT_FINAL_ASSEMBLY));
+  else
+    PetscCall(AssembleBonds(sys, K));
   PetscCall(MatSetOption(*K, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(MatSetOption(*K, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));

@@ -41,32 +41,32 @@ PetscErrorCode PeriReadProbes(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Energy of the state-based particles' families: W_i V_i = u^T K_i u / 2 of each owned particle. */
-static PetscErrorCode FamilyEnergy(PeriSystem sys, const PetscScalar u[], PetscReal W[], PetscReal *energy)
+/* What the energy evaluation accumulates: all particles' DOFs, W per particle, the body's energy. */
+typedef struct {
+  const PetscScalar *u;
+  PetscReal         *W, energy;
+} EnergyCtx;
+
+/* An element's energy e = u_e^T K_e u_e / 2, shared equally by the particles that own it (a bond's
+ * two ends, a family's particle): their W gets share / V, the body's energy the shares of its own
+ * particles (fictitious ones are not part of the body). */
+static PetscErrorCode ElementEnergy(PeriSystem sys, const PeriElement *el, void *ctx)
 {
-  PeriModel         m  = sys->model;
-  const PetscInt    bs = m->dofs, nmax = PeriSystemMaxFamily(sys);
-  PeriBondGeometry *fam;
-  PetscReal        *Ke, *ue;
+  EnergyCtx     *E  = (EnergyCtx *)ctx;
+  const PetscInt bs = sys->model->dofs, N = el->n * bs;
+  PetscReal     *ue = el->work, e = 0, share;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc3(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, (nmax + 1) * bs, &ue));
-  for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
-    PetscInt  n, N;
-    PetscReal e = 0;
-    PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
-    N = (n + 1) * bs;
-    PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
-    for (PetscInt c = 0; c < bs; c++) {
-      ue[c] = PetscRealPart(u[i * bs + c]);
-      for (PetscInt t = 0; t < n; t++) ue[(t + 1) * bs + c] = PetscRealPart(u[fam[t].j * bs + c]);
-    }
-    for (PetscInt a = 0; a < N; a++)
-      for (PetscInt c = 0; c < N; c++) e += 0.5 * ue[a] * Ke[a * N + c] * ue[c];
-    W[i] += e / sys->particles.volume[i];
-    if (!PeriParticleIsFictitious(&sys->particles, i)) *energy += e;
+  for (PetscInt c = 0; c < bs; c++)
+    for (PetscInt t = 0; t < el->n; t++) ue[t * bs + c] = PetscRealPart(E->u[el->idx[t] * bs + c]);
+  for (PetscInt a = 0; a < N; a++)
+    for (PetscInt c = 0; c < N; c++) e += 0.5 * ue[a] * el->K[a * N + c] * ue[c];
+  share = e / el->nshare;
+  for (PetscInt t = 0; t < el->nshare; t++) {
+    PetscInt p = el->idx[t];
+    if (!PeriParticleIsFictitious(&sys->particles, p)) E->energy += share;
+    E->W[p] += share / sys->particles.volume[p];
   }
-  PetscCall(PetscFree3(fam, Ke, ue));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -138,8 +138,9 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   const PetscScalar   *u;
   PeriModel            m  = sys->model;
   const PeriParticles *pt = &sys->particles;
-  const PetscInt       n = pt->n, bs = m->dofs, nb = 2 * bs;
-  PetscReal           *W, energy = 0, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], umax[PERI_MAX_DOF] = {0, 0, 0};
+  const PetscInt       n = pt->n, bs = m->dofs;
+  PetscReal            umax[PERI_MAX_DOF] = {0, 0, 0}, *W;
+  EnergyCtx            E;
 
   PetscFunctionBeginUser;
   PetscCall(VecScatterCreateToAll(sys->u, &scatter, &all));
@@ -147,32 +148,14 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   PetscCall(VecScatterEnd(scatter, sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(all, &u));
   PetscCall(PetscCalloc1(n, &W));
-  if (m->ops.family_stiffness)
-    PetscCall(FamilyEnergy(sys, u, W, &energy));
-  else
-    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
-      for (PetscInt k = sys->bonds.offset[i - sys->bonds.rstart]; k < sys->bonds.offset[i - sys->bonds.rstart + 1]; k++) {
-        PeriBondGeometry g;
-        PetscReal        ue[2 * PERI_MAX_DOF], e = 0;
-        if (!sys->bonds.live[k] || sys->bonds.j[k] == i) continue;
-        PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
-        m->ops.bond_stiffness(m, &g, Ke);
-        for (PetscInt c = 0; c < bs; c++) {
-          ue[c]      = PetscRealPart(u[i * bs + c]);
-          ue[bs + c] = PetscRealPart(u[g.j * bs + c]);
-        }
-        for (PetscInt a = 0; a < nb; a++)
-          for (PetscInt c = 0; c < nb; c++) e += 0.5 * ue[a] * Ke[a * nb + c] * ue[c];
-        /* each end owns half of the pair; fictitious particles are not part of the body */
-        if (!PeriParticleIsFictitious(pt, i)) energy += 0.5 * e;
-        if (!PeriParticleIsFictitious(pt, g.j)) energy += 0.5 * e;
-        W[i] += 0.5 * e / g.Vi;
-        W[g.j] += 0.5 * e / g.Vj;
-      }
+  E.u      = u;
+  E.W      = W;
+  E.energy = 0;
+  PetscCall(PeriElementsForEach(sys, ElementEnergy, &E));
   for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
     for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(pt, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
   PetscCallMPI(MPI_Allreduce(umax, sys->results.max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
-  PetscCallMPI(MPI_Allreduce(&energy, &sys->results.strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(&E.energy, &sys->results.strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
   PetscCallMPI(MPI_Reduce(sys->rank ? W : MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, 0, sys->comm));
   if (m->antiplane) PetscCall(ShearStresses(sys, u));
   PetscCall(PetscFree(sys->W));

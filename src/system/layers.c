@@ -302,6 +302,28 @@ PetscErrorCode PeriLayersDestroy(PeriLayers *L)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The twist's load of one element: f_e = -K_e e with e_t = psi ((X_i - X0) x (X_t - X0))_z, the
+ * rigid twist's relative displacement of particle t from the element's particle i (one DOF). */
+static PetscErrorCode TorsionElementLoad(PeriSystem sys, const PeriElement *el, void *ctx)
+{
+  const PetscReal *x = sys->particles.x, psi = sys->torsion.twist, *c = sys->torsion.center;
+  const PetscInt   i = el->idx[0], n = el->n;
+  PetscReal       *e = el->work, *fe = el->work + n;
+
+  PetscFunctionBeginUser;
+  e[0] = 0;
+  for (PetscInt t = 1; t < n; t++) {
+    PetscInt j = el->idx[t];
+    e[t]       = psi * ((x[3 * i] - c[0]) * (x[3 * j + 1] - c[1]) - (x[3 * j] - c[0]) * (x[3 * i + 1] - c[1]));
+  }
+  for (PetscInt a = 0; a < n; a++) {
+    fe[a] = 0;
+    for (PetscInt b = 0; b < n; b++) fe[a] -= el->K[a * n + b] * e[b];
+  }
+  PetscCall(VecSetValues((Vec)ctx, n, el->idx, fe, ADD_VALUES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriTorsionLoads - without fictitious layers the twist enters every bond as a prescribed relative
   displacement e0 = psi ((X_i - X0) x (X_j - X0))_z (the rigid twist's contribution to the shear
@@ -311,52 +333,9 @@ PetscErrorCode PeriLayersDestroy(PeriLayers *L)
 @*/
 PetscErrorCode PeriTorsionLoads(PeriSystem sys, Vec f)
 {
-  const PeriParticles *pt  = &sys->particles;
-  PeriModel            m   = sys->model;
-  const PetscReal      psi = sys->torsion.twist, *c = sys->torsion.center;
-
   PetscFunctionBeginUser;
   if (!sys->torsion.active || sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
-  if (m->ops.family_stiffness) {
-    PetscInt          nmax = PeriSystemMaxFamily(sys), n;
-    PeriBondGeometry *fam;
-    PetscReal        *Ke, *e, *fe;
-    PetscInt         *idx;
-    PetscCall(PetscMalloc5(nmax, &fam, PetscSqr(nmax + 1), &Ke, nmax + 1, &e, nmax + 1, &fe, nmax + 1, &idx));
-    for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
-      PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
-      PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
-      e[0]   = 0;
-      idx[0] = i;
-      for (PetscInt t = 0; t < n; t++) {
-        PetscInt j = fam[t].j;
-        e[t + 1]   = psi * ((pt->x[3 * i] - c[0]) * (pt->x[3 * j + 1] - c[1]) - (pt->x[3 * j] - c[0]) * (pt->x[3 * i + 1] - c[1]));
-        idx[t + 1] = j;
-      }
-      for (PetscInt a = 0; a <= n; a++) {
-        fe[a] = 0;
-        for (PetscInt b = 0; b <= n; b++) fe[a] -= Ke[a * (n + 1) + b] * e[b];
-      }
-      PetscCall(VecSetValues(f, n + 1, idx, fe, ADD_VALUES));
-    }
-    PetscCall(PetscFree5(fam, Ke, e, fe, idx));
-  } else {
-    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
-      for (PetscInt k = sys->bonds.offset[i - sys->bonds.rstart]; k < sys->bonds.offset[i - sys->bonds.rstart + 1]; k++) {
-        PeriBondGeometry g;
-        PetscReal        Ke[4], e0, fe[2];
-        PetscInt         idx[2];
-        if (!sys->bonds.live[k] || sys->bonds.j[k] == i) continue;
-        PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
-        m->ops.bond_stiffness(m, &g, Ke);
-        e0     = psi * ((pt->x[3 * i] - c[0]) * (pt->x[3 * g.j + 1] - c[1]) - (pt->x[3 * g.j] - c[0]) * (pt->x[3 * i + 1] - c[1]));
-        fe[0]  = -Ke[1] * e0;
-        fe[1]  = -Ke[3] * e0;
-        idx[0] = i;
-        idx[1] = g.j;
-        PetscCall(VecSetValues(f, 2, idx, fe, ADD_VALUES));
-      }
-  }
+  PetscCall(PeriElementsForEach(sys, TorsionElementLoad, f));
   PetscCall(VecAssemblyBegin(f));
   PetscCall(VecAssemblyEnd(f));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -300,38 +300,39 @@ static PetscErrorCode SmootherFallback(PeriSystem sys, KSP ksp, KSPConvergedReas
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriStaticSolve - solves K u = lambda f for sys->u with the prescribed values and the layers'
-  offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
-  eliminated (A = R K T), prescribed DOFs symmetrically; a free body with balanced loads is solved
-  orthogonal to its rigid motions. sys->K is kept unless inplace. *ksp is created on first use
-  (CG + GAMG, or GMRES for an unsymmetric operator, then the options). Sets sys->results' solver
-  fields and returns the converged reason instead of failing. Collective.
-@*/
-PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
+/* The operator A and the right-hand side b = lambda f of the solve: K with the fictitious layers
+ * eliminated (A = R K T), else K itself (inplace) or a copy; A carries the rigid-body modes. */
+static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool inplace, Mat *A, Vec *b)
 {
-  Mat       A;
-  Vec       r, b, free[PERI_MAX_MODES];
-  PetscReal diag, fnorm, rnorm, *values;
-  PetscInt  N, nfree = 0, nrows, *rows;
-  PetscBool retry;
-
   PetscFunctionBeginUser;
-  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   if (!sys->u) PetscCall(MatCreateVecs(sys->K, &sys->u, NULL));
-  PetscCall(VecDuplicate(sys->f, &b));
-  PetscCall(VecCopy(sys->f, b));
-  PetscCall(VecScale(b, lambda));
+  PetscCall(VecDuplicate(sys->f, b));
+  PetscCall(VecCopy(sys->f, *b));
+  PetscCall(VecScale(*b, lambda));
   sys->results.symmetric = PETSC_TRUE;
   if (sys->layers.T)
-    PetscCall(PeriLayersApply(sys, lambda, &A, b));
+    PetscCall(PeriLayersApply(sys, lambda, A, *b));
   else if (inplace) {
     PetscCall(PetscObjectReference((PetscObject)sys->K));
-    A = sys->K;
+    *A = sys->K;
   } else
-    PetscCall(MatDuplicate(sys->K, MAT_COPY_VALUES, &A));
-  PetscCall(PeriSetNearNullSpace(sys, A));
-  nrows = sys->nconstrained + nhold;
+    PetscCall(MatDuplicate(sys->K, MAT_COPY_VALUES, A));
+  PetscCall(PeriSetNearNullSpace(sys, *A));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Sets the prescribed (lambda times their values) and held DOFs in sys->u and eliminates them
+ * symmetrically from A and b, with the system scaled to O(1) numbers first (ScaleToUnits); *diag
+ * gets the value left on the eliminated rows. */
+static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Vec b, PetscReal lambda, PetscInt nhold, const PetscInt hold[], const PetscReal held[], PetscReal *diag)
+{
+  const PetscInt nrows = sys->nconstrained + nhold;
+  PetscReal     *values;
+  PetscInt      *rows, N;
+  PetscBool      mpisbaij;
+  Vec            d;
+
+  PetscFunctionBeginUser;
   PetscCall(PetscMalloc2(nrows, &rows, nrows, &values));
   for (PetscInt k = 0; k < sys->nconstrained; k++) {
     rows[k]   = sys->constrained[k];
@@ -345,22 +346,27 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
   PetscCall(VecAssemblyBegin(sys->u));
   PetscCall(VecAssemblyEnd(sys->u));
   /* a unit of the mean diagonal on eliminated rows keeps the conditioning of the free block */
-  PetscCall(MatCreateVecs(A, &r, NULL));
-  PetscCall(MatGetDiagonal(A, r));
-  PetscCall(VecNorm(r, NORM_1, &diag));
-  PetscCall(VecGetSize(r, &N));
-  diag /= N;
-  PetscCall(ScaleToUnits(sys, A, b, &diag));
-  {
-    PetscBool mpisbaij;
-    PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPISBAIJ, &mpisbaij));
-    PetscCheck(!mpisbaij, sys->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
-  }
-  PetscCall(MatZeroRowsColumns(A, nrows, rows, diag, sys->u, b));
+  PetscCall(MatCreateVecs(A, &d, NULL));
+  PetscCall(MatGetDiagonal(A, d));
+  PetscCall(VecNorm(d, NORM_1, diag));
+  PetscCall(VecGetSize(d, &N));
+  PetscCall(VecDestroy(&d));
+  *diag /= N;
+  PetscCall(ScaleToUnits(sys, A, b, diag));
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPISBAIJ, &mpisbaij));
+  PetscCheck(!mpisbaij, sys->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
+  PetscCall(MatZeroRowsColumns(A, nrows, rows, *diag, sys->u, b));
   PetscCall(PetscFree2(rows, values));
-  PetscCall(CheckRightHandSide(sys, b));
-  PetscCall(HandleFreeMotions(sys, A, sys->u, b, diag, nhold, hold, &nfree, free));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
+/* Solves A u = b for sys->u with *ksp (created on first use), once more with SOR smoothing when
+ * GAMG's Chebyshev smoother fails (SmootherFallback). */
+static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Vec b, KSPConvergedReason *reason)
+{
+  PetscBool retry;
+
+  PetscFunctionBeginUser;
   if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->results.symmetric, ksp));
   PetscCall(KSPSetOperators(*ksp, A, A));
   PetscCall(KSPSolve(*ksp, b, sys->u));
@@ -370,24 +376,61 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
     PetscCall(KSPSolve(*ksp, b, sys->u));
     PetscCall(KSPGetConvergedReason(*ksp, reason));
   }
-  PetscCall(KSPGetIterationNumber(*ksp, &sys->results.iterations));
-  /* the true relative residual, whatever norm the KSP monitored */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* sys->results' solver fields: iterations, the true relative residual (whatever norm the KSP
+ * monitored), the KSP and PC types and the converged reason. */
+static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConvergedReason reason)
+{
+  Vec       r;
+  PetscReal rnorm, fnorm;
+  KSPType   kt;
+  PCType    pt;
+  PC        pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetIterationNumber(ksp, &sys->results.iterations));
+  PetscCall(MatCreateVecs(A, &r, NULL));
   PetscCall(MatMult(A, sys->u, r));
   PetscCall(VecAYPX(r, -1, b));
   PetscCall(VecNorm(r, NORM_2, &rnorm));
   PetscCall(VecNorm(b, NORM_2, &fnorm));
+  PetscCall(VecDestroy(&r));
   sys->results.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
-  {
-    KSPType kt;
-    PCType  pt;
-    PC      pc;
-    PetscCall(KSPGetType(*ksp, &kt));
-    PetscCall(KSPGetPC(*ksp, &pc));
-    PetscCall(PCGetType(pc, &pt));
-    PetscCall(PetscStrncpy(sys->results.ksp_type, kt, sizeof(sys->results.ksp_type)));
-    PetscCall(PetscStrncpy(sys->results.pc_type, pt, sizeof(sys->results.pc_type)));
-  }
-  PetscCall(PetscStrncpy(sys->results.converged_reason, KSPConvergedReasons[*reason], sizeof(sys->results.converged_reason)));
+  PetscCall(KSPGetType(ksp, &kt));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCGetType(pc, &pt));
+  PetscCall(PetscStrncpy(sys->results.ksp_type, kt, sizeof(sys->results.ksp_type)));
+  PetscCall(PetscStrncpy(sys->results.pc_type, pt, sizeof(sys->results.pc_type)));
+  PetscCall(PetscStrncpy(sys->results.converged_reason, KSPConvergedReasons[reason], sizeof(sys->results.converged_reason)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriStaticSolve - solves K u = lambda f for sys->u with the prescribed values and the layers'
+  offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
+  eliminated (A = R K T), prescribed DOFs symmetrically; a free body with balanced loads is solved
+  orthogonal to its rigid motions. sys->K is kept unless inplace. *ksp is created on first use
+  (CG + GAMG, or GMRES for an unsymmetric operator, then the options). Sets sys->results' solver
+  fields and returns the converged reason instead of failing. Collective.
+@*/
+PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
+{
+  Mat       A;
+  Vec       b, free[PERI_MAX_MODES];
+  PetscReal diag;
+  PetscInt  nfree = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscCall(StaticOperator(sys, lambda, inplace, &A, &b));
+  PetscCall(EliminatePrescribed(sys, A, b, lambda, nhold, hold, held, &diag));
+  PetscCall(CheckRightHandSide(sys, b));
+  PetscCall(HandleFreeMotions(sys, A, sys->u, b, diag, nhold, hold, &nfree, free));
+  PetscCall(SolveWithFallback(sys, ksp, A, b, reason));
+  PetscCall(RecordSolve(sys, *ksp, A, b, *reason));
+  /* the solution orthogonal to the free rigid motions */
   for (PetscInt q = 0; q < nfree; q++) {
     PetscScalar dot;
     PetscCall(VecDot(sys->u, free[q], &dot));
@@ -395,7 +438,6 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
     PetscCall(VecDestroy(&free[q]));
   }
   PetscCall(PeriLayersComplete(sys, lambda, sys->u));
-  PetscCall(VecDestroy(&r));
   PetscCall(VecDestroy(&b));
   PetscCall(MatDestroy(&A));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));

@@ -159,6 +159,18 @@ PETSC_EXTERN PetscErrorCode PeriSystemAddFields(PeriSystem, PeriFieldList);
 PETSC_EXTERN PetscErrorCode PeriSystemWriteVTU(PeriSystem, const PetscReal *, const char[]);
 
 /* assembly (src/system/assembly.c) */
+/* One element of the energy, as PeriElementsForEach visits it: a live bond of a bond-based model,
+ * or the family of an owned particle of a state-based model. */
+typedef struct {
+  PetscInt                n;      /* particles: 2 for a bond, the family's size + 1 */
+  const PetscInt         *idx;    /* their global indices, the bond's or family's particle i first */
+  PetscInt                nshare; /* idx[0..nshare-1] share its energy equally: a bond's 2 ends, a family's i */
+  const PetscReal        *K;      /* the ((n dofs)^2) stiffness block, row-major, DOFs in the order of idx */
+  const PeriBondGeometry *g;      /* the bond's geometry, or the family's n - 1 bonds */
+  PetscReal              *work;   /* scratch of 2 n dofs reals for the callback */
+} PeriElement;
+typedef PetscErrorCode (*PeriElementFn)(PeriSystem, const PeriElement *, void *);
+PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void *);
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat);
