@@ -43,11 +43,11 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
   PeriNode                 a;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscStrncpy(p->analysis, "static", sizeof(p->analysis)));
+  PetscCall(PetscStrncpy(p->analysis_type, "static", sizeof(p->analysis_type)));
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
-  PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis, sizeof(p->analysis), NULL));
+  PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis_type, sizeof(p->analysis_type), NULL));
   for (PetscInt o = 0; o < s->nowners; o++)
-    if (!strcmp(s->owners[o].kind, "analysis") && !strcmp(s->owners[o].name, p->analysis)) active = &s->owners[o];
+    if (!strcmp(s->owners[o].kind, "analysis") && !strcmp(s->owners[o].name, p->analysis_type)) active = &s->owners[o];
   PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", base, active));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -102,28 +102,49 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The analysis' snapshot callback: the system's present state as NAME in the output set,
+ * which is opened here if the run has not opened it yet (a test drives the library without it). */
+static PetscErrorCode WriteSnapshot(void *ctx, const char name[])
+{
+  PeriProblem p = (PeriProblem)ctx;
+  char        path[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", p->staging_dir, name));
+  PetscCall(PeriSystemWriteVTU(p->sys, p->sys->u_all, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriProblemRun - runs the scene's analysis (analysis.type), found by name. Collective.
 @*/
 PetscErrorCode PeriProblemRun(PeriProblem p)
 {
-  struct rusage  ru;
-  PetscReal      mb;
-  PetscLogDouble t;
+  const PeriAnalysisType *type;
+  struct rusage           ru;
+  PetscReal               mb;
+  PetscLogDouble          t;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriAnalysisFind(p->analysis, &p->atype));
-  if (!p->atype) {
+  PetscCall(PeriAnalysisFind(p->analysis_type, &type));
+  if (!type) {
     PeriNode a;
     char     list[256];
     PetscCall(PeriSceneGetNode(p->scene->root, "analysis", &a));
     PetscCall(PeriAnalysisListTypes(list, sizeof(list)));
-    PeriInputCheck(PETSC_FALSE, p->scene, a, "type", "unknown analysis '%s'; available: %s", p->analysis, list);
+    PeriInputCheck(PETSC_FALSE, p->scene, a, "type", "unknown analysis '%s'; available: %s", p->analysis_type, list);
   }
+  PetscCall(PeriAnalysisCreate(type, p->sys, &p->analysis));
+  p->analysis->vtk         = p->vtk;
+  p->analysis->every       = p->output_every;
+  p->analysis->output_dir  = p->output_dir;
+  p->analysis->snapshot    = WriteSnapshot;
+  p->analysis->snapshotctx = p;
   /* a signal during the set-up: no analysis, only the summary saying so */
   PetscCall(PeriSignalReceived(p->comm, &p->sys->interrupted));
   PetscCall(PetscLogStagePush(PERI_STAGE_Solve));
-  if (!p->sys->interrupted) PetscCall(p->atype->ops.run(p));
+  if (!p->sys->interrupted) PetscCall(type->ops.run(p->analysis));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscTime(&t));
   p->sys->results.total_s = t - p->t_start;
@@ -144,7 +165,7 @@ static PetscErrorCode WriteParticles(PeriProblem p, const char path[])
   if (p->rank) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFieldListCreate(sys->particles.n, sys->particles.x, &fl));
   if (sys->u_all) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->u_all));
-  if (p->atype && p->atype->ops.fields) PetscCall(p->atype->ops.fields(p, fl));
+  if (p->analysis && p->analysis->type->ops.fields) PetscCall(p->analysis->type->ops.fields(p->analysis, fl));
   PetscCall(PeriSystemAddFields(sys, fl));
   PetscCall(PeriWriteVTU(fl, path));
   PetscCall(PeriFieldListDestroy(&fl));
@@ -168,7 +189,7 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.vtu", p->staging_dir));
     PetscCall(WriteParticles(p, path));
   }
-  if (p->atype && p->atype->ops.files) PetscCall(p->atype->ops.files(p, p->staging_dir));
+  if (p->analysis && p->analysis->type->ops.files) PetscCall(p->analysis->type->ops.files(p->analysis, p->staging_dir));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/summary.json", p->staging_dir));
   PetscCall(PeriWriteSummary(p, path));
   PetscCall(PeriOutputSetCommit(p->comm, p->staging_dir, p->output_dir));
@@ -185,7 +206,7 @@ PetscErrorCode PeriProblemDestroy(PeriProblem *problem)
   if (!p) PetscFunctionReturn(PETSC_SUCCESS);
   if (p->staging_dir[0] && p->rank == 0) PeriOutputSetDiscard(); /* never committed: the previous results stay */
   PetscCall(PeriSystemDestroy(&p->sys));
-  if (p->atype && p->atype->ops.destroy) PetscCall(p->atype->ops.destroy(p));
+  PetscCall(PeriAnalysisDestroy(&p->analysis));
   PetscCall(PeriSceneDestroy(&p->scene));
   PetscCall(PetscFree(p));
   *problem = NULL;
@@ -208,7 +229,7 @@ PetscErrorCode PeriProblemCheckOptions(PeriProblem p)
 
 PetscErrorCode PeriProblemCheckUnusedOptions(PeriProblem p)
 {
-  PeriRunSolvers run = {p->comm, p->scene, p->sys->mat_type, p->sys->results.ksp_type, p->sys->results.pc_type, p->atype ? p->atype->eigensolver : PETSC_FALSE};
+  PeriRunSolvers run = {p->comm, p->scene, p->sys->mat_type, p->sys->results.ksp_type, p->sys->results.pc_type, p->analysis ? p->analysis->type->eigensolver : PETSC_FALSE};
 
   PetscFunctionBeginUser;
   if (p->sys->K) PetscCall(MatGetType(p->sys->K, &run.mat_type));
@@ -230,15 +251,15 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   const PeriResults *r   = &sys->results;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis, sys->model->type, sys->particles.n, r->nbonds_total, sys->particles.n * sys->model->dofs, p->size));
+  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->particles.n, r->nbonds_total, sys->particles.n * sys->model->dofs, p->size));
   if (r->ksp_type[0])
     PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", r->neighbors_s, r->assembly_s, r->solve_s, r->ksp_type, r->pc_type, r->iterations, r->converged_reason, (double)r->residual_norm, r->memory_mb));
   else
     PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", r->neighbors_s, r->memory_mb));
   if (sys->interrupted) {
     PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->u_all ? "the last complete state was written" : "no result was reached", p->output_dir));
-  } else if (p->atype && p->atype->ops.report) {
-    PetscCall(p->atype->ops.report(p));
+  } else if (p->analysis && p->analysis->type->ops.report) {
+    PetscCall(p->analysis->type->ops.report(p->analysis));
   } else {
     const PeriTorsion *t = &sys->torsion;
     if (t->active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)t->torque, (double)t->J, (double)t->J_rectangle, 100 * (double)(t->J / t->J_rectangle - 1), (double)t->max_stress, (double)t->max_at[0], (double)t->max_at[1]));

@@ -10,19 +10,20 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscFunctionBeginUser;
   PetscCall(PeriJSONString(j, "scene", p->scene->file));
   PetscCall(PeriSystemSummaryModel(sys, j));
-  PetscCall(PeriJSONString(j, "analysis", p->analysis));
+  PetscCall(PeriJSONString(j, "analysis", p->analysis_type));
   /* false only for a run stopped by a signal: then the fields below describe the last complete
      state (quasistatic), or there are none */
   PetscCall(PeriJSONBool(j, "complete", sys->interrupted ? PETSC_FALSE : PETSC_TRUE));
   if (sys->interrupted) PetscCall(PeriJSONString(j, "interrupted_by", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
   PetscCall(PeriSystemSummaryDiscretization(sys, j));
+  PetscCall(PeriLayersSummary(sys, j));
   PetscCall(PeriSystemSummaryCost(sys, j));
   PetscCall(PeriSystemSummarySolver(sys, j));
-  if (p->atype && p->atype->ops.summary) PetscCall(p->atype->ops.summary(p, j));
-  PetscCall(PeriSystemSummaryTorsion(sys, j));
+  if (p->analysis && p->analysis->type->ops.summary) PetscCall(p->analysis->type->ops.summary(p->analysis, j));
+  PetscCall(PeriTorsionSummary(sys, j));
   PetscCall(PeriSystemSummaryFields(sys, j));
-  PetscCall(PeriSystemSummaryReference(sys, j));
-  PetscCall(PeriSystemSummaryProbes(sys, j));
+  PetscCall(PeriReferenceSummary(sys, j));
+  PetscCall(PeriProbesSummary(sys, j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -12,3 +12,13 @@
 
 PetscErrorCode PeriTestRunScene(MPI_Comm, const char[], PeriProblem *);
 PetscErrorCode PeriTestSetOption(const char[], const char[]);
+
+/* The analysis' results (its data) when the problem ran an analysis of that type, else NULL. */
+static inline PeriModal *PeriTestModal(PeriProblem p)
+{
+  return p->analysis && !strcmp(p->analysis->type->name, "modal") ? (PeriModal *)p->analysis->data : NULL;
+}
+static inline PeriQuasistatic *PeriTestQuasistatic(PeriProblem p)
+{
+  return p->analysis && !strcmp(p->analysis->type->name, "quasistatic") ? (PeriQuasistatic *)p->analysis->data : NULL;
+}

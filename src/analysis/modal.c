@@ -2,30 +2,36 @@
  * shift-and-invert around a target with a direct factorization, on the free DOFs only (prescribed
  * DOFs are removed, so they give no spurious eigenvalues). M is lumped: rho V_i per translation,
  * rho V_i (dx^2 + dy^2)/12 per rotation (Diana & Casolo sec. 3.1, with r_i^2 for their r_i). */
-#include "perilin/private/problem.h"
+#include "perilin/private/analysis.h"
+
+/* the analysis' results (its data) */
+static inline PeriModal *Modal(PeriAnalysis an)
+{
+  return (PeriModal *)an->data;
+}
 #include <slepceps.h>
 
 /* The density of each owned particle: material.rho, or material.rho_by_region {region: rho}
  * (later regions win where they overlap). */
-static PetscErrorCode Densities(PeriProblem p, PetscReal **rho)
+static PetscErrorCode Densities(PeriAnalysis an, PetscReal **rho)
 {
-  PeriScene      s    = p->scene;
-  const PetscInt nloc = p->sys->bonds.rend - p->sys->bonds.rstart;
+  PeriScene      s    = an->sys->scene;
+  const PetscInt nloc = an->sys->bonds.rend - an->sys->bonds.rstart;
   PeriNode       mat, map;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(nloc, rho));
-  for (PetscInt i = 0; i < nloc; i++) (*rho)[i] = p->sys->model->material.rho;
+  for (PetscInt i = 0; i < nloc; i++) (*rho)[i] = an->sys->model->material.rho;
   PetscCall(PeriSceneGetNode(s->root, "material", &mat));
   PetscCall(PeriSceneGetMap(s, mat, "rho_by_region", PETSC_FALSE, &map));
   for (PetscInt k = 0; map && k < map->n; k++) {
     PeriRegion *r;
     PetscReal   v;
-    PetscCall(PeriRegionFind(s, map->child[k], NULL, p->sys->nregions, p->sys->regions, &r));
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, an->sys->nregions, an->sys->regions, &r));
     PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &v, NULL));
     PeriInputCheck(v > 0, s, map, map->child[k]->key, "must be positive");
     for (PetscInt i = 0; i < nloc; i++)
-      if (PeriRegionContains(r, &p->sys->particles.x[3 * (p->sys->bonds.rstart + i)])) (*rho)[i] = v;
+      if (PeriRegionContains(r, &an->sys->particles.x[3 * (an->sys->bonds.rstart + i)])) (*rho)[i] = v;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -33,27 +39,27 @@ static PetscErrorCode Densities(PeriProblem p, PetscReal **rho)
 /*@C
   PeriAssembleMass - the lumped mass matrix, diagonal, in the layout of K. Collective.
 @*/
-static PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
+static PetscErrorCode PeriAssembleMass(PeriAnalysis an, Mat *M)
 {
-  const PetscInt bs = p->sys->model->dofs, nloc = p->sys->bonds.rend - p->sys->bonds.rstart;
+  const PetscInt bs = an->sys->model->dofs, nloc = an->sys->bonds.rend - an->sys->bonds.rstart;
   PetscReal     *rho;
   Vec            d;
   PetscScalar   *a;
 
   PetscFunctionBeginUser;
-  PetscCall(MatCreate(p->comm, M));
+  PetscCall(MatCreate(an->comm, M));
   PetscCall(MatSetSizes(*M, nloc * bs, nloc * bs, PETSC_DETERMINE, PETSC_DETERMINE));
   PetscCall(MatSetBlockSize(*M, bs));
   PetscCall(MatSetType(*M, MATAIJ));
   PetscCall(MatXAIJSetPreallocation(*M, 1, NULL, NULL, NULL, NULL));
   PetscCall(MatSeqAIJSetPreallocation(*M, 1, NULL));
   PetscCall(MatMPIAIJSetPreallocation(*M, 1, NULL, 0, NULL));
-  PetscCall(PeriSystemCreateVec(p->sys, &d));
-  PetscCall(Densities(p, &rho));
+  PetscCall(PeriSystemCreateVec(an->sys, &d));
+  PetscCall(Densities(an, &rho));
   PetscCall(VecGetArray(d, &a));
   for (PetscInt i = 0; i < nloc; i++) {
-    PetscReal V = p->sys->particles.volume[p->sys->bonds.rstart + i], h = p->sys->particles.spacing[p->sys->bonds.rstart + i];
-    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = p->sys->model->rotational[c] ? rho[i] * V * (h * h + h * h) / 12 : rho[i] * V;
+    PetscReal V = an->sys->particles.volume[an->sys->bonds.rstart + i], h = an->sys->particles.spacing[an->sys->bonds.rstart + i];
+    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = an->sys->model->rotational[c] ? rho[i] * V * (h * h + h * h) / 12 : rho[i] * V;
   }
   PetscCall(VecRestoreArray(d, &a));
   PetscCall(PetscFree(rho));
@@ -66,19 +72,19 @@ static PetscErrorCode PeriAssembleMass(PeriProblem p, Mat *M)
 
 /* The structure's main axis: away from its constraints (a cantilever's length), or, for a free
  * body, its longest extent. Components held at 0 because they are inactive do not count. */
-static PetscErrorCode MainAxis(PeriProblem p, PetscInt *axis)
+static PetscErrorCode MainAxis(PeriAnalysis an, PetscInt *axis)
 {
-  const PeriParticles *pt   = &p->sys->particles;
+  const PeriParticles *pt   = &an->sys->particles;
   PetscReal            s[4] = {0, 0, 0, 0}, best = -1;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < p->sys->nconstrained; k++) {
-    PetscInt i = p->sys->constrained[k] / p->sys->model->dofs;
-    if (p->sys->model->inactive[p->sys->constrained[k] % p->sys->model->dofs]) continue;
+  for (PetscInt k = 0; k < an->sys->nconstrained; k++) {
+    PetscInt i = an->sys->constrained[k] / an->sys->model->dofs;
+    if (an->sys->model->inactive[an->sys->constrained[k] % an->sys->model->dofs]) continue;
     for (PetscInt d = 0; d < pt->dim; d++) s[d] += pt->x[3 * i + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
     s[3] += 1;
   }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, s, 4, MPIU_REAL, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, s, 4, MPIU_REAL, MPI_SUM, an->comm));
   *axis = 0;
   for (PetscInt d = 0; d < pt->dim; d++) {
     PetscReal v = s[3] > 0 ? PetscAbsReal(s[d] / s[3]) / (pt->upper[d] - pt->lower[d]) : pt->upper[d] - pt->lower[d];
@@ -90,9 +96,9 @@ static PetscErrorCode MainAxis(PeriProblem p, PetscInt *axis)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ReadSettings(PeriProblem p, PetscInt *nev, PetscReal *target_hz)
+static PetscErrorCode ReadSettings(PeriAnalysis an, PetscInt *nev, PetscReal *target_hz)
 {
-  PeriScene s = p->scene;
+  PeriScene s = an->sys->scene;
   PeriNode  a, mat;
 
   PetscFunctionBeginUser;
@@ -104,35 +110,35 @@ static PetscErrorCode ReadSettings(PeriProblem p, PetscInt *nev, PetscReal *targ
   PeriInputCheck(*nev >= 1, s, a, "nev", "must be at least 1");
   PeriInputCheck(*target_hz >= 0, s, a, "target_hz", "must not be negative");
   PetscCall(PeriSceneGetNode(s->root, "material", &mat));
-  PeriInputCheck(p->sys->model->material.rho > 0, s, mat, "rho", "a modal analysis needs the density (material.rho > 0)");
-  PeriInputCheck(!p->sys->layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
+  PeriInputCheck(an->sys->model->material.rho > 0, s, mat, "rho", "a modal analysis needs the density (material.rho > 0)");
+  PeriInputCheck(!an->sys->layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The owned DOFs that are not prescribed. */
-static PetscErrorCode FreeDOFs(PeriProblem p, IS *is)
+static PetscErrorCode FreeDOFs(PeriAnalysis an, IS *is)
 {
-  const PetscInt bs = p->sys->model->dofs, nloc = (p->sys->bonds.rend - p->sys->bonds.rstart) * bs, r0 = p->sys->bonds.rstart * bs;
+  const PetscInt bs = an->sys->model->dofs, nloc = (an->sys->bonds.rend - an->sys->bonds.rstart) * bs, r0 = an->sys->bonds.rstart * bs;
   PetscInt      *idx, n = 0, c = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(nloc, &idx));
-  /* p->sys->constrained is sorted: built by a loop over the owned DOFs */
+  /* an->sys->constrained is sorted: built by a loop over the owned DOFs */
   for (PetscInt k = 0; k < nloc; k++) {
-    if (c < p->sys->nconstrained && p->sys->constrained[c] == r0 + k) {
+    if (c < an->sys->nconstrained && an->sys->constrained[c] == r0 + k) {
       c++;
       continue;
     }
     idx[n++] = r0 + k;
   }
-  PetscCall(ISCreateGeneral(p->comm, n, idx, PETSC_OWN_POINTER, is));
+  PetscCall(ISCreateGeneral(an->comm, n, idx, PETSC_OWN_POINTER, is));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Shares of kinetic energy per component, effective modal masses per direction, and the kind. */
-static PetscErrorCode Classify(PeriProblem p, Vec x, Vec mdiag, PeriMode *mode, PetscInt axis)
+static PetscErrorCode Classify(PeriAnalysis an, Vec x, Vec mdiag, PeriMode *mode, PetscInt axis)
 {
-  const PetscInt     bs = p->sys->model->dofs, nloc = p->sys->bonds.rend - p->sys->bonds.rstart;
+  const PetscInt     bs = an->sys->model->dofs, nloc = an->sys->bonds.rend - an->sys->bonds.rstart;
   const PetscScalar *xa, *ma;
   PetscReal          e[PERI_MAX_DOF + 4] = {0}, tot = 0, trans = 0, rot = 0, along = 0;
   PetscInt           comp[3];
@@ -140,7 +146,7 @@ static PetscErrorCode Classify(PeriProblem p, Vec x, Vec mdiag, PeriMode *mode, 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) {
     static const char *const names[] = {"ux", "uy", "uz"};
-    PetscCall(PeriModelComponentIndex(p->sys->model, names[d], &comp[d]));
+    PetscCall(PeriModelComponentIndex(an->sys->model, names[d], &comp[d]));
   }
   PetscCall(VecGetArrayRead(x, &xa));
   PetscCall(VecGetArrayRead(mdiag, &ma));
@@ -153,55 +159,55 @@ static PetscErrorCode Classify(PeriProblem p, Vec x, Vec mdiag, PeriMode *mode, 
     }
   PetscCall(VecRestoreArrayRead(x, &xa));
   PetscCall(VecRestoreArrayRead(mdiag, &ma));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, e, PERI_MAX_DOF + 3, MPIU_REAL, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, e, PERI_MAX_DOF + 3, MPIU_REAL, MPI_SUM, an->comm));
   for (PetscInt c = 0; c < bs; c++) tot += e[c];
   for (PetscInt c = 0; c < bs; c++) {
     mode->energy_share[c] = e[c] / tot;
-    if (p->sys->model->rotational[c])
+    if (an->sys->model->rotational[c])
       rot += e[c] / tot;
     else
       trans += e[c] / tot;
     if (c == comp[axis]) along = e[c] / tot;
   }
   /* effective mass = (phi^T M r)^2 / (phi^T M phi), as a fraction of the total mass */
-  for (PetscInt d = 0; d < 3; d++) mode->effective_mass[d] = comp[d] >= 0 ? e[PERI_MAX_DOF + d] * e[PERI_MAX_DOF + d] / tot / p->modal->total_mass : 0;
+  for (PetscInt d = 0; d < 3; d++) mode->effective_mass[d] = comp[d] >= 0 ? e[PERI_MAX_DOF + d] * e[PERI_MAX_DOF + d] / tot / Modal(an)->total_mass : 0;
   /* A mode that moves the mass as a whole moves it along the axis (axial) or across it (flexural);
    * symmetric structures separate the two exactly. Modes with no net momentum are told apart by
    * where their kinetic energy is. */
   {
     PetscReal maxis = mode->effective_mass[axis], macross = 0;
-    for (PetscInt d = 0; d < p->sys->particles.dim; d++)
+    for (PetscInt d = 0; d < an->sys->particles.dim; d++)
       if (d != axis) macross = PetscMax(macross, mode->effective_mass[d]);
     if (rot > 0.5)
       PetscCall(PetscStrncpy(mode->kind, "rotational", sizeof(mode->kind)));
     else if (PetscMax(maxis, macross) > 1e-3 ? maxis > macross : along > 0.5 * trans)
-      PetscCall(PetscStrncpy(mode->kind, p->sys->particles.dim == 2 ? "axial" : "longitudinal", sizeof(mode->kind)));
+      PetscCall(PetscStrncpy(mode->kind, an->sys->particles.dim == 2 ? "axial" : "longitudinal", sizeof(mode->kind)));
     else
-      PetscCall(PetscStrncpy(mode->kind, p->sys->particles.dim == 2 ? "flexural" : "transverse", sizeof(mode->kind)));
+      PetscCall(PetscStrncpy(mode->kind, an->sys->particles.dim == 2 ? "flexural" : "transverse", sizeof(mode->kind)));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Gathers the full mode vector to rank 0, scaled to max |u| = 1. */
-static PetscErrorCode StoreShape(PeriProblem p, Vec full, PetscInt k)
+static PetscErrorCode StoreShape(PeriAnalysis an, Vec full, PetscInt k)
 {
   VecScatter         sc;
   Vec                all;
   const PetscScalar *a;
-  const PetscInt     nd = p->sys->particles.n * p->sys->model->dofs;
+  const PetscInt     nd = an->sys->particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   PetscCall(VecScatterCreateToZero(full, &sc, &all));
   PetscCall(VecScatterBegin(sc, full, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecScatterEnd(sc, full, all, INSERT_VALUES, SCATTER_FORWARD));
-  if (p->rank == 0) {
-    PetscReal amax = 0, *s = &p->modal->shapes[k * nd];
+  if (an->rank == 0) {
+    PetscReal amax = 0, *s = &Modal(an)->shapes[k * nd];
     PetscBool trans = PETSC_FALSE;
-    for (PetscInt c = 0; c < p->sys->model->dofs; c++) trans = (PetscBool)(trans || !p->sys->model->rotational[c]);
+    for (PetscInt c = 0; c < an->sys->model->dofs; c++) trans = (PetscBool)(trans || !an->sys->model->rotational[c]);
     PetscCall(VecGetArrayRead(all, &a));
     /* the largest displacement is 1 (rotations, in radians, do not set the scale) */
     for (PetscInt i = 0; i < nd; i++)
-      if (!trans || !p->sys->model->rotational[i % p->sys->model->dofs]) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
+      if (!trans || !an->sys->model->rotational[i % an->sys->model->dofs]) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
     for (PetscInt i = 0; i < nd; i++) s[i] = PetscRealPart(a[i]) / (amax > 0 ? amax : 1);
     PetscCall(VecRestoreArrayRead(all, &a));
   }
@@ -214,10 +220,10 @@ static PetscErrorCode StoreShape(PeriProblem p, Vec full, PetscInt k)
  * inexact one (an iterative KSP with a loose -st_ksp_rtol, or preonly with a mere preconditioner)
  * makes shift-and-invert converge to wrong modes, and SLEPc does not notice. */
 typedef struct {
-  PeriProblem p;
-  Vec         r;
-  PetscReal   worst; /* the largest ||b - A y|| / ||b|| so far */
-  PetscInt    nsolves;
+  PeriAnalysis an;
+  Vec          r;
+  PetscReal    worst; /* the largest ||b - A y|| / ||b|| so far */
+  PetscInt     nsolves;
 } InnerCheck;
 
 /* KSP post-solve hook. It fails at the first bad solve, on every rank at once (the norms are
@@ -239,7 +245,7 @@ static PetscErrorCode InnerSolveCheck(KSP ksp, Vec b, Vec y, void *ctx)
   c->nsolves++;
   if (rel > c->worst || PetscIsNanReal(rel)) c->worst = rel;
   PetscCall(KSPGetTolerances(ksp, &rtol, NULL, NULL, NULL));
-  tol = PeriResidualTolerance(c->p->sys, rtol);
+  tol = PeriResidualTolerance(c->an->sys, rtol);
   if (PetscUnlikely(!(rel <= tol))) {
     KSPType            kt;
     PCType             pt;
@@ -255,14 +261,14 @@ static PetscErrorCode InnerSolveCheck(KSP ksp, Vec b, Vec y, void *ctx)
             "%s: inner solve %" PetscInt_FMT " of the spectral transform, (K - sigma M) y = b, left the true relative residual ||b - (K - sigma M) y|| / ||b|| = %.3g, above the tolerance %.3g "
             "(KSP %s, PC %s: %s after %" PetscInt_FMT " iterations): the modes would be wrong. Use a direct factorization (-st_ksp_type preonly -st_pc_type cholesky, the default) "
             "or a tighter -st_ksp_rtol (now %g); solver.residual_tol raises the tolerance",
-            c->p->scene->file, c->nsolves, (double)rel, (double)tol, kt, pt, KSPConvergedReasons[reason], its, (double)rtol);
+            c->an->sys->scene->file, c->nsolves, (double)rel, (double)tol, kt, pt, KSPConvergedReasons[reason], its, (double)rtol);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Krylov-Schur, shift-and-invert at sigma with a direct factorization, the nreq pairs nearest
  * sigma; then every -eps_* and -st_* option; then the check of the inner solves. */
-static PetscErrorCode CreateEPS(PeriProblem p, Mat Kff, Mat Mff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
+static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
 {
   ST        st;
   KSP       ksp;
@@ -270,7 +276,7 @@ static PetscErrorCode CreateEPS(PeriProblem p, Mat Kff, Mat Mff, PetscReal sigma
   PetscBool precond;
 
   PetscFunctionBeginUser;
-  PetscCall(EPSCreate(p->comm, eps));
+  PetscCall(EPSCreate(an->comm, eps));
   PetscCall(EPSSetOperators(*eps, Kff, Mff));
   PetscCall(EPSSetProblemType(*eps, EPS_GHEP));
   PetscCall(EPSSetDimensions(*eps, nreq, PETSC_DEFAULT, PETSC_DEFAULT));
@@ -290,7 +296,7 @@ static PetscErrorCode CreateEPS(PeriProblem p, Mat Kff, Mat Mff, PetscReal sigma
   /* STPRECOND (Davidson methods) solves only approximately by design: there only the modes
    * themselves are checked */
   PetscCall(PetscObjectTypeCompare((PetscObject)st, STPRECOND, &precond));
-  inner->p       = p;
+  inner->an      = an;
   inner->r       = NULL;
   inner->worst   = 0;
   inner->nsolves = 0;
@@ -371,9 +377,9 @@ static PetscBool Covered(const Pair a[], PetscInt n, PetscInt nev, PetscReal tar
 
 /* EPSSolve, then the pairs to return; with a target, solved again asking for twice as many
  * pairs until the nev nearest the target in frequency are surely among the converged ones. */
-static PetscErrorCode SolveModes(PeriProblem p, EPS eps, PetscInt nev, PetscReal target_hz, PetscReal sigma, PetscInt nfree, PetscReal scale, PetscInt *n, Pair **pairs)
+static PetscErrorCode SolveModes(PeriAnalysis an, EPS eps, PetscInt nev, PetscReal target_hz, PetscReal sigma, PetscInt nfree, PetscReal scale, PetscInt *n, Pair **pairs)
 {
-  PeriModal *md = p->modal;
+  PeriModal *md = Modal(an);
   PetscInt   nreq, ncv;
   PetscReal  radius = 0;
 
@@ -410,10 +416,10 @@ static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal
 }
 
 /* Every returned mode must satisfy K x = omega^2 M x to PeriResidualTolerance(eps_tol). */
-static PetscErrorCode CheckModes(PeriProblem p, PetscReal eps_tol)
+static PetscErrorCode CheckModes(PeriAnalysis an, PetscReal eps_tol)
 {
-  const PeriModal *md   = p->modal;
-  const PetscReal  tol  = PeriResidualTolerance(p->sys, eps_tol);
+  const PeriModal *md   = Modal(an);
+  const PetscReal  tol  = PeriResidualTolerance(an->sys, eps_tol);
   PetscInt         nbad = 0, first = -1;
 
   PetscFunctionBeginUser;
@@ -422,69 +428,69 @@ static PetscErrorCode CheckModes(PeriProblem p, PetscReal eps_tol)
       nbad++;
       if (first < 0) first = k;
     }
-  PetscCheck(!nbad, p->comm, PETSC_ERR_NOT_CONVERGED,
+  PetscCheck(!nbad, an->comm, PETSC_ERR_NOT_CONVERGED,
              "%s: mode %" PetscInt_FMT " (%.6g Hz) has the relative residual ||K x - omega^2 M x|| / (omega^2 ||M x||) = %.3g, above the tolerance %.3g (%" PetscInt_FMT " of the %" PetscInt_FMT
              " modes fail): its frequency and shape cannot be trusted. Try a tighter -eps_tol (now %g), a larger -eps_ncv, a direct inner solve (-st_ksp_type preonly -st_pc_type cholesky), "
              "or accept it with a larger solver.residual_tol",
-             p->scene->file, first + 1, (double)md->modes[first].f_hz, (double)md->modes[first].residual, (double)tol, nbad, md->nmodes, (double)eps_tol);
+             an->sys->scene->file, first + 1, (double)md->modes[first].f_hz, (double)md->modes[first].residual, (double)tol, nbad, md->nmodes, (double)eps_tol);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The mass, the free DOFs and the blocks of K and M on them. */
-static PetscErrorCode SetUpModal(PeriProblem p, PetscReal target_hz, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff)
+static PetscErrorCode SetUpModal(PeriAnalysis an, PetscReal target_hz, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff)
 {
   PeriModal *md;
   PetscReal *rho;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriAssembleMass(p, M));
+  PetscCall(PeriAssembleMass(an, M));
   PetscCall(MatCreateVecs(*M, mdiag, NULL));
   PetscCall(MatGetDiagonal(*M, *mdiag));
   PetscCall(PetscNew(&md));
-  p->modal = md;
+  an->data = md;
   /* rotations carry inertia, not mass: the total mass is that of the particles */
-  PetscCall(Densities(p, &rho));
-  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++) md->total_mass += rho[i - p->sys->bonds.rstart] * p->sys->particles.volume[i];
+  PetscCall(Densities(an, &rho));
+  for (PetscInt i = an->sys->bonds.rstart; i < an->sys->bonds.rend; i++) md->total_mass += rho[i - an->sys->bonds.rstart] * an->sys->particles.volume[i];
   PetscCall(PetscFree(rho));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, an->comm));
   md->target_hz = target_hz;
-  PetscCall(MainAxis(p, &md->axis));
-  PetscCall(FreeDOFs(p, isfree));
+  PetscCall(MainAxis(an, &md->axis));
+  PetscCall(FreeDOFs(an, isfree));
   PetscCall(ISGetSize(*isfree, &md->nfree_dofs));
-  PetscCheck(md->nfree_dofs > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", p->scene->file);
-  PetscCall(MatCreateSubMatrix(p->sys->K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
+  PetscCheck(md->nfree_dofs > 0, an->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", an->sys->scene->file);
+  PetscCall(MatCreateSubMatrix(an->sys->K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
   PetscCall(MatCreateSubMatrix(*M, *isfree, *isfree, MAT_INITIAL_MATRIX, Mff));
   PetscCall(MatSetOption(*Kff, MAT_SYMMETRIC, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Each chosen pair becomes a mode: frequency, residual, kind, shape. */
-static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS isfree, Vec mdiag, PetscInt nev, PetscInt npairs, const Pair pairs[], PetscReal lam_floor)
+static PetscErrorCode CollectModes(PeriAnalysis an, EPS eps, Mat Kff, Mat Mff, IS isfree, Vec mdiag, PetscInt nev, PetscInt npairs, const Pair pairs[], PetscReal lam_floor)
 {
-  PeriModal *md = p->modal;
+  PeriModal *md = Modal(an);
   Vec        x, r, y, full;
-  PetscInt   nd = p->sys->particles.n * p->sys->model->dofs;
+  PetscInt   nd = an->sys->particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(Kff, &x, &r));
   PetscCall(VecDuplicate(r, &y));
-  PetscCall(PeriSystemCreateVec(p->sys, &full));
+  PetscCall(PeriSystemCreateVec(an->sys, &full));
   /* no more modes than free DOFs, whatever nev asks for */
   PetscCall(PetscCalloc1(PetscMin(nev, md->nfree_dofs), &md->modes));
   md->nshapes = PetscMin(PetscMin(nev, md->nfree_dofs), PERI_MAX_VTU_MODES);
-  if (p->rank == 0) PetscCall(PetscCalloc1(md->nshapes * nd, &md->shapes));
+  if (an->rank == 0) PetscCall(PetscCalloc1(md->nshapes * nd, &md->shapes));
   for (PetscInt s = 0; s < npairs && md->nmodes < nev; s++) {
     PeriMode *mode = &md->modes[md->nmodes];
     PetscReal l    = pairs[s].lam;
-    PetscCheck(l > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: a negative eigenvalue omega^2 = %g: the stiffness is indefinite (Poisson ratio above the bond-based value?)", p->scene->file, (double)l);
+    PetscCheck(l > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: a negative eigenvalue omega^2 = %g: the stiffness is indefinite (Poisson ratio above the bond-based value?)", an->sys->scene->file, (double)l);
     PetscCall(EPSGetEigenvector(eps, pairs[s].k, x, NULL));
     PetscCall(ModeResidual(Kff, Mff, x, l, lam_floor, r, y, &mode->residual));
     mode->omega2 = l;
     mode->f_hz   = Frequency(l);
     PetscCall(VecSet(full, 0));
     PetscCall(VecISCopy(full, isfree, SCATTER_FORWARD, x));
-    PetscCall(Classify(p, full, mdiag, mode, md->axis));
-    if (md->nmodes < md->nshapes) PetscCall(StoreShape(p, full, md->nmodes));
+    PetscCall(Classify(an, full, mdiag, mode, md->axis));
+    if (md->nmodes < md->nshapes) PetscCall(StoreShape(an, full, md->nmodes));
     md->nmodes++;
   }
   md->nshapes = PetscMin(md->nmodes, md->nshapes); /* only converged modes go to particles.vtu */
@@ -497,7 +503,7 @@ static PetscErrorCode CollectModes(PeriProblem p, EPS eps, Mat Kff, Mat Mff, IS 
 
 /* What summary.json reports of the solver: the inner KSP, and its worst true residual. Partial:
  * fewer pairs converged than asked for, or fewer modes than nev where the body has more. */
-static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, PetscInt nev, const InnerCheck *inner)
+static PetscErrorCode RecordSolver(PeriAnalysis an, EPS eps, PetscInt nev, const InnerCheck *inner)
 {
   ST        st;
   KSP       ksp;
@@ -513,14 +519,14 @@ static PetscErrorCode RecordSolver(PeriProblem p, EPS eps, PetscInt nev, const I
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pt));
-  PetscCall(PetscStrncpy(p->sys->results.ksp_type, kt, sizeof(p->sys->results.ksp_type)));
-  PetscCall(PetscStrncpy(p->sys->results.pc_type, pt, sizeof(p->sys->results.pc_type)));
+  PetscCall(PetscStrncpy(an->sys->results.ksp_type, kt, sizeof(an->sys->results.ksp_type)));
+  PetscCall(PetscStrncpy(an->sys->results.pc_type, pt, sizeof(an->sys->results.pc_type)));
   PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &nconv));
-  partial = (PetscBool)(nconv < asked || p->modal->nmodes < PetscMin(nev, p->modal->nfree_dofs - p->modal->nrigid));
-  PetscCall(PetscStrncpy(p->sys->results.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(p->sys->results.converged_reason)));
-  PetscCall(EPSGetIterationNumber(eps, &p->sys->results.iterations));
-  p->sys->results.residual_norm = inner->worst;
+  partial = (PetscBool)(nconv < asked || Modal(an)->nmodes < PetscMin(nev, Modal(an)->nfree_dofs - Modal(an)->nrigid));
+  PetscCall(PetscStrncpy(an->sys->results.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(an->sys->results.converged_reason)));
+  PetscCall(EPSGetIterationNumber(eps, &an->sys->results.iterations));
+  an->sys->results.residual_norm = inner->worst;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -548,7 +554,7 @@ static PetscErrorCode ModalWorkDestroy(ModalWork *w)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_hz, ModalWork *w)
+static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target_hz, ModalWork *w)
 {
   PeriModal     *md;
   PetscInt       nfree, npairs = 0;
@@ -558,9 +564,9 @@ static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_h
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
-  PetscCall(SetUpModal(p, target_hz, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff));
-  md = p->modal;
-  PetscCall(PeriRigidMotionFree(p->sys, &nfree, what, sizeof(what), NULL));
+  PetscCall(SetUpModal(an, target_hz, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff));
+  md = Modal(an);
+  PetscCall(PeriRigidMotionFree(an->sys, &nfree, what, sizeof(what), NULL));
   md->nrigid = 0;
 
   /* the scale of the largest omega^2 */
@@ -571,30 +577,30 @@ static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_h
   /* a free body makes K singular: shift just below its zero eigenvalues */
   if (nfree && target_hz == 0) sigma = -1e-8 * scale;
 
-  PetscCall(CreateEPS(p, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
+  PetscCall(CreateEPS(an, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
   PetscCall(EPSSetUp(w->eps));
   PetscCall(PetscTime(&t1));
-  PetscCall(SolveModes(p, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
+  PetscCall(SolveModes(an, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
   PetscCall(PetscTime(&t2));
-  md->factor_s            = t1 - t0;
-  md->solve_s             = t2 - t1;
-  p->sys->results.solve_s = t2 - t0;
-  PetscCheck(npairs + md->nrigid > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", p->scene->file);
-  PetscCall(CollectModes(p, w->eps, w->Kff, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
+  md->factor_s             = t1 - t0;
+  md->solve_s              = t2 - t1;
+  an->sys->results.solve_s = t2 - t0;
+  PetscCheck(npairs + md->nrigid > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", an->sys->scene->file);
+  PetscCall(CollectModes(an, w->eps, w->Kff, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
   PetscCall(EPSGetTolerances(w->eps, &eps_tol, NULL));
-  PetscCall(CheckModes(p, eps_tol));
+  PetscCall(CheckModes(an, eps_tol));
   /* a free bar's lowest longitudinal mode is half a wave over its length */
   if (nfree)
     for (PetscInt k = 0; k < md->nmodes; k++)
       if (!strcmp(md->modes[k].kind, "longitudinal") || !strcmp(md->modes[k].kind, "axial")) {
-        PetscReal L            = p->sys->particles.upper[md->axis] - p->sys->particles.lower[md->axis];
+        PetscReal L            = an->sys->particles.upper[md->axis] - an->sys->particles.lower[md->axis];
         md->longitudinal_speed = 2 * L * md->modes[k].f_hz;
-        if (p->sys->particles.dim == 3) md->theory_speed = PetscSqrtReal((p->sys->model->material.K + 4 * p->sys->model->material.G / 3) / p->sys->model->material.rho);
+        if (an->sys->particles.dim == 3) md->theory_speed = PetscSqrtReal((an->sys->model->material.K + 4 * an->sys->model->material.G / 3) / an->sys->model->material.rho);
         break;
       }
-  PetscCall(RecordSolver(p, w->eps, nev, &w->inner));
-  PetscCheck(md->nmodes > 0, p->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", p->scene->file, md->nrigid);
-  if (md->nmodes < nev) PetscCall(PetscPrintf(p->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
+  PetscCall(RecordSolver(an, w->eps, nev, &w->inner));
+  PetscCheck(md->nmodes > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", an->sys->scene->file, md->nrigid);
+  if (md->nmodes < nev) PetscCall(PetscPrintf(an->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -608,7 +614,7 @@ static PetscErrorCode ModalSolve(PeriProblem p, PetscInt nev, PetscReal target_h
   the run fails with PETSC_ERR_NOT_CONVERGED. Options: every -eps_* and -st_* option (e.g.
   -st_pc_factor_mat_solver_type, -eps_tol). SLEPc must be initialized. Collective.
 @*/
-static PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
+static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
 {
   PetscInt       nev;
   PetscReal      target_hz;
@@ -616,13 +622,13 @@ static PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
   PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadSettings(p, &nev, &target_hz));
-  PetscCall(PetscStrncpy(p->sys->mat_type, MATAIJ, sizeof(p->sys->mat_type)));
-  if (!p->sys->K) PetscCall(PeriSystemAssemble(p->sys));
+  PetscCall(ReadSettings(an, &nev, &target_hz));
+  PetscCall(PetscStrncpy(an->sys->mat_type, MATAIJ, sizeof(an->sys->mat_type)));
+  if (!an->sys->K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   /* a failed check may return from deep inside SLEPc: free everything, then pass the error on */
-  ierr = ModalSolve(p, nev, target_hz, &w);
+  ierr = ModalSolve(an, nev, target_hz, &w);
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(ModalWorkDestroy(&w));
   PetscCall(ierr);
@@ -633,22 +639,22 @@ static PetscErrorCode PeriAnalysisRun_Modal(PeriProblem p)
   PeriWriteModesCSV - one row per mode: frequency, residual, kind, energy shares, effective
   masses. Rank 0 writes (temporary name, then rename). Collective.
 @*/
-PetscErrorCode PeriWriteModesCSV(PeriProblem p, const char path[])
+static PetscErrorCode PeriWriteModesCSV(PeriAnalysis an, const char path[])
 {
   char  tmp[PETSC_MAX_PATH_LEN];
   FILE *fp;
   int   bad = 0;
 
   PetscFunctionBeginUser;
-  if (p->rank || !p->modal) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->rank || !Modal(an)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "mode,f_hz,omega2,residual,kind") < 0;
-  for (PetscInt c = 0; c < p->sys->model->dofs; c++) bad |= fprintf(fp, ",share_%s", p->sys->model->components[c]) < 0;
+  for (PetscInt c = 0; c < an->sys->model->dofs; c++) bad |= fprintf(fp, ",share_%s", an->sys->model->components[c]) < 0;
   bad |= fprintf(fp, ",meff_x,meff_y,meff_z\n") < 0;
-  for (PetscInt k = 0; k < p->modal->nmodes; k++) {
-    const PeriMode *m = &p->modal->modes[k];
+  for (PetscInt k = 0; k < Modal(an)->nmodes; k++) {
+    const PeriMode *m = &Modal(an)->modes[k];
     bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%.3g,%s", k + 1, (double)m->f_hz, (double)m->omega2, (double)m->residual, m->kind) < 0;
-    for (PetscInt c = 0; c < p->sys->model->dofs; c++) bad |= fprintf(fp, ",%.6f", (double)m->energy_share[c]) < 0;
+    for (PetscInt c = 0; c < an->sys->model->dofs; c++) bad |= fprintf(fp, ",%.6f", (double)m->energy_share[c]) < 0;
     bad |= fprintf(fp, ",%.6f,%.6f,%.6f\n", (double)m->effective_mass[0], (double)m->effective_mass[1], (double)m->effective_mass[2]) < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
@@ -656,16 +662,16 @@ PetscErrorCode PeriWriteModesCSV(PeriProblem p, const char path[])
 }
 
 /* The stored mode shapes as fields of particles.vtu: mode_1, mode_1_theta, ... */
-static PetscErrorCode ModalAddFields(PeriProblem p, PeriFieldList fl)
+static PetscErrorCode ModalAddFields(PeriAnalysis an, PeriFieldList fl)
 {
-  const PeriModal *md = p->modal;
-  const PetscInt   nd = p->sys->particles.n * p->sys->model->dofs;
+  const PeriModal *md = Modal(an);
+  const PetscInt   nd = an->sys->particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; md && k < md->nshapes; k++) {
     char prefix[32];
     PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "mode_%" PetscInt_FMT, k + 1));
-    PetscCall(PeriFieldListAddSolution(fl, prefix, p->sys->model->dofs, p->sys->model->components, &md->shapes[k * nd]));
+    PetscCall(PeriFieldListAddSolution(fl, prefix, an->sys->model->dofs, an->sys->model->components, &md->shapes[k * nd]));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -675,15 +681,15 @@ static PetscErrorCode ModalAddFields(PeriProblem p, PeriFieldList fl)
   "displacement", and modes.pvd listing them by mode number (ParaView steps through the modes
   like time steps). Collective; rank 0 writes.
 @*/
-static PetscErrorCode WriteModeShapes(PeriProblem p, const char dir[])
+static PetscErrorCode WriteModeShapes(PeriAnalysis an, const char dir[])
 {
-  PeriModal     *md = p->modal;
+  PeriModal     *md = Modal(an);
   PetscReal     *times;
   char         **files, path[PETSC_MAX_PATH_LEN];
-  const PetscInt nd = p->sys->particles.n * p->sys->model->dofs;
+  const PetscInt nd = an->sys->particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
-  if (p->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc2(md->nshapes, &times, md->nshapes, &files));
   /* each file is particles.vtu's layout with the mode as the displacement field */
   for (PetscInt k = 0; k < md->nshapes; k++) {
@@ -691,7 +697,7 @@ static PetscErrorCode WriteModeShapes(PeriProblem p, const char dir[])
     PetscCall(PetscMalloc1(32, &files[k]));
     PetscCall(PetscSNPrintf(files[k], 32, "mode_%02" PetscInt_FMT ".vtu", k + 1));
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", dir, files[k]));
-    PetscCall(PeriSystemWriteVTU(p->sys, &md->shapes[k * nd], path));
+    PetscCall(PeriSystemWriteVTU(an->sys, &md->shapes[k * nd], path));
   }
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
   PetscCall(PeriWritePVD(path, md->nshapes, times, (const char *const *)files));
@@ -702,13 +708,13 @@ static PetscErrorCode WriteModeShapes(PeriProblem p, const char dir[])
 
 /* summary.json's "modal" object: frequencies, masses, and per mode its residual, kind, energy
  * shares and effective masses. */
-static PetscErrorCode ModalSummary(PeriProblem p, PeriJSON j)
+static PetscErrorCode ModalSummary(PeriAnalysis an, PeriJSON j)
 {
-  const PetscInt bs = p->sys->model->dofs;
+  const PetscInt bs = an->sys->model->dofs;
 
   PetscFunctionBeginUser;
-  if (!p->modal) PetscFunctionReturn(PETSC_SUCCESS);
-  const PeriModal *md = p->modal;
+  if (!Modal(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  const PeriModal *md = Modal(an);
   PetscReal        f[256];
   PetscCall(PeriJSONBeginObject(j, "modal"));
   for (PetscInt k = 0; k < PetscMin(md->nmodes, 256); k++) f[k] = md->modes[k].f_hz;
@@ -729,9 +735,9 @@ static PetscErrorCode ModalSummary(PeriProblem p, PeriJSON j)
     PetscCall(PeriJSONReal(j, "residual", m->residual));
     PetscCall(PeriJSONString(j, "kind", m->kind));
     PetscCall(PeriJSONBeginObject(j, "energy_share"));
-    for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, p->sys->model->components[c], m->energy_share[c]));
+    for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, an->sys->model->components[c], m->energy_share[c]));
     PetscCall(PeriJSONEndObject(j));
-    PetscCall(PeriJSONRealArray(j, "effective_mass", p->sys->particles.dim, m->effective_mass));
+    PetscCall(PeriJSONRealArray(j, "effective_mass", an->sys->particles.dim, m->effective_mass));
     PetscCall(PeriJSONEndObject(j));
   }
   PetscCall(PeriJSONEndArray(j));
@@ -739,35 +745,33 @@ static PetscErrorCode ModalSummary(PeriProblem p, PeriJSON j)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ModalReport(PeriProblem p)
+static PetscErrorCode ModalReport(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(p->comm, "perilin: %" PetscInt_FMT " modes (Hz):", p->modal->nmodes));
-  for (PetscInt k = 0; k < p->modal->nmodes; k++) PetscCall(PetscPrintf(p->comm, " %.6g (%s)", (double)p->modal->modes[k].f_hz, p->modal->modes[k].kind));
-  PetscCall(PetscPrintf(p->comm, "; results in %s/\n", p->output_dir));
+  PetscCall(PetscPrintf(an->comm, "perilin: %" PetscInt_FMT " modes (Hz):", Modal(an)->nmodes));
+  for (PetscInt k = 0; k < Modal(an)->nmodes; k++) PetscCall(PetscPrintf(an->comm, " %.6g (%s)", (double)Modal(an)->modes[k].f_hz, Modal(an)->modes[k].kind));
+  PetscCall(PetscPrintf(an->comm, "; results in %s/\n", an->output_dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* modes.csv, and with output.vtk the shapes mode_NN.vtu and modes.pvd. */
-static PetscErrorCode ModalFiles(PeriProblem p, const char dir[])
+static PetscErrorCode ModalFiles(PeriAnalysis an, const char dir[])
 {
   char path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  if (!p->modal) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!Modal(an)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", dir));
-  PetscCall(PeriWriteModesCSV(p, path));
-  if (p->vtk) PetscCall(WriteModeShapes(p, dir));
+  PetscCall(PeriWriteModesCSV(an, path));
+  if (an->vtk) PetscCall(WriteModeShapes(an, dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ModalDestroy(PeriProblem p)
+static PetscErrorCode ModalDestroy(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  if (!p->modal) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscFree(p->modal->modes));
-  PetscCall(PetscFree(p->modal->shapes));
-  PetscCall(PetscFree(p->modal));
+  PetscCall(PetscFree(Modal(an)->modes));
+  PetscCall(PetscFree(Modal(an)->shapes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -5,7 +5,13 @@
  * from the constraints are held where they are; when a loaded piece is cut off, the solve fails,
  * or no equilibrium is found, the body has failed: with adaptive steps the step is halved from the
  * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
-#include "perilin/private/problem.h"
+#include "perilin/private/analysis.h"
+
+/* the analysis' results (its data) */
+static inline PeriQuasistatic *QS(PeriAnalysis an)
+{
+  return (PeriQuasistatic *)an->data;
+}
 #include <signal.h>
 #include <unistd.h>
 
@@ -21,24 +27,24 @@ typedef struct {
 
 /* The load factor scales the loads, the prescribed values, the layers' values and the twist:
  * with all of them zero every step is the unloaded body, and the loop would run to the end. */
-static PetscErrorCode CheckSomethingLoaded(PeriProblem p, PeriNode a)
+static PetscErrorCode CheckSomethingLoaded(PeriAnalysis an, PeriNode a)
 {
   PetscReal fnorm, v = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecNorm(p->sys->f, NORM_INFINITY, &fnorm));
-  for (PetscInt k = 0; k < p->sys->nconstrained; k++) v = PetscMax(v, PetscAbsReal(p->sys->constrained_value[k]));
-  for (PetscInt f = 0; f < 6; f++) v = PetscMax(v, p->sys->layers.kind[f] ? PetscAbsReal(p->sys->layers.value[f]) : 0);
-  if (p->sys->torsion.active) v = PetscMax(v, PetscAbsReal(p->sys->torsion.twist));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_REAL, MPI_MAX, p->comm));
-  PeriInputCheck(fnorm > 0 || v > 0, p->scene, a, "type", "a quasistatic analysis scales the loads and prescribed values, and this scene has none (no loads, every bc value 0): give loads or a bc value");
+  PetscCall(VecNorm(an->sys->f, NORM_INFINITY, &fnorm));
+  for (PetscInt k = 0; k < an->sys->nconstrained; k++) v = PetscMax(v, PetscAbsReal(an->sys->constrained_value[k]));
+  for (PetscInt f = 0; f < 6; f++) v = PetscMax(v, an->sys->layers.kind[f] ? PetscAbsReal(an->sys->layers.value[f]) : 0);
+  if (an->sys->torsion.active) v = PetscMax(v, PetscAbsReal(an->sys->torsion.twist));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_REAL, MPI_MAX, an->comm));
+  PeriInputCheck(fnorm > 0 || v > 0, an->sys->scene, a, "type", "a quasistatic analysis scales the loads and prescribed values, and this scene has none (no loads, every bc value 0): give loads or a bc value");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
+static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
 {
   static const char *const policies[] = {"all", "fraction", NULL};
-  PeriScene                s          = p->scene;
+  PeriScene                s          = an->sys->scene;
   PeriNode                 a;
   PetscInt                 policy              = 0;
   char                     name[PERI_NAME_LEN] = "";
@@ -46,7 +52,7 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
-  PeriInputCheck(p->sys->failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
+  PeriInputCheck(an->sys->failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
   PetscCall(PeriSceneGetReal(s, a, "load_factor_max", PETSC_TRUE, &st->max, NULL));
   PetscCall(PeriSceneGetReal(s, a, "load_factor_step", PETSC_TRUE, &st->step, NULL));
   PeriInputCheck(st->max > 0, s, a, "load_factor_max", "must be positive, got %g", (double)st->max);
@@ -73,15 +79,15 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
   PeriInputCheck(st->max_iterations >= 1, s, a, "max_iterations", "must be at least 1");
   st->reuse = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));
-  st->control = p->sys->nprobes ? &p->sys->probes[0] : NULL;
+  st->control = an->sys->nprobes ? &an->sys->probes[0] : NULL;
   PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, name, sizeof(name), &has));
   if (has) {
     st->control = NULL;
-    for (PetscInt k = 0; k < p->sys->nprobes; k++)
-      if (!strcmp(p->sys->probes[k].name, name)) st->control = &p->sys->probes[k];
+    for (PetscInt k = 0; k < an->sys->nprobes; k++)
+      if (!strcmp(an->sys->probes[k].name, name)) st->control = &an->sys->probes[k];
     PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", name);
   }
-  PetscCall(CheckSomethingLoaded(p, a));
+  PetscCall(CheckSomethingLoaded(an, a));
   st->quiet = PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-quiet", &st->quiet, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -91,10 +97,10 @@ static PetscErrorCode ReadSettings(PeriProblem p, Settings *st)
  * those within the top fraction of the worst index), subtracting their blocks from K; softening
  * bonds lose stiffness by eqs. 45-46 (irreversibly). Returns the global number of bonds broken or
  * softened by more than 1 %. */
-static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nbroken)
+static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *nbroken)
 {
-  PeriBonds         *b  = &p->sys->bonds;
-  PeriModel          m  = p->sys->model;
+  PeriBonds         *b  = &an->sys->bonds;
+  PeriModel          m  = an->sys->model;
   const PetscInt     bs = m->dofs, nb = 2 * bs;
   VecScatter         scatter;
   Vec                all;
@@ -104,9 +110,9 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
   PetscInt           mine = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecScatterCreateToAll(p->sys->u, &scatter, &all));
-  PetscCall(VecScatterBegin(scatter, p->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(scatter, p->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterCreateToAll(an->sys->u, &scatter, &all));
+  PetscCall(VecScatterBegin(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(all, &u));
   PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
   for (PetscInt i = b->rstart; i < b->rend; i++)
@@ -115,20 +121,20 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       PetscReal        ui[PERI_MAX_DOF], uj[PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
       index[k] = 0;
       if (!b->live[k] || b->j[k] == i) continue;
-      PetscCall(PeriSystemBondGeometry(p->sys, i, k, &g));
+      PetscCall(PeriSystemBondGeometry(an->sys, i, k, &g));
       for (PetscInt c = 0; c < bs; c++) {
         ui[c] = PetscRealPart(u[i * bs + c]);
         uj[c] = PetscRealPart(u[g.j * bs + c]);
       }
       m->ops.bond_measures(m, &g, ui, uj, meas);
-      index[k] = PeriBondFailureIndex(p->sys, &g, meas, &cause[k]);
-      soft[k]  = b->intact ? PeriBondSoftening(p->sys, meas) : 1;
+      index[k] = PeriBondFailureIndex(an->sys, &g, meas, &cause[k]);
+      soft[k]  = b->intact ? PeriBondSoftening(an->sys, meas) : 1;
       worst    = PetscMax(worst, index[k]);
     }
   PetscCall(VecRestoreArrayRead(all, &u));
   PetscCall(VecDestroy(&all));
   PetscCall(VecScatterDestroy(&scatter));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, an->comm));
   /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
   if (!st->all && worst > 1) threshold = worst - st->fraction * (worst - 1);
   for (PetscInt i = b->rstart; i < b->rend; i++)
@@ -142,13 +148,13 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       /* K changes by (new share / old share - 1) times the bond's present block (state-based
          models: K is reassembled from the synchronized families below) */
       if (m->ops.bond_stiffness) {
-        PetscCall(PeriSystemBondGeometry(p->sys, i, k, &g));
+        PetscCall(PeriSystemBondGeometry(an->sys, i, k, &g));
         m->ops.bond_stiffness(m, &g, Ke);
         scale = breaks ? -1 : soft[k] / b->intact[k] - 1;
         for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
         idx[0] = i;
         idx[1] = g.j;
-        PetscCall(MatSetValuesBlocked(p->sys->K, 2, idx, 2, idx, Ke, ADD_VALUES));
+        PetscCall(MatSetValuesBlocked(an->sys->K, 2, idx, 2, idx, Ke, ADD_VALUES));
       }
       if (breaks || soft[k] <= 0) {
         b->live[k]  = 0;
@@ -162,12 +168,12 @@ static PetscErrorCode BreakBonds(PeriProblem p, const Settings *st, PetscInt *nb
       }
     }
   PetscCall(PetscFree3(index, soft, cause));
-  PetscCall(MatAssemblyBegin(p->sys->K, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(p->sys->K, MAT_FINAL_ASSEMBLY));
-  PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, p->comm));
+  PetscCall(MatAssemblyBegin(an->sys->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(an->sys->K, MAT_FINAL_ASSEMBLY));
+  PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, an->comm));
   if (*nbroken && !m->ops.bond_stiffness) {
-    PetscCall(PeriFamilySync(p->sys));
-    PetscCall(PeriSystemAssemble(p->sys));
+    PetscCall(PeriFamilySync(an->sys));
+    PetscCall(PeriSystemAssemble(an->sys));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -188,24 +194,24 @@ static PetscErrorCode RecordStep(PeriQuasistatic *q, const PeriStep *s)
 }
 
 /* The control probe's first component at the current solution (collective). */
-static PetscErrorCode ControlValue(PeriProblem p, PeriProbe *probe, PetscReal *v)
+static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscReal *v)
 {
   PetscInt row;
 
   PetscFunctionBeginUser;
   *v = 0;
   if (!probe) PetscFunctionReturn(PETSC_SUCCESS);
-  row = probe->particle * p->sys->model->dofs;
-  if (p->sys->owner[probe->particle] == p->rank) {
+  row = probe->particle * an->sys->model->dofs;
+  if (an->sys->owner[probe->particle] == an->rank) {
     PetscScalar x;
-    PetscCall(VecGetValues(p->sys->u, 1, &row, &x));
+    PetscCall(VecGetValues(an->sys->u, 1, &row, &x));
     *v = PetscRealPart(x);
   }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, v, 1, MPIU_REAL, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, v, 1, MPIU_REAL, MPI_SUM, an->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode Progress(PeriProblem p, const Settings *st, const PeriStep *s)
+static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriStep *s)
 {
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
@@ -214,9 +220,9 @@ static PetscErrorCode Progress(PeriProblem p, const Settings *st, const PeriStep
     PetscInt fill = (PetscInt)(40 * s->lambda / st->max);
     for (PetscInt k = 0; k < 40; k++) bar[k] = k < fill ? '#' : '.';
     bar[40] = 0;
-    PetscCall(PetscPrintf(p->comm, "\r[%s] ", bar));
+    PetscCall(PetscPrintf(an->comm, "\r[%s] ", bar));
   }
-  PetscCall(PetscPrintf(p->comm, "step %4" PetscInt_FMT "  lambda %-12.6g u %-12.5g broken %6" PetscInt_FMT " (total %8" PetscInt_FMT ")  equilibrium its %3" PetscInt_FMT "  ksp its %5" PetscInt_FMT "  %.2f s\n", p->quasistatic->nsteps, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds));
+  PetscCall(PetscPrintf(an->comm, "step %4" PetscInt_FMT "  lambda %-12.6g u %-12.5g broken %6" PetscInt_FMT " (total %8" PetscInt_FMT ")  equilibrium its %3" PetscInt_FMT "  ksp its %5" PetscInt_FMT "  %.2f s\n", QS(an)->nsteps, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -229,46 +235,46 @@ typedef struct {
   PeriResults    solve; /* the solver fields of the solve that reached it */
 } Equilibrium;
 
-static PetscErrorCode EquilibriumCreate(PeriProblem p, Equilibrium *e)
+static PetscErrorCode EquilibriumCreate(PeriAnalysis an, Equilibrium *e)
 {
   PetscFunctionBeginUser;
-  PetscCall(MatCreateVecs(p->sys->K, &e->u, NULL)); /* lambda = 0: no displacement */
-  PetscCall(PetscMalloc1(p->sys->bonds.nbonds, &e->live));
-  PetscCall(PetscArraycpy(e->live, p->sys->bonds.live, p->sys->bonds.nbonds));
+  PetscCall(MatCreateVecs(an->sys->K, &e->u, NULL)); /* lambda = 0: no displacement */
+  PetscCall(PetscMalloc1(an->sys->bonds.nbonds, &e->live));
+  PetscCall(PetscArraycpy(e->live, an->sys->bonds.live, an->sys->bonds.nbonds));
   e->intact = NULL;
-  if (p->sys->bonds.intact) {
-    PetscCall(PetscMalloc1(p->sys->bonds.nbonds, &e->intact));
-    PetscCall(PetscArraycpy(e->intact, p->sys->bonds.intact, p->sys->bonds.nbonds));
+  if (an->sys->bonds.intact) {
+    PetscCall(PetscMalloc1(an->sys->bonds.nbonds, &e->intact));
+    PetscCall(PetscArraycpy(e->intact, an->sys->bonds.intact, an->sys->bonds.nbonds));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode EquilibriumSave(PeriProblem p, Equilibrium *e)
+static PetscErrorCode EquilibriumSave(PeriAnalysis an, Equilibrium *e)
 {
   PetscFunctionBeginUser;
-  PetscCall(VecCopy(p->sys->u, e->u));
-  e->solve = p->sys->results;
-  PetscCall(PetscArraycpy(e->live, p->sys->bonds.live, p->sys->bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(e->intact, p->sys->bonds.intact, p->sys->bonds.nbonds));
+  PetscCall(VecCopy(an->sys->u, e->u));
+  e->solve = an->sys->results;
+  PetscCall(PetscArraycpy(e->live, an->sys->bonds.live, an->sys->bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(e->intact, an->sys->bonds.intact, an->sys->bonds.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Back to the last equilibrium: bonds (and the families and K built from them when the loop goes
  * on), and, with restore_u, the displacements. */
-static PetscErrorCode EquilibriumRestore(PeriProblem p, Equilibrium *e, PetscBool reassemble, PetscBool restore_u)
+static PetscErrorCode EquilibriumRestore(PeriAnalysis an, Equilibrium *e, PetscBool reassemble, PetscBool restore_u)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscArraycpy(p->sys->bonds.live, e->live, p->sys->bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(p->sys->bonds.intact, e->intact, p->sys->bonds.nbonds));
-  PetscCall(PeriFamilySync(p->sys));
+  PetscCall(PetscArraycpy(an->sys->bonds.live, e->live, an->sys->bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(an->sys->bonds.intact, e->intact, an->sys->bonds.nbonds));
+  PetscCall(PeriFamilySync(an->sys));
   if (reassemble) {
-    PetscCall(PeriSystemAssemble(p->sys));
-    if (p->sys->torsion.active && !p->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(p->sys, p->sys->f));
+    PetscCall(PeriSystemAssemble(an->sys));
+    if (an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
   }
   if (restore_u) {
-    PeriResults *r = &p->sys->results;
-    if (!p->sys->u) PetscCall(VecDuplicate(e->u, &p->sys->u));
-    PetscCall(VecCopy(e->u, p->sys->u));
+    PeriResults *r = &an->sys->results;
+    if (!an->sys->u) PetscCall(VecDuplicate(e->u, &an->sys->u));
+    PetscCall(VecCopy(e->u, an->sys->u));
     /* summary.json's solver section describes the solve of this state, not the abandoned one */
     if (e->solve.ksp_type[0]) {
       PetscCall(PetscStrncpy(r->ksp_type, e->solve.ksp_type, sizeof(r->ksp_type)));
@@ -291,45 +297,42 @@ static PetscErrorCode EquilibriumDestroy(Equilibrium *e)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* particles_NNNN.vtu (or another name) of the present state, in the output set. */
-static PetscErrorCode WriteState(PeriProblem p, const char name[])
+/* particles_NNNN.vtu (or another name) of the present state, in the output set, through the
+ * snapshot callback the problem installed (the analysis does not know where the set lives). */
+static PetscErrorCode WriteState(PeriAnalysis an, const char name[])
 {
-  char path[PETSC_MAX_PATH_LEN];
-
   PetscFunctionBeginUser;
-  PetscCall(PeriSystemEvaluateEnergy(p->sys));
-  PetscCall(PeriDamage(p->sys, &p->sys->damage));
-  if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", p->staging_dir, name));
-  PetscCall(PeriSystemWriteVTU(p->sys, p->sys->u_all, path));
+  PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  PetscCall(PeriDamage(an->sys, &an->sys->damage));
+  PetscCall(an->snapshot(an->snapshotctx, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode WriteSnapshot(PeriProblem p)
+static PetscErrorCode WriteSnapshot(PeriAnalysis an)
 {
   char name[64];
 
   PetscFunctionBeginUser;
-  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT ".vtu", p->quasistatic->nsteps));
-  PetscCall(WriteState(p, name));
+  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT ".vtu", QS(an)->nsteps));
+  PetscCall(WriteState(an, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode PrintCriteria(PeriProblem p, const Settings *st)
+static PetscErrorCode PrintCriteria(PeriAnalysis an, const Settings *st)
 {
-  const PeriFailure *F = &p->sys->failure;
+  const PeriFailure *F = &an->sys->failure;
 
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscPrintf(p->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
-  PetscCall(PetscPrintf(p->comm, "perilin: failure:"));
-  if (F->stretch > 0) PetscCall(PetscPrintf(p->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
-  if (F->G > 0) PetscCall(PetscPrintf(p->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, p->sys->model->type));
-  if (F->compressive > 0) PetscCall(PetscPrintf(p->comm, " -s > %g", (double)F->compressive));
-  if (F->sliding > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g", (double)F->sliding));
-  if (F->friction_angle > 0) PetscCall(PetscPrintf(p->comm, " |gamma| > %g - s tan(%g deg)", (double)F->cohesion, (double)F->friction_angle));
-  if (F->shear_angle > 0) PetscCall(PetscPrintf(p->comm, " |r| > r_c = %g", (double)F->shear_angle));
-  PetscCall(PetscPrintf(p->comm, " (formulas: docs/failure.md)\n"));
+  PetscCall(PetscPrintf(an->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
+  PetscCall(PetscPrintf(an->comm, "perilin: failure:"));
+  if (F->stretch > 0) PetscCall(PetscPrintf(an->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
+  if (F->G > 0) PetscCall(PetscPrintf(an->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, an->sys->model->type));
+  if (F->compressive > 0) PetscCall(PetscPrintf(an->comm, " -s > %g", (double)F->compressive));
+  if (F->sliding > 0) PetscCall(PetscPrintf(an->comm, " |gamma| > %g", (double)F->sliding));
+  if (F->friction_angle > 0) PetscCall(PetscPrintf(an->comm, " |gamma| > %g - s tan(%g deg)", (double)F->cohesion, (double)F->friction_angle));
+  if (F->shear_angle > 0) PetscCall(PetscPrintf(an->comm, " |r| > r_c = %g", (double)F->shear_angle));
+  PetscCall(PetscPrintf(an->comm, " (formulas: docs/failure.md)\n"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -349,9 +352,9 @@ typedef enum {
 } TrialEnd;
 
 /* Solve, break, solve again at the load factor trial until no bond breaks (or the body fails). */
-static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscReal trial, PetscInt total, PeriStep *s, TrialEnd *end, char why[], size_t len)
+static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscReal trial, PetscInt total, PeriStep *s, TrialEnd *end, char why[], size_t len)
 {
-  PeriQuasistatic *q = p->quasistatic;
+  PeriQuasistatic *q = QS(an);
 
   PetscFunctionBeginUser;
   *end = TRIAL_FAILED;
@@ -359,20 +362,20 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
     KSPConvergedReason reason;
     PetscInt           nb;
     PetscBool          ok;
-    PetscCall(PeriSignalReceived(p->comm, &p->sys->interrupted));
-    if (p->sys->interrupted) {
+    PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
+    if (an->sys->interrupted) {
       *end = TRIAL_INTERRUPTED;
       PetscFunctionReturn(PETSC_SUCCESS);
     }
     /* the pieces change only when bonds do */
     if (L->stale) {
       PetscCall(PetscFree2(L->hold, L->held));
-      PetscCall(PeriPieces(p->sys, &L->nhold, &L->hold, &L->held, &L->npieces, &L->lost));
+      PetscCall(PeriPieces(an->sys, &L->nhold, &L->hold, &L->held, &L->npieces, &L->lost));
       L->stale = PETSC_FALSE;
     }
     if (L->lost) {
       /* cut off before any bond broke: the scene's own cracks did it, at every load */
-      PetscCheck(total > 0 || s->broken > 0, p->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", p->scene->file, L->npieces);
+      PetscCheck(total > 0 || s->broken > 0, an->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", an->sys->scene->file, L->npieces);
       PetscCall(PetscSNPrintf(why, len, "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", L->npieces));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
@@ -382,25 +385,25 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
       q->pc_setups++;
       L->since_setup = 0;
     }
-    PetscCall(PeriStaticSolve(p->sys, &L->ksp, trial, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
+    PetscCall(PeriStaticSolve(an->sys, &L->ksp, trial, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
     /* later solves start from the last solution: few bonds change between them */
     PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
     q->solves++;
-    s->ksp_iterations += p->sys->results.iterations;
-    PetscCall(PeriStaticConverged(p->sys, L->ksp, reason, &ok));
-    PetscCall(PeriSignalReceived(p->comm, &p->sys->interrupted));
-    if (p->sys->interrupted) {
+    s->ksp_iterations += an->sys->results.iterations;
+    PetscCall(PeriStaticConverged(an->sys, L->ksp, reason, &ok));
+    PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
+    if (an->sys->interrupted) {
       *end = TRIAL_INTERRUPTED;
       PetscFunctionReturn(PETSC_SUCCESS);
     }
     if (!ok) {
       /* the body as set up is linear: a solve that fails before any bond broke fails at every
          load, so it is the solver's failure, not the body's */
-      if (total == 0 && s->broken == 0) PetscCall(PeriStaticCheckConverged(p->sys, reason));
-      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)p->sys->results.residual_norm));
+      if (total == 0 && s->broken == 0) PetscCall(PeriStaticCheckConverged(an->sys, reason));
+      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)an->sys->results.residual_norm));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
-    PetscCall(BreakBonds(p, st, &nb));
+    PetscCall(BreakBonds(an, st, &nb));
     L->stale = (PetscBool)(nb > 0);
     if (!nb) {
       *end = TRIAL_SETTLED;
@@ -409,7 +412,7 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
     s->broken += nb;
     L->since_setup += nb;
     /* a twist carried by the bonds themselves loses the broken bonds' share */
-    if (p->sys->torsion.active && !p->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(p->sys, p->sys->f));
+    if (an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
     if (st->adaptive && s->broken > st->runaway * L->nbonds) {
       /* a crack running away at this load: a smaller step tells whether it would settle */
       PetscCall(PetscSNPrintf(why, len, "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s->broken, (double)st->runaway));
@@ -422,9 +425,9 @@ static PetscErrorCode Trial(PeriProblem p, const Settings *st, Loop *L, PetscRea
 
 /* The body failed at trial: the trial's state goes to failed_trial.vtu (named as such), and
  * everything else describes the last equilibrium. */
-static PetscErrorCode Failed(PeriProblem p, Equilibrium *eq, PetscReal trial, const PeriStep *s, const char why[])
+static PetscErrorCode Failed(PeriAnalysis an, Equilibrium *eq, PetscReal trial, const PeriStep *s, const char why[])
 {
-  PeriQuasistatic *q = p->quasistatic;
+  PeriQuasistatic *q = QS(an);
 
   PetscFunctionBeginUser;
   q->failed               = PETSC_TRUE;
@@ -432,46 +435,46 @@ static PetscErrorCode Failed(PeriProblem p, Equilibrium *eq, PetscReal trial, co
   q->failure_step         = q->nsteps + 1;
   q->failed_trial_broken  = s->broken;
   PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
-  if (p->vtk && p->sys->u) PetscCall(WriteState(p, "failed_trial.vtu"));
-  PetscCall(PeriDamage(p->sys, &q->trial_damage)); /* where the failure went, for the caller */
-  PetscCall(EquilibriumRestore(p, eq, PETSC_FALSE, PETSC_TRUE));
+  if (an->vtk && an->sys->u) PetscCall(WriteState(an, "failed_trial.vtu"));
+  PetscCall(PeriDamage(an->sys, &q->trial_damage)); /* where the failure went, for the caller */
+  PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* An accepted step: recorded, reported, saved, and the next step size chosen. */
-static PetscErrorCode Accept(PeriProblem p, const Settings *st, Equilibrium *eq, PeriStep *s, PetscReal *dl, PetscInt nbonds)
+static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, Equilibrium *eq, PeriStep *s, PetscReal *dl, PetscInt nbonds)
 {
-  PeriQuasistatic *q = p->quasistatic;
+  PeriQuasistatic *q = QS(an);
 
   PetscFunctionBeginUser;
-  PetscCall(ControlValue(p, st->control, &s->control_u));
+  PetscCall(ControlValue(an, st->control, &s->control_u));
   PetscCall(RecordStep(q, s));
   q->peak_load_factor = s->lambda;
   q->broken_bonds     = s->broken_total;
-  PetscCall(EquilibriumSave(p, eq));
-  PetscCall(Progress(p, st, s));
-  if (p->output_every && q->nsteps % p->output_every == 0 && p->vtk) PetscCall(WriteSnapshot(p));
+  PetscCall(EquilibriumSave(an, eq));
+  PetscCall(Progress(an, st, s));
+  if (an->every && q->nsteps % an->every == 0 && an->vtk) PetscCall(WriteSnapshot(an));
   /* many breaks: smaller steps; none: back towards the scene's step */
   if (st->adaptive) *dl = s->broken > nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : s->broken ? *dl
                                                                                                    : PetscMin(2 * *dl, st->step);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode Finish(PeriProblem p, const Settings *st)
+static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
 {
-  PeriQuasistatic *q = p->quasistatic;
+  PeriQuasistatic *q = QS(an);
 
   PetscFunctionBeginUser;
-  q->complete = p->sys->interrupted ? PETSC_FALSE : PETSC_TRUE;
-  if (p->sys->interrupted)
-    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", p->sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  q->complete = an->sys->interrupted ? PETSC_FALSE : PETSC_TRUE;
+  if (an->sys->interrupted)
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", an->sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
   else if (!q->failed)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st->max));
-  PetscCall(PeriSystemEvaluateEnergy(p->sys));
-  PetscCall(PeriDamage(p->sys, &p->sys->damage));
+  PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  PetscCall(PeriDamage(an->sys, &an->sys->damage));
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscPrintf(p->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
-  if (q->failed) PetscCall(PetscPrintf(p->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
+  PetscCall(PetscPrintf(an->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
+  if (q->failed) PetscCall(PetscPrintf(an->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -480,7 +483,7 @@ static PetscErrorCode Finish(PeriProblem p, const Settings *st)
   probes, energies, damage) describe the last equilibrium; a failed trial is written apart as
   failed_trial.vtu. Collective.
 @*/
-static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
+static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
 {
   Settings       st;
   Loop           L      = {0};
@@ -489,71 +492,75 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriProblem p)
   PetscLogDouble t0, tstep, t;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadSettings(p, &st));
-  PetscCall(PetscNew(&p->quasistatic));
-  PetscCall(PetscStrncpy(p->quasistatic->control, st.control ? st.control->name : "", sizeof(p->quasistatic->control)));
-  PetscCall(PeriStaticDefaultMatType(p->sys->mat_type, sizeof(p->sys->mat_type)));
-  PetscCall(PeriSystemAssemble(p->sys));
-  PetscCall(EquilibriumCreate(p, &eq));
-  PetscCallMPI(MPI_Allreduce(&p->sys->bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, p->comm));
+  PetscCall(ReadSettings(an, &st));
+  {
+    PeriQuasistatic *q;
+    PetscCall(PetscNew(&q));
+    an->data = q;
+  }
+  PetscCall(PetscStrncpy(QS(an)->control, st.control ? st.control->name : "", sizeof(QS(an)->control)));
+  PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
+  PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(EquilibriumCreate(an, &eq));
+  PetscCallMPI(MPI_Allreduce(&an->sys->bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
   L.stale = PETSC_TRUE;
   PetscCall(PetscTime(&t0));
   dl = st.step;
-  PetscCall(PrintCriteria(p, &st));
+  PetscCall(PrintCriteria(an, &st));
   while (lambda < st.max * (1 - 1e-12)) {
     PetscReal trial = PetscMin(lambda + dl, st.max);
     PeriStep  s     = {0};
     TrialEnd  end;
     char      why[160] = "";
     PetscCall(PetscTime(&tstep));
-    PetscCall(Trial(p, &st, &L, trial, p->quasistatic->broken_bonds, &s, &end, why, sizeof(why)));
+    PetscCall(Trial(an, &st, &L, trial, QS(an)->broken_bonds, &s, &end, why, sizeof(why)));
     if (end == TRIAL_INTERRUPTED) {
-      PetscCall(EquilibriumRestore(p, &eq, PETSC_FALSE, PETSC_TRUE));
+      PetscCall(EquilibriumRestore(an, &eq, PETSC_FALSE, PETSC_TRUE));
       break;
     }
     if (end == TRIAL_FAILED && st.adaptive && dl > st.min_step * (1 + 1e-12)) {
       /* back to the last equilibrium, with half the step */
-      PetscCall(EquilibriumRestore(p, &eq, PETSC_TRUE, PETSC_FALSE));
+      PetscCall(EquilibriumRestore(an, &eq, PETSC_TRUE, PETSC_FALSE));
       L.stale       = PETSC_TRUE;
       L.since_setup = L.nbonds;
       dl            = PetscMax(0.5 * dl, st.min_step);
       continue;
     }
     if (end == TRIAL_FAILED) {
-      PetscCall(Failed(p, &eq, trial, &s, why));
+      PetscCall(Failed(an, &eq, trial, &s, why));
       break;
     }
     lambda = trial;
     PetscCall(PetscTime(&t));
     s.lambda       = lambda;
-    s.broken_total = p->quasistatic->broken_bonds + s.broken;
+    s.broken_total = QS(an)->broken_bonds + s.broken;
     s.seconds      = t - tstep;
-    PetscCall(Accept(p, &st, &eq, &s, &dl, L.nbonds));
+    PetscCall(Accept(an, &st, &eq, &s, &dl, L.nbonds));
   }
   PetscCall(KSPDestroy(&L.ksp));
   PetscCall(PetscFree2(L.hold, L.held));
   PetscCall(EquilibriumDestroy(&eq));
   PetscCall(PetscTime(&t));
-  p->sys->results.solve_s = t - t0;
-  PetscCall(Finish(p, &st));
+  an->sys->results.solve_s = t - t0;
+  PetscCall(Finish(an, &st));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
   PeriWriteStepsCSV - one row per load step. Rank 0 writes (temporary name, then rename). Collective.
 @*/
-PetscErrorCode PeriWriteStepsCSV(PeriProblem p, const char path[])
+static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
 {
   char  tmp[PETSC_MAX_PATH_LEN];
   FILE *fp;
   int   bad = 0;
 
   PetscFunctionBeginUser;
-  if (p->rank || !p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->rank || !QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,equilibrium_iterations,ksp_iterations,seconds\n") < 0;
-  for (PetscInt k = 0; k < p->quasistatic->nsteps; k++) {
-    const PeriStep *s = &p->quasistatic->steps[k];
+  for (PetscInt k = 0; k < QS(an)->nsteps; k++) {
+    const PeriStep *s = &QS(an)->steps[k];
     bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f\n", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
@@ -564,17 +571,17 @@ PetscErrorCode PeriWriteStepsCSV(PeriProblem p, const char path[])
   WriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
   (output.every) by load factor. Rank 0 writes. Collective.
 @*/
-static PetscErrorCode WriteSnapshotsPVD(PeriProblem p, const char path[])
+static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
 {
-  PeriQuasistatic *q = p->quasistatic;
+  PeriQuasistatic *q = QS(an);
   PetscReal       *times;
   char           **files;
   PetscInt         n = 0;
 
   PetscFunctionBeginUser;
-  if (p->rank || !q || !p->output_every || !p->vtk || q->nsteps < p->output_every) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->rank || !q || !an->every || !an->vtk || q->nsteps < an->every) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc2(q->nsteps, &times, q->nsteps, &files));
-  for (PetscInt k = p->output_every; k <= q->nsteps; k += p->output_every) {
+  for (PetscInt k = an->every; k <= q->nsteps; k += an->every) {
     times[n] = q->steps[k - 1].lambda;
     PetscCall(PetscMalloc1(32, &files[n]));
     PetscCall(PetscSNPrintf(files[n++], 32, "particles_%04" PetscInt_FMT ".vtu", k));
@@ -586,13 +593,13 @@ static PetscErrorCode WriteSnapshotsPVD(PeriProblem p, const char path[])
 }
 
 /* summary.json's "quasistatic" object: the path's end, the critical load, what broke. */
-static PetscErrorCode QSSummary(PeriProblem p, PeriJSON j)
+static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
 {
-  const PeriResults *r = &p->sys->results;
+  const PeriResults *r = &an->sys->results;
 
   PetscFunctionBeginUser;
-  if (!p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
-  const PeriQuasistatic *q = p->quasistatic;
+  if (!QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  const PeriQuasistatic *q = QS(an);
   PetscCall(PeriJSONBeginObject(j, "quasistatic"));
   PetscCall(PeriJSONInt(j, "steps", q->nsteps));
   PetscCall(PeriJSONString(j, "state", "last equilibrium"));
@@ -615,26 +622,24 @@ static PetscErrorCode QSSummary(PeriProblem p, PeriJSON j)
 }
 
 /* steps.csv and the snapshot series particles.pvd. */
-static PetscErrorCode QSFiles(PeriProblem p, const char dir[])
+static PetscErrorCode QSFiles(PeriAnalysis an, const char dir[])
 {
   char path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  if (!p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/steps.csv", dir));
-  PetscCall(PeriWriteStepsCSV(p, path));
+  PetscCall(PeriWriteStepsCSV(an, path));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.pvd", dir));
-  PetscCall(WriteSnapshotsPVD(p, path));
+  PetscCall(WriteSnapshotsPVD(an, path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode QSDestroy(PeriProblem p)
+static PetscErrorCode QSDestroy(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  if (!p->quasistatic) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscFree(p->quasistatic->steps));
-  PetscCall(PetscFree(p->quasistatic->trial_damage));
-  PetscCall(PetscFree(p->quasistatic));
+  PetscCall(PetscFree(QS(an)->steps));
+  PetscCall(PetscFree(QS(an)->trial_damage));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -47,3 +47,34 @@ PetscErrorCode PeriAnalysisListTypes(char buf[], size_t len)
   for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(builtin); k++) PeriListAppend(buf, len, builtin[k]->name);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriAnalysisCreate - an analysis of the given type on the system sys (borrowed). The caller sets
+  what the output asks (vtk, every, output_dir) and the snapshot callback before ops.run.
+@*/
+PetscErrorCode PeriAnalysisCreate(const PeriAnalysisType *type, PeriSystem sys, PeriAnalysis *analysis)
+{
+  PeriAnalysis an;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&an));
+  an->type  = type;
+  an->sys   = sys;
+  an->comm  = sys->comm;
+  an->rank  = sys->rank;
+  *analysis = an;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *analysis)
+{
+  PeriAnalysis an = *analysis;
+
+  PetscFunctionBeginUser;
+  if (!an) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->data && an->type->ops.destroy) PetscCall(an->type->ops.destroy(an));
+  PetscCall(PetscFree(an->data));
+  PetscCall(PetscFree(an));
+  *analysis = NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -3,21 +3,21 @@
  * solved. summary.json gives the sizes, the edge cut and the set-up cost, particles.vtu the
  * volumes, neighbour counts and ranks: a scene is checked, or a large run sized, before it is paid
  * for. Also the smallest example of an analysis (docs/design.md, "How to add an analysis"). */
-#include "perilin/private/problem.h"
+#include "perilin/private/analysis.h"
 
 /* Nothing to run: no solver was used, so summary.json has no solver section and the report no
  * solver line. */
-static PetscErrorCode Run_Setup(PeriProblem p)
+static PetscErrorCode Run_Setup(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  (void)p;
+  (void)an;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode Report_Setup(PeriProblem p)
+static PetscErrorCode Report_Setup(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(p->comm, "perilin: set-up only, nothing solved: %" PetscInt_FMT " bonds between ranks; results in %s/\n", p->sys->results.edge_cut, p->output_dir));
+  PetscCall(PetscPrintf(an->comm, "perilin: set-up only, nothing solved: %" PetscInt_FMT " bonds between ranks; results in %s/\n", an->sys->results.edge_cut, an->output_dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -1,12 +1,12 @@
 /* Static analysis: K u = f with the prescribed DOFs eliminated symmetrically, solved with KSP
  * (CG + GAMG with the rigid-body near-null space unless the options say otherwise). */
-#include "perilin/private/problem.h"
+#include "perilin/private/analysis.h"
 
 /*@C
   PeriAnalysisRun_Static - solves the linear static problem once and evaluates energies and probes.
   Options: every KSP/PC option (-ksp_type, -pc_type, -ksp_rtol, ...). Collective.
 @*/
-static PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
+static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
 {
   KSP                ksp = NULL;
   PetscInt           nc;
@@ -14,52 +14,52 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriProblem p)
   PetscLogDouble     t0, t1;
 
   PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Allreduce(&p->sys->nconstrained, &nc, 1, MPIU_INT, MPI_SUM, p->comm));
-  if (nc == p->sys->particles.n * p->sys->model->dofs) {
+  PetscCallMPI(MPI_Allreduce(&an->sys->nconstrained, &nc, 1, MPIU_INT, MPI_SUM, an->comm));
+  if (nc == an->sys->particles.n * an->sys->model->dofs) {
     /* every DOF prescribed: the solution is known, K is not needed */
-    PetscCall(VecDestroy(&p->sys->u));
-    PetscCall(PeriSystemCreateVec(p->sys, &p->sys->u));
-    PetscCall(VecSetValues(p->sys->u, p->sys->nconstrained, p->sys->constrained, p->sys->constrained_value, INSERT_VALUES));
-    PetscCall(VecAssemblyBegin(p->sys->u));
-    PetscCall(VecAssemblyEnd(p->sys->u));
-    PetscCall(PetscStrncpy(p->sys->results.ksp_type, "none", sizeof(p->sys->results.ksp_type)));
-    PetscCall(PetscStrncpy(p->sys->results.pc_type, "none", sizeof(p->sys->results.pc_type)));
-    PetscCall(PetscStrncpy(p->sys->results.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(p->sys->results.converged_reason)));
-    PetscCall(PeriSystemEvaluateEnergy(p->sys));
-    PetscCall(PeriReferenceEvaluate(p->sys));
+    PetscCall(VecDestroy(&an->sys->u));
+    PetscCall(PeriSystemCreateVec(an->sys, &an->sys->u));
+    PetscCall(VecSetValues(an->sys->u, an->sys->nconstrained, an->sys->constrained, an->sys->constrained_value, INSERT_VALUES));
+    PetscCall(VecAssemblyBegin(an->sys->u));
+    PetscCall(VecAssemblyEnd(an->sys->u));
+    PetscCall(PetscStrncpy(an->sys->results.ksp_type, "none", sizeof(an->sys->results.ksp_type)));
+    PetscCall(PetscStrncpy(an->sys->results.pc_type, "none", sizeof(an->sys->results.pc_type)));
+    PetscCall(PetscStrncpy(an->sys->results.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(an->sys->results.converged_reason)));
+    PetscCall(PeriSystemEvaluateEnergy(an->sys));
+    PetscCall(PeriReferenceEvaluate(an->sys));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(PeriStaticDefaultMatType(p->sys->mat_type, sizeof(p->sys->mat_type)));
-  if (!p->sys->K) PetscCall(PeriSystemAssemble(p->sys));
+  PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
+  if (!an->sys->K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscTime(&t0));
-  PetscCall(VecDestroy(&p->sys->u));
+  PetscCall(VecDestroy(&an->sys->u));
   {
     /* pieces cut off by cracks: held in place when unloaded, an error when loaded */
     PetscInt   nhold, npieces, *hold;
     PetscReal *held;
     PetscBool  lost;
-    PetscCall(PeriPieces(p->sys, &nhold, &hold, &held, &npieces, &lost));
-    PetscCheck(!lost, p->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", p->scene->file, npieces);
-    if (npieces > 1) PetscCall(PetscPrintf(p->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
-    PetscCall(PeriStaticSolve(p->sys, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));
+    PetscCall(PeriPieces(an->sys, &nhold, &hold, &held, &npieces, &lost));
+    PetscCheck(!lost, an->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", an->sys->scene->file, npieces);
+    if (npieces > 1) PetscCall(PetscPrintf(an->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
+    PetscCall(PeriStaticSolve(an->sys, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));
     PetscCall(PetscFree2(hold, held));
   }
-  PetscCall(PeriSignalReceived(p->comm, &p->sys->interrupted));
-  if (p->sys->interrupted) {
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
+  if (an->sys->interrupted) {
     /* an unfinished solve is no result: the output will say so and hold no fields */
     PetscCall(KSPDestroy(&ksp));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   {
     PetscBool ok;
-    PetscCall(PeriStaticConverged(p->sys, ksp, reason, &ok));
+    PetscCall(PeriStaticConverged(an->sys, ksp, reason, &ok));
   }
   PetscCall(KSPDestroy(&ksp));
-  PetscCall(PeriStaticCheckConverged(p->sys, reason));
+  PetscCall(PeriStaticCheckConverged(an->sys, reason));
   PetscCall(PetscTime(&t1));
-  p->sys->results.solve_s = t1 - t0;
-  PetscCall(PeriSystemEvaluateEnergy(p->sys));
-  PetscCall(PeriReferenceEvaluate(p->sys));
+  an->sys->results.solve_s = t1 - t0;
+  PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  PetscCall(PeriReferenceEvaluate(an->sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -406,3 +406,24 @@ PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, Pets
   PetscCall(PetscFree3(anchored, size, loaded));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* particles.vtu's damage: the total, and the share lost to each criterion the scene uses (Diana &
+ * Casolo eqs. 47, 48, 51). */
+PetscErrorCode PeriFailureAddFields(PeriSystem sys, PeriFieldList fl)
+{
+  const PeriFailure *F      = &sys->failure;
+  const PetscBool    used[] = {(PetscBool)(sys->results.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
+  const PetscInt     map0   = 0;
+
+  PetscFunctionBeginUser;
+  if (!sys->damage) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage, PERI_NCAUSES + 1, &map0));
+  for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
+    char           name[32];
+    const PetscInt map = 1 + c;
+    if (!used[c]) continue;
+    PetscCall(PetscSNPrintf(name, sizeof(name), "damage_%s", PeriFailureCauses[c]));
+    PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage, PERI_NCAUSES + 1, &map));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -191,14 +191,12 @@ PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe 
 
 /*@C
   PeriSystemAddFields - the system's per-particle fields besides the solution: volume, neighbours,
-  rank, and where they exist strain energy density, antiplane shear stresses, damage (the total
-  and the share of each criterion the scene uses, Diana & Casolo eqs. 47, 48, 51) and the mirror
-  images of fictitious layer particles. Rank 0, after the fields were gathered.
+  rank, and where they exist strain energy density and antiplane shear stresses; then the
+  features' own (damage: PeriFailureAddFields; mirror images: PeriLayersAddFields). Rank 0, after
+  the fields were gathered.
 @*/
 PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
 {
-  const PeriFailure *F = &sys->failure;
-
   PetscFunctionBeginUser;
   PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->particles.volume, 1, NULL));
   PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->neighbor_count));
@@ -209,19 +207,8 @@ PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
     PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
     PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau, 3, &nmap));
   }
-  if (sys->damage) {
-    const PetscBool used[] = {(PetscBool)(sys->results.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
-    const PetscInt  map0   = 0;
-    PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage, PERI_NCAUSES + 1, &map0));
-    for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
-      char           name[32];
-      const PetscInt map = 1 + c;
-      if (!used[c]) continue;
-      PetscCall(PetscSNPrintf(name, sizeof(name), "damage_%s", PeriFailureCauses[c]));
-      PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage, PERI_NCAUSES + 1, &map));
-    }
-  }
-  if (sys->particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->particles.image)); /* -1: a body particle */
+  PetscCall(PeriFailureAddFields(sys, fl));
+  PetscCall(PeriLayersAddFields(sys, fl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -240,5 +227,24 @@ PetscErrorCode PeriSystemWriteVTU(PeriSystem sys, const PetscReal *u, const char
   PetscCall(PeriSystemAddFields(sys, fl));
   PetscCall(PeriWriteVTU(fl, path));
   PetscCall(PeriFieldListDestroy(&fl));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* probes: the values at the nearest particle of each point, when there is a solution. */
+PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriJSONBeginObject(j, "probes"));
+  for (PetscInt k = 0; sys->u_all && k < sys->nprobes; k++) {
+    const PeriProbe *pr = &sys->probes[k];
+    PetscCall(PeriJSONBeginObject(j, pr->name));
+    PetscCall(PeriJSONRealArray(j, "x", sys->particles.dim, pr->x));
+    PetscCall(PeriJSONRealArray(j, "particle_x", sys->particles.dim, &sys->particles.x[3 * pr->particle]));
+    PetscCall(PeriJSONString(j, "sampling", "nearest particle"));
+    PetscCall(PeriJSONRealArray(j, "u", sys->model->dofs, pr->u));
+    PetscCall(PeriJSONReal(j, "W", pr->W));
+    PetscCall(PeriJSONEndObject(j));
+  }
+  PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

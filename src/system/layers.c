@@ -377,3 +377,46 @@ PetscErrorCode PeriTorsionEvaluate(PeriSystem sys)
   t->J_rectangle = RectangleTorsionConstant(pt->upper[0] - pt->lower[0], pt->upper[1] - pt->lower[1]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+PetscErrorCode PeriTorsionSummary(PeriSystem sys, PeriJSON j)
+{
+  const PeriTorsion *t = &sys->torsion;
+
+  PetscFunctionBeginUser;
+  if (!t->active || !sys->tau) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriJSONBeginObject(j, "torsion"));
+  PetscCall(PeriJSONReal(j, "twist", t->twist));
+  PetscCall(PeriJSONRealArray(j, "center", 2, t->center));
+  PetscCall(PeriJSONReal(j, "torque", t->torque));
+  PetscCall(PeriJSONReal(j, "J", t->J));
+  PetscCall(PeriJSONReal(j, "J_rectangle_exact", t->J_rectangle));
+  PetscCall(PeriJSONReal(j, "J_error_vs_rectangle", t->J / t->J_rectangle - 1));
+  PetscCall(PeriJSONReal(j, "max_shear_stress", t->max_stress));
+  PetscCall(PeriJSONRealArray(j, "max_shear_stress_at", 2, t->max_at));
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* summary.json's boundary_layers: the fictitious particles and each face's kind. */
+PetscErrorCode PeriLayersSummary(PeriSystem sys, PeriJSON j)
+{
+  static const char *const faces[] = {"x-", "x+", "y-", "y+"};
+
+  PetscFunctionBeginUser;
+  if (!sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriJSONBeginObject(j, "boundary_layers"));
+  PetscCall(PeriJSONInt(j, "fictitious_particles", sys->particles.nfictitious));
+  for (PetscInt f = 0; f < 4; f++)
+    if (sys->layers.kind[f]) PetscCall(PeriJSONString(j, faces[f], PeriLayerKinds[sys->layers.kind[f]]));
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* particles.vtu's mirror_of: for each fictitious particle the body particle it mirrors (-1: a body
+ * particle). */
+PetscErrorCode PeriLayersAddFields(PeriSystem sys, PeriFieldList fl)
+{
+  PetscFunctionBeginUser;
+  if (sys->particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->particles.image));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

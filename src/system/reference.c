@@ -204,3 +204,28 @@ PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
   res->has_reference = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* Against reference.*: interior strain, effective moduli, errors. */
+PetscErrorCode PeriReferenceSummary(PeriSystem sys, PeriJSON j)
+{
+  const PeriResults *r = &sys->results;
+
+  PetscFunctionBeginUser;
+  if (!r->has_reference) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriJSONBeginObject(j, "reference"));
+  PetscCall(PeriJSONString(j, "type", PeriReferenceTypes[sys->reference.type]));
+  PetscCall(PeriJSONReal(j, "stress", sys->reference.stress));
+  PetscCall(PeriJSONEndObject(j));
+  PetscCall(PeriJSONInt(j, "interior_particles", r->interior_particles));
+  PetscCall(PeriJSONRealArray(j, "interior_strain", 3, r->interior_strain));
+  PetscCall(PeriJSONBeginObject(j, "effective"));
+  if (r->effective_E != 0) PetscCall(PeriJSONReal(j, "E", r->effective_E));
+  if (r->effective_E != 0) PetscCall(PeriJSONReal(j, "nu", r->effective_nu));
+  if (r->effective_G != 0) PetscCall(PeriJSONReal(j, "G", r->effective_G));
+  PetscCall(PeriJSONEndObject(j));
+  PetscCall(PeriJSONBeginObject(j, "error"));
+  PetscCall(PeriJSONReal(j, "l2_rel", r->error_l2_rel));
+  PetscCall(PeriJSONReal(j, "max_rel", r->error_max_rel));
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

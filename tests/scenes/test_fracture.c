@@ -36,8 +36,8 @@ int main(int argc, char **argv)
   for (PetscInt k = 0; k < 2; k++) {
     PetscCall(Run(argv[1], spacings[k], &p));
     PetscCall(PetscSNPrintf(what, sizeof(what), "edge crack dx = %s: critical traction / LEFM", spacings[k]));
-    PeriTestClose(what, p->quasistatic->critical_load_factor / lefm, 1, 0.05);
-    PeriTestClose("edge crack: failed, and the bracket is min_step wide", p->quasistatic->critical_load_factor - p->quasistatic->peak_load_factor, 0.25, 1e-9);
+    PeriTestClose(what, PeriTestQuasistatic(p)->critical_load_factor / lefm, 1, 0.05);
+    PeriTestClose("edge crack: failed, and the bracket is min_step wide", PeriTestQuasistatic(p)->critical_load_factor - PeriTestQuasistatic(p)->peak_load_factor, 0.25, 1e-9);
     PetscCall(PeriProblemDestroy(&p));
   }
 
@@ -47,13 +47,13 @@ int main(int argc, char **argv)
     PetscCall(Run(argv[2], k ? "0.04" : "0.02", &p));
     PetscCall(PeriTestSetOption("-model_type", NULL));
     /* in stable steps, or in the failed trial only (the state-based model's crack runs away at once) */
-    PeriTestClose("cracked bar: the crack grew (bonds broken)", (PetscReal)(p->quasistatic->broken_bonds + p->quasistatic->failed_trial_broken > 0), 1, 0);
+    PeriTestClose("cracked bar: the crack grew (bonds broken)", (PetscReal)(PeriTestQuasistatic(p)->broken_bonds + PeriTestQuasistatic(p)->failed_trial_broken > 0), 1, 0);
     /* one state: the results are those of the last equilibrium, steps.csv's last row */
-    PeriTestClose("cracked bar: broken bonds = the last step's broken_total", (PetscReal)p->quasistatic->broken_bonds, (PetscReal)p->quasistatic->steps[p->quasistatic->nsteps - 1].broken_total, 0);
+    PeriTestClose("cracked bar: broken bonds = the last step's broken_total", (PetscReal)PeriTestQuasistatic(p)->broken_bonds, (PetscReal)PeriTestQuasistatic(p)->steps[PeriTestQuasistatic(p)->nsteps - 1].broken_total, 0);
     if (p->rank == 0) {
       /* the stable growth at the last equilibrium, then the failed trial's run-away crack */
       for (PetscInt t = 0; t < 2; t++) {
-        const PetscReal *damage = t ? p->quasistatic->trial_damage : p->sys->damage;
+        const PetscReal *damage = t ? PeriTestQuasistatic(p)->trial_damage : p->sys->damage;
         PetscReal        ymax = 0, xmin = 0, xmax = 0;
         for (PetscInt i = 0; i < p->sys->particles.n; i++) {
           const PetscReal *X = &p->sys->particles.x[3 * i];
@@ -71,7 +71,7 @@ int main(int argc, char **argv)
   }
 
   PetscCall(Run(argv[3], "0.005", &p));
-  PeriTestClose("micropolar shear: bonds broke by sliding before the last load", (PetscReal)(p->quasistatic->broken_bonds > 0 && p->quasistatic->peak_load_factor > 0), 1, 0);
+  PeriTestClose("micropolar shear: bonds broke by sliding before the last load", (PetscReal)(PeriTestQuasistatic(p)->broken_bonds > 0 && PeriTestQuasistatic(p)->peak_load_factor > 0), 1, 0);
   PetscCall(PeriProblemDestroy(&p));
 
   {

@@ -45,7 +45,7 @@ static PetscErrorCode Lamina(const char file[])
       PeriProblem p;
       PeriModal  *md;
       PetscCall(RunModal(file, models[mo], nus[k], &p));
-      md = p->modal;
+      md = PeriTestModal(p);
       for (int m = 0; m < 3; m++) PetscCheck(md->modes[m].residual < 1e-8, PETSC_COMM_SELF, PETSC_ERR_PLIB, "mode %d residual %g", m, (double)md->modes[m].residual);
       if (mo == 0 || (mo == 1 && k >= 3)) {
         for (int m = 0; m < 3; m++) {
@@ -109,9 +109,9 @@ static PetscErrorCode Bar(const char file[])
     PetscReal   lat = PetscSqrtReal(LatticeC11Ratio(mo == 0 ? PETSC_TRUE : PETSC_FALSE, 2.5)), ratio;
     PetscCall(PeriTestSetOption("-model_type", models[mo]));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, file, &p));
-    PetscCheck(p->modal->longitudinal_speed > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "no longitudinal mode among the %" PetscInt_FMT " computed", p->modal->nmodes);
-    PetscCheck(p->modal->nrigid == 3, PETSC_COMM_SELF, PETSC_ERR_PLIB, "expected the 3 translations as rigid modes, got %" PetscInt_FMT, p->modal->nrigid);
-    ratio = p->modal->longitudinal_speed / p->modal->theory_speed;
+    PetscCheck(PeriTestModal(p)->longitudinal_speed > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "no longitudinal mode among the %" PetscInt_FMT " computed", PeriTestModal(p)->nmodes);
+    PetscCheck(PeriTestModal(p)->nrigid == 3, PETSC_COMM_SELF, PETSC_ERR_PLIB, "expected the 3 translations as rigid modes, got %" PetscInt_FMT, PeriTestModal(p)->nrigid);
+    ratio = PeriTestModal(p)->longitudinal_speed / PeriTestModal(p)->theory_speed;
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s bar: c / c_lattice (c / theory = %.4f, paper: %s)", models[mo], (double)ratio, mo ? "+13 %" : "< 1 %"));
     PeriTestClose(what, ratio / lat, 1.0, 2e-3);
     PetscCall(PeriProblemDestroy(&p));
@@ -133,17 +133,17 @@ static PetscErrorCode Extremes(const char lamina[], const char tiny[])
   PetscCall(PeriTestSetOption("-regions_base_depth", "0.01"));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &p));
   PetscCall(PeriTestSetOption("-regions_base_depth", NULL));
-  for (int m = 0; m < 3; m++) PetscCheck(p->modal->modes[m].residual < 1e-8, PETSC_COMM_SELF, PETSC_ERR_PLIB, "single-row clamp: mode %d residual %g", m, (double)p->modal->modes[m].residual);
-  PetscCheck(p->modal->modes[0].f_hz < q->modal->modes[0].f_hz && !strcmp(p->modal->modes[0].kind, "flexural"), PETSC_COMM_SELF, PETSC_ERR_PLIB, "a one-row clamp must be softer than a three-row one");
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: one-row clamp: f1 = %.1f Hz < %.1f Hz (three rows), residuals < 1e-8\n", (double)p->modal->modes[0].f_hz, (double)q->modal->modes[0].f_hz));
+  for (int m = 0; m < 3; m++) PetscCheck(PeriTestModal(p)->modes[m].residual < 1e-8, PETSC_COMM_SELF, PETSC_ERR_PLIB, "single-row clamp: mode %d residual %g", m, (double)PeriTestModal(p)->modes[m].residual);
+  PetscCheck(PeriTestModal(p)->modes[0].f_hz < PeriTestModal(q)->modes[0].f_hz && !strcmp(PeriTestModal(p)->modes[0].kind, "flexural"), PETSC_COMM_SELF, PETSC_ERR_PLIB, "a one-row clamp must be softer than a three-row one");
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: one-row clamp: f1 = %.1f Hz < %.1f Hz (three rows), residuals < 1e-8\n", (double)PeriTestModal(p)->modes[0].f_hz, (double)PeriTestModal(q)->modes[0].f_hz));
   PetscCall(PeriProblemDestroy(&p));
 
   PetscCall(PeriProblemDestroy(&q));
 
   PetscCall(PeriTestSetOption("-material_nu", "-0.99"));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &p));
-  for (int m = 0; m < 3; m++) PetscCheck(p->modal->modes[m].residual < 1e-8 && p->modal->modes[m].f_hz > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "nu = -0.99: mode %d residual %g", m, (double)p->modal->modes[m].residual);
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: nu = -0.99: modes at %.1f, %.1f, %.1f Hz with residuals < 1e-8\n", (double)p->modal->modes[0].f_hz, (double)p->modal->modes[1].f_hz, (double)p->modal->modes[2].f_hz));
+  for (int m = 0; m < 3; m++) PetscCheck(PeriTestModal(p)->modes[m].residual < 1e-8 && PeriTestModal(p)->modes[m].f_hz > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "nu = -0.99: mode %d residual %g", m, (double)PeriTestModal(p)->modes[m].residual);
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: nu = -0.99: modes at %.1f, %.1f, %.1f Hz with residuals < 1e-8\n", (double)PeriTestModal(p)->modes[0].f_hz, (double)PeriTestModal(p)->modes[1].f_hz, (double)PeriTestModal(p)->modes[2].f_hz));
   PetscCall(PeriProblemDestroy(&p));
 
   PetscCall(PeriTestSetOption("-model_type", NULL));
@@ -168,17 +168,17 @@ static PetscErrorCode Extremes(const char lamina[], const char tiny[])
     {
       /* the bouncing tip carries the mass along the axis: the largest axial effective mass */
       PetscInt best = 0;
-      for (PetscInt m = 0; m < p->modal->nmodes; m++)
-        if (p->modal->modes[m].effective_mass[1] > p->modal->modes[best].effective_mass[1]) best = m;
-      PetscCheck(p->modal->modes[best].residual < 1e-8, PETSC_COMM_SELF, PETSC_ERR_PLIB, "mass ratio 1e6: residual %g", (double)p->modal->modes[best].residual);
-      PeriTestClose("mass ratio 1e6: bouncing mode f / (sqrt(k/M) / 2 pi)", p->modal->modes[best].f_hz / f, 1.0, 1e-2);
+      for (PetscInt m = 0; m < PeriTestModal(p)->nmodes; m++)
+        if (PeriTestModal(p)->modes[m].effective_mass[1] > PeriTestModal(p)->modes[best].effective_mass[1]) best = m;
+      PetscCheck(PeriTestModal(p)->modes[best].residual < 1e-8, PETSC_COMM_SELF, PETSC_ERR_PLIB, "mass ratio 1e6: residual %g", (double)PeriTestModal(p)->modes[best].residual);
+      PeriTestClose("mass ratio 1e6: bouncing mode f / (sqrt(k/M) / 2 pi)", PeriTestModal(p)->modes[best].f_hz / f, 1.0, 1e-2);
     }
     PetscCall(PeriProblemDestroy(&s));
     PetscCall(PeriProblemDestroy(&p));
   }
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, tiny, &p));
-  PetscCall(PetscSNPrintf(what, sizeof(what), "nev 50 on %" PetscInt_FMT " free DOFs: modes returned", p->modal->nfree_dofs));
-  PeriTestClose(what, (PetscReal)p->modal->nmodes, (PetscReal)p->modal->nfree_dofs, 0);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "nev 50 on %" PetscInt_FMT " free DOFs: modes returned", PeriTestModal(p)->nfree_dofs));
+  PeriTestClose(what, (PetscReal)PeriTestModal(p)->nmodes, (PetscReal)PeriTestModal(p)->nfree_dofs, 0);
   PetscCall(PeriProblemDestroy(&p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -214,7 +214,7 @@ static PetscErrorCode RunTarget(const char lamina[], PetscReal t, PetscInt nev, 
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, p));
   PetscCall(PeriTestSetOption("-analysis_target_hz", NULL));
   PetscCall(PeriTestSetOption("-analysis_nev", NULL));
-  PetscCheck((*p)->modal->nmodes == nev, PETSC_COMM_SELF, PETSC_ERR_PLIB, "target %g Hz: %" PetscInt_FMT " modes, asked for %" PetscInt_FMT, (double)t, (*p)->modal->nmodes, nev);
+  PetscCheck(PeriTestModal(*p)->nmodes == nev, PETSC_COMM_SELF, PETSC_ERR_PLIB, "target %g Hz: %" PetscInt_FMT " modes, asked for %" PetscInt_FMT, (double)t, PeriTestModal(*p)->nmodes, nev);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -232,9 +232,9 @@ static PetscErrorCode Target(const char lamina[])
   PetscCall(PeriTestSetOption("-model_type", "mppd"));
   PetscCall(PeriTestSetOption("-material_nu", "0"));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &q));
-  n = PetscMin(q->modal->nmodes, PERI_MAX_MODES);
+  n = PetscMin(PeriTestModal(q)->nmodes, PERI_MAX_MODES);
   PetscCheck(n == 6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "expected the 6 lowest modes, got %" PetscInt_FMT, n);
-  for (PetscInt i = 0; i < n; i++) f[i] = q->modal->modes[i].f_hz;
+  for (PetscInt i = 0; i < n; i++) f[i] = PeriTestModal(q)->modes[i].f_hz;
 
   /* strictly between modes 2 and 3, nearer 3: mode 3, then mode 2, then the nearer of 1 and 4 */
   t = f[1] + 0.7 * (f[2] - f[1]);
@@ -242,8 +242,8 @@ static PetscErrorCode Target(const char lamina[])
   PetscCheck(expected[0] == f[2] && expected[1] == f[1], PETSC_COMM_SELF, PETSC_ERR_PLIB, "target %g: mode 3, then 2, expected nearest", (double)t);
   PetscCall(RunTarget(lamina, t, 3, &p));
   for (PetscInt m = 0; m < 3; m++) {
-    PetscCall(PetscSNPrintf(what, sizeof(what), "target %.1f Hz: mode %" PetscInt_FMT " (%s) / the run without target's %.1f Hz", (double)t, m + 1, p->modal->modes[m].kind, (double)expected[m]));
-    PeriTestClose(what, p->modal->modes[m].f_hz / expected[m], 1.0, 1e-8);
+    PetscCall(PetscSNPrintf(what, sizeof(what), "target %.1f Hz: mode %" PetscInt_FMT " (%s) / the run without target's %.1f Hz", (double)t, m + 1, PeriTestModal(p)->modes[m].kind, (double)expected[m]));
+    PeriTestClose(what, PeriTestModal(p)->modes[m].f_hz / expected[m], 1.0, 1e-8);
   }
   PetscCall(PeriProblemDestroy(&p));
 
@@ -253,7 +253,7 @@ static PetscErrorCode Target(const char lamina[])
   PetscCheck(f[1] - t < t - f[0] && f[1] * f[1] - t * t > t * t - f[0] * f[0], PETSC_COMM_SELF, PETSC_ERR_PLIB, "target %g: not nearer mode 2 in f and mode 1 in omega^2", (double)t);
   PetscCall(RunTarget(lamina, t, 1, &p));
   PetscCall(PetscSNPrintf(what, sizeof(what), "target %.1f Hz (nearer %.1f Hz in f, %.1f Hz in omega^2): mode / %.1f Hz", (double)t, (double)f[1], (double)f[0], (double)f[1]));
-  PeriTestClose(what, p->modal->modes[0].f_hz / f[1], 1.0, 1e-8);
+  PeriTestClose(what, PeriTestModal(p)->modes[0].f_hz / f[1], 1.0, 1e-8);
   PetscCall(PeriProblemDestroy(&p));
   /* the same with a Krylov subspace of 3: too few pairs converge to be sure of the nearest, and
    * the run must ask SLEPc for more (-info shows it) */
@@ -261,7 +261,7 @@ static PetscErrorCode Target(const char lamina[])
   PetscCall(RunTarget(lamina, t, 1, &p));
   PetscCall(PeriTestSetOption("-eps_ncv", NULL));
   PetscCall(PetscSNPrintf(what, sizeof(what), "target %.1f Hz, -eps_ncv 3: mode / %.1f Hz", (double)t, (double)f[1]));
-  PeriTestClose(what, p->modal->modes[0].f_hz / f[1], 1.0, 1e-8);
+  PeriTestClose(what, PeriTestModal(p)->modes[0].f_hz / f[1], 1.0, 1e-8);
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));
   PetscCall(PeriTestSetOption("-model_type", NULL));
@@ -322,8 +322,8 @@ static PetscErrorCode Checks(const char lamina[])
   /* the default (preonly + Cholesky): accepted, its inner residual recorded */
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &a));
   PetscCheck(a->sys->results.residual_norm > 0 && a->sys->results.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "direct inner solve: worst true residual %g, expected in (0, 1e-6]", (double)a->sys->results.residual_norm);
-  for (PetscInt m = 0; m < a->modal->nmodes; m++) PetscCheck(a->modal->modes[m].residual <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "mode %" PetscInt_FMT " residual %g", m + 1, (double)a->modal->modes[m].residual);
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: direct inner solve: worst true residual %.2g <= 1e-6, the %" PetscInt_FMT " modes' residuals <= 1e-6\n", (double)a->sys->results.residual_norm, a->modal->nmodes));
+  for (PetscInt m = 0; m < PeriTestModal(a)->nmodes; m++) PetscCheck(PeriTestModal(a)->modes[m].residual <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "mode %" PetscInt_FMT " residual %g", m + 1, (double)PeriTestModal(a)->modes[m].residual);
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: direct inner solve: worst true residual %.2g <= 1e-6, the %" PetscInt_FMT " modes' residuals <= 1e-6\n", (double)a->sys->results.residual_norm, PeriTestModal(a)->nmodes));
   /* a preconditioner alone as the inner solve: refused at its first solve */
   PetscCall(ExpectRefused(lamina, jacobi, "inner solve 1 of the spectral transform", "-st_ksp_type preonly -st_pc_type cholesky"));
   /* CG to 1e-3: each inner solve within its own tolerance (100 rtol), the modes not: refused by the
@@ -337,11 +337,11 @@ static PetscErrorCode Checks(const char lamina[])
   PetscCall(PeriTestSetOption("-st_ksp_type", NULL));
   PetscCall(PeriTestSetOption("-st_pc_type", NULL));
   PetscCall(PeriTestSetOption("-st_ksp_rtol", NULL));
-  PetscCheck(b->modal->nmodes == a->modal->nmodes, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: %" PetscInt_FMT " modes, direct %" PetscInt_FMT, b->modal->nmodes, a->modal->nmodes);
+  PetscCheck(PeriTestModal(b)->nmodes == PeriTestModal(a)->nmodes, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: %" PetscInt_FMT " modes, direct %" PetscInt_FMT, PeriTestModal(b)->nmodes, PeriTestModal(a)->nmodes);
   PetscCheck(b->sys->results.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: worst true residual %g", (double)b->sys->results.residual_norm);
-  for (PetscInt m = 0; m < a->modal->nmodes; m++) {
+  for (PetscInt m = 0; m < PeriTestModal(a)->nmodes; m++) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "cg + jacobi to 1e-12 inner solves: mode %" PetscInt_FMT " f / f with Cholesky", m + 1));
-    PeriTestClose(what, b->modal->modes[m].f_hz / a->modal->modes[m].f_hz, 1.0, 1e-8);
+    PeriTestClose(what, PeriTestModal(b)->modes[m].f_hz / PeriTestModal(a)->modes[m].f_hz, 1.0, 1e-8);
   }
   PetscCall(PeriProblemDestroy(&a));
   PetscCall(PeriProblemDestroy(&b));

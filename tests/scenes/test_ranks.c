@@ -15,23 +15,23 @@ int main(int argc, char **argv)
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   PetscCall(PeriTestRunScene(PETSC_COMM_SELF, argv[1], &q));
-  if (p->modal) {
+  if (PeriTestModal(p)) {
     /* modes: the frequencies, which the eigensolver converges to 1e-10 */
-    for (PetscInt k = 0; k < p->modal->nmodes; k++) {
+    for (PetscInt k = 0; k < PeriTestModal(p)->nmodes; k++) {
       PetscCall(PetscSNPrintf(what, sizeof(what), "%s: mode %" PetscInt_FMT " frequency on %d ranks vs 1", p->sys->model->type, k + 1, size));
-      PeriTestClose(what, p->modal->modes[k].f_hz, q->modal->modes[k].f_hz, 1e-7 * q->modal->modes[k].f_hz);
+      PeriTestClose(what, PeriTestModal(p)->modes[k].f_hz, PeriTestModal(q)->modes[k].f_hz, 1e-7 * PeriTestModal(q)->modes[k].f_hz);
     }
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
     PetscCall(PeriFinalize());
     return 0;
   }
-  if (p->quasistatic) {
+  if (PeriTestQuasistatic(p)) {
     /* the same bonds break at the same loads: the bracket of the critical load is identical */
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s: last equilibrium load factor on %d ranks vs 1", p->sys->model->type, size));
-    PeriTestClose(what, p->quasistatic->peak_load_factor, q->quasistatic->peak_load_factor, 1e-12 * q->quasistatic->peak_load_factor);
+    PeriTestClose(what, PeriTestQuasistatic(p)->peak_load_factor, PeriTestQuasistatic(q)->peak_load_factor, 1e-12 * PeriTestQuasistatic(q)->peak_load_factor);
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s: load steps on %d ranks vs 1", p->sys->model->type, size));
-    PeriTestClose(what, (PetscReal)p->quasistatic->nsteps, (PetscReal)q->quasistatic->nsteps, 0);
+    PeriTestClose(what, (PetscReal)PeriTestQuasistatic(p)->nsteps, (PetscReal)PeriTestQuasistatic(q)->nsteps, 0);
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
     PetscCall(PeriFinalize());

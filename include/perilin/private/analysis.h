@@ -3,7 +3,10 @@
 
 #include "perilin/private/system.h"
 
-typedef struct _p_PeriProblem *PeriProblem;
+typedef struct _p_PeriAnalysis *PeriAnalysis;
+/* Writes the system's present state as NAME (a .vtu) into the output set: installed by the
+ * problem, which owns the set, so that an analysis can write a series while it runs. */
+typedef PetscErrorCode (*PeriSnapshotFn)(void *ctx, const char name[]);
 
 #define PERI_MAX_VTU_MODES 12
 
@@ -52,12 +55,12 @@ typedef struct {
  * "What is left"), the ops receive the problem; their results live in the problem's `modal` or
  * `quasistatic` member, freed by ops.destroy. */
 typedef struct {
-  PetscErrorCode (*run)(PeriProblem);
-  PetscErrorCode (*fields)(PeriProblem, PeriFieldList); /* its arrays in particles.vtu, or NULL */
-  PetscErrorCode (*files)(PeriProblem, const char[]);   /* its files in the output set (the directory), or NULL */
-  PetscErrorCode (*summary)(PeriProblem, PeriJSON);     /* its object in summary.json, or NULL */
-  PetscErrorCode (*report)(PeriProblem);                /* its result line on stdout, or NULL: the strain energy */
-  PetscErrorCode (*destroy)(PeriProblem);               /* frees its results, or NULL */
+  PetscErrorCode (*run)(PeriAnalysis);
+  PetscErrorCode (*fields)(PeriAnalysis, PeriFieldList); /* its arrays in particles.vtu, or NULL */
+  PetscErrorCode (*files)(PeriAnalysis, const char[]);   /* its files in the output set (the directory), or NULL */
+  PetscErrorCode (*summary)(PeriAnalysis, PeriJSON);     /* its object in summary.json, or NULL */
+  PetscErrorCode (*report)(PeriAnalysis);                /* its result line on stdout, or NULL: the strain energy */
+  PetscErrorCode (*destroy)(PeriAnalysis);               /* frees what data points to (data itself is freed after), or NULL */
 } PeriAnalysisOps;
 
 typedef struct {
@@ -67,6 +70,23 @@ typedef struct {
   PetscBool         eigensolver; /* its linear solves are an eigensolver's (options -st_ksp_type ...) */
   PeriAnalysisOps   ops;
 } PeriAnalysisType;
+/* One analysis of one problem: its type, the system it works on (borrowed), what the output
+ * asks of it, and its own data (PeriModal, PeriQuasistatic, ...), private to its file and its
+ * tests. */
+struct _p_PeriAnalysis {
+  const PeriAnalysisType *type;
+  MPI_Comm                comm;
+  PetscMPIInt             rank;
+  PeriSystem              sys;
+  PetscBool               vtk;        /* output.vtk: fields are written */
+  PetscInt                every;      /* output.every: snapshots every k steps (0: none) */
+  const char             *output_dir; /* for messages only */
+  PeriSnapshotFn          snapshot;   /* writes the present state into the output set */
+  void                   *snapshotctx;
+  void                   *data;
+};
+PETSC_EXTERN PetscErrorCode PeriAnalysisCreate(const PeriAnalysisType *, PeriSystem, PeriAnalysis *);
+PETSC_EXTERN PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisFind(const char[], const PeriAnalysisType **);
 PETSC_EXTERN PetscErrorCode PeriAnalysisListTypes(char[], size_t);

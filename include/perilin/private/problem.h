@@ -1,5 +1,4 @@
-/* struct _p_PeriProblem: for src/problem.c, the analyses (until they take a PeriSystem) and the
- * white-box tests. */
+/* struct _p_PeriProblem: for src/ (problem.c, summary.c, package.c) and the white-box tests. */
 #pragma once
 
 #include "perilin.h"
@@ -8,20 +7,18 @@
 #include "perilin/private/sys.h"
 
 struct _p_PeriProblem {
-  MPI_Comm                comm;
-  PetscMPIInt             rank, size;
-  PeriScene               scene;
-  PeriSystem              sys;                     /* the discretized physics: everything but the analysis and the output */
-  char                    analysis[PERI_NAME_LEN]; /* analysis.type */
-  const PeriAnalysisType *atype;                   /* its type, found by PeriProblemRun */
-  PeriQuasistatic        *quasistatic;             /* the quasi-static analysis' results */
-  PeriModal              *modal;                   /* the modal analysis' results */
-  PetscInt                output_every;            /* output.every (quasi-static snapshots) */
-  char                    output_dir[PETSC_MAX_PATH_LEN];
-  char                    staging_dir[PETSC_MAX_PATH_LEN]; /* where the outputs are written until the set is committed */
-  PetscBool               write_output;                    /* set by the executable: check output.dir before computing */
-  PetscBool               vtk;
-  PetscLogDouble          t_start;
+  MPI_Comm       comm;
+  PetscMPIInt    rank, size;
+  PeriScene      scene;
+  PeriSystem     sys;                          /* the discretized physics: everything but the analysis and the output */
+  char           analysis_type[PERI_NAME_LEN]; /* analysis.type */
+  PeriAnalysis   analysis;                     /* created by PeriProblemRun; its results are its data */
+  PetscInt       output_every;                 /* output.every (quasi-static snapshots) */
+  char           output_dir[PETSC_MAX_PATH_LEN];
+  char           staging_dir[PETSC_MAX_PATH_LEN]; /* where the outputs are written until the set is committed */
+  PetscBool      write_output;                    /* set by the executable: check output.dir before computing */
+  PetscBool      vtk;
+  PetscLogDouble t_start;
 };
 
 PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
