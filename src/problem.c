@@ -147,11 +147,11 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   if (!p->sys->interrupted) PetscCall(type->ops.run(p->analysis));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscTime(&t));
-  p->sys->results.total_s = t - p->t_start;
+  p->sys->log.total_s = t - p->t_start;
   getrusage(RUSAGE_SELF, &ru);
   mb = (PetscReal)ru.ru_maxrss / 1024.0; /* kilobytes on Linux */
-  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->results.memory_mb, 1, MPIU_REAL, MPI_SUM, p->comm));
-  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->results.memory_mb_max_rank, 1, MPIU_REAL, MPI_MAX, p->comm));
+  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->log.memory_mb, 1, MPIU_REAL, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->log.memory_mb_max_rank, 1, MPIU_REAL, MPI_MAX, p->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -229,7 +229,7 @@ PetscErrorCode PeriProblemCheckOptions(PeriProblem p)
 
 PetscErrorCode PeriProblemCheckUnusedOptions(PeriProblem p)
 {
-  PeriRunSolvers run = {p->comm, p->scene, p->sys->mat_type, p->sys->results.ksp_type, p->sys->results.pc_type, p->analysis ? p->analysis->type->eigensolver : PETSC_FALSE};
+  PeriRunSolvers run = {p->comm, p->scene, p->sys->mat_type, p->sys->solve.ksp_type, p->sys->solve.pc_type, p->analysis ? p->analysis->type->eigensolver : PETSC_FALSE};
 
   PetscFunctionBeginUser;
   if (p->sys->K) PetscCall(MatGetType(p->sys->K, &run.mat_type));
@@ -247,15 +247,14 @@ PetscErrorCode PeriProblemInterrupted(PeriProblem p, int *signal)
 /* The one-paragraph report on stdout: what ran, what it cost, the main results. */
 PetscErrorCode PeriProblemReport(PeriProblem p)
 {
-  PeriSystem         sys = p->sys;
-  const PeriResults *r   = &sys->results;
+  PeriSystem sys = p->sys;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->particles.n, r->nbonds_total, sys->particles.n * sys->model->dofs, p->size));
-  if (r->ksp_type[0])
-    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", r->neighbors_s, r->assembly_s, r->solve_s, r->ksp_type, r->pc_type, r->iterations, r->converged_reason, (double)r->residual_norm, r->memory_mb));
+  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->particles.n, sys->log.nbonds_total, sys->particles.n * sys->model->dofs, p->size));
+  if (sys->solve.ksp_type[0])
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.assembly_s, sys->log.solve_s, sys->solve.ksp_type, sys->solve.pc_type, sys->solve.iterations, sys->solve.converged_reason, (double)sys->solve.residual_norm, sys->log.memory_mb));
   else
-    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", r->neighbors_s, r->memory_mb));
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.memory_mb));
   if (sys->interrupted) {
     PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->u_all ? "the last complete state was written" : "no result was reached", p->output_dir));
   } else if (p->analysis && p->analysis->type->ops.report) {
@@ -263,7 +262,7 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   } else {
     const PeriTorsion *t = &sys->torsion;
     if (t->active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)t->torque, (double)t->J, (double)t->J_rectangle, 100 * (double)(t->J / t->J_rectangle - 1), (double)t->max_stress, (double)t->max_at[0], (double)t->max_at[1]));
-    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", r->strain_energy, p->output_dir));
+    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", sys->strain_energy, p->output_dir));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

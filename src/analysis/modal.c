@@ -519,14 +519,14 @@ static PetscErrorCode RecordSolver(PeriAnalysis an, EPS eps, PetscInt nev, const
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pt));
-  PetscCall(PetscStrncpy(an->sys->results.ksp_type, kt, sizeof(an->sys->results.ksp_type)));
-  PetscCall(PetscStrncpy(an->sys->results.pc_type, pt, sizeof(an->sys->results.pc_type)));
+  PetscCall(PetscStrncpy(an->sys->solve.ksp_type, kt, sizeof(an->sys->solve.ksp_type)));
+  PetscCall(PetscStrncpy(an->sys->solve.pc_type, pt, sizeof(an->sys->solve.pc_type)));
   PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &nconv));
   partial = (PetscBool)(nconv < asked || Modal(an)->nmodes < PetscMin(nev, Modal(an)->nfree_dofs - Modal(an)->nrigid));
-  PetscCall(PetscStrncpy(an->sys->results.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(an->sys->results.converged_reason)));
-  PetscCall(EPSGetIterationNumber(eps, &an->sys->results.iterations));
-  an->sys->results.residual_norm = inner->worst;
+  PetscCall(PetscStrncpy(an->sys->solve.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(an->sys->solve.converged_reason)));
+  PetscCall(EPSGetIterationNumber(eps, &an->sys->solve.iterations));
+  an->sys->solve.residual_norm = inner->worst;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -582,9 +582,9 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   PetscCall(PetscTime(&t1));
   PetscCall(SolveModes(an, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
   PetscCall(PetscTime(&t2));
-  md->factor_s             = t1 - t0;
-  md->solve_s              = t2 - t1;
-  an->sys->results.solve_s = t2 - t0;
+  md->factor_s         = t1 - t0;
+  md->solve_s          = t2 - t1;
+  an->sys->log.solve_s = t2 - t0;
   PetscCheck(npairs + md->nrigid > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", an->sys->scene->file);
   PetscCall(CollectModes(an, w->eps, w->Kff, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
   PetscCall(EPSGetTolerances(w->eps, &eps_tol, NULL));

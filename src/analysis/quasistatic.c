@@ -232,7 +232,7 @@ typedef struct {
   Vec            u;
   unsigned char *live;
   PetscReal     *intact;
-  PeriResults    solve; /* the solver fields of the solve that reached it */
+  PeriSolveInfo  solve; /* the solve that reached it */
 } Equilibrium;
 
 static PetscErrorCode EquilibriumCreate(PeriAnalysis an, Equilibrium *e)
@@ -253,7 +253,7 @@ static PetscErrorCode EquilibriumSave(PeriAnalysis an, Equilibrium *e)
 {
   PetscFunctionBeginUser;
   PetscCall(VecCopy(an->sys->u, e->u));
-  e->solve = an->sys->results;
+  e->solve = an->sys->solve;
   PetscCall(PetscArraycpy(e->live, an->sys->bonds.live, an->sys->bonds.nbonds));
   if (e->intact) PetscCall(PetscArraycpy(e->intact, an->sys->bonds.intact, an->sys->bonds.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -272,18 +272,10 @@ static PetscErrorCode EquilibriumRestore(PeriAnalysis an, Equilibrium *e, PetscB
     if (an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
   }
   if (restore_u) {
-    PeriResults *r = &an->sys->results;
     if (!an->sys->u) PetscCall(VecDuplicate(e->u, &an->sys->u));
     PetscCall(VecCopy(e->u, an->sys->u));
     /* summary.json's solver section describes the solve of this state, not the abandoned one */
-    if (e->solve.ksp_type[0]) {
-      PetscCall(PetscStrncpy(r->ksp_type, e->solve.ksp_type, sizeof(r->ksp_type)));
-      PetscCall(PetscStrncpy(r->pc_type, e->solve.pc_type, sizeof(r->pc_type)));
-      PetscCall(PetscStrncpy(r->converged_reason, e->solve.converged_reason, sizeof(r->converged_reason)));
-      r->iterations    = e->solve.iterations;
-      r->residual_norm = e->solve.residual_norm;
-      r->residual_tol  = e->solve.residual_tol;
-    }
+    if (e->solve.ksp_type[0]) an->sys->solve = e->solve;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -389,7 +381,7 @@ static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscR
     /* later solves start from the last solution: few bonds change between them */
     PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
     q->solves++;
-    s->ksp_iterations += an->sys->results.iterations;
+    s->ksp_iterations += an->sys->solve.iterations;
     PetscCall(PeriStaticConverged(an->sys, L->ksp, reason, &ok));
     PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
     if (an->sys->interrupted) {
@@ -400,7 +392,7 @@ static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscR
       /* the body as set up is linear: a solve that fails before any bond broke fails at every
          load, so it is the solver's failure, not the body's */
       if (total == 0 && s->broken == 0) PetscCall(PeriStaticCheckConverged(an->sys, reason));
-      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)an->sys->results.residual_norm));
+      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)an->sys->solve.residual_norm));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
     PetscCall(BreakBonds(an, st, &nb));
@@ -541,7 +533,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscCall(PetscFree2(L.hold, L.held));
   PetscCall(EquilibriumDestroy(&eq));
   PetscCall(PetscTime(&t));
-  an->sys->results.solve_s = t - t0;
+  an->sys->log.solve_s = t - t0;
   PetscCall(Finish(an, &st));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -595,7 +587,6 @@ static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
 /* summary.json's "quasistatic" object: the path's end, the critical load, what broke. */
 static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
 {
-  const PeriResults *r = &an->sys->results;
 
   PetscFunctionBeginUser;
   if (!QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
@@ -610,7 +601,7 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
     PetscCall(PeriJSONInt(j, "failed_trial_broken_bonds", q->failed_trial_broken));
   }
   PetscCall(PeriJSONInt(j, "broken_bonds", q->broken_bonds));
-  PetscCall(PeriJSONInt(j, "precracked_bonds", r->precracked_bonds));
+  PetscCall(PeriJSONInt(j, "precracked_bonds", an->sys->failure.precracked_bonds));
   PetscCall(PeriJSONBool(j, "failed", q->failed));
   PetscCall(PeriJSONBool(j, "complete", q->complete));
   PetscCall(PeriJSONString(j, "ending", q->ending));

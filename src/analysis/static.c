@@ -22,9 +22,9 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscCall(VecSetValues(an->sys->u, an->sys->nconstrained, an->sys->constrained, an->sys->constrained_value, INSERT_VALUES));
     PetscCall(VecAssemblyBegin(an->sys->u));
     PetscCall(VecAssemblyEnd(an->sys->u));
-    PetscCall(PetscStrncpy(an->sys->results.ksp_type, "none", sizeof(an->sys->results.ksp_type)));
-    PetscCall(PetscStrncpy(an->sys->results.pc_type, "none", sizeof(an->sys->results.pc_type)));
-    PetscCall(PetscStrncpy(an->sys->results.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(an->sys->results.converged_reason)));
+    PetscCall(PetscStrncpy(an->sys->solve.ksp_type, "none", sizeof(an->sys->solve.ksp_type)));
+    PetscCall(PetscStrncpy(an->sys->solve.pc_type, "none", sizeof(an->sys->solve.pc_type)));
+    PetscCall(PetscStrncpy(an->sys->solve.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(an->sys->solve.converged_reason)));
     PetscCall(PeriSystemEvaluateEnergy(an->sys));
     PetscCall(PeriReferenceEvaluate(an->sys));
     PetscFunctionReturn(PETSC_SUCCESS);
@@ -57,7 +57,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   PetscCall(KSPDestroy(&ksp));
   PetscCall(PeriStaticCheckConverged(an->sys, reason));
   PetscCall(PetscTime(&t1));
-  an->sys->results.solve_s = t1 - t0;
+  an->sys->log.solve_s = t1 - t0;
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
   PetscCall(PeriReferenceEvaluate(an->sys));
   PetscFunctionReturn(PETSC_SUCCESS);

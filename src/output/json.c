@@ -85,7 +85,7 @@ static PetscErrorCode JSONAppend(char dst[], const char src[], size_t size)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Dotted path of the value about to be written ("results.max_abs_u[2]"), for error messages. */
+/* Dotted path of the value about to be written ("max_abs_u[2]"), for error messages. */
 static PetscErrorCode JSONPath(PeriJSON j, const char key[], char path[], size_t len)
 {
   char last[PERI_NAME_LEN + 32];

@@ -134,7 +134,7 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
   if (sys->family.offset) CutBonds(&sys->particles, &sys->family, list->n, seg);
   PetscCall(PetscFree(seg));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, sys->comm));
-  sys->results.precracked_bonds = cut;
+  sys->failure.precracked_bonds = cut;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -412,7 +412,7 @@ PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, Pets
 PetscErrorCode PeriFailureAddFields(PeriSystem sys, PeriFieldList fl)
 {
   const PeriFailure *F      = &sys->failure;
-  const PetscBool    used[] = {(PetscBool)(sys->results.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
+  const PetscBool    used[] = {(PetscBool)(sys->failure.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
   const PetscInt     map0   = 0;
 
   PetscFunctionBeginUser;

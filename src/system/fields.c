@@ -154,8 +154,8 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   PetscCall(PeriElementsForEach(sys, ElementEnergy, &E));
   for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
     for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(pt, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
-  PetscCallMPI(MPI_Allreduce(umax, sys->results.max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
-  PetscCallMPI(MPI_Allreduce(&E.energy, &sys->results.strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(umax, sys->max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscCallMPI(MPI_Allreduce(&E.energy, &sys->strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
   PetscCallMPI(MPI_Reduce(sys->rank ? W : MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, 0, sys->comm));
   if (m->antiplane) PetscCall(ShearStresses(sys, u));
   PetscCall(PetscFree(sys->W));

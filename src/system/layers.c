@@ -276,7 +276,7 @@ PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
   PetscCall(MatNorm(*A, NORM_INFINITY, &kmax));
   PetscCall(MatIsSymmetric(*A, 1e-12 * kmax, &sym));
   PetscCall(MatSetOption(*A, MAT_SYMMETRIC, sym));
-  sys->results.symmetric = sym;
+  sys->solve.symmetric = sym;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

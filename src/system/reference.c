@@ -132,7 +132,6 @@ static PetscBool Interior(PeriSystem sys, PetscInt i)
 @*/
 PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
 {
-  PeriResults     *res     = &sys->results;
   const PetscInt   bs      = sys->model->dofs;
   const PetscReal *c       = sys->reference.center;
   PetscReal        A[3][3] = {{0}}, bx[3] = {0, 0, 0}, by[3] = {0, 0, 0}, R[3][3] = {{0}}, br[3] = {0, 0, 0};
@@ -140,7 +139,7 @@ PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
   PetscInt         n = 0, ux, uy;
 
   PetscFunctionBeginUser;
-  res->has_reference = PETSC_FALSE;
+  sys->reference.evaluated = PETSC_FALSE;
   if (sys->rank || sys->reference.type == PERI_REFERENCE_NONE) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
   PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
@@ -174,10 +173,10 @@ PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
     PetscCall(SmallSolve(3, A2, by));
     PetscCall(SmallSolve(3, R, br));
   }
-  res->interior_particles = n;
-  res->interior_strain[0] = bx[1];
-  res->interior_strain[1] = by[2];
-  res->interior_strain[2] = bx[2] + by[1];
+  sys->reference.interior_particles = n;
+  sys->reference.interior_strain[0] = bx[1];
+  sys->reference.interior_strain[1] = by[2];
+  sys->reference.interior_strain[2] = bx[2] + by[1];
   for (PetscInt i = 0; i < sys->particles.n; i++) {
     const PetscReal *X = &sys->particles.x[3 * i], *u = &sys->u_all[i * bs];
     PetscReal        ref[2], e[2];
@@ -191,41 +190,40 @@ PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
     umax = PetscMax(umax, PetscSqrtReal(ref[0] * ref[0] + ref[1] * ref[1]));
   }
   PetscCheck(den > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the reference field vanishes on the interior particles (reference.stress = 0?)", sys->scene->file);
-  res->error_l2_rel  = PetscSqrtReal(num / den);
-  res->error_max_rel = dmax / umax;
-  res->effective_E = res->effective_nu = res->effective_G = 0;
+  sys->reference.error_l2_rel  = PetscSqrtReal(num / den);
+  sys->reference.error_max_rel = dmax / umax;
+  sys->reference.effective_E = sys->reference.effective_nu = sys->reference.effective_G = 0;
   if (sys->reference.type == PERI_REFERENCE_UNIAXIAL) {
     PetscInt  a  = sys->reference.axis;
-    PetscReal ea = res->interior_strain[a], eb = res->interior_strain[1 - a];
-    res->effective_E  = sys->reference.stress / ea;
-    res->effective_nu = -eb / ea;
+    PetscReal ea = sys->reference.interior_strain[a], eb = sys->reference.interior_strain[1 - a];
+    sys->reference.effective_E  = sys->reference.stress / ea;
+    sys->reference.effective_nu = -eb / ea;
   } else if (sys->reference.type == PERI_REFERENCE_SHEAR)
-    res->effective_G = sys->reference.stress / res->interior_strain[2];
-  res->has_reference = PETSC_TRUE;
+    sys->reference.effective_G = sys->reference.stress / sys->reference.interior_strain[2];
+  sys->reference.evaluated = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Against reference.*: interior strain, effective moduli, errors. */
 PetscErrorCode PeriReferenceSummary(PeriSystem sys, PeriJSON j)
 {
-  const PeriResults *r = &sys->results;
 
   PetscFunctionBeginUser;
-  if (!r->has_reference) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->reference.evaluated) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONBeginObject(j, "reference"));
   PetscCall(PeriJSONString(j, "type", PeriReferenceTypes[sys->reference.type]));
   PetscCall(PeriJSONReal(j, "stress", sys->reference.stress));
   PetscCall(PeriJSONEndObject(j));
-  PetscCall(PeriJSONInt(j, "interior_particles", r->interior_particles));
-  PetscCall(PeriJSONRealArray(j, "interior_strain", 3, r->interior_strain));
+  PetscCall(PeriJSONInt(j, "interior_particles", sys->reference.interior_particles));
+  PetscCall(PeriJSONRealArray(j, "interior_strain", 3, sys->reference.interior_strain));
   PetscCall(PeriJSONBeginObject(j, "effective"));
-  if (r->effective_E != 0) PetscCall(PeriJSONReal(j, "E", r->effective_E));
-  if (r->effective_E != 0) PetscCall(PeriJSONReal(j, "nu", r->effective_nu));
-  if (r->effective_G != 0) PetscCall(PeriJSONReal(j, "G", r->effective_G));
+  if (sys->reference.effective_E != 0) PetscCall(PeriJSONReal(j, "E", sys->reference.effective_E));
+  if (sys->reference.effective_E != 0) PetscCall(PeriJSONReal(j, "nu", sys->reference.effective_nu));
+  if (sys->reference.effective_G != 0) PetscCall(PeriJSONReal(j, "G", sys->reference.effective_G));
   PetscCall(PeriJSONEndObject(j));
   PetscCall(PeriJSONBeginObject(j, "error"));
-  PetscCall(PeriJSONReal(j, "l2_rel", r->error_l2_rel));
-  PetscCall(PeriJSONReal(j, "max_rel", r->error_max_rel));
+  PetscCall(PeriJSONReal(j, "l2_rel", sys->reference.error_l2_rel));
+  PetscCall(PeriJSONReal(j, "max_rel", sys->reference.error_max_rel));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

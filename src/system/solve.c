@@ -24,7 +24,7 @@ static const char *Advice(KSPConvergedReason reason)
 /* What to tell the user when KSP claims convergence but the true residual is too large. */
 static const char *AdviceResidual(PeriSystem sys)
 {
-  if (!strcmp(sys->results.ksp_type, KSPPREONLY)) return "preonly applies the preconditioner once, which solves the system only when it is a direct factorization: use -pc_type cholesky (or lu), or drop -ksp_type preonly for the default CG + GAMG";
+  if (!strcmp(sys->solve.ksp_type, KSPPREONLY)) return "preonly applies the preconditioner once, which solves the system only when it is a direct factorization: use -pc_type cholesky (or lu), or drop -ksp_type preonly for the default CG + GAMG";
   return "tighten -ksp_rtol, or check -ksp_norm_type (the preconditioned norm can be far below the true one); a larger solver.residual_tol accepts the answer as it is";
 }
 
@@ -151,9 +151,9 @@ static PetscErrorCode HandleFreeMotions(PeriSystem sys, Mat A, Vec u, Vec b, Pet
     PetscCall(VecDot(b, free[q], &dot));
     share += PetscSqr(PetscRealPart(dot));
   }
-  share                       = bnorm > 0 ? PetscSqrtReal(share) / bnorm : 0;
-  sys->results.free_modes     = *nfree;
-  sys->results.load_imbalance = share;
+  share                     = bnorm > 0 ? PetscSqrtReal(share) / bnorm : 0;
+  sys->solve.free_modes     = *nfree;
+  sys->solve.load_imbalance = share;
   PetscCheck(bnorm > 0 && share<1e-6, sys->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular%s. Constrain it in bc (e.g. fix the component on a small region)", sys->scene->file, what, bnorm> 0 ? " and the loads are not balanced along it" : "");
   for (PetscInt q = 0; q < *nfree; q++) {
     PetscScalar dot;
@@ -162,8 +162,8 @@ static PetscErrorCode HandleFreeMotions(PeriSystem sys, Mat A, Vec u, Vec b, Pet
   }
   PetscCall(PinFreeMotions(sys, *nfree, free, &npin, pins));
   PetscCall(MatZeroRowsColumns(A, npin, pins, diag, u, b));
-  if (!sys->results.free_modes_noted) PetscCall(PetscPrintf(sys->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
-  sys->results.free_modes_noted = PETSC_TRUE;
+  if (!sys->log.free_modes_noted) PetscCall(PetscPrintf(sys->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
+  sys->log.free_modes_noted = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -309,7 +309,7 @@ static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool
   PetscCall(VecDuplicate(sys->f, b));
   PetscCall(VecCopy(sys->f, *b));
   PetscCall(VecScale(*b, lambda));
-  sys->results.symmetric = PETSC_TRUE;
+  sys->solve.symmetric = PETSC_TRUE;
   if (sys->layers.T)
     PetscCall(PeriLayersApply(sys, lambda, A, *b));
   else if (inplace) {
@@ -367,7 +367,7 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Vec b, 
   PetscBool retry;
 
   PetscFunctionBeginUser;
-  if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->results.symmetric, ksp));
+  if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->solve.symmetric, ksp));
   PetscCall(KSPSetOperators(*ksp, A, A));
   PetscCall(KSPSolve(*ksp, b, sys->u));
   PetscCall(KSPGetConvergedReason(*ksp, reason));
@@ -390,20 +390,20 @@ static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConv
   PC        pc;
 
   PetscFunctionBeginUser;
-  PetscCall(KSPGetIterationNumber(ksp, &sys->results.iterations));
+  PetscCall(KSPGetIterationNumber(ksp, &sys->solve.iterations));
   PetscCall(MatCreateVecs(A, &r, NULL));
   PetscCall(MatMult(A, sys->u, r));
   PetscCall(VecAYPX(r, -1, b));
   PetscCall(VecNorm(r, NORM_2, &rnorm));
   PetscCall(VecNorm(b, NORM_2, &fnorm));
   PetscCall(VecDestroy(&r));
-  sys->results.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
+  sys->solve.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pt));
-  PetscCall(PetscStrncpy(sys->results.ksp_type, kt, sizeof(sys->results.ksp_type)));
-  PetscCall(PetscStrncpy(sys->results.pc_type, pt, sizeof(sys->results.pc_type)));
-  PetscCall(PetscStrncpy(sys->results.converged_reason, KSPConvergedReasons[reason], sizeof(sys->results.converged_reason)));
+  PetscCall(PetscStrncpy(sys->solve.ksp_type, kt, sizeof(sys->solve.ksp_type)));
+  PetscCall(PetscStrncpy(sys->solve.pc_type, pt, sizeof(sys->solve.pc_type)));
+  PetscCall(PetscStrncpy(sys->solve.converged_reason, KSPConvergedReasons[reason], sizeof(sys->solve.converged_reason)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -453,19 +453,19 @@ PetscErrorCode PeriStaticConverged(PeriSystem sys, KSP ksp, KSPConvergedReason r
 
   PetscFunctionBeginUser;
   PetscCall(KSPGetTolerances(ksp, &rtol, NULL, NULL, NULL));
-  sys->results.residual_tol = PeriResidualTolerance(sys, rtol);
-  *ok                       = (PetscBool)(reason > 0 && !PetscIsInfOrNanReal(sys->results.residual_norm) && sys->results.residual_norm <= sys->results.residual_tol);
+  sys->solve.residual_tol = PeriResidualTolerance(sys, rtol);
+  *ok                     = (PetscBool)(reason > 0 && !PetscIsInfOrNanReal(sys->solve.residual_norm) && sys->solve.residual_norm <= sys->solve.residual_tol);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* What a failed static solve tells the user (after PeriStaticConverged). */
 PetscErrorCode PeriStaticCheckConverged(PeriSystem sys, KSPConvergedReason reason)
 {
-  PetscBool ok = (PetscBool)(reason > 0 && sys->results.residual_norm <= sys->results.residual_tol);
+  PetscBool ok = (PetscBool)(reason > 0 && sys->solve.residual_norm <= sys->solve.residual_tol);
 
   PetscFunctionBeginUser;
-  PetscCheck(!PetscIsInfOrNanReal(sys->results.residual_norm), sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: the solution contains NaN or Inf (%s/%s, %s): %s", sys->results.ksp_type, sys->results.pc_type, KSPConvergedReasons[reason], Advice(KSP_DIVERGED_NANORINF));
-  PetscCheck(reason > 0, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g (tolerance %.3g), %s/%s stopped with %s after %" PetscInt_FMT " iterations: %s", (double)sys->results.residual_norm, (double)sys->results.residual_tol, sys->results.ksp_type, sys->results.pc_type, KSPConvergedReasons[reason], sys->results.iterations, Advice(reason));
-  PetscCheck(ok, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g > tolerance %.3g although %s/%s reported %s after %" PetscInt_FMT " iterations: %s", (double)sys->results.residual_norm, (double)sys->results.residual_tol, sys->results.ksp_type, sys->results.pc_type, KSPConvergedReasons[reason], sys->results.iterations, AdviceResidual(sys));
+  PetscCheck(!PetscIsInfOrNanReal(sys->solve.residual_norm), sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: the solution contains NaN or Inf (%s/%s, %s): %s", sys->solve.ksp_type, sys->solve.pc_type, KSPConvergedReasons[reason], Advice(KSP_DIVERGED_NANORINF));
+  PetscCheck(reason > 0, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g (tolerance %.3g), %s/%s stopped with %s after %" PetscInt_FMT " iterations: %s", (double)sys->solve.residual_norm, (double)sys->solve.residual_tol, sys->solve.ksp_type, sys->solve.pc_type, KSPConvergedReasons[reason], sys->solve.iterations, Advice(reason));
+  PetscCheck(ok, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g > tolerance %.3g although %s/%s reported %s after %" PetscInt_FMT " iterations: %s", (double)sys->solve.residual_norm, (double)sys->solve.residual_tol, sys->solve.ksp_type, sys->solve.pc_type, KSPConvergedReasons[reason], sys->solve.iterations, AdviceResidual(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -18,15 +18,14 @@ PetscErrorCode PeriSystemSummaryModel(PeriSystem sys, PeriJSON j)
 /* Sizes and the discretization: particles, bonds, DOFs, ranks, horizon, corrections, material. */
 PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
 {
-  const PeriResults *r = &sys->results;
-  const PeriModel    m = sys->model;
+  const PeriModel m = sys->model;
 
   PetscFunctionBeginUser;
   PetscCall(PeriJSONInt(j, "particles", sys->particles.n));
-  PetscCall(PeriJSONInt(j, "bonds", r->nbonds_total));
+  PetscCall(PeriJSONInt(j, "bonds", sys->log.nbonds_total));
   PetscCall(PeriJSONInt(j, "dofs", sys->particles.n * m->dofs));
   PetscCall(PeriJSONInt(j, "ranks", sys->size));
-  PetscCall(PeriJSONInt(j, "edge_cut", r->edge_cut));
+  PetscCall(PeriJSONInt(j, "edge_cut", sys->log.edge_cut));
   PetscCall(PeriJSONReal(j, "horizon", sys->delta));
   PetscCall(PeriJSONString(j, "partial_volume", PeriPartialVolumes[sys->partial_volume]));
   PetscCall(PeriJSONString(j, "surface_correction", PeriSurfaceCorrections[sys->surface]));
@@ -42,17 +41,16 @@ PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
 /* What the run cost: time per phase and peak memory. */
 PetscErrorCode PeriSystemSummaryCost(PeriSystem sys, PeriJSON j)
 {
-  const PeriResults *r = &sys->results;
 
   PetscFunctionBeginUser;
   PetscCall(PeriJSONBeginObject(j, "timing"));
-  PetscCall(PeriJSONReal(j, "neighbors_s", r->neighbors_s));
-  PetscCall(PeriJSONReal(j, "assembly_s", r->assembly_s));
-  PetscCall(PeriJSONReal(j, "solve_s", r->solve_s));
-  PetscCall(PeriJSONReal(j, "total_s", r->total_s));
+  PetscCall(PeriJSONReal(j, "neighbors_s", sys->log.neighbors_s));
+  PetscCall(PeriJSONReal(j, "assembly_s", sys->log.assembly_s));
+  PetscCall(PeriJSONReal(j, "solve_s", sys->log.solve_s));
+  PetscCall(PeriJSONReal(j, "total_s", sys->log.total_s));
   PetscCall(PeriJSONEndObject(j));
-  PetscCall(PeriJSONReal(j, "memory_mb", r->memory_mb));
-  PetscCall(PeriJSONReal(j, "memory_mb_max_rank", r->memory_mb_max_rank));
+  PetscCall(PeriJSONReal(j, "memory_mb", sys->log.memory_mb));
+  PetscCall(PeriJSONReal(j, "memory_mb_max_rank", sys->log.memory_mb_max_rank));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -60,23 +58,22 @@ PetscErrorCode PeriSystemSummaryCost(PeriSystem sys, PeriJSON j)
  * solver was used (analysis setup); an interrupted run always says whether it converged. */
 PetscErrorCode PeriSystemSummarySolver(PeriSystem sys, PeriJSON j)
 {
-  const PeriResults *r = &sys->results;
 
   PetscFunctionBeginUser;
-  if (!r->ksp_type[0] && !sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->solve.ksp_type[0] && !sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONBeginObject(j, "solver"));
-  PetscCall(PeriJSONString(j, "ksp_type", r->ksp_type));
-  PetscCall(PeriJSONString(j, "pc_type", r->pc_type));
-  PetscCall(PeriJSONInt(j, "iterations", r->iterations));
-  PetscCall(PeriJSONString(j, "converged_reason", r->converged_reason));
-  PetscCall(PeriJSONReal(j, "residual_norm", r->residual_norm));
-  if (r->residual_tol > 0) PetscCall(PeriJSONReal(j, "residual_tol", r->residual_tol));
+  PetscCall(PeriJSONString(j, "ksp_type", sys->solve.ksp_type));
+  PetscCall(PeriJSONString(j, "pc_type", sys->solve.pc_type));
+  PetscCall(PeriJSONInt(j, "iterations", sys->solve.iterations));
+  PetscCall(PeriJSONString(j, "converged_reason", sys->solve.converged_reason));
+  PetscCall(PeriJSONReal(j, "residual_norm", sys->solve.residual_norm));
+  if (sys->solve.residual_tol > 0) PetscCall(PeriJSONReal(j, "residual_tol", sys->solve.residual_tol));
   /* written results passed every check; an interrupted solve did not finish */
   PetscCall(PeriJSONBool(j, "converged", sys->interrupted && !sys->u_all ? PETSC_FALSE : PETSC_TRUE));
-  PetscCall(PeriJSONString(j, "operator", r->symmetric ? "symmetric" : "unsymmetric"));
-  if (r->free_modes) {
-    PetscCall(PeriJSONInt(j, "free_rigid_motions", r->free_modes));
-    PetscCall(PeriJSONReal(j, "load_share_removed", r->load_imbalance));
+  PetscCall(PeriJSONString(j, "operator", sys->solve.symmetric ? "symmetric" : "unsymmetric"));
+  if (sys->solve.free_modes) {
+    PetscCall(PeriJSONInt(j, "free_rigid_motions", sys->solve.free_modes));
+    PetscCall(PeriJSONReal(j, "load_share_removed", sys->solve.load_imbalance));
   }
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -85,13 +82,12 @@ PetscErrorCode PeriSystemSummarySolver(PeriSystem sys, PeriJSON j)
 /* Strain energy and the largest |u| per component, when there is a solution. */
 PetscErrorCode PeriSystemSummaryFields(PeriSystem sys, PeriJSON j)
 {
-  const PeriResults *r = &sys->results;
 
   PetscFunctionBeginUser;
   if (!sys->u_all) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriJSONReal(j, "strain_energy", r->strain_energy));
+  PetscCall(PeriJSONReal(j, "strain_energy", sys->strain_energy));
   PetscCall(PeriJSONBeginObject(j, "max_abs_u"));
-  for (PetscInt c = 0; c < sys->model->dofs; c++) PetscCall(PeriJSONReal(j, sys->model->components[c], r->max_abs_u[c]));
+  for (PetscInt c = 0; c < sys->model->dofs; c++) PetscCall(PeriJSONReal(j, sys->model->components[c], sys->max_abs_u[c]));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -280,10 +280,10 @@ static PetscErrorCode SetUpBonds(PeriSystem sys)
   PetscCall(PeriSurfaceCorrectionApply(sys->surface, &sys->particles, sys->delta, sys->family_volume, &sys->bonds));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Neighbors, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
-  sys->results.neighbors_s = t1 - t0;
-  PetscCallMPI(MPI_Allreduce(&sys->bonds.nbonds, &sys->results.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
+  sys->log.neighbors_s = t1 - t0;
+  PetscCallMPI(MPI_Allreduce(&sys->bonds.nbonds, &sys->log.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
   for (PetscInt k = 0; k < sys->bonds.nbonds; k++) cut += sys->owner[sys->bonds.j[k]] != sys->rank;
-  PetscCallMPI(MPI_Allreduce(&cut, &sys->results.edge_cut, 1, MPIU_INT, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(&cut, &sys->log.edge_cut, 1, MPIU_INT, MPI_SUM, sys->comm));
   PetscCall(PetscFree(perm));
   PetscCall(PetscFree(range));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -411,7 +411,7 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
   PetscCall(MatDestroy(&sys->K));
   PetscCall(PeriAssembleStiffness(sys, &sys->K));
   PetscCall(PetscTime(&t1));
-  sys->results.assembly_s = t1 - t0;
+  sys->log.assembly_s = t1 - t0;
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -93,7 +93,7 @@ static PetscErrorCode Extremes(const char dir[])
     Lattice(lm, -0.99, 3, &lnu, &lE, &lG);
     PetscCall(Run(dir, "traction", models[mo], "-0.99", &p));
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=-0.99 traction: nu_eff vs lattice", models[mo]));
-    if (!rank) PeriTestClose(what, p->sys->results.effective_nu, lnu, 0.03);
+    if (!rank) PeriTestClose(what, p->sys->reference.effective_nu, lnu, 0.03);
     PetscCall(PeriProblemDestroy(&p));
     /* nu = 0.34 > 1/3: negative shear springs. The direct solver always answers; CG either converges
      * or stops with a reason */
@@ -110,7 +110,7 @@ static PetscErrorCode Extremes(const char dir[])
         PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s nu=0.34 with CG: stops with 'did not converge' (indefinite), as documented\n", models[mo]));
       } else {
         PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=0.34 (%s) traction: nu_eff vs lattice", models[mo], direct ? "lu" : "cg"));
-        if (!rank) PeriTestClose(what, p->sys->results.effective_nu, lnu, 0.02);
+        if (!rank) PeriTestClose(what, p->sys->reference.effective_nu, lnu, 0.02);
       }
       PetscCall(PeriProblemDestroy(&p));
       PetscCall(PeriTestSetOption("-ksp_type", NULL));
@@ -128,7 +128,7 @@ static PetscErrorCode Extremes(const char dir[])
       LatticePlane(LATTICE_PDS_MPPD, PETSC_TRUE, (PetscReal)atof(nus[k]), 3, &lnu, &lE, &lG);
       PetscCall(Run(dir, "traction", "mppd", nus[k], &p));
       PetscCall(PetscSNPrintf(what, sizeof(what), "mppd plane strain nu=%s (lu): in-plane nu_eff vs lattice", nus[k]));
-      if (!rank) PeriTestClose(what, p->sys->results.effective_nu, lnu, 0.035);
+      if (!rank) PeriTestClose(what, p->sys->reference.effective_nu, lnu, 0.035);
       PetscCall(PeriProblemDestroy(&p));
     }
     PetscCall(PeriTestSetOption("-model_plane", NULL));
@@ -143,7 +143,7 @@ static PetscErrorCode Extremes(const char dir[])
       PetscCall(PeriTestSetOption("-horizon_m", ms[k]));
       PetscCall(Run(dir, "traction", "mppd", "0.25", &p));
       PetscCall(PetscSNPrintf(what, sizeof(what), "mppd nu=0.25 m=%s traction: nu_eff vs lattice", ms[k]));
-      if (!rank) PeriTestClose(what, p->sys->results.effective_nu, lnu, 0.02);
+      if (!rank) PeriTestClose(what, p->sys->reference.effective_nu, lnu, 0.02);
       PetscCall(PeriProblemDestroy(&p));
     }
     PetscCall(PeriTestSetOption("-horizon_m", NULL));
@@ -182,8 +182,8 @@ int main(int argc, char **argv)
   /* what the finite plate costs: pmb (= pds at nu = 1/3) against its own lattice */
   Lattice(LATTICE_PMB, 1.0 / 3, 3, &lnu, &lE, &lG);
   PetscCall(Run(argv[1], "shear", "pds", "1/3", &p));
-  shear_allow = PetscAbsReal(p->sys->results.effective_G / (E * lG) - 1) + 0.02;
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "pmb plate: G_eff / G_lattice - 1 = %+.4f: shear tolerance %.4f\n", (double)(p->sys->results.effective_G / (E * lG) - 1), (double)shear_allow));
+  shear_allow = PetscAbsReal(p->sys->reference.effective_G / (E * lG) - 1) + 0.02;
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "pmb plate: G_eff / G_lattice - 1 = %+.4f: shear tolerance %.4f\n", (double)(p->sys->reference.effective_G / (E * lG) - 1), (double)shear_allow));
   PetscCall(PeriProblemDestroy(&p));
 
   for (int k = 0; k < 4; k++) {
@@ -195,16 +195,16 @@ int main(int argc, char **argv)
       PetscCall(Run(argv[1], "traction", models[mo], nus[k], &p));
       if (!rank) {
         PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s traction: nu_eff vs lattice", models[mo], nus[k]));
-        PeriTestClose(what, p->sys->results.effective_nu, lnu, 0.02);
+        PeriTestClose(what, p->sys->reference.effective_nu, lnu, 0.02);
         PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s traction: E_eff / E_lattice", models[mo], nus[k]));
-        PeriTestClose(what, p->sys->results.effective_E / (E * lE), 1.0, 0.03);
+        PeriTestClose(what, p->sys->reference.effective_E / (E * lE), 1.0, 0.03);
       }
       PetscCall(PeriProblemDestroy(&p));
 
       PetscCall(Run(argv[1], "shear", models[mo], nus[k], &p));
       if (!rank) {
-        PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s shear: G_eff / G_lattice (exact G ratio %.4f)", models[mo], nus[k], (double)(p->sys->results.effective_G / G)));
-        PeriTestClose(what, p->sys->results.effective_G / (E * lG), 1.0, shear_allow);
+        PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s shear: G_eff / G_lattice (exact G ratio %.4f)", models[mo], nus[k], (double)(p->sys->reference.effective_G / G)));
+        PeriTestClose(what, p->sys->reference.effective_G / (E * lG), 1.0, shear_allow);
       }
       PetscCall(PeriProblemDestroy(&p));
 
@@ -223,7 +223,7 @@ int main(int argc, char **argv)
         PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, what, &p));
       }
       if (!rank) {
-        PetscReal err = p->sys->results.error_l2_rel;
+        PetscReal err = p->sys->reference.error_l2_rel;
         PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu=%s bending: interior l2 error vs elasticity%s", models[mo], nus[k], mo == 2 ? " with the lattice's E, nu" : ""));
         if (mo == 0) {
           PetscCheck(err > 0.3, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s: %g, but pds should miss bending by tens of percent (Table 3)", what, (double)err);

@@ -24,14 +24,14 @@ int main(int argc, char **argv)
   meas[0] = -0.03;
   PeriTestClose("compression index -s/s_cc", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1.5, 1e-14);
   /* the cut-off piece: held, the rest loaded and solved */
-  PeriTestClose("static solve converged with a held piece", (PetscReal)(p->sys->results.residual_norm < 1e-8), 1, 0);
+  PeriTestClose("static solve converged with a held piece", (PetscReal)(p->sys->solve.residual_norm < 1e-8), 1, 0);
   PetscCall(PeriDamage(p->sys, &p->sys->damage));
   if (p->rank == 0) {
     PetscReal dmax = 0;
     for (PetscInt i = 0; i < p->sys->particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
     PeriTestClose("largest damage of the cut particles in (0, 1)", (PetscReal)(dmax > 0.2 && dmax < 1), 1, 0);
   }
-  PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->sys->results.precracked_bonds > 0), 1, 0);
+  PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->sys->failure.precracked_bonds > 0), 1, 0);
   /* G: pmb, plane stress: s_c = sqrt(4 pi G / (9 E delta)) */
   p->sys->failure.stretch = 0;
   p->sys->failure.G       = 100;
@@ -68,11 +68,11 @@ int main(int argc, char **argv)
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
     meas[0] = 2e-3;
     PeriTestClose("softening share at (s_0 + s_u)/2", PeriBondSoftening(p->sys, meas), 0.5, 1e-14);
-    E1 = p->sys->results.strain_energy;
+    E1 = p->sys->strain_energy;
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriTestSetOption("-analysis_load_factor_max", "4"));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
-    E2 = p->sys->results.strain_energy;
+    E2 = p->sys->strain_energy;
     if (p->rank == 0)
       for (PetscInt i = 0; i < p->sys->particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
     PetscCallMPI(MPI_Bcast(&dmax, 1, MPIU_REAL, 0, PETSC_COMM_WORLD));

@@ -246,7 +246,7 @@ static PetscErrorCode EnergyError(PeriProblem p, PetscReal norm2, const PetscRea
     PetscCall(VecNorm(p->sys->u, NORM_2, &unorm));
     PetscCall(VecDestroy(&Ku));
     /* relative to the round-off scale ||K||_2 ||u||^2 / 2: a smooth u cancels much of K */
-    *mismatch = PetscAbsReal(p->sys->results.strain_energy - 0.5 * PetscRealPart(uKu)) / (0.5 * norm2 * unorm * unorm);
+    *mismatch = PetscAbsReal(p->sys->strain_energy - 0.5 * PetscRealPart(uKu)) / (0.5 * norm2 * unorm * unorm);
   }
   W      = TargetEnergy(m, G, comp);
   reach  = 2 * PeriSearchRadius(p->sys->partial_volume, p->sys->delta, pt->mean_spacing);

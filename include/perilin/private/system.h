@@ -17,29 +17,25 @@ typedef struct {
   PetscReal W;
 } PeriProbe;
 
+/* The last linear solve: what solved it, how well, and the rigid motions it left free. */
 typedef struct {
-  PetscReal neighbors_s, assembly_s, solve_s, total_s;
-  PetscReal memory_mb, memory_mb_max_rank;
-  char      ksp_type[64], pc_type[64], converged_reason[64];
+  char      ksp_type[64], pc_type[64], converged_reason[64]; /* "" until a solve ran */
   PetscInt  iterations;
-  PetscReal residual_norm; /* true relative residual of the last solve */
-  PetscReal residual_tol;  /* the largest accepted (solver.residual_tol or its default) */
-  PetscReal strain_energy;
-  PetscReal max_abs_u[PERI_MAX_DOF];
-  PetscInt  nbonds_total;
+  PetscReal residual_norm;  /* true relative residual of the last solve */
+  PetscReal residual_tol;   /* the largest accepted (solver.residual_tol or its default) */
   PetscBool symmetric;      /* the operator solved was symmetric */
   PetscInt  free_modes;     /* rigid motions left free with balanced loads: solved orthogonal to them */
   PetscReal load_imbalance; /* share of the load along those motions, removed */
-  PetscInt  precracked_bonds;
-  PetscBool free_modes_noted; /* the note on free motions is printed once per run */
+} PeriSolveInfo;
+
+/* What the run cost and how large it was. */
+typedef struct {
+  PetscReal neighbors_s, assembly_s, solve_s, total_s;
+  PetscReal memory_mb, memory_mb_max_rank;
+  PetscInt  nbonds_total;
   PetscInt  edge_cut;         /* bonds between particles of different ranks */
-  /* against the scene's reference field (src/reference.c) */
-  PetscBool has_reference;
-  PetscInt  interior_particles;
-  PetscReal interior_strain[3];                     /* e_xx, e_yy, gamma_xy */
-  PetscReal effective_E, effective_nu, effective_G; /* 0 where the stress state does not define it */
-  PetscReal error_l2_rel, error_max_rel;
-} PeriResults;
+  PetscBool free_modes_noted; /* the note on free motions is printed once per run */
+} PeriRunLog;
 
 typedef enum {
   PERI_REFERENCE_NONE,
@@ -55,6 +51,12 @@ typedef struct {
   PetscInt          axis;   /* uniaxial: the loaded axis */
   PetscReal         center[3];
   PetscReal         E, nu; /* elastic constants of the reference; default the material's */
+  /* the comparison (PeriReferenceEvaluate) */
+  PetscBool evaluated;
+  PetscInt  interior_particles;
+  PetscReal interior_strain[3];                     /* e_xx, e_yy, gamma_xy */
+  PetscReal effective_E, effective_nu, effective_G; /* 0 where the stress state does not define it */
+  PetscReal error_l2_rel, error_max_rel;
 } PeriReference;
 
 /* Fictitious boundary layers outside the body's faces (Oterkus & Madenci sec. 6, src/layers.c):
@@ -99,6 +101,7 @@ typedef struct {
   PetscReal stretch, G, compressive, sliding, friction_angle, cohesion, shear_angle;
   PetscReal ultimate, ultimate_compressive; /* softening: the stretch where the stiffness is gone (0: brittle) */
   PetscInt  istretch, isliding, ishear;     /* the model's measures, -1 when absent */
+  PetscInt  precracked_bonds;               /* bonds the scene's cracks removed */
 } PeriFailure;
 
 typedef struct _p_PeriSystem *PeriSystem;
@@ -136,7 +139,10 @@ struct _p_PeriSystem {
   PeriProbe            *probes;
   PetscReal            *W;     /* strain energy density per particle (rank 0, after the solve) */
   PetscReal            *u_all; /* displacements of all particles (rank 0, after the solve) */
-  PeriResults           results;
+  PeriSolveInfo         solve;
+  PeriRunLog            log;
+  PetscReal             strain_energy;           /* after the last solve */
+  PetscReal             max_abs_u[PERI_MAX_DOF]; /* per component, after the last solve */
   PeriReference         reference;
   int                   interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
   PetscReal             residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
