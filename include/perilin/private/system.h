@@ -204,3 +204,7 @@ PETSC_EXTERN PetscErrorCode PeriSystemSummaryTorsion(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryFields(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryReference(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryProbes(PeriSystem, PeriJSON);
+
+/* The scene keys each system module declares, next to the code that reads them (src/package.c
+ * hands them to the scene layer). */
+PETSC_EXTERN const PeriSchema PeriSystemSchema[], PeriBoundarySchema[], PeriReferenceSchema[], PeriLayersSchema[], PeriFailureSchema[], PeriProbesSchema[];
