@@ -22,6 +22,7 @@ PETSC_EXTERN PetscErrorCode PeriInitialize(int *, char ***, const char[]);
 PETSC_EXTERN PetscErrorCode PeriFinalize(void);
 /* Every scene key with its meaning (perilin -help). */
 PETSC_EXTERN PetscErrorCode PeriPrintHelp(MPI_Comm);
+PETSC_EXTERN PetscErrorCode PeriSceneDoc(MPI_Comm, const char[], PetscBool);
 
 PETSC_EXTERN PetscErrorCode PeriProblemCreate(MPI_Comm, PeriProblem *);
 /* Reads the scene file and applies the option overrides (-material_nu 0.3). */

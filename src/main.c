@@ -23,6 +23,24 @@ static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, con
   return n;
 }
 
+/* -scene_doc_update FILE rewrites the key tables of docs/scene.md from the declared keys;
+ * -scene_doc_check FILE fails when they are out of date (the scene_doc test). *done: either ran. */
+static PetscErrorCode SceneDoc(PetscBool *done)
+{
+  char      file[PETSC_MAX_PATH_LEN];
+  PetscBool update, check;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-scene_doc_update", file, sizeof(file), &update));
+  if (!update)
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-scene_doc_check", file, sizeof(file), &check));
+  else
+    check = PETSC_FALSE;
+  *done = (PetscBool)(update || check);
+  if (*done) PetscCall(PeriSceneDoc(PETSC_COMM_WORLD, file, check));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode Run(int argc, char **argv, PeriProblem *problem, int *status)
 {
   PeriProblem p;
@@ -34,6 +52,8 @@ static PetscErrorCode Run(int argc, char **argv, PeriProblem *problem, int *stat
     PetscCall(PeriPrintHelp(PETSC_COMM_WORLD));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
+  PetscCall(SceneDoc(&help_asked));
+  if (help_asked) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(argc >= 2 && argv[1][0] != '-', PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "usage: perilin SCENE.yaml [options]; perilin -help lists the scene keys");
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, problem));
   p = *problem;

@@ -4,6 +4,7 @@
 #include "perilin/private/scene.h"
 #include "perilin/private/model.h"
 #include "perilin/private/problem.h"
+#include "perilin/private/system.h"
 #include <slepcsys.h>
 
 static PetscBool PeriPackageInitialized = PETSC_FALSE;
@@ -59,34 +60,66 @@ PetscErrorCode PeriFinalize(void)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The core modules' schemas, each next to the code that reads its sections; the root keys
+ * (problem) first. */
+static const PeriSchemaOwner core_owners[] = {
+    {"core", "problem", PeriProblemSchema},
+    {"core", "system", PeriSystemSchema},
+    {"core", "material", PeriMaterialSchema},
+    {"core", "particles", PeriParticlesSchema},
+    {"core", "regions", PeriRegionsSchema},
+    {"core", "boundary", PeriBoundarySchema},
+    {"core", "probes", PeriProbesSchema},
+    {"core", "reference", PeriReferenceSchema},
+    {"core", "layers", PeriLayersSchema},
+    {"core", "failure", PeriFailureSchema},
+};
+
 /*@C
-  PeriPluginSchemas - every built-in model's and analysis' schema, for the scene layer, which
-  cannot ask the registries itself: it validates, documents and adds from options the keys they
-  declare. At most max; not collective.
+  PeriSchemaOwners - the core's schemas, then every built-in model's and analysis' schema, for the
+  scene layer, which cannot ask the modules and registries itself: it validates, documents and
+  adds from options the keys they declare. At most max; not collective.
 @*/
-PetscErrorCode PeriPluginSchemas(PetscInt max, PeriSchemaOwner owners[], PetscInt *n)
+PetscErrorCode PeriSchemaOwners(PetscInt max, PeriSchemaOwner owners[], PetscInt *n)
 {
   const PeriModelType *const    *models;
   const PeriAnalysisType *const *analyses;
+  const PetscInt                 nc = (PetscInt)PETSC_STATIC_ARRAY_LENGTH(core_owners);
   PetscInt                       nm, na;
 
   PetscFunctionBeginUser;
   PetscCall(PeriModelGetTypes(&nm, &models));
   PetscCall(PeriAnalysisGetTypes(&na, &analyses));
-  PetscCheck(nm + na <= max, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%" PetscInt_FMT " plug-ins, more than PERI_MAX_PLUGINS = %" PetscInt_FMT, nm + na, max);
-  for (PetscInt k = 0; k < nm; k++) owners[k] = (PeriSchemaOwner){"model", models[k]->name, models[k]->schema};
-  for (PetscInt k = 0; k < na; k++) owners[nm + k] = (PeriSchemaOwner){"analysis", analyses[k]->name, analyses[k]->schema};
-  *n = nm + na;
+  PetscCheck(nc + nm + na <= max, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%" PetscInt_FMT " schema owners, more than %" PetscInt_FMT, nc + nm + na, max);
+  for (PetscInt k = 0; k < nc; k++) owners[k] = core_owners[k];
+  for (PetscInt k = 0; k < nm; k++) owners[nc + k] = (PeriSchemaOwner){"model", models[k]->name, models[k]->schema};
+  for (PetscInt k = 0; k < na; k++) owners[nc + nm + k] = (PeriSchemaOwner){"analysis", analyses[k]->name, analyses[k]->schema};
+  *n = nc + nm + na;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode PeriPrintHelp(MPI_Comm comm)
 {
-  PeriSchemaOwner owners[PERI_MAX_PLUGINS];
+  PeriSchemaOwner owners[PERI_MAX_SCHEMA_OWNERS];
   PetscInt        n;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriPluginSchemas(PERI_MAX_PLUGINS, owners, &n));
+  PetscCall(PeriSchemaOwners(PERI_MAX_SCHEMA_OWNERS, owners, &n));
   PetscCall(PeriSceneHelp(comm, n, owners));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSceneDoc - rewrites the key tables of file (docs/scene.md) from the schemas, or with check
+  only compares them: an out-of-date table is a PETSC_ERR_USER_INPUT. Collective.
+@*/
+PetscErrorCode PeriSceneDoc(MPI_Comm comm, const char file[], PetscBool check)
+{
+  PeriSchemaOwner owners[PERI_MAX_SCHEMA_OWNERS];
+  PetscInt        n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSchemaOwners(PERI_MAX_SCHEMA_OWNERS, owners, &n));
+  PetscCall(PeriSceneDocUpdate(comm, file, check, n, owners));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

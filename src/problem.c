@@ -23,24 +23,63 @@ PetscErrorCode PeriProblemCreate(MPI_Comm comm, PeriProblem *problem)
 @*/
 PetscErrorCode PeriProblemLoad(PeriProblem p, const char file[])
 {
-  PeriSchemaOwner owners[PERI_MAX_PLUGINS];
+  PeriSchemaOwner owners[PERI_MAX_SCHEMA_OWNERS];
   PetscInt        n;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriPluginSchemas(PERI_MAX_PLUGINS, owners, &n));
+  PetscCall(PeriSchemaOwners(PERI_MAX_SCHEMA_OWNERS, owners, &n));
   PetscCall(PeriSceneCreateFromFile(file, n, owners, &p->scene));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The root keys, in the order "allowed here" lists them, and the core's keys of analysis and
+ * output (the analyses declare theirs). */
+static const PeriKey root_keys[] = {
+    {"dim", PERI_KEY_INT, "required", "{2, 3}", NULL, NULL, "the space dimension"},
+    {"model", PERI_KEY_MAP, "required", NULL, NULL, NULL, "the bond model and its constants"},
+    {"material", PERI_KEY_MAP, "required", NULL, NULL, NULL, "the elastic constants and the density"},
+    {"grid", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "particles on a regular grid filling a box (or particles)"},
+    {"particles", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "particles read from a CSV file (or grid)"},
+    {"horizon", PERI_KEY_MAP, "required", NULL, NULL, NULL, "the horizon radius"},
+    {"corrections", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "partial-volume and surface corrections"},
+    {"regions", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "named boxes and boundary layers"},
+    {"bc", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "boundary conditions, applied in order"},
+    {"loads", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "forces, tractions and body forces"},
+    {"probes", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "named points reported after the solve"},
+    {"analysis", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "what to compute"},
+    {"output", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "where and what to write"},
+    {"reference", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an exact plane elasticity field to compare with"},
+    {"boundary_layers", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "fictitious layers outside the faces (cross-section models)"},
+    {"torsion", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the twist of a bar (cross-section models)"},
+    {"failure", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "bond failure criteria"},
+    {"cracks", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "pre-existing cracks"},
+    {"solver", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "checks of the linear solves"},
+    {NULL},
+};
+static const PeriKey analysis_keys[] = {
+    {"type", PERI_KEY_STRING, "static", NULL, NULL, NULL, "the analysis"},
+    {NULL},
+};
+static const PeriKey output_keys[] = {
+    {"dir", PERI_KEY_STRING, "<scene file name without directory and last extension>-out", NULL, NULL, NULL, "output directory"},
+    {"vtk", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "write particles.vtu"},
+    {NULL},
+};
+const PeriSchema PeriProblemSchema[] = {
+    {"", root_keys},
+    {"analysis", analysis_keys},
+    {"output", output_keys},
+    {NULL},
+};
 
 /* analysis.type, and analysis.* against that analysis' schema (p->scene->owners holds every
  * plug-in's). An unknown type allows every analysis' keys here: PeriProblemRun reports it with
  * the list of types. */
 static PetscErrorCode ReadAnalysis(PeriProblem p)
 {
-  static const char *const base[] = {"type", NULL};
-  PeriScene                s      = p->scene;
-  const PeriSchemaOwner   *active = NULL;
-  PeriNode                 a;
+  PeriScene              s      = p->scene;
+  const PeriSchemaOwner *active = NULL;
+  PeriNode               a;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(p->analysis_type, "static", sizeof(p->analysis_type)));
@@ -48,16 +87,16 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
   PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis_type, sizeof(p->analysis_type), NULL));
   for (PetscInt o = 0; o < s->nowners; o++)
     if (!strcmp(s->owners[o].kind, "analysis") && !strcmp(s->owners[o].name, p->analysis_type)) active = &s->owners[o];
-  PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", base, active));
+  PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", active));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* output.*; output.every is quasistatic's key (its schema), read here with the others for now. */
 static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
 {
-  static const char *const keys[] = {"dir", "vtk", "every", NULL};
-  PeriScene                s      = p->scene;
-  PeriNode                 o;
-  char                     base[PETSC_MAX_PATH_LEN], *slash, *dot;
+  PeriScene s = p->scene;
+  PeriNode  o;
+  char      base[PETSC_MAX_PATH_LEN], *slash, *dot;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(base, (slash = strrchr(file, '/')) ? slash + 1 : file, sizeof(base)));
@@ -65,21 +104,12 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PetscSNPrintf(p->output_dir, sizeof(p->output_dir), "%s-out", base));
   p->vtk = PETSC_TRUE;
   PetscCall(PeriSceneGetMap(s, s->root, "output", PETSC_FALSE, &o));
-  PetscCall(PeriSceneCheckKeys(s, o, keys));
+  PetscCall(PeriSceneCheckSection(s, o, "output"));
   PetscCall(PeriSceneGetString(s, o, "dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
   PetscCall(PeriSceneGetBool(s, o, "vtk", &p->vtk, NULL));
   PetscCall(PeriSceneGetInt(s, o, "every", PETSC_FALSE, &p->output_every, NULL));
   PeriInputCheck(p->output_every >= 0, s, o, "every", "must not be negative (0: only the end), got %" PetscInt_FMT, p->output_every);
   PetscCall(ReadAnalysis(p));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode CheckRootKeys(PeriScene s)
-{
-  static const char *const keys[] = {"dim", "model", "material", "grid", "particles", "horizon", "corrections", "regions", "bc", "loads", "probes", "analysis", "output", "reference", "boundary_layers", "torsion", "failure", "cracks", "solver", NULL};
-
-  PetscFunctionBeginUser;
-  PetscCall(PeriSceneCheckKeys(s, s->root, keys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -92,7 +122,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
-  PetscCall(CheckRootKeys(p->scene));
+  PetscCall(PeriSceneCheckSection(p->scene, p->scene->root, ""));
   PetscCall(PeriSystemCreate(p->comm, p->scene, &p->sys));
   PetscCall(PeriSystemSetFromScene(p->sys));
   PetscCall(ReadOutput(p, p->scene->file));

@@ -21,9 +21,8 @@ struct _PeriNode {
   PeriNode    *child;
 };
 
-/* A scene key, declared once next to the code that reads it: validation, -help and the options
- * that add a missing key all come from the declaration. Today only the plug-ins (model types,
- * analysis types) declare their keys this way; the core sections still list theirs in code. */
+/* A scene key, declared once next to the code that reads it: validation, -help, the key tables of
+ * docs/scene.md and the options that add a missing key all come from the declaration. */
 typedef enum {
   PERI_KEY_REAL,
   PERI_KEY_INT,
@@ -44,14 +43,16 @@ typedef struct {
   const char *const *choices; /* PERI_KEY_CHOICE: NULL-terminated; else NULL */
   const char        *help;    /* one line */
 } PeriKey;
-/* The keys one owner declares in one section ("model", "analysis"). A plug-in's schema is an
- * array of these ended by {NULL}, so that it may also own keys in other sections. */
+/* The keys one owner declares in one section: "model", "bc.<k>" (each item of the list bc),
+ * "regions.<name>" (each entry of the mapping regions), "" for the root keys. A schema is an array
+ * of these ended by {NULL}, so that an owner may declare keys in several sections. */
 typedef struct _PeriSchema {
   const char    *section;
   const PeriKey *keys;
 } PeriSchema;
-/* A plug-in and its schema, as the core hands them to the scene layer: kind "model" or
- * "analysis", name its type ("mppd"), schema NULL when it declares no key. */
+/* An owner of keys and its schema, as the core hands them to the scene layer: kind "core" (name
+ * its module, "system"), "model" or "analysis" (name its type, "mppd"); schema NULL when it
+ * declares no key. */
 typedef struct {
   const char       *kind, *name;
   const PeriSchema *schema;
@@ -63,14 +64,15 @@ struct _p_PeriScene {
   char                   dir[PETSC_MAX_PATH_LEN]; /* directory of the scene file, for relative paths */
   PeriNode               root;
   PetscInt               nowners;
-  const PeriSchemaOwner *owners; /* every plug-in's schema: options may add their keys */
+  const PeriSchemaOwner *owners; /* the core's schemas, then every plug-in's */
 };
 
 PETSC_EXTERN PetscErrorCode PeriSceneWhere(PeriScene, PeriNode, const char[], char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriSceneGetNode(PeriNode, const char[], PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetMap(PeriScene, PeriNode, const char[], PetscBool, PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriSceneCheckKeys(PeriScene, PeriNode, const char *const[]);
-PETSC_EXTERN PetscErrorCode PeriSceneCheckKeysSchema(PeriScene, PeriNode, const char[], const char *const[], const PeriSchemaOwner *);
+PETSC_EXTERN PetscErrorCode PeriSceneCheckSection(PeriScene, PeriNode, const char[]);
+PETSC_EXTERN PetscErrorCode PeriSceneCheckKeysSchema(PeriScene, PeriNode, const char[], const PeriSchemaOwner *);
 PETSC_EXTERN const PeriKey *PeriSchemaFindKey(const PeriSchema *, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneGetReal(PeriScene, PeriNode, const char[], PetscBool, PetscReal *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetInt(PeriScene, PeriNode, const char[], PetscBool, PetscInt *, PetscBool *);

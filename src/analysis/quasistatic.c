@@ -649,6 +649,11 @@ static const PeriKey     qs_keys[]     = {
             {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "adaptive: more bonds than this share breaking in one step is a runaway"},
             {NULL},
 };
-static const PeriSchema qs_schema[] = {{"analysis", qs_keys}, {NULL}};
+/* output.every, which the run's snapshots follow (problem.c reads it with output.*) */
+static const PeriKey qs_output_keys[] = {
+    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k equilibrium steps (0: only the end)"},
+    {NULL},
+};
+static const PeriSchema qs_schema[] = {{"analysis", qs_keys}, {"output", qs_output_keys}, {NULL}};
 
 const PeriAnalysisType PeriAnalysis_Quasistatic = {"quasistatic", "load stepping with bond failure to the critical load", qs_schema, PETSC_FALSE, {PeriAnalysisRun_Quasistatic, NULL, QSFiles, QSSummary, NULL, QSDestroy}};

@@ -11,15 +11,32 @@ static PetscErrorCode ParticlesAllocate(PeriParticles *p, PetscInt n)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* grid.* and particles.*: a body is one or the other. */
+static const PeriKey grid_keys[] = {
+    {"lower", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "the box's lower corner, dim numbers"},
+    {"upper", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "the box's upper corner, dim numbers, above lower on every axis"},
+    {"spacing", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "particle spacing dx: every box length a whole number of spacings"},
+    {"periodic", PERI_KEY_BOOLS, "all false", NULL, NULL, NULL, "dim booleans: the periodic axes (minimum image)"},
+    {NULL},
+};
+static const PeriKey particles_keys[] = {
+    {"file", PERI_KEY_STRING, "required", NULL, NULL, NULL, "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid"},
+    {NULL},
+};
+const PeriSchema PeriParticlesSchema[] = {
+    {"grid", grid_keys},
+    {"particles", particles_keys},
+    {NULL},
+};
+
 static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, PeriParticles *p)
 {
-  static const char *const keys[]   = {"lower", "upper", "spacing", "periodic", NULL};
-  PetscReal                lower[3] = {0, 0, 0}, upper[3] = {0, 0, 0}, h, cellvol;
-  PetscInt                 nl, nu, cells[3] = {1, 1, 1}, n = 1, k = 0;
-  PeriNode                 per;
+  PetscReal lower[3] = {0, 0, 0}, upper[3] = {0, 0, 0}, h, cellvol;
+  PetscInt  nl, nu, cells[3] = {1, 1, 1}, n = 1, k = 0;
+  PeriNode  per;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneCheckKeys(scene, grid, keys));
+  PetscCall(PeriSceneCheckSection(scene, grid, "grid"));
   PetscCall(PeriSceneGetRealArray(scene, grid, "lower", PETSC_TRUE, dim, dim, lower, &nl));
   PetscCall(PeriSceneGetRealArray(scene, grid, "upper", PETSC_TRUE, dim, dim, upper, &nu));
   PetscCall(PeriSceneGetReal(scene, grid, "spacing", PETSC_TRUE, &h, NULL));
@@ -60,11 +77,10 @@ static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, P
 /* The particles file's path from the section's one key: absolute as given, else relative to the scene file's folder. */
 static PetscErrorCode CSVPath(PeriScene scene, PeriNode node, char path[], size_t size)
 {
-  static const char *const keys[] = {"file", NULL};
-  char                     name[PETSC_MAX_PATH_LEN];
+  char name[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneCheckKeys(scene, node, keys));
+  PetscCall(PeriSceneCheckSection(scene, node, "particles"));
   PetscCall(PeriSceneGetString(scene, node, "file", PETSC_TRUE, name, sizeof(name), NULL));
   if (name[0] == '/')
     PetscCall(PetscStrncpy(path, name, size));

@@ -1,7 +1,15 @@
 /* Named regions: boxes, and boundary layers of a given depth along a face of the body. */
 #include "perilin/private/disc.h"
 
-static const char *const sides[] = {"x-", "x+", "y-", "y+", "z-", "z+", NULL};
+static const char *const sides[]       = {"x-", "x+", "y-", "y+", "z-", "z+", NULL};
+static const PeriKey     region_keys[] = {
+        {"lower", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a box region: its lower corner, with upper"},
+        {"upper", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a box region: its upper corner, at least lower"},
+        {"side", PERI_KEY_CHOICE, NULL, NULL, NULL, sides, "a boundary layer instead: the face it lies along (z- and z+ in 3D only)"},
+        {"depth", PERI_KEY_REAL, "horizon delta", "(0, inf)", "[length]", NULL, "a boundary layer's depth"},
+        {NULL},
+};
+const PeriSchema PeriRegionsSchema[] = {{"regions.<name>", region_keys}, {NULL}};
 
 /* Points on a region's boundary belong to it: tolerance relative to the body size. */
 static PetscReal Tolerance(const PeriParticles *p)
@@ -21,14 +29,13 @@ PetscBool PeriRegionContains(const PeriRegion *r, const PetscReal x[])
 
 static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const PeriParticles *p, PetscReal delta, PeriRegion *r)
 {
-  static const char *const keys[] = {"lower", "upper", "side", "depth", NULL};
-  PetscReal                tol    = Tolerance(p);
-  PetscInt                 n, dim = p->dim, side = -1;
-  PeriNode                 lower, sidenode;
+  PetscReal tol = Tolerance(p);
+  PetscInt  n, dim = p->dim, side = -1;
+  PeriNode  lower, sidenode;
 
   PetscFunctionBeginUser;
   PeriInputCheck(node->kind == PERI_NODE_MAP, scene, node, NULL, "a region is a box {lower: [..], upper: [..]} or a layer {side: x-, depth: d}");
-  PetscCall(PeriSceneCheckKeys(scene, node, keys));
+  PetscCall(PeriSceneCheckSection(scene, node, "regions.<name>"));
   PetscCall(PetscStrncpy(r->name, node->key, sizeof(r->name)));
   r->node = node;
   PetscCall(PeriSceneGetNode(node, "lower", &lower));

@@ -83,21 +83,35 @@ PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* material.*: rho_by_region is read by the modal analysis, but declared here to keep the order of
+ * "allowed here". */
+static const PeriKey material_keys[] = {
+    {"E", PERI_KEY_REAL, NULL, "(0, inf)", "[stress]", NULL, "Young's modulus; give exactly one of E, K and mu"},
+    {"nu", PERI_KEY_REAL, "the model's fixed value", NULL, NULL, NULL, "Poisson ratio: pmb/npmb only 1/3 (plane stress) or 1/4 (plane strain, 3D); pds/mppd/gerstle in (-1, 1/2)"},
+    {"K", PERI_KEY_REAL, NULL, "(0, inf)", "[stress]", NULL, "3D bulk modulus, instead of E: E = 3 K (1 - 2 nu)"},
+    {"mu", PERI_KEY_REAL, NULL, "(0, inf)", "[stress]", NULL, "shear modulus, instead of E: E = 2 mu (1 + nu) (the cross-section models need only mu)"},
+    {"rho", PERI_KEY_REAL, "0", "[0, inf)", "[mass/volume]", NULL, "density; the modal analysis requires > 0"},
+    {"rho_by_region", PERI_KEY_MAP, NULL, NULL, "[mass/volume]", NULL, "modal only: map region -> density (> 0), replacing rho there (later entries win)"},
+    {"mu_by_region", PERI_KEY_MAP, NULL, NULL, "[stress]", NULL, "antiplane models: map region -> shear modulus (> 0) there (later entries win; interfaces: eq. 60)"},
+    {"thickness", PERI_KEY_REAL, "1", "(0, inf)", "[length]", NULL, "2D thickness (ignored in 3D); for antiplane models the bar length"},
+    {NULL},
+};
+const PeriSchema PeriMaterialSchema[] = {{"material", material_keys}, {NULL}};
+
 /*@C
   PeriModelSetFromScene - reads material.* (E and nu, or K and nu; nu defaults to the model's only
   admissible value when it has one), the model's own keys, and the horizon delta. Not collective.
 @*/
 PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal delta)
 {
-  static const char *const keys[] = {"E", "nu", "K", "mu", "rho", "rho_by_region", "mu_by_region", "thickness", NULL};
-  PeriNode                 mat, node;
-  PetscReal                lo, hi, E = 0, nu = 0, K = 0, mu = 0;
-  PetscBool                hasE, hasnu, hasK, hasmu;
+  PeriNode  mat, node;
+  PetscReal lo, hi, E = 0, nu = 0, K = 0, mu = 0;
+  PetscBool hasE, hasnu, hasK, hasmu;
 
   PetscFunctionBeginUser;
   m->delta = delta;
   PetscCall(PeriSceneGetMap(scene, scene->root, "material", PETSC_TRUE, &mat));
-  PetscCall(PeriSceneCheckKeys(scene, mat, keys));
+  PetscCall(PeriSceneCheckSection(scene, mat, "material"));
   PetscCall(PeriSceneGetReal(scene, mat, "E", PETSC_FALSE, &E, &hasE));
   PetscCall(PeriSceneGetReal(scene, mat, "nu", PETSC_FALSE, &nu, &hasnu));
   PetscCall(PeriSceneGetReal(scene, mat, "K", PETSC_FALSE, &K, &hasK));

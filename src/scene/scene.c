@@ -8,76 +8,6 @@
 #include <libgen.h>
 #include <strings.h>
 
-/* The documented scalar keys of the core sections: `perilin -help` lists them, and an option
- * naming one that the file lacks adds it (so -model_plane strain works on a scene that does not
- * name the plane). The plug-ins' keys (model.k_theta, analysis.nev, ...) are not here: each model
- * and analysis type declares them in its schema, which the scene receives as scene->owners. */
-typedef struct {
-  const char *path, *meaning;
-} PeriSceneKey;
-
-static const PeriSceneKey scene_keys[] = {
-    {"dim", "2 or 3"},
-    {"model.type", "bond model (docs/models/)"},
-    {"model.plane", "2D only: stress | strain"},
-    {"material.E", "Young's modulus [stress]"},
-    {"material.nu", "Poisson ratio: pmb/npmb only 1/3 (plane stress) or 1/4 (plane strain, 3D); pds/mppd/gerstle (-1, 1/2)"},
-    {"material.K", "3D bulk modulus [stress], instead of E"},
-    {"material.mu", "shear modulus [stress], instead of E (antiplane models need only mu)"},
-    {"material.mu_by_region", "antiplane models: map region -> shear modulus there (interfaces: eq. 60)"},
-    {"material.rho", "density [mass/volume] (modal analysis)"},
-    {"material.rho_by_region", "map region -> density, overriding material.rho there (modal)"},
-    {"material.thickness", "2D thickness [length]; default 1"},
-    {"grid.spacing", "particle spacing dx [length]"},
-    {"grid.lower", "box lower corner [length], a list of dim numbers"},
-    {"grid.upper", "box upper corner [length], a list of dim numbers"},
-    {"grid.periodic", "list of dim booleans: periodic axes (minimum image)"},
-    {"particles.file", "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid"},
-    {"horizon.m", "horizon as a multiple of the spacing, delta = m dx"},
-    {"horizon.delta", "horizon radius [length], instead of m"},
-    {"corrections.partial_volume", "none | linear (alpha ramp cut at delta) | linear_continued (ramp to delta + dx/2)"},
-    {"corrections.surface", "none | volume (lambda = 2 V0 / (V(H_i) + V(H_j))) | energy (antiplane models, Oterkus & Madenci eq. 53)"},
-    {"regions.<name>.lower/upper", "a box region"},
-    {"regions.<name>.side", "a boundary layer: x- | x+ | y- | y+ | z- | z+, with .depth [length] (default delta)"},
-    {"bc.<k>.region", "region the condition applies to (all = every particle)"},
-    {"bc.<k>.fix", "list of components held at zero, e.g. [ux, uy]"},
-    {"bc.<k>.value", "map component -> prescribed value, e.g. {ux: 0.001}"},
-    {"bc.<k>.affine", "prescribed linear field u = A X + b: {A: [[..],..], b: [..]}"},
-    {"loads.<k>.region", "region the load applies to"},
-    {"loads.<k>.force", "total force [force], spread over the region's particles by volume"},
-    {"loads.<k>.traction", "traction [stress] on the face of a layer region (force = traction x face area)"},
-    {"loads.<k>.body_force", "force per unit volume [force/volume]"},
-    {"loads.<k>.traction_field", "traction [stress] varying over a layer region: {A: [[..],..], b: [..]}, t = A X + b"},
-    {"bc.<k>.optional", "true: skip the listed components the model lacks (one scene for several models)"},
-    {"reference.type", "exact plane field to compare with: uniaxial | shear | bending"},
-    {"reference.stress", "its stress: sigma (uniaxial), tau (shear), extreme fibre stress (bending) [stress]"},
-    {"reference.axis", "uniaxial: the loaded axis, x | y"},
-    {"reference.E", "Young's modulus of the reference solution [stress]; default material.E"},
-    {"reference.nu", "Poisson ratio of the reference solution; default material.nu"},
-    {"reference.center", "the point where the reference field has no displacement; default the body centre"},
-    {"boundary_layers.<k>.side", "fictitious layer outside a face of a grid body (antiplane models): x- | x+ | y- | y+"},
-    {"boundary_layers.<k>.condition", "displacement (u_z = value) | shear_stress (sigma_nz = value) | free"},
-    {"boundary_layers.<k>.value", "the prescribed displacement [length] or shear stress [stress]"},
-    {"torsion.twist", "angle of twist per unit length psi [1/length]: the free layers carry it"},
-    {"torsion.center", "the axis of twist [x0, y0]; default the centre of the box"},
-    {"failure.critical_stretch", "critical tensile stretch s_c"},
-    {"failure.G", "energy release rate [energy/length^2]: each bond's critical stretch or shear angle from the model"},
-    {"failure.compressive_stretch", "critical compressive stretch (a positive number)"},
-    {"failure.sliding", "pds/mppd/gerstle: critical sliding gamma_0"},
-    {"failure.friction_angle", "pds/mppd/gerstle: frictional sliding gamma_l = cohesion - s tan(angle), degrees"},
-    {"failure.cohesion", "pds/mppd/gerstle: the sliding limit without stretch"},
-    {"failure.shear_angle", "antiplane: critical shear angle r_c"},
-    {"failure.ultimate_stretch", "softening (eq. 45): the stiffness falls linearly from critical_stretch to 0 here"},
-    {"failure.ultimate_compressive_stretch", "softening in compression (eq. 46)"},
-    {"cracks.<k>.from/to", "a pre-existing crack: 2D segment; bonds crossing it are removed before the first step"},
-    {"output.every", "quasistatic: write particles_NNNN.vtu every k steps (0: only the end)"},
-    {"probes.<name>", "a point [x, y(, z)]: displacement and energy density of the nearest particle"},
-    {"analysis.type", "the analysis (default static)"},
-    {"solver.residual_tol", "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; default max(100 rtol, 1e-6)"},
-    {"output.dir", "output directory; default <scene name>-out"},
-    {"output.vtk", "true | false: write particles.vtu (default true)"},
-};
-
 static PetscErrorCode NodeCreate(PeriNodeKind kind, const char key[], const char parent_path[], int line, PeriNode *node)
 {
   PeriNode n;
@@ -353,41 +283,43 @@ static PetscErrorCode AddOptionKey(PeriNode root, const char path[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* "section.key" of a schema key. */
-static void SchemaPath(const PeriSchema *sec, const PeriKey *key, char path[], size_t len)
+/* Whether an option may stand for the key: a value or a list of values, not a mapping or a list
+ * of items, and not a pattern (regions.<name>.side: the options of the file's items exist). */
+static PetscBool KeyIsOption(const PeriSchema *sec, const PeriKey *key)
 {
-  snprintf(path, len, "%s.%s", sec->section, key->name);
+  return (PetscBool)(key->type != PERI_KEY_MAP && key->type != PERI_KEY_LIST && !strchr(sec->section, '<') && !strchr(key->name, '<'));
 }
 
-/* Every documented key, the core's and every plug-in's, that an option adds when the file lacks it. */
+/* Every declared key, the core's and every plug-in's, that an option adds when the file lacks it. */
 static PetscErrorCode AddOptionKeys(PeriScene scene)
 {
   char path[256];
 
   PetscFunctionBeginUser;
-  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) PetscCall(AddOptionKey(scene->root, scene_keys[k].path));
   for (PetscInt o = 0; o < scene->nowners; o++)
     for (const PeriSchema *sec = scene->owners[o].schema; sec && sec->section; sec++)
       for (const PeriKey *key = sec->keys; key->name; key++) {
-        SchemaPath(sec, key, path, sizeof(path));
+        if (!KeyIsOption(sec, key)) continue;
+        PeriSchemaPath(sec, key, path, sizeof(path));
         PetscCall(AddOptionKey(scene->root, path));
       }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Options that name the scene (src/options.c checks them): a top-level key of the documented
- * keys, alone or followed by '_'. Option names ignore case, as PETSc's do. */
-PetscErrorCode PeriSceneOptionIsScene(const char opt[], PetscBool *is)
+/* Options that name the scene (src/options.c checks them): a root key of the schemas, alone or
+ * followed by '_'. Option names ignore case, as PETSc's do. */
+PetscErrorCode PeriSceneOptionIsScene(PeriScene scene, const char opt[], PetscBool *is)
 {
   const char *o = opt[0] == '-' ? opt + 1 : opt;
 
   PetscFunctionBeginUser;
   *is = PETSC_FALSE;
-  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys) && !*is; k++) {
-    const char *path = scene_keys[k].path, *dot = strchr(path, '.');
-    size_t      len = dot ? (size_t)(dot - path) : strlen(path);
-    if (!strncasecmp(o, path, len) && (o[len] == 0 || o[len] == '_')) *is = PETSC_TRUE;
-  }
+  for (PetscInt k = 0; k < scene->nowners; k++)
+    for (const PeriSchema *sec = scene->owners[k].schema; sec && sec->section; sec++)
+      for (const PeriKey *key = sec->keys; !sec->section[0] && key->name; key++) {
+        size_t len = strlen(key->name);
+        if (!strncasecmp(o, key->name, len) && (o[len] == 0 || o[len] == '_')) *is = PETSC_TRUE;
+      }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -436,13 +368,12 @@ PetscErrorCode PeriSceneOptionNames(PeriScene scene, char ***names)
 
   PetscFunctionBeginUser;
   PetscCall(NameListAddNodes(&l, scene->root));
-  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++)
-    if (!strchr(scene_keys[k].path, '<')) PetscCall(NameListAdd(&l, scene_keys[k].path));
   for (PetscInt o = 0; o < scene->nowners; o++)
     for (const PeriSchema *sec = scene->owners[o].schema; sec && sec->section; sec++)
       for (const PeriKey *key = sec->keys; key->name; key++) {
         char path[256];
-        SchemaPath(sec, key, path, sizeof(path));
+        if (!KeyIsOption(sec, key)) continue;
+        PeriSchemaPath(sec, key, path, sizeof(path));
         PetscCall(NameListAdd(&l, path));
       }
   if (!l.name) PetscCall(PetscCalloc1(1, &l.name));
@@ -593,51 +524,6 @@ PetscErrorCode PeriSceneDestroy(PeriScene *scene)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* One -help row per key the plug-ins declare in section, tagged with its owner: "(model mppd)". */
-static PetscErrorCode HelpSchemaRows(MPI_Comm comm, const char section[], PetscInt nowners, const PeriSchemaOwner owners[])
-{
-  char path[256], text[512];
-
-  PetscFunctionBeginUser;
-  for (PetscInt o = 0; o < nowners; o++)
-    for (const PeriSchema *sec = owners[o].schema; sec && sec->section; sec++) {
-      if (strcmp(sec->section, section)) continue;
-      for (const PeriKey *key = sec->keys; key->name; key++) {
-        SchemaPath(sec, key, path, sizeof(path));
-        PetscCall(PetscSNPrintf(text, sizeof(text), "(%s %s) %s", owners[o].kind, owners[o].name, key->help));
-        if (key->units) PetscCall(PetscSNPrintf(text + strlen(text), sizeof(text) - strlen(text), " %s", key->units));
-        if (key->range) PetscCall(PetscSNPrintf(text + strlen(text), sizeof(text) - strlen(text), "; in %s", key->range));
-        if (key->deflt) PetscCall(PetscSNPrintf(text + strlen(text), sizeof(text) - strlen(text), strcmp(key->deflt, "required") ? "; default %s" : "; %s", key->deflt));
-        PetscCall(PetscPrintf(comm, "  %-30s %s\n", path, text));
-      }
-    }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriSceneHelp - prints the documented scene keys and their options: the core's, and after each
-  "<section>.type" row the keys the plug-ins (owners) declare in that section. Collective.
-@*/
-PetscErrorCode PeriSceneHelp(MPI_Comm comm, PetscInt nowners, const PeriSchemaOwner owners[])
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(comm, "Scene keys (YAML; every scalar key is also an option: its path joined with '_', e.g. -material_nu 0.1):\n"));
-  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(scene_keys); k++) {
-    const char *path = scene_keys[k].path, *dot = strchr(path, '.');
-    if (dot && !strcmp(dot, ".type")) {
-      /* a plug-in selector: its values are the registered types, its keys their schemas */
-      char section[64], types[512] = "";
-      PetscCall(PetscStrncpy(section, path, PetscMin((size_t)(dot - path + 1), sizeof(section))));
-      for (PetscInt o = 0; o < nowners; o++)
-        if (!strcmp(owners[o].kind, section)) PeriListAppend(types, sizeof(types), owners[o].name);
-      PetscCall(PetscPrintf(comm, "  %-30s %s%s%s\n", path, scene_keys[k].meaning, types[0] ? ": " : "", types));
-      PetscCall(HelpSchemaRows(comm, section, nowners, owners));
-    } else
-      PetscCall(PetscPrintf(comm, "  %-30s %s\n", path, scene_keys[k].meaning));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* "file:line: key 'material.nu' (option -material_nu)" for node (or its child key when given). */
 PetscErrorCode PeriSceneWhere(PeriScene scene, PeriNode node, const char key[], char buf[], size_t len)
 {
@@ -732,22 +618,25 @@ const PeriKey *PeriSchemaFindKey(const PeriSchema *schema, const char section[],
 static const PeriSchemaOwner *OtherOwner(PeriScene scene, const PeriSchemaOwner *active, const char section[], const char name[])
 {
   for (PetscInt o = 0; o < scene->nowners; o++)
-    if ((!active || strcmp(scene->owners[o].name, active->name)) && PeriSchemaFindKey(scene->owners[o].schema, section, name)) return &scene->owners[o];
+    if (strcmp(scene->owners[o].kind, "core") && (!active || strcmp(scene->owners[o].name, active->name)) && PeriSchemaFindKey(scene->owners[o].schema, section, name)) return &scene->owners[o];
   return NULL;
 }
 
 /*@C
   PeriSceneCheckKeysSchema - checks the keys of map, the plug-in section named section
-  ("analysis", "model"): allowed are base (the core's keys there, e.g. type) and the keys the
-  active plug-in declares. A key another plug-in declares says which one owns it, so that a key
-  left from another analysis (load_factor_max in a modal scene) is not taken for a typo; the
-  message keeps the "unknown key; allowed here" start of any other unknown key. active NULL (the
-  type is unknown, reported later with the list of types) allows every plug-in's keys.
+  ("analysis", "model"): allowed are the core's keys there (type) and the keys the active plug-in
+  declares. A key another plug-in declares says which one owns it, so that a key left from another
+  analysis (load_factor_max in a modal scene) is not taken for a typo; the message keeps the
+  "unknown key; allowed here" start of any other unknown key. active NULL (the type is unknown,
+  reported later with the list of types) allows every plug-in's keys.
 @*/
-PetscErrorCode PeriSceneCheckKeysSchema(PeriScene scene, PeriNode map, const char section[], const char *const base[], const PeriSchemaOwner *active)
+PetscErrorCode PeriSceneCheckKeysSchema(PeriScene scene, PeriNode map, const char section[], const PeriSchemaOwner *active)
 {
+  const char *base[PERI_SECTION_MAX_KEYS];
+
   PetscFunctionBeginUser;
   if (!map) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneSectionKeys(scene, section, PETSC_FALSE, base));
   for (PetscInt k = 0; k < map->n; k++) {
     const char            *name      = map->child[k]->key;
     const PeriSchemaOwner *other     = OtherOwner(scene, active, section, name);

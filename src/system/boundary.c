@@ -33,18 +33,47 @@ static PetscErrorCode ComponentFromNode(PeriSystem sys, PeriNode node, const cha
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* {A: [[..], ..], b: [..]}: a field A X + b with dim rows (b optional). */
-static PetscErrorCode ParseAffine(PeriSystem sys, PeriNode node, PetscReal A[3][3], PetscReal b[3])
+/* bc.<k>, loads.<k> and their fields A X + b. */
+static const PeriKey bc_keys[] = {
+    {"region", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the region the condition applies to (all: every particle)"},
+    {"fix", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "components held at zero, e.g. [ux, uy]"},
+    {"value", PERI_KEY_MAP, NULL, NULL, "[length] (theta: radians)", NULL, "map component -> prescribed value, e.g. {ux: 0.001}"},
+    {"affine", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the prescribed field u = A X + b at the reference positions X: {A: [[..],..], b: [..]}; every translational component, never theta"},
+    {"optional", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "skip the components of fix and value the model lacks (one scene for several models)"},
+    {NULL},
+};
+static const PeriKey affine_keys[] = {
+    {"A", PERI_KEY_LIST, "required", NULL, NULL, NULL, "dim rows of dim numbers"},
+    {"b", PERI_KEY_REALS, "0", NULL, NULL, NULL, "dim numbers"},
+    {NULL},
+};
+static const PeriKey load_keys[] = {
+    {"region", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the region the load applies to"},
+    {"force", PERI_KEY_REALS, NULL, NULL, "[force]", NULL, "total force, spread over the region's particles by volume"},
+    {"traction", PERI_KEY_REALS, NULL, NULL, "[stress]", NULL, "traction on the face of a layer region: force = traction x face area, spread by volume"},
+    {"body_force", PERI_KEY_REALS, NULL, NULL, "[force/volume]", NULL, "force per unit volume"},
+    {"traction_field", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "traction varying over a layer region, t = A X + b at the particles: {A: [[..],..], b: [..]}"},
+    {NULL},
+};
+const PeriSchema PeriBoundarySchema[] = {
+    {"bc.<k>", bc_keys},
+    {"bc.<k>.affine", affine_keys},
+    {"loads.<k>", load_keys},
+    {"loads.<k>.traction_field", affine_keys},
+    {NULL},
+};
+
+/* {A: [[..], ..], b: [..]}, the mapping of section: a field A X + b with dim rows (b optional). */
+static PetscErrorCode ParseAffine(PeriSystem sys, PeriNode node, const char section[], PetscReal A[3][3], PetscReal b[3])
 {
-  static const char *const keys[] = {"A", "b", NULL};
-  PeriScene                s      = sys->scene;
-  const PetscInt           dim    = sys->particles.dim;
-  PeriNode                 Anode;
-  PetscInt                 n;
+  PeriScene      s   = sys->scene;
+  const PetscInt dim = sys->particles.dim;
+  PeriNode       Anode;
+  PetscInt       n;
 
   PetscFunctionBeginUser;
   PeriInputCheck(node->kind == PERI_NODE_MAP, s, node, NULL, "must be {A: [[..], ..], b: [..]}");
-  PetscCall(PeriSceneCheckKeys(s, node, keys));
+  PetscCall(PeriSceneCheckSection(s, node, section));
   PetscCall(PeriSceneGetNode(node, "A", &Anode));
   PeriInputCheck(Anode && Anode->kind == PERI_NODE_SEQ && Anode->n == dim, s, Anode ? Anode : node, Anode ? NULL : "A", "must be a list of %" PetscInt_FMT " rows of %" PetscInt_FMT " numbers (A X + b)", dim, dim);
   for (PetscInt a = 0; a < dim; a++) PetscCall(PeriSceneParseRealArray(s, Anode->child[a], dim, dim, A[a], &n));
@@ -55,20 +84,19 @@ static PetscErrorCode ParseAffine(PeriSystem sys, PeriNode node, PetscReal A[3][
 /* value[] and set[] over the owned DOFs; later conditions override earlier ones. */
 static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal value[], PetscBool set[])
 {
-  static const char *const keys[] = {"region", "fix", "value", "affine", "optional", NULL};
-  PeriScene                s      = sys->scene;
-  PeriModel                m      = sys->model;
-  const PetscInt           bs = m->dofs, dim = sys->particles.dim;
-  PeriRegion              *r;
-  PeriNode                 fix, val, aff;
-  PetscReal                v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
-  PetscBool                use[PERI_MAX_DOF] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
-  PetscInt                 axis_comp[3]      = {-1, -1, -1};
-  PetscBool                optional          = PETSC_FALSE;
+  PeriScene      s  = sys->scene;
+  PeriModel      m  = sys->model;
+  const PetscInt bs = m->dofs, dim = sys->particles.dim;
+  PeriRegion    *r;
+  PeriNode       fix, val, aff;
+  PetscReal      v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
+  PetscBool      use[PERI_MAX_DOF] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
+  PetscInt       axis_comp[3]      = {-1, -1, -1};
+  PetscBool      optional          = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a boundary condition is a mapping {region: name, fix: [..] | value: {..} | affine: {..}}");
-  PetscCall(PeriSceneCheckKeys(s, item, keys));
+  PetscCall(PeriSceneCheckSection(s, item, "bc.<k>"));
   PetscCall(PeriRegionFind(s, item, "region", sys->nregions, sys->regions, &r));
   PetscCall(PeriSceneGetBool(s, item, "optional", &optional, NULL));
   PetscCall(PeriSceneGetNode(item, "fix", &fix));
@@ -97,7 +125,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
       use[c] = PETSC_TRUE;
     }
   } else {
-    PetscCall(ParseAffine(sys, aff, A, b0));
+    PetscCall(ParseAffine(sys, aff, "bc.<k>.affine", A, b0));
     for (PetscInt a = 0; a < dim; a++) {
       PetscCall(AxisComponent(m, a, &axis_comp[a]));
       PeriInputCheck(axis_comp[a] >= 0, s, aff, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + a));
@@ -171,14 +199,13 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
 @*/
 PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
 {
-  static const char *const keys[] = {"region", "force", "traction", "body_force", "traction_field", NULL};
-  PeriScene                s      = sys->scene;
-  PeriModel                m      = sys->model;
-  const PetscInt           bs = m->dofs, dim = sys->particles.dim;
-  PeriNode                 loads;
-  PetscScalar             *a;
-  PetscInt                 ncomp, uz;
-  PetscReal                largest;
+  PeriScene      s  = sys->scene;
+  PeriModel      m  = sys->model;
+  const PetscInt bs = m->dofs, dim = sys->particles.dim;
+  PeriNode       loads;
+  PetscScalar   *a;
+  PetscInt       ncomp, uz;
+  PetscReal      largest;
 
   PetscFunctionBeginUser;
   /* a 2D cross-section model's loads act along z: they take 3 components, [0, 0, F] */
@@ -196,7 +223,7 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
     PetscReal   A[3][3] = {{0}}, F[3] = {0, 0, 0}, scale;
     PetscInt    n, comp[3]            = {-1, -1, -1};
     PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force | traction_field: ..}");
-    PetscCall(PeriSceneCheckKeys(s, item, keys));
+    PetscCall(PeriSceneCheckSection(s, item, "loads.<k>"));
     PetscCall(PeriRegionFind(s, item, "region", sys->nregions, sys->regions, &r));
     PetscCall(PeriSceneGetNode(item, "force", &force));
     PetscCall(PeriSceneGetNode(item, "traction", &traction));
@@ -204,7 +231,7 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
     PetscCall(PeriSceneGetNode(item, "traction_field", &field));
     PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) + (field ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force, traction_field");
     if (field)
-      PetscCall(ParseAffine(sys, field, A, F));
+      PetscCall(ParseAffine(sys, field, "loads.<k>.traction_field", A, F));
     else
       PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
                                                                           : "body_force",

@@ -6,19 +6,42 @@
 
 const char *const PeriFailureCauses[] = {"crack", "tension", "compression", "sliding", "shear_angle", NULL};
 
+/* failure.* (read in this order into PeriFailure) and cracks.<k>. */
+static const PeriKey failure_keys[] = {
+    {"critical_stretch", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "critical tensile stretch s_c (models with a stretch: pmb, npmb, cpmb, pds, mppd, gerstle); not with G"},
+    {"G", PERI_KEY_REAL, NULL, "(0, inf)", "[energy/length^2]", NULL, "energy release rate: each bond's critical stretch or shear angle from its model"},
+    {"compressive_stretch", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "critical compressive stretch: a bond breaks when s < -value"},
+    {"sliding", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "pds/mppd/gerstle: critical sliding gamma_0"},
+    {"friction_angle", PERI_KEY_REAL, NULL, "(0, 90)", "[degrees]", NULL, "pds/mppd/gerstle: frictional sliding gamma_l = cohesion - s tan(angle); with cohesion"},
+    {"cohesion", PERI_KEY_REAL, NULL, NULL, NULL, NULL, "pds/mppd/gerstle: the sliding limit without stretch; with friction_angle"},
+    {"shear_angle", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "antiplane: critical shear angle r_c; not with G"},
+    {"ultimate_stretch", PERI_KEY_REAL, NULL, "(critical_stretch, inf)", NULL, NULL, "softening (eq. 45): the stiffness falls linearly from critical_stretch to 0 here"},
+    {"ultimate_compressive_stretch", PERI_KEY_REAL, NULL, "(compressive_stretch, inf)", NULL, NULL, "softening in compression (eq. 46)"},
+    {NULL},
+};
+static const PeriKey crack_keys[] = {
+    {"from", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "a pre-existing crack, a 2D segment: its first end [x, y]; bonds crossing it are removed before the first step"},
+    {"to", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "its other end"},
+    {NULL},
+};
+const PeriSchema PeriFailureSchema[] = {
+    {"failure", failure_keys},
+    {"cracks.<k>", crack_keys},
+    {NULL},
+};
+
 /*@C
   PeriFailureSetUp - reads failure: and checks each criterion against the model's measures.
   Not collective.
 @*/
 PetscErrorCode PeriFailureSetUp(PeriSystem sys)
 {
-  static const char *const keys[] = {"critical_stretch", "G", "compressive_stretch", "sliding", "friction_angle", "cohesion", "shear_angle", "ultimate_stretch", "ultimate_compressive_stretch", NULL};
-  PeriScene                s      = sys->scene;
-  PeriFailure             *F      = &sys->failure;
-  PeriModel                m      = sys->model;
-  PeriNode                 node;
-  PetscBool                has[9];
-  PetscReal               *val[9] = {&F->stretch, &F->G, &F->compressive, &F->sliding, &F->friction_angle, &F->cohesion, &F->shear_angle, &F->ultimate, &F->ultimate_compressive};
+  PeriScene    s = sys->scene;
+  PeriFailure *F = &sys->failure;
+  PeriModel    m = sys->model;
+  PeriNode     node;
+  PetscBool    has[9];
+  PetscReal   *val[9] = {&F->stretch, &F->G, &F->compressive, &F->sliding, &F->friction_angle, &F->cohesion, &F->shear_angle, &F->ultimate, &F->ultimate_compressive};
 
   PetscFunctionBeginUser;
   F->istretch = F->isliding = F->ishear = -1;
@@ -29,10 +52,10 @@ PetscErrorCode PeriFailureSetUp(PeriSystem sys)
   }
   PetscCall(PeriSceneGetMap(s, s->root, "failure", PETSC_FALSE, &node));
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriSceneCheckKeys(s, node, keys));
-  for (PetscInt k = 0; keys[k]; k++) {
-    PetscCall(PeriSceneGetReal(s, node, keys[k], PETSC_FALSE, val[k], &has[k]));
-    PeriInputCheck(!has[k] || *val[k] > 0 || k == 5, s, node, keys[k], "must be positive, got %g", (double)*val[k]);
+  PetscCall(PeriSceneCheckSection(s, node, "failure"));
+  for (PetscInt k = 0; failure_keys[k].name; k++) {
+    PetscCall(PeriSceneGetReal(s, node, failure_keys[k].name, PETSC_FALSE, val[k], &has[k]));
+    PeriInputCheck(!has[k] || *val[k] > 0 || k == 5, s, node, failure_keys[k].name, "must be positive, got %g", (double)*val[k]);
   }
   PeriInputCheck(!has[5] || F->cohesion >= 0, s, node, "cohesion", "must not be negative, got %g", (double)F->cohesion);
   PeriInputCheck(has[0] || has[1] || has[2] || has[3] || has[4] || has[6], s, node, NULL, "give at least one criterion: %s", "critical_stretch, G, compressive_stretch, sliding, friction_angle with cohesion, shear_angle");
@@ -109,11 +132,10 @@ static PetscBool SegmentMeetsBox(const PetscReal s[], const PetscReal lo[], cons
 @*/
 PetscErrorCode PeriCracksApply(PeriSystem sys)
 {
-  static const char *const keys[] = {"from", "to", NULL};
-  PeriScene                s      = sys->scene;
-  PeriNode                 list;
-  PetscReal               *seg;
-  PetscInt                 cut, n;
+  PeriScene  s = sys->scene;
+  PeriNode   list;
+  PetscReal *seg;
+  PetscInt   cut, n;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "cracks", &list));
@@ -124,7 +146,7 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
   for (PetscInt c = 0; c < list->n; c++) {
     PeriNode item = list->child[c];
     PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a crack is a segment {from: [x, y], to: [x, y]}");
-    PetscCall(PeriSceneCheckKeys(s, item, keys));
+    PetscCall(PeriSceneCheckSection(s, item, "cracks.<k>"));
     PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
     PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
     PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");

@@ -8,6 +8,13 @@ static PetscBool LexLess(const PetscReal a[], const PetscReal b[])
   return PETSC_FALSE;
 }
 
+/* probes: any names, each a point. */
+static const PeriKey probe_keys[] = {
+    {"<name>", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a point [x, y(, z)] inside the body: the displacement and energy density of the nearest particle"},
+    {NULL},
+};
+const PeriSchema PeriProbesSchema[] = {{"probes", probe_keys}, {NULL}};
+
 PetscErrorCode PeriReadProbes(PeriSystem sys)
 {
   PeriScene            s = sys->scene;

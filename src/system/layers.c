@@ -13,17 +13,35 @@
 
 const char *const PeriLayerKinds[] = {"none", "displacement", "shear_stress", "free", NULL};
 
+/* boundary_layers.<k> and torsion (cross-section models). */
+static const char *const sides[]      = {"x-", "x+", "y-", "y+", NULL};
+static const PeriKey     layer_keys[] = {
+        {"side", PERI_KEY_CHOICE, "required", NULL, NULL, sides, "the face of the grid body the fictitious layer lies outside (each face at most once; not on a periodic axis)"},
+        {"condition", PERI_KEY_CHOICE, "required", NULL, NULL, PeriLayerKinds + 1, "displacement (u_z = value on the face), shear_stress (sigma_nz = value), free (traction-free)"},
+        {"value", PERI_KEY_REAL, NULL, NULL, "[length] or [stress]", NULL, "the prescribed displacement or shear stress; required for displacement and shear_stress, an error for free"},
+        {NULL},
+};
+static const PeriKey torsion_keys[] = {
+    {"twist", PERI_KEY_REAL, "required", NULL, "[1/length]", NULL, "angle of twist per unit length psi, not 0: the free layers carry it"},
+    {"center", PERI_KEY_REALS, "the centre of the box", NULL, "[length]", NULL, "the axis of twist [x0, y0]"},
+    {NULL},
+};
+const PeriSchema PeriLayersSchema[] = {
+    {"boundary_layers.<k>", layer_keys},
+    {"torsion", torsion_keys},
+    {NULL},
+};
+
 static PetscErrorCode ReadTorsion(PeriSystem sys)
 {
-  static const char *const keys[] = {"twist", "center", NULL};
-  PeriScene                s      = sys->scene;
-  PeriNode                 t;
-  PetscInt                 n;
+  PeriScene s = sys->scene;
+  PeriNode  t;
+  PetscInt  n;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "torsion", PETSC_FALSE, &t));
   if (!t) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriSceneCheckKeys(s, t, keys));
+  PetscCall(PeriSceneCheckSection(s, t, "torsion"));
   PeriInputCheck(sys->model->antiplane, s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", sys->model->type);
   PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &sys->torsion.twist, NULL));
   PeriInputCheck(sys->torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
@@ -46,16 +64,14 @@ static PetscInt LayerCells(PeriSystem sys, PetscReal h)
 /* Reads one boundary_layers item into sys->layers and sets the depth nl of its face in lo or hi. */
 static PetscErrorCode LayerRead(PeriSystem sys, PeriNode item, const PetscInt cells[], PetscInt nl, PetscInt lo[], PetscInt hi[])
 {
-  static const char *const keys[]  = {"side", "condition", "value", NULL};
-  static const char *const sides[] = {"x-", "x+", "y-", "y+", NULL};
-  PeriScene                s       = sys->scene;
-  PeriLayers              *L       = &sys->layers;
-  PetscInt                 side = 0, kind = 0, face;
-  PetscBool                hasv;
+  PeriScene   s    = sys->scene;
+  PeriLayers *L    = &sys->layers;
+  PetscInt    side = 0, kind = 0, face;
+  PetscBool   hasv;
 
   PetscFunctionBeginUser;
   PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a layer is a mapping {side: .., condition: .., value: ..}");
-  PetscCall(PeriSceneCheckKeys(s, item, keys));
+  PetscCall(PeriSceneCheckSection(s, item, "boundary_layers.<k>"));
   PetscCall(PeriSceneGetChoice(s, item, "side", sides, &side, NULL));
   PetscCall(PeriSceneGetChoice(s, item, "condition", PeriLayerKinds + 1, &kind, NULL));
   kind++;

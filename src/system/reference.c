@@ -7,9 +7,20 @@ const char *const PeriReferenceTypes[] = {"none", "uniaxial", "shear", "bending"
 
 static PetscBool Interior(PeriSystem, PetscInt);
 
+static const char *const axes[]           = {"x", "y", NULL};
+static const PeriKey     reference_keys[] = {
+        {"type", PERI_KEY_CHOICE, "required", NULL, NULL, PeriReferenceTypes + 1, "the exact plane field to compare with"},
+        {"stress", PERI_KEY_REAL, "required", NULL, "[stress]", NULL, "its stress: sigma (uniaxial), tau (shear), the extreme fibre stress (bending)"},
+        {"axis", PERI_KEY_CHOICE, "x", NULL, NULL, axes, "uniaxial: the loaded axis"},
+        {"center", PERI_KEY_REALS, "the centre of the bounding box", NULL, "[length]", NULL, "2 numbers: the point where the reference field has no displacement, and the origin of the fits"},
+        {"E", PERI_KEY_REAL, "material.E", "(0, inf)", "[stress]", NULL, "Young's modulus of the reference solution"},
+        {"nu", PERI_KEY_REAL, "material.nu", "(-1, 1/2)", NULL, NULL, "Poisson ratio of the reference solution"},
+        {NULL},
+};
+const PeriSchema PeriReferenceSchema[] = {{"reference", reference_keys}, {NULL}};
+
 PetscErrorCode PeriReferenceSetUp(PeriSystem sys)
 {
-  static const char *const keys[] = {"type", "stress", "axis", "center", "E", "nu", NULL}, *const axes[] = {"x", "y", NULL};
   PeriScene      s = sys->scene;
   PeriReference *r = &sys->reference;
   PeriNode       node;
@@ -19,7 +30,7 @@ PetscErrorCode PeriReferenceSetUp(PeriSystem sys)
   PetscCall(PeriSceneGetMap(s, s->root, "reference", PETSC_FALSE, &node));
   r->type = PERI_REFERENCE_NONE;
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriSceneCheckKeys(s, node, keys));
+  PetscCall(PeriSceneCheckSection(s, node, "reference"));
   PeriInputCheck(sys->particles.dim == 2, s, node, NULL, "reference fields are plane elasticity solutions: dim must be 2");
   PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
   PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));

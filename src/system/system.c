@@ -4,17 +4,46 @@
 #include "perilin/private/sys.h"
 #include "perilin/private/model.h"
 
+/* The sections read below: model (the core's keys; each model type declares its own), horizon,
+ * corrections, solver. */
+static const char *const planes[]     = {"stress", "strain", NULL};
+static const PeriKey     model_keys[] = {
+        {"type", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the bond model (docs/models/)"},
+        {"plane", PERI_KEY_CHOICE, "stress", NULL, NULL, planes, "2D only: plane stress or plane strain"},
+        {NULL},
+};
+static const PeriKey horizon_keys[] = {
+    {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the mean spacing: delta = m dx (may be fractional); m or delta is required"},
+    {"delta", PERI_KEY_REAL, NULL, NULL, "[length]", NULL, "the horizon radius, instead of m"},
+    {NULL},
+};
+static const PeriKey corrections_keys[] = {
+    {"partial_volume", PERI_KEY_CHOICE, "linear_continued", NULL, NULL, PeriPartialVolumes, "partial volumes of the particles the horizon cuts: none, linear (alpha ramp cut at delta), linear_continued (the ramp continued to delta + dx/2)"},
+    {"surface", PERI_KEY_CHOICE, "none", NULL, NULL, PeriSurfaceCorrections, "surface correction: volume (lambda = 2 V0 / (V(H_i) + V(H_j))); energy (antiplane models, Oterkus & Madenci eq. 53); each model names those it takes"},
+    {NULL},
+};
+static const PeriKey solver_keys[] = {
+    {"residual_tol", PERI_KEY_REAL, "0", "[0, 1)", NULL, NULL, "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; 0: min(max(100 rtol, 1e-6), 1e-3)"},
+    {NULL},
+};
+const PeriSchema PeriSystemSchema[] = {
+    {"model", model_keys},
+    {"horizon", horizon_keys},
+    {"corrections", corrections_keys},
+    {"solver", solver_keys},
+    {NULL},
+};
+
 static PetscErrorCode ReadHorizon(PeriSystem sys)
 {
-  static const char *const keys[] = {"m", "delta", NULL};
-  PeriScene                s      = sys->scene;
-  PeriNode                 h;
-  PetscReal                m = 0, hmax = 0;
-  PetscBool                hasm, hasd;
+  PeriScene s = sys->scene;
+  PeriNode  h;
+  PetscReal m = 0, hmax = 0;
+  PetscBool hasm, hasd;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "horizon", PETSC_TRUE, &h));
-  PetscCall(PeriSceneCheckKeys(s, h, keys));
+  PetscCall(PeriSceneCheckSection(s, h, "horizon"));
   PetscCall(PeriSceneGetReal(s, h, "m", PETSC_FALSE, &m, &hasm));
   PetscCall(PeriSceneGetReal(s, h, "delta", PETSC_FALSE, &sys->delta, &hasd));
   PeriInputCheck(hasm || hasd, s, h, "m", "is required (or give horizon.delta)");
@@ -36,15 +65,14 @@ static PetscErrorCode ReadHorizon(PeriSystem sys)
 
 static PetscErrorCode ReadCorrections(PeriSystem sys)
 {
-  static const char *const keys[] = {"partial_volume", "surface", NULL};
-  PeriScene                s      = sys->scene;
-  PeriNode                 c;
-  PetscInt                 pv = PERI_PARTIAL_VOLUME_LINEAR_CONTINUED, sc = PERI_SURFACE_NONE;
-  PetscBool                found;
+  PeriScene s = sys->scene;
+  PeriNode  c;
+  PetscInt  pv = PERI_PARTIAL_VOLUME_LINEAR_CONTINUED, sc = PERI_SURFACE_NONE;
+  PetscBool found;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "corrections", PETSC_FALSE, &c));
-  PetscCall(PeriSceneCheckKeys(s, c, keys));
+  PetscCall(PeriSceneCheckSection(s, c, "corrections"));
   PetscCall(PeriSceneGetChoice(s, c, "partial_volume", PeriPartialVolumes, &pv, NULL));
   PetscCall(PeriSceneGetChoice(s, c, "surface", PeriSurfaceCorrections, &sc, &found));
   PeriInputCheck(sc == PERI_SURFACE_NONE || sys->model->allows_surface_correction, s, c, "surface", "model %s normalizes each particle's micromodulus by its own family volume, which already corrects surfaces: use surface: none", sys->model->type);
@@ -67,13 +95,12 @@ static PetscErrorCode ReadCorrections(PeriSystem sys)
 /* solver.residual_tol: every solve's true relative residual must lie below it. */
 static PetscErrorCode ReadSolver(PeriSystem sys)
 {
-  static const char *const keys[] = {"residual_tol", NULL};
-  PeriScene                s      = sys->scene;
-  PeriNode                 node;
+  PeriScene s = sys->scene;
+  PeriNode  node;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &node));
-  PetscCall(PeriSceneCheckKeys(s, node, keys));
+  PetscCall(PeriSceneCheckSection(s, node, "solver"));
   PetscCall(PeriSceneGetReal(s, node, "residual_tol", PETSC_FALSE, &sys->residual_tol, NULL));
   PeriInputCheck(sys->residual_tol >= 0 && sys->residual_tol < 1, s, node, "residual_tol", "must lie in [0, 1) (0: the default, max(100 rtol, 1e-6)), got %g", (double)sys->residual_tol);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -93,7 +120,7 @@ PetscReal PeriResidualTolerance(PeriSystem sys, PetscReal rtol)
 
 /* model.* against the chosen model's schema (s->owners holds every plug-in's); a model registered
  * at run time has no schema, and takes type and plane only. */
-static PetscErrorCode CheckModelKeys(PeriScene s, PeriNode m, const char type[], const char *const keys[])
+static PetscErrorCode CheckModelKeys(PeriScene s, PeriNode m, const char type[])
 {
   PeriSchemaOwner        none   = {"model", type, NULL};
   const PeriSchemaOwner *active = &none;
@@ -101,13 +128,12 @@ static PetscErrorCode CheckModelKeys(PeriScene s, PeriNode m, const char type[],
   PetscFunctionBeginUser;
   for (PetscInt o = 0; o < s->nowners; o++)
     if (!strcmp(s->owners[o].kind, "model") && !strcmp(s->owners[o].name, type)) active = &s->owners[o];
-  PetscCall(PeriSceneCheckKeysSchema(s, m, "model", keys, active));
+  PetscCall(PeriSceneCheckKeysSchema(s, m, "model", active));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode CreateModel(PeriSystem sys)
 {
-  static const char *const keys[] = {"type", "plane", NULL}, *const planes[] = {"stress", "strain", NULL};
   PeriScene s = sys->scene;
   PeriNode  m;
   PetscInt  dim = 0, plane = 0;
@@ -128,7 +154,7 @@ static PetscErrorCode CreateModel(PeriSystem sys)
     PeriInputCheck(PETSC_FALSE, s, m, "type", "unknown model '%s'; registered models: %s", type, list);
   }
   PetscCall(PeriModelCreate(type, dim, plane == 1 ? PETSC_TRUE : PETSC_FALSE, &sys->model));
-  PetscCall(CheckModelKeys(s, m, type, keys));
+  PetscCall(CheckModelKeys(s, m, type));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -39,3 +39,6 @@ PETSC_EXTERN PetscReal      PeriSearchRadius(PeriPartialVolume, PetscReal, Petsc
 PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm, const PeriParticles *, const PeriBonds *, PetscReal[], PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
+
+/* grid, particles and regions.<name>, declared next to the code that reads them. */
+PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];

@@ -23,6 +23,8 @@ struct _p_PeriProblem {
 
 PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
 
-/* Every built-in model's and analysis' schema (src/package.c), handed down to the scene layer. */
-#define PERI_MAX_PLUGINS 32
-PETSC_EXTERN PetscErrorCode PeriPluginSchemas(PetscInt, PeriSchemaOwner[], PetscInt *);
+/* The core modules' schemas, then every built-in model's and analysis' (src/package.c), handed
+ * down to the scene layer. */
+#define PERI_MAX_SCHEMA_OWNERS 64
+PETSC_EXTERN PetscErrorCode   PeriSchemaOwners(PetscInt, PeriSchemaOwner[], PetscInt *);
+PETSC_EXTERN const PeriSchema PeriProblemSchema[];

@@ -7,11 +7,18 @@
 PETSC_EXTERN PetscErrorCode PeriSceneCreateFromFile(const char[], PetscInt, const PeriSchemaOwner[], PeriScene *);
 PETSC_EXTERN PetscErrorCode PeriSceneDestroy(PeriScene *);
 PETSC_EXTERN PetscErrorCode PeriSceneHelp(MPI_Comm, PetscInt, const PeriSchemaOwner[]);
+PETSC_EXTERN PetscErrorCode PeriSceneDocUpdate(MPI_Comm, const char[], PetscBool, PetscInt, const PeriSchemaOwner[]);
+
+/* The schemas (src/scene/schema.c): the keys declared in a section, the core's (and with plugins
+ * the plug-ins' too) in declaration order, NULL-ended; a schema key's dotted path. */
+#define PERI_SECTION_MAX_KEYS 64
+PETSC_EXTERN PetscErrorCode PeriSceneSectionKeys(PeriScene, const char[], PetscBool, const char *[PERI_SECTION_MAX_KEYS]);
+PETSC_EXTERN void           PeriSchemaPath(const PeriSchema *, const PeriKey *, char[], size_t);
 
 /* Options that name nothing (src/options.c; docs/scene.md): an option naming no scene key is an
  * error before any computation, and an option nothing read is one after the analysis, both with a
  * "did you mean"; -options_unused_ok makes them warnings. */
-PETSC_EXTERN PetscErrorCode PeriSceneOptionIsScene(const char[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSceneOptionIsScene(PeriScene, const char[], PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneOptionNames(PeriScene, char ***);
 PETSC_EXTERN PetscErrorCode PeriSceneOptionExplain(PeriScene, const char[], char[], size_t, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckScene(MPI_Comm, PeriScene);

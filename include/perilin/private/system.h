@@ -225,3 +225,7 @@ PETSC_EXTERN PetscErrorCode PeriFailureAddFields(PeriSystem, PeriFieldList);
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryFields(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriReferenceSummary(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriProbesSummary(PeriSystem, PeriJSON);
+
+/* The scene keys each system module declares, next to the code that reads them (src/package.c
+ * hands them to the scene layer). */
+PETSC_EXTERN const PeriSchema PeriSystemSchema[], PeriBoundarySchema[], PeriReferenceSchema[], PeriLayersSchema[], PeriFailureSchema[], PeriProbesSchema[];
