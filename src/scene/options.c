@@ -127,6 +127,16 @@ static void Suggest(const char name[], char *const cand[], char buf[], size_t le
     snprintf(buf, len, "did you mean %s or %s?", cand[first], cand[second]);
 }
 
+/*@C
+  PeriSceneSuggest - "did you mean X?" (or "X or Y") for the names of cand (NULL-ended) within a
+  few typos of name, else "". For unknown scene keys, as for unknown options.
+@*/
+void PeriSceneSuggest(const char name[], const char *const cand[], char buf[], size_t len)
+{
+  PetscBool exact;
+  Suggest(name, (char *const *)cand, buf, len, &exact);
+}
+
 static void Append(char buf[], size_t len, const char fmt[], ...) PETSC_ATTRIBUTE_FORMAT(3, 4);
 static void Append(char buf[], size_t len, const char fmt[], ...)
 {

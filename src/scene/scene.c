@@ -590,11 +590,10 @@ PetscErrorCode PeriSceneCheckKeys(PeriScene scene, PeriNode map, const char *con
     for (PetscInt a = 0; allowed[a]; a++)
       if (!strcmp(map->child[k]->key, allowed[a])) ok = PETSC_TRUE;
     if (!ok) {
-      char list[512] = "";
-      for (PetscInt a = 0; allowed[a]; a++) {
-        PeriListAppend(list, sizeof(list), allowed[a]);
-      }
-      PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s", list);
+      char list[512] = "", hint[160];
+      for (PetscInt a = 0; allowed[a]; a++) PeriListAppend(list, sizeof(list), allowed[a]);
+      PeriSceneSuggest(map->child[k]->key, allowed, hint, sizeof(hint));
+      PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s%s%s", list, hint[0] ? "; " : "", hint);
     }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -620,6 +619,28 @@ static const PeriSchemaOwner *OtherOwner(PeriScene scene, const PeriSchemaOwner 
   for (PetscInt o = 0; o < scene->nowners; o++)
     if (strcmp(scene->owners[o].kind, "core") && (!active || strcmp(scene->owners[o].name, active->name)) && PeriSchemaFindKey(scene->owners[o].schema, section, name)) return &scene->owners[o];
   return NULL;
+}
+
+/* "; did you mean X?" for name among the comma-separated names of list, or "". */
+static PetscErrorCode SuggestFromList(const char name[], const char list[], char buf[], size_t len)
+{
+  char      **names;
+  int         n;
+  char        hint[160];
+  const char *cand[PERI_SECTION_MAX_KEYS + 1];
+
+  PetscFunctionBeginUser;
+  buf[0] = 0;
+  PetscCall(PetscStrToArray(list, ',', &n, &names));
+  for (int a = 0; a < n && a < PERI_SECTION_MAX_KEYS; a++) {
+    cand[a] = names[a];
+    while (*cand[a] == ' ') cand[a]++;
+  }
+  cand[PetscMin(n, PERI_SECTION_MAX_KEYS)] = NULL;
+  PeriSceneSuggest(name, cand, hint, sizeof(hint));
+  if (hint[0]) PetscCall(PetscSNPrintf(buf, len, "; %s", hint));
+  PetscCall(PetscStrToArrayDestroy(n, names));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
@@ -648,7 +669,10 @@ PetscErrorCode PeriSceneCheckKeysSchema(PeriScene scene, PeriNode map, const cha
     for (PetscInt a = 0; base[a]; a++) PeriListAppend(list, sizeof(list), base[a]);
     for (const PeriSchema *sec = active ? active->schema : NULL; sec && sec->section; sec++)
       for (const PeriKey *key = sec->keys; !strcmp(sec->section, section) && key->name; key++) PeriListAppend(list, sizeof(list), key->name);
-    if (other) PetscCall(PetscSNPrintf(owner, sizeof(owner), " (key '%s' belongs to %s %s, not %s)", name, other->kind, other->name, active->name));
+    if (other)
+      PetscCall(PetscSNPrintf(owner, sizeof(owner), " (key '%s' belongs to %s %s, not %s)", name, other->kind, other->name, active->name));
+    else
+      PetscCall(SuggestFromList(name, list, owner, sizeof(owner)));
     PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s%s", list, owner);
   }
   PetscFunctionReturn(PETSC_SUCCESS);

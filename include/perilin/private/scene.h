@@ -30,3 +30,4 @@ typedef struct {
   PetscBool   eigen;                         /* the linear solves were an eigensolver's (-st_ prefix) */
 } PeriRunSolvers;
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckUnused(const PeriRunSolvers *);
+PETSC_EXTERN void           PeriSceneSuggest(const char[], const char *const[], char[], size_t);
