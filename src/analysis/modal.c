@@ -16,7 +16,7 @@ static inline PeriModal *Modal(PeriAnalysis an)
 static PetscErrorCode Densities(PeriAnalysis an, PetscReal **rho)
 {
   PeriScene      s    = an->sys->scene;
-  const PetscInt nloc = an->sys->bonds.rend - an->sys->bonds.rstart;
+  const PetscInt nloc = an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart;
   PeriNode       mat, map;
 
   PetscFunctionBeginUser;
@@ -27,11 +27,11 @@ static PetscErrorCode Densities(PeriAnalysis an, PetscReal **rho)
   for (PetscInt k = 0; map && k < map->n; k++) {
     PeriRegion *r;
     PetscReal   v;
-    PetscCall(PeriRegionFind(s, map->child[k], NULL, an->sys->nregions, an->sys->regions, &r));
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, an->sys->disc.nregions, an->sys->disc.regions, &r));
     PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &v, NULL));
     PeriInputCheck(v > 0, s, map, map->child[k]->key, "must be positive");
     for (PetscInt i = 0; i < nloc; i++)
-      if (PeriRegionContains(r, &an->sys->particles.x[3 * (an->sys->bonds.rstart + i)])) (*rho)[i] = v;
+      if (PeriRegionContains(r, &an->sys->disc.particles.x[3 * (an->sys->disc.bonds.rstart + i)])) (*rho)[i] = v;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -41,7 +41,7 @@ static PetscErrorCode Densities(PeriAnalysis an, PetscReal **rho)
 @*/
 static PetscErrorCode PeriAssembleMass(PeriAnalysis an, Mat *M)
 {
-  const PetscInt bs = an->sys->model->dofs, nloc = an->sys->bonds.rend - an->sys->bonds.rstart;
+  const PetscInt bs = an->sys->model->dofs, nloc = an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart;
   PetscReal     *rho;
   Vec            d;
   PetscScalar   *a;
@@ -58,7 +58,7 @@ static PetscErrorCode PeriAssembleMass(PeriAnalysis an, Mat *M)
   PetscCall(Densities(an, &rho));
   PetscCall(VecGetArray(d, &a));
   for (PetscInt i = 0; i < nloc; i++) {
-    PetscReal V = an->sys->particles.volume[an->sys->bonds.rstart + i], h = an->sys->particles.spacing[an->sys->bonds.rstart + i];
+    PetscReal V = an->sys->disc.particles.volume[an->sys->disc.bonds.rstart + i], h = an->sys->disc.particles.spacing[an->sys->disc.bonds.rstart + i];
     for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = an->sys->model->rotational[c] ? rho[i] * V * (h * h + h * h) / 12 : rho[i] * V;
   }
   PetscCall(VecRestoreArray(d, &a));
@@ -74,7 +74,7 @@ static PetscErrorCode PeriAssembleMass(PeriAnalysis an, Mat *M)
  * body, its longest extent. Components held at 0 because they are inactive do not count. */
 static PetscErrorCode MainAxis(PeriAnalysis an, PetscInt *axis)
 {
-  const PeriParticles *pt   = &an->sys->particles;
+  const PeriParticles *pt   = &an->sys->disc.particles;
   PetscReal            s[4] = {0, 0, 0, 0}, best = -1;
 
   PetscFunctionBeginUser;
@@ -118,7 +118,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, PetscInt *nev, PetscReal *ta
 /* The owned DOFs that are not prescribed. */
 static PetscErrorCode FreeDOFs(PeriAnalysis an, IS *is)
 {
-  const PetscInt bs = an->sys->model->dofs, nloc = (an->sys->bonds.rend - an->sys->bonds.rstart) * bs, r0 = an->sys->bonds.rstart * bs;
+  const PetscInt bs = an->sys->model->dofs, nloc = (an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart) * bs, r0 = an->sys->disc.bonds.rstart * bs;
   PetscInt      *idx, n = 0, c = 0;
 
   PetscFunctionBeginUser;
@@ -138,7 +138,7 @@ static PetscErrorCode FreeDOFs(PeriAnalysis an, IS *is)
 /* Shares of kinetic energy per component, effective modal masses per direction, and the kind. */
 static PetscErrorCode Classify(PeriAnalysis an, Vec x, Vec mdiag, PeriMode *mode, PetscInt axis)
 {
-  const PetscInt     bs = an->sys->model->dofs, nloc = an->sys->bonds.rend - an->sys->bonds.rstart;
+  const PetscInt     bs = an->sys->model->dofs, nloc = an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart;
   const PetscScalar *xa, *ma;
   PetscReal          e[PERI_MAX_DOF + 4] = {0}, tot = 0, trans = 0, rot = 0, along = 0;
   PetscInt           comp[3];
@@ -176,14 +176,14 @@ static PetscErrorCode Classify(PeriAnalysis an, Vec x, Vec mdiag, PeriMode *mode
    * where their kinetic energy is. */
   {
     PetscReal maxis = mode->effective_mass[axis], macross = 0;
-    for (PetscInt d = 0; d < an->sys->particles.dim; d++)
+    for (PetscInt d = 0; d < an->sys->disc.particles.dim; d++)
       if (d != axis) macross = PetscMax(macross, mode->effective_mass[d]);
     if (rot > 0.5)
       PetscCall(PetscStrncpy(mode->kind, "rotational", sizeof(mode->kind)));
     else if (PetscMax(maxis, macross) > 1e-3 ? maxis > macross : along > 0.5 * trans)
-      PetscCall(PetscStrncpy(mode->kind, an->sys->particles.dim == 2 ? "axial" : "longitudinal", sizeof(mode->kind)));
+      PetscCall(PetscStrncpy(mode->kind, an->sys->disc.particles.dim == 2 ? "axial" : "longitudinal", sizeof(mode->kind)));
     else
-      PetscCall(PetscStrncpy(mode->kind, an->sys->particles.dim == 2 ? "flexural" : "transverse", sizeof(mode->kind)));
+      PetscCall(PetscStrncpy(mode->kind, an->sys->disc.particles.dim == 2 ? "flexural" : "transverse", sizeof(mode->kind)));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -194,7 +194,7 @@ static PetscErrorCode StoreShape(PeriAnalysis an, Vec full, PetscInt k)
   VecScatter         sc;
   Vec                all;
   const PetscScalar *a;
-  const PetscInt     nd = an->sys->particles.n * an->sys->model->dofs;
+  const PetscInt     nd = an->sys->disc.particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   PetscCall(VecScatterCreateToZero(full, &sc, &all));
@@ -450,7 +450,7 @@ static PetscErrorCode SetUpModal(PeriAnalysis an, PetscReal target_hz, Mat *M, V
   an->data = md;
   /* rotations carry inertia, not mass: the total mass is that of the particles */
   PetscCall(Densities(an, &rho));
-  for (PetscInt i = an->sys->bonds.rstart; i < an->sys->bonds.rend; i++) md->total_mass += rho[i - an->sys->bonds.rstart] * an->sys->particles.volume[i];
+  for (PetscInt i = an->sys->disc.bonds.rstart; i < an->sys->disc.bonds.rend; i++) md->total_mass += rho[i - an->sys->disc.bonds.rstart] * an->sys->disc.particles.volume[i];
   PetscCall(PetscFree(rho));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, an->comm));
   md->target_hz = target_hz;
@@ -469,7 +469,7 @@ static PetscErrorCode CollectModes(PeriAnalysis an, EPS eps, Mat Kff, Mat Mff, I
 {
   PeriModal *md = Modal(an);
   Vec        x, r, y, full;
-  PetscInt   nd = an->sys->particles.n * an->sys->model->dofs;
+  PetscInt   nd = an->sys->disc.particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(Kff, &x, &r));
@@ -593,9 +593,9 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   if (nfree)
     for (PetscInt k = 0; k < md->nmodes; k++)
       if (!strcmp(md->modes[k].kind, "longitudinal") || !strcmp(md->modes[k].kind, "axial")) {
-        PetscReal L            = an->sys->particles.upper[md->axis] - an->sys->particles.lower[md->axis];
+        PetscReal L            = an->sys->disc.particles.upper[md->axis] - an->sys->disc.particles.lower[md->axis];
         md->longitudinal_speed = 2 * L * md->modes[k].f_hz;
-        if (an->sys->particles.dim == 3) md->theory_speed = PetscSqrtReal((an->sys->model->material.K + 4 * an->sys->model->material.G / 3) / an->sys->model->material.rho);
+        if (an->sys->disc.particles.dim == 3) md->theory_speed = PetscSqrtReal((an->sys->model->material.K + 4 * an->sys->model->material.G / 3) / an->sys->model->material.rho);
         break;
       }
   PetscCall(RecordSolver(an, w->eps, nev, &w->inner));
@@ -665,7 +665,7 @@ static PetscErrorCode PeriWriteModesCSV(PeriAnalysis an, const char path[])
 static PetscErrorCode ModalAddFields(PeriAnalysis an, PeriFieldList fl)
 {
   const PeriModal *md = Modal(an);
-  const PetscInt   nd = an->sys->particles.n * an->sys->model->dofs;
+  const PetscInt   nd = an->sys->disc.particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; md && k < md->nshapes; k++) {
@@ -686,7 +686,7 @@ static PetscErrorCode WriteModeShapes(PeriAnalysis an, const char dir[])
   PeriModal     *md = Modal(an);
   PetscReal     *times;
   char         **files, path[PETSC_MAX_PATH_LEN];
-  const PetscInt nd = an->sys->particles.n * an->sys->model->dofs;
+  const PetscInt nd = an->sys->disc.particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   if (an->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
@@ -737,7 +737,7 @@ static PetscErrorCode ModalSummary(PeriAnalysis an, PeriJSON j)
     PetscCall(PeriJSONBeginObject(j, "energy_share"));
     for (PetscInt c = 0; c < bs; c++) PetscCall(PeriJSONReal(j, an->sys->model->components[c], m->energy_share[c]));
     PetscCall(PeriJSONEndObject(j));
-    PetscCall(PeriJSONRealArray(j, "effective_mass", an->sys->particles.dim, m->effective_mass));
+    PetscCall(PeriJSONRealArray(j, "effective_mass", an->sys->disc.particles.dim, m->effective_mass));
     PetscCall(PeriJSONEndObject(j));
   }
   PetscCall(PeriJSONEndArray(j));

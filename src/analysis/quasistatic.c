@@ -99,7 +99,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
  * softened by more than 1 %. */
 static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *nbroken)
 {
-  PeriBonds         *b  = &an->sys->bonds;
+  PeriBonds         *b  = &an->sys->disc.bonds;
   PeriModel          m  = an->sys->model;
   const PetscInt     bs = m->dofs, nb = 2 * bs;
   VecScatter         scatter;
@@ -202,7 +202,7 @@ static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscReal 
   *v = 0;
   if (!probe) PetscFunctionReturn(PETSC_SUCCESS);
   row = probe->particle * an->sys->model->dofs;
-  if (an->sys->owner[probe->particle] == an->rank) {
+  if (an->sys->disc.owner[probe->particle] == an->rank) {
     PetscScalar x;
     PetscCall(VecGetValues(an->sys->u, 1, &row, &x));
     *v = PetscRealPart(x);
@@ -239,12 +239,12 @@ static PetscErrorCode EquilibriumCreate(PeriAnalysis an, Equilibrium *e)
 {
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(an->sys->K, &e->u, NULL)); /* lambda = 0: no displacement */
-  PetscCall(PetscMalloc1(an->sys->bonds.nbonds, &e->live));
-  PetscCall(PetscArraycpy(e->live, an->sys->bonds.live, an->sys->bonds.nbonds));
+  PetscCall(PetscMalloc1(an->sys->disc.bonds.nbonds, &e->live));
+  PetscCall(PetscArraycpy(e->live, an->sys->disc.bonds.live, an->sys->disc.bonds.nbonds));
   e->intact = NULL;
-  if (an->sys->bonds.intact) {
-    PetscCall(PetscMalloc1(an->sys->bonds.nbonds, &e->intact));
-    PetscCall(PetscArraycpy(e->intact, an->sys->bonds.intact, an->sys->bonds.nbonds));
+  if (an->sys->disc.bonds.intact) {
+    PetscCall(PetscMalloc1(an->sys->disc.bonds.nbonds, &e->intact));
+    PetscCall(PetscArraycpy(e->intact, an->sys->disc.bonds.intact, an->sys->disc.bonds.nbonds));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -254,8 +254,8 @@ static PetscErrorCode EquilibriumSave(PeriAnalysis an, Equilibrium *e)
   PetscFunctionBeginUser;
   PetscCall(VecCopy(an->sys->u, e->u));
   e->solve = an->sys->solve;
-  PetscCall(PetscArraycpy(e->live, an->sys->bonds.live, an->sys->bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(e->intact, an->sys->bonds.intact, an->sys->bonds.nbonds));
+  PetscCall(PetscArraycpy(e->live, an->sys->disc.bonds.live, an->sys->disc.bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(e->intact, an->sys->disc.bonds.intact, an->sys->disc.bonds.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -264,8 +264,8 @@ static PetscErrorCode EquilibriumSave(PeriAnalysis an, Equilibrium *e)
 static PetscErrorCode EquilibriumRestore(PeriAnalysis an, Equilibrium *e, PetscBool reassemble, PetscBool restore_u)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscArraycpy(an->sys->bonds.live, e->live, an->sys->bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(an->sys->bonds.intact, e->intact, an->sys->bonds.nbonds));
+  PetscCall(PetscArraycpy(an->sys->disc.bonds.live, e->live, an->sys->disc.bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(an->sys->disc.bonds.intact, e->intact, an->sys->disc.bonds.nbonds));
   PetscCall(PeriFamilySync(an->sys));
   if (reassemble) {
     PetscCall(PeriSystemAssemble(an->sys));
@@ -494,7 +494,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
   PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(EquilibriumCreate(an, &eq));
-  PetscCallMPI(MPI_Allreduce(&an->sys->bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
+  PetscCallMPI(MPI_Allreduce(&an->sys->disc.bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
   L.stale = PETSC_TRUE;
   PetscCall(PetscTime(&t0));
   dl = st.step;

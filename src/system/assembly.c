@@ -21,8 +21,8 @@ static PetscInt RowPartners(const PeriBonds *b, PetscInt i, PetscInt buf[])
  * (lower), which may live on other ranks: counts for those are summed with MPI_Reduce_scatter. */
 static PetscErrorCode Preallocation(PeriSystem sys, PetscInt **dnz, PetscInt **onz, PetscInt **dnzu, PetscInt **onzu)
 {
-  const PeriBonds *b = &sys->bonds;
-  const PetscInt   n = sys->particles.n, nloc = b->rend - b->rstart;
+  const PeriBonds *b = &sys->disc.bonds;
+  const PetscInt   n = sys->disc.particles.n, nloc = b->rend - b->rstart;
   PetscInt        *cnt, *buf, maxrow = 0;
   PetscMPIInt     *recv;
 
@@ -35,7 +35,7 @@ static PetscErrorCode Preallocation(PeriSystem sys, PetscInt **dnz, PetscInt **o
     PetscInt m = RowPartners(b, i, buf), du = 1, ou = 0;
     for (PetscInt k = 0; k < m; k++) {
       PetscInt  j    = buf[k];
-      PetscBool same = (PetscBool)(sys->owner[j] == sys->rank);
+      PetscBool same = (PetscBool)(sys->disc.owner[j] == sys->rank);
       if (same)
         du++;
       else
@@ -50,7 +50,7 @@ static PetscErrorCode Preallocation(PeriSystem sys, PetscInt **dnz, PetscInt **o
   PetscCall(PetscFree(buf));
   /* owners hold contiguous ranges, so the rows in global order are already grouped by rank */
   PetscCall(PetscCalloc1(sys->size, &recv));
-  for (PetscInt i = 0; i < n; i++) recv[sys->owner[i]] += 2;
+  for (PetscInt i = 0; i < n; i++) recv[sys->disc.owner[i]] += 2;
   {
     PetscInt *mine, *sendbuf;
     PetscCall(PetscMalloc2(2 * nloc, &mine, 2 * n, &sendbuf));
@@ -101,7 +101,7 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
   el.K      = Ke;
   el.g      = fam;
   el.work   = work;
-  for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) {
+  for (PetscInt i = sys->disc.family.rstart; i < sys->disc.family.rend; i++) {
     PetscInt n;
     PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
     PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
@@ -118,7 +118,7 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
  * ends alike and carry no energy. */
 static PetscErrorCode BondsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
 {
-  const PeriBonds *b = &sys->bonds;
+  const PeriBonds *b = &sys->disc.bonds;
   PeriModel        m = sys->model;
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], work[4 * PERI_MAX_DOF];
   PetscInt         idx[2];
@@ -176,11 +176,11 @@ static PetscErrorCode InsertElements(PeriSystem sys, Mat K)
 /* An empty block matrix of K's layout and the given type: the options and preallocation follow. */
 static PetscErrorCode CreateBlockMatrix(PeriSystem sys, MatType type, Mat *K)
 {
-  const PetscInt bs = sys->model->dofs, nloc = sys->bonds.rend - sys->bonds.rstart;
+  const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreate(sys->comm, K));
-  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->particles.n * bs, sys->particles.n * bs));
+  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->disc.particles.n * bs, sys->disc.particles.n * bs));
   PetscCall(MatSetBlockSize(*K, bs));
   PetscCall(MatSetType(*K, type));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -209,7 +209,7 @@ static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
  * *maxcol gets the most blocks of a row (the size of the row buffers). */
 static PetscErrorCode CreateBondStiffness(PeriSystem sys, Mat *K, PetscInt *maxcol)
 {
-  const PetscInt nloc = sys->bonds.rend - sys->bonds.rstart;
+  const PetscInt nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
   PetscInt      *dnz, *onz, *dnzu, *onzu;
   PetscBool      sym;
 
@@ -277,7 +277,7 @@ typedef struct {
  * store towards it. Blocks of rows owned by other ranks go to K through the stash. */
 static PetscErrorCode GatherBondRow(PeriSystem sys, const Incoming *in, PetscInt i, RowBuffer *w, Mat K)
 {
-  const PeriBonds *b  = &sys->bonds;
+  const PeriBonds *b  = &sys->disc.bonds;
   PeriModel        m  = sys->model;
   const PetscInt   bs = m->dofs, nb = 2 * bs, rstart = b->rstart;
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
@@ -296,7 +296,7 @@ static PetscErrorCode GatherBondRow(PeriSystem sys, const Incoming *in, PetscInt
     m->ops.bond_stiffness(m, &g, Ke);
     RowAdd(bs, i, &Ke[0], nb, w->slot, w->col, w->blocks, &w->ncol);
     RowAdd(bs, j, &Ke[bs], nb, w->slot, w->col, w->blocks, &w->ncol);
-    if (sys->owner[j] != sys->rank) {
+    if (sys->disc.owner[j] != sys->rank) {
       PetscInt idx[2] = {i, j};
       PetscCall(MatSetValuesBlocked(K, 1, &j, 2, idx, &Ke[bs * nb], ADD_VALUES));
     }
@@ -331,7 +331,7 @@ static PetscErrorCode InsertRow(PetscInt bs, PetscInt i, RowBuffer *w, Mat K)
 /* Bond-based models: each owned block row gathered in full and inserted with one call. */
 static PetscErrorCode AssembleBonds(PeriSystem sys, Mat *K)
 {
-  const PeriBonds *b  = &sys->bonds;
+  const PeriBonds *b  = &sys->disc.bonds;
   const PetscInt   bs = sys->model->dofs;
   PetscInt         maxcol;
   Incoming         in;
@@ -340,8 +340,8 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, Mat *K)
   PetscFunctionBeginUser;
   PetscCall(CreateBondStiffness(sys, K, &maxcol));
   PetscCall(IncomingBonds(b, &in));
-  PetscCall(PetscMalloc1(sys->particles.n, &w.slot));
-  for (PetscInt i = 0; i < sys->particles.n; i++) w.slot[i] = -1;
+  PetscCall(PetscMalloc1(sys->disc.particles.n, &w.slot));
+  for (PetscInt i = 0; i < sys->disc.particles.n; i++) w.slot[i] = -1;
   PetscCall(PetscMalloc4(maxcol, &w.col, maxcol, &w.perm, maxcol * bs * bs, &w.blocks, maxcol * bs * bs, &w.row));
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     PetscCall(GatherBondRow(sys, &in, i, &w, *K));
@@ -388,11 +388,11 @@ PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 @*/
 PetscErrorCode PeriRigidModes(PeriSystem sys, PetscInt *nmodes, Vec modes[], PetscReal norm[])
 {
-  const PeriParticles *pt = &sys->particles;
+  const PeriParticles *pt = &sys->disc.particles;
   PeriModel            m  = sys->model;
   PetscReal            centre[3], vals[PERI_MAX_MODES][PERI_MAX_DOF], X[3];
   PetscScalar         *a[PERI_MAX_MODES];
-  PetscInt             nm = 0, rstart = sys->bonds.rstart;
+  PetscInt             nm = 0, rstart = sys->disc.bonds.rstart;
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
@@ -402,7 +402,7 @@ PetscErrorCode PeriRigidModes(PeriSystem sys, PetscInt *nmodes, Vec modes[], Pet
     PetscCall(PeriSystemCreateVec(sys, &modes[k]));
     PetscCall(VecGetArray(modes[k], &a[k]));
   }
-  for (PetscInt i = rstart; i < sys->bonds.rend; i++) {
+  for (PetscInt i = rstart; i < sys->disc.bonds.rend; i++) {
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
     m->ops.rigid_modes(m, X, vals);
     for (PetscInt k = 0; k < nm; k++)

@@ -67,7 +67,7 @@ const PeriSchema PeriBoundarySchema[] = {
 static PetscErrorCode ParseAffine(PeriSystem sys, PeriNode node, const char section[], PetscReal A[3][3], PetscReal b[3])
 {
   PeriScene      s   = sys->scene;
-  const PetscInt dim = sys->particles.dim;
+  const PetscInt dim = sys->disc.particles.dim;
   PeriNode       Anode;
   PetscInt       n;
 
@@ -86,7 +86,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
 {
   PeriScene      s  = sys->scene;
   PeriModel      m  = sys->model;
-  const PetscInt bs = m->dofs, dim = sys->particles.dim;
+  const PetscInt bs = m->dofs, dim = sys->disc.particles.dim;
   PeriRegion    *r;
   PeriNode       fix, val, aff;
   PetscReal      v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
@@ -97,7 +97,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
   PetscFunctionBeginUser;
   PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a boundary condition is a mapping {region: name, fix: [..] | value: {..} | affine: {..}}");
   PetscCall(PeriSceneCheckSection(s, item, "bc.<k>"));
-  PetscCall(PeriRegionFind(s, item, "region", sys->nregions, sys->regions, &r));
+  PetscCall(PeriRegionFind(s, item, "region", sys->disc.nregions, sys->disc.regions, &r));
   PetscCall(PeriSceneGetBool(s, item, "optional", &optional, NULL));
   PetscCall(PeriSceneGetNode(item, "fix", &fix));
   PetscCall(PeriSceneGetNode(item, "value", &val));
@@ -132,8 +132,8 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
       use[axis_comp[a]] = PETSC_TRUE;
     }
   }
-  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
-    const PetscReal *X = &sys->particles.x[3 * i];
+  for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++) {
+    const PetscReal *X = &sys->disc.particles.x[3 * i];
     if (!PeriRegionContains(r, X)) continue;
     if (aff)
       for (PetscInt a = 0; a < dim; a++) {
@@ -142,8 +142,8 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
       }
     for (PetscInt c = 0; c < bs; c++)
       if (use[c]) {
-        value[(i - sys->bonds.rstart) * bs + c] = v[c];
-        set[(i - sys->bonds.rstart) * bs + c]   = PETSC_TRUE;
+        value[(i - sys->disc.bonds.rstart) * bs + c] = v[c];
+        set[(i - sys->disc.bonds.rstart) * bs + c]   = PETSC_TRUE;
       }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -155,7 +155,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
 PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
 {
   PeriScene      s  = sys->scene;
-  const PetscInt bs = sys->model->dofs, nloc = (sys->bonds.rend - sys->bonds.rstart) * bs;
+  const PetscInt bs = sys->model->dofs, nloc = (sys->disc.bonds.rend - sys->disc.bonds.rstart) * bs;
   PeriNode       bc;
   PetscReal     *value;
   PetscBool     *set;
@@ -185,7 +185,7 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   n = 0;
   for (PetscInt k = 0; k < nloc; k++)
     if (set[k]) {
-      sys->constrained[n]       = sys->bonds.rstart * bs + k;
+      sys->constrained[n]       = sys->disc.bonds.rstart * bs + k;
       sys->constrained_value[n] = value[k];
       n++;
     }
@@ -201,7 +201,7 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
 {
   PeriScene      s  = sys->scene;
   PeriModel      m  = sys->model;
-  const PetscInt bs = m->dofs, dim = sys->particles.dim;
+  const PetscInt bs = m->dofs, dim = sys->disc.particles.dim;
   PeriNode       loads;
   PetscScalar   *a;
   PetscInt       ncomp, uz;
@@ -224,7 +224,7 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
     PetscInt    n, comp[3]            = {-1, -1, -1};
     PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force | traction_field: ..}");
     PetscCall(PeriSceneCheckSection(s, item, "loads.<k>"));
-    PetscCall(PeriRegionFind(s, item, "region", sys->nregions, sys->regions, &r));
+    PetscCall(PeriRegionFind(s, item, "region", sys->disc.nregions, sys->disc.regions, &r));
     PetscCall(PeriSceneGetNode(item, "force", &force));
     PetscCall(PeriSceneGetNode(item, "traction", &traction));
     PetscCall(PeriSceneGetNode(item, "body_force", &body));
@@ -244,15 +244,15 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
       PeriInputCheck(comp[d] >= 0 || (F[d] == 0 && A[d][0] == 0 && A[d][1] == 0 && A[d][2] == 0), s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
     }
     largest = 0;
-    for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
-      const PetscReal *X = &sys->particles.x[3 * i];
+    for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++) {
+      const PetscReal *X = &sys->disc.particles.x[3 * i];
       if (!PeriRegionContains(r, X)) continue;
       for (PetscInt d = 0; d < ncomp; d++) {
         PetscReal v = F[d];
         for (PetscInt e = 0; e < dim; e++) v += A[d][e] * X[e];
         if (comp[d] < 0) continue;
-        v *= scale * sys->particles.volume[i];
-        a[(i - sys->bonds.rstart) * bs + comp[d]] += v;
+        v *= scale * sys->disc.particles.volume[i];
+        a[(i - sys->disc.bonds.rstart) * bs + comp[d]] += v;
         /* NaN must fail the check below, so it counts as infinitely large */
         largest = PetscIsInfOrNanReal(v) ? PETSC_INFINITY : PetscMax(largest, PetscAbsReal(v));
       }
@@ -260,9 +260,9 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
     /* Finite but huge values (1e308) overflow the solver's inner products, which then stops with
        a NaN residual that blames the operator; say here that the load is at fault. */
     PetscCallMPI(MPIU_Allreduce(MPI_IN_PLACE, &largest, 1, MPIU_REAL, MPIU_MAX, sys->comm));
-    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(sys->particles.n * bs)), s, item, field ? "traction_field" : force  ? "force"
-                                                                                                                                 : traction ? "traction"
-                                                                                                                                            : "body_force",
+    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(sys->disc.particles.n * bs)), s, item, field ? "traction_field" : force  ? "force"
+                                                                                                                                      : traction ? "traction"
+                                                                                                                                                 : "body_force",
                    "the load is too large for double precision: a particle force of %g overflows the solver's inner products (keep particle forces below about 1e150)", (double)largest);
   }
   PetscCall(VecRestoreArray(f, &a));
@@ -329,13 +329,13 @@ static PetscErrorCode RigidGramConstrained(PeriSystem sys, PetscInt nm, Vec mode
  * u_f = s u_m + o holds a mode v unless v_f = s v_m. */
 static PetscErrorCode RigidGramLayers(PeriSystem sys, PetscInt nm, const PetscReal norm[], PetscReal G[PERI_MAX_MODES][PERI_MAX_MODES])
 {
-  const PeriParticles *pt = &sys->particles;
+  const PeriParticles *pt = &sys->disc.particles;
   PeriModel            m  = sys->model;
   PetscReal            centre[3], X[3], vf[PERI_MAX_MODES][PERI_MAX_DOF], vm[PERI_MAX_MODES][PERI_MAX_DOF];
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) centre[d] = 0.5 * (pt->lower[d] + pt->upper[d]);
-  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++) {
+  for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++) {
     PetscInt           mi = pt->image ? pt->image[i] : -1, ncols;
     const PetscInt    *cols;
     const PetscScalar *vals;
@@ -377,7 +377,7 @@ static PetscErrorCode RigidMotionName(PeriSystem sys, PetscInt nm, const PetscRe
   static const char *const names1[] = {"translation along z"};
   static const char *const names2[] = {"translation along x", "translation along y", "rotation about z"};
   static const char *const names3[] = {"translation along x", "translation along y", "translation along z", "rotation about x", "rotation about y", "rotation about z"};
-  const PeriParticles     *pt       = &sys->particles;
+  const PeriParticles     *pt       = &sys->disc.particles;
   PetscInt                 best     = 0;
 
   PetscFunctionBeginUser;
@@ -436,7 +436,7 @@ PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[],
   *nfree = 0;
   if (what) what[0] = 0;
   for (PetscInt k = 0; k < nm; k++) {
-    if (w[k] > 1e-12 / sys->particles.n) continue;
+    if (w[k] > 1e-12 / sys->disc.particles.n) continue;
     if (free) PetscCall(RigidFreeVector(nm, modes, V, k, *nfree, free));
     if ((*nfree)++ || !what) continue;
     PetscCall(RigidMotionName(sys, nm, norm, V, k, what, len));

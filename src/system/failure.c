@@ -69,10 +69,10 @@ PetscErrorCode PeriFailureSetUp(PeriSystem sys)
   PeriInputCheck(!has[4] || F->friction_angle < 90, s, node, "friction_angle", "must lie in (0, 90) degrees, got %g", (double)F->friction_angle);
   PeriInputCheck(!has[7] || (has[0] && F->ultimate > F->stretch), s, node, "ultimate_stretch", "softening needs critical_stretch (where it starts) below ultimate_stretch (where the bond is gone)");
   PeriInputCheck(!has[8] || (has[2] && F->ultimate_compressive > F->compressive), s, node, "ultimate_compressive_stretch", "softening needs compressive_stretch below ultimate_compressive_stretch");
-  PetscCall(PetscCalloc1(sys->bonds.nbonds, &sys->bonds.cause));
+  PetscCall(PetscCalloc1(sys->disc.bonds.nbonds, &sys->disc.bonds.cause));
   if (has[7] || has[8]) {
-    PetscCall(PetscMalloc1(sys->bonds.nbonds, &sys->bonds.intact));
-    for (PetscInt k = 0; k < sys->bonds.nbonds; k++) sys->bonds.intact[k] = 1;
+    PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &sys->disc.bonds.intact));
+    for (PetscInt k = 0; k < sys->disc.bonds.nbonds; k++) sys->disc.bonds.intact[k] = 1;
   }
   F->active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -141,7 +141,7 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
   PetscCall(PeriSceneGetNode(s->root, "cracks", &list));
   if (!list) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(list->kind == PERI_NODE_SEQ, s, list, NULL, "must be a list of segments, each {from: [x, y], to: [x, y]}");
-  PeriInputCheck(sys->particles.dim == 2, s, list, NULL, "cracks are 2D segments; 3D scenes cannot have them yet");
+  PeriInputCheck(sys->disc.particles.dim == 2, s, list, NULL, "cracks are 2D segments; 3D scenes cannot have them yet");
   PetscCall(PetscMalloc1(4 * list->n, &seg));
   for (PetscInt c = 0; c < list->n; c++) {
     PeriNode item = list->child[c];
@@ -150,10 +150,10 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
     PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
     PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
     PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");
-    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], sys->particles.lower, sys->particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)sys->particles.lower[0], (double)sys->particles.upper[0], (double)sys->particles.lower[1], (double)sys->particles.upper[1]);
+    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], sys->disc.particles.lower, sys->disc.particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)sys->disc.particles.lower[0], (double)sys->disc.particles.upper[0], (double)sys->disc.particles.lower[1], (double)sys->disc.particles.upper[1]);
   }
-  cut = CutBonds(&sys->particles, &sys->bonds, list->n, seg);
-  if (sys->family.offset) CutBonds(&sys->particles, &sys->family, list->n, seg);
+  cut = CutBonds(&sys->disc.particles, &sys->disc.bonds, list->n, seg);
+  if (sys->disc.family.offset) CutBonds(&sys->disc.particles, &sys->disc.family, list->n, seg);
   PetscCall(PetscFree(seg));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, sys->comm));
   sys->failure.precracked_bonds = cut;
@@ -234,8 +234,8 @@ PetscReal PeriBondSoftening(PeriSystem sys, const PetscReal meas[])
 @*/
 PetscErrorCode PeriDamage(PeriSystem sys, PetscReal **damage)
 {
-  const PeriBonds     *b  = &sys->bonds;
-  const PeriParticles *pt = &sys->particles;
+  const PeriBonds     *b  = &sys->disc.bonds;
+  const PeriParticles *pt = &sys->disc.particles;
   const PetscInt       w  = PERI_NCAUSES + 2; /* all, live, then the lost share per cause */
   PetscReal           *acc;
 
@@ -274,15 +274,15 @@ static int ComparePair(const void *a, const void *b)
 }
 
 /*@C
-  PeriFamilySync - state-based models keep each particle's whole family (sys->family, both
-  directions); this marks dead every family entry whose bond is dead in sys->bonds (stored once, at
+  PeriFamilySync - state-based models keep each particle's whole family (sys->disc.family, both
+  directions); this marks dead every family entry whose bond is dead in sys->disc.bonds (stored once, at
   the smaller index, possibly on another rank): the dead pairs are gathered on every rank.
   Collective.
 @*/
 PetscErrorCode PeriFamilySync(PeriSystem sys)
 {
-  const PeriBonds *b = &sys->bonds;
-  PeriBonds       *F = &sys->family;
+  const PeriBonds *b = &sys->disc.bonds;
+  PeriBonds       *F = &sys->disc.family;
   PetscInt        *mine, *all, nmine = 0, nall;
   PetscMPIInt      n2, *counts, *displs;
 
@@ -340,8 +340,8 @@ static void Union(PetscInt parent[], PetscInt a, PetscInt b)
 @*/
 PetscErrorCode PeriComponents(PeriSystem sys, PetscInt label[])
 {
-  const PeriBonds *b   = &sys->bonds;
-  const PetscInt   n   = sys->particles.n;
+  const PeriBonds *b   = &sys->disc.bonds;
+  const PetscInt   n   = sys->disc.particles.n;
   PetscInt        *all = NULL;
 
   PetscFunctionBeginUser;
@@ -373,8 +373,8 @@ PetscErrorCode PeriComponents(PeriSystem sys, PetscInt label[])
 @*/
 PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, PetscReal **held, PetscInt *npieces, PetscBool *lost)
 {
-  const PeriParticles *pt = &sys->particles;
-  const PetscInt       n = pt->n, bs = sys->model->dofs, rstart = sys->bonds.rstart, rend = sys->bonds.rend;
+  const PeriParticles *pt = &sys->disc.particles;
+  const PetscInt       n = pt->n, bs = sys->model->dofs, rstart = sys->disc.bonds.rstart, rend = sys->disc.bonds.rend;
   PetscInt            *label, *anchored, *size, *loaded, main = -1, big = 0, lostl = 0;
   const PetscScalar   *f, *u = NULL;
 

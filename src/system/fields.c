@@ -19,7 +19,7 @@ PetscErrorCode PeriReadProbes(PeriSystem sys)
 {
   PeriScene            s = sys->scene;
   PeriNode             map;
-  const PeriParticles *pt = &sys->particles;
+  const PeriParticles *pt = &sys->disc.particles;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "probes", PETSC_FALSE, &map));
@@ -71,8 +71,8 @@ static PetscErrorCode ElementEnergy(PeriSystem sys, const PeriElement *el, void 
   share = e / el->nshare;
   for (PetscInt t = 0; t < el->nshare; t++) {
     PetscInt p = el->idx[t];
-    if (!PeriParticleIsFictitious(&sys->particles, p)) E->energy += share;
-    E->W[p] += share / sys->particles.volume[p];
+    if (!PeriParticleIsFictitious(&sys->disc.particles, p)) E->energy += share;
+    E->W[p] += share / sys->disc.particles.volume[p];
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -83,8 +83,8 @@ static PetscErrorCode ElementEnergy(PeriSystem sys, const PeriElement *el, void 
  * tau_xz, tau_yz and |tau| of every particle. */
 static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
 {
-  const PeriBonds     *b  = &sys->bonds;
-  const PeriParticles *pt = &sys->particles;
+  const PeriBonds     *b  = &sys->disc.bonds;
+  const PeriParticles *pt = &sys->disc.particles;
   const PetscInt       n  = pt->n;
   PetscReal           *acc; /* per particle: M00 M01 M11 R0 R1 */
 
@@ -144,7 +144,7 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   Vec                  all;
   const PetscScalar   *u;
   PeriModel            m  = sys->model;
-  const PeriParticles *pt = &sys->particles;
+  const PeriParticles *pt = &sys->disc.particles;
   const PetscInt       n = pt->n, bs = m->dofs;
   PetscReal            umax[PERI_MAX_DOF] = {0, 0, 0}, *W;
   EnergyCtx            E;
@@ -159,7 +159,7 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   E.W      = W;
   E.energy = 0;
   PetscCall(PeriElementsForEach(sys, ElementEnergy, &E));
-  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
+  for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++)
     for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(pt, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
   PetscCallMPI(MPI_Allreduce(umax, sys->max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
   PetscCallMPI(MPI_Allreduce(&E.energy, &sys->strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
@@ -205,9 +205,9 @@ PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe 
 PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
 {
   PetscFunctionBeginUser;
-  PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->particles.volume, 1, NULL));
-  PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->neighbor_count));
-  PetscCall(PeriFieldListAddInt(fl, "rank", sys->owner));
+  PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->disc.particles.volume, 1, NULL));
+  PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count));
+  PetscCall(PeriFieldListAddInt(fl, "rank", sys->disc.owner));
   if (sys->W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->W, 1, NULL));
   if (sys->tau) {
     const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
@@ -229,7 +229,7 @@ PetscErrorCode PeriSystemWriteVTU(PeriSystem sys, const PetscReal *u, const char
 
   PetscFunctionBeginUser;
   if (sys->rank) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFieldListCreate(sys->particles.n, sys->particles.x, &fl));
+  PetscCall(PeriFieldListCreate(sys->disc.particles.n, sys->disc.particles.x, &fl));
   if (u) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, u));
   PetscCall(PeriSystemAddFields(sys, fl));
   PetscCall(PeriWriteVTU(fl, path));
@@ -245,8 +245,8 @@ PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
   for (PetscInt k = 0; sys->u_all && k < sys->nprobes; k++) {
     const PeriProbe *pr = &sys->probes[k];
     PetscCall(PeriJSONBeginObject(j, pr->name));
-    PetscCall(PeriJSONRealArray(j, "x", sys->particles.dim, pr->x));
-    PetscCall(PeriJSONRealArray(j, "particle_x", sys->particles.dim, &sys->particles.x[3 * pr->particle]));
+    PetscCall(PeriJSONRealArray(j, "x", sys->disc.particles.dim, pr->x));
+    PetscCall(PeriJSONRealArray(j, "particle_x", sys->disc.particles.dim, &sys->disc.particles.x[3 * pr->particle]));
     PetscCall(PeriJSONString(j, "sampling", "nearest particle"));
     PetscCall(PeriJSONRealArray(j, "u", sys->model->dofs, pr->u));
     PetscCall(PeriJSONReal(j, "W", pr->W));

@@ -45,8 +45,8 @@ static PetscErrorCode ReadTorsion(PeriSystem sys)
   PeriInputCheck(sys->model->antiplane, s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", sys->model->type);
   PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &sys->torsion.twist, NULL));
   PeriInputCheck(sys->torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
-  sys->torsion.center[0] = 0.5 * (sys->particles.lower[0] + sys->particles.upper[0]);
-  sys->torsion.center[1] = 0.5 * (sys->particles.lower[1] + sys->particles.upper[1]);
+  sys->torsion.center[0] = 0.5 * (sys->disc.particles.lower[0] + sys->disc.particles.upper[0]);
+  sys->torsion.center[1] = 0.5 * (sys->disc.particles.lower[1] + sys->disc.particles.upper[1]);
   PetscCall(PeriSceneGetRealArray(s, t, "center", PETSC_FALSE, 2, 2, sys->torsion.center, &n));
   sys->torsion.active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -57,7 +57,7 @@ static PetscErrorCode ReadTorsion(PeriSystem sys)
  * fictitious particle that a body particle bonds to has a complete family. */
 static PetscInt LayerCells(PeriSystem sys, PetscReal h)
 {
-  PetscReal R = PeriSearchRadius(sys->partial_volume, sys->delta, h);
+  PetscReal R = PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, h);
   return (sys->model->ops.family_stiffness ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
 }
 
@@ -76,7 +76,7 @@ static PetscErrorCode LayerRead(PeriSystem sys, PeriNode item, const PetscInt ce
   PetscCall(PeriSceneGetChoice(s, item, "condition", PeriLayerKinds + 1, &kind, NULL));
   kind++;
   face = side;
-  PeriInputCheck(!sys->particles.periodic[face / 2], s, item, "side", "axis %c is periodic: it has no face", (char)('x' + face / 2));
+  PeriInputCheck(!sys->disc.particles.periodic[face / 2], s, item, "side", "axis %c is periodic: it has no face", (char)('x' + face / 2));
   PeriInputCheck(L->kind[face] == PERI_LAYER_NONE, s, item, "side", "face %s already has a layer", sides[face]);
   L->kind[face] = (PeriLayerKind)kind;
   PetscCall(PeriSceneGetReal(s, item, "value", kind != PERI_LAYER_FREE, &L->value[face], &hasv));
@@ -95,7 +95,7 @@ static PetscErrorCode LayerRead(PeriSystem sys, PeriNode item, const PetscInt ce
  * its mirror image in the body and the faces it crossed. */
 static PetscErrorCode LayersAppendParticles(PeriSystem sys, const PetscInt cells[], const PetscInt lo[], const PetscInt hi[])
 {
-  PeriParticles *pt = &sys->particles;
+  PeriParticles *pt = &sys->disc.particles;
   PetscReal      h  = pt->mean_spacing;
   PetscInt       n  = (cells[0] + lo[0] + hi[0]) * (cells[1] + lo[1] + hi[1]) - cells[0] * cells[1];
   PetscInt       nb = pt->n, N = pt->n + n, k;
@@ -158,7 +158,7 @@ static PetscErrorCode LayersAppendParticles(PeriSystem sys, const PetscInt cells
 PetscErrorCode PeriLayersAddParticles(PeriSystem sys)
 {
   PeriScene      s  = sys->scene;
-  PeriParticles *pt = &sys->particles;
+  PeriParticles *pt = &sys->disc.particles;
   PeriNode       list, grid;
   PetscInt       cells[2], lo[2] = {0, 0}, hi[2] = {0, 0}, nl;
   PetscReal      h;
@@ -204,9 +204,9 @@ static void FaceRelation(PeriSystem sys, PetscInt face, const PetscReal X[], con
 @*/
 PetscErrorCode PeriLayersSetUp(PeriSystem sys)
 {
-  const PeriParticles *pt     = &sys->particles;
+  const PeriParticles *pt     = &sys->disc.particles;
   PeriLayers          *L      = &sys->layers;
-  const PetscInt       rstart = sys->bonds.rstart, rend = sys->bonds.rend;
+  const PetscInt       rstart = sys->disc.bonds.rstart, rend = sys->disc.bonds.rend;
 
   PetscFunctionBeginUser;
   if (!L->nfaces) PetscFunctionReturn(PETSC_SUCCESS);
@@ -257,7 +257,7 @@ PetscErrorCode PeriLayersSetUp(PeriSystem sys)
 @*/
 PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
 {
-  const PeriParticles *pt = &sys->particles;
+  const PeriParticles *pt = &sys->disc.particles;
   PeriLayers          *L  = &sys->layers;
   Mat                  K = sys->K, Kaij = NULL;
   Vec                  w;
@@ -281,8 +281,8 @@ PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
   diag /= N;
   PetscCall(VecDestroy(&w));
   PetscCall(MatDestroy(&Kaij));
-  PetscCall(PetscMalloc1(sys->bonds.rend - sys->bonds.rstart, &rows));
-  for (PetscInt i = sys->bonds.rstart; i < sys->bonds.rend; i++)
+  PetscCall(PetscMalloc1(sys->disc.bonds.rend - sys->disc.bonds.rstart, &rows));
+  for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++)
     if (PeriParticleIsFictitious(pt, i)) rows[nf++] = i;
   PetscCall(MatZeroRows(*A, nf, rows, diag, NULL, NULL));
   for (PetscInt k = 0; k < nf; k++) PetscCall(VecSetValue(f, rows[k], 0.0, INSERT_VALUES));
@@ -322,7 +322,7 @@ PetscErrorCode PeriLayersDestroy(PeriLayers *L)
  * rigid twist's relative displacement of particle t from the element's particle i (one DOF). */
 static PetscErrorCode TorsionElementLoad(PeriSystem sys, const PeriElement *el, void *ctx)
 {
-  const PetscReal *x = sys->particles.x, psi = sys->torsion.twist, *c = sys->torsion.center;
+  const PetscReal *x = sys->disc.particles.x, psi = sys->torsion.twist, *c = sys->torsion.center;
   const PetscInt   i = el->idx[0], n = el->n;
   PetscReal       *e = el->work, *fe = el->work + n;
 
@@ -372,7 +372,7 @@ static PetscReal RectangleTorsionConstant(PetscReal A, PetscReal B)
 @*/
 PetscErrorCode PeriTorsionEvaluate(PeriSystem sys)
 {
-  const PeriParticles *pt = &sys->particles;
+  const PeriParticles *pt = &sys->disc.particles;
   PeriTorsion         *t  = &sys->torsion;
 
   PetscFunctionBeginUser;
@@ -421,7 +421,7 @@ PetscErrorCode PeriLayersSummary(PeriSystem sys, PeriJSON j)
   PetscFunctionBeginUser;
   if (!sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONBeginObject(j, "boundary_layers"));
-  PetscCall(PeriJSONInt(j, "fictitious_particles", sys->particles.nfictitious));
+  PetscCall(PeriJSONInt(j, "fictitious_particles", sys->disc.particles.nfictitious));
   for (PetscInt f = 0; f < 4; f++)
     if (sys->layers.kind[f]) PetscCall(PeriJSONString(j, faces[f], PeriLayerKinds[sys->layers.kind[f]]));
   PetscCall(PeriJSONEndObject(j));
@@ -433,6 +433,6 @@ PetscErrorCode PeriLayersSummary(PeriSystem sys, PeriJSON j)
 PetscErrorCode PeriLayersAddFields(PeriSystem sys, PeriFieldList fl)
 {
   PetscFunctionBeginUser;
-  if (sys->particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->particles.image));
+  if (sys->disc.particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->disc.particles.image));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -31,7 +31,7 @@ PetscErrorCode PeriReferenceSetUp(PeriSystem sys)
   r->type = PERI_REFERENCE_NONE;
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckSection(s, node, "reference"));
-  PeriInputCheck(sys->particles.dim == 2, s, node, NULL, "reference fields are plane elasticity solutions: dim must be 2");
+  PeriInputCheck(sys->disc.particles.dim == 2, s, node, NULL, "reference fields are plane elasticity solutions: dim must be 2");
   PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
   PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
   /* checked here, not only after the solve, so that a bad scene fails before any work */
@@ -41,11 +41,11 @@ PetscErrorCode PeriReferenceSetUp(PeriSystem sys)
   r->type = (PeriReferenceType)type;
   PetscCall(PeriSceneGetReal(s, node, "stress", PETSC_TRUE, &r->stress, NULL));
   PeriInputCheck(r->stress != 0, s, node, "stress", "must not be 0: the reference field would vanish and there is nothing to compare with");
-  for (PetscInt i = 0; i < sys->particles.n; i++) ninterior += Interior(sys, i);
-  PeriInputCheck(ninterior >= 3, s, node, NULL, "only %" PetscInt_FMT " particles lie farther than 2 delta = %g from the edges: too few to measure the interior strain (enlarge the body or reduce the horizon)", ninterior, (double)(2 * sys->delta));
+  for (PetscInt i = 0; i < sys->disc.particles.n; i++) ninterior += Interior(sys, i);
+  PeriInputCheck(ninterior >= 3, s, node, NULL, "only %" PetscInt_FMT " particles lie farther than 2 delta = %g from the edges: too few to measure the interior strain (enlarge the body or reduce the horizon)", ninterior, (double)(2 * sys->disc.delta));
   r->axis = 0;
   PetscCall(PeriSceneGetChoice(s, node, "axis", axes, &r->axis, NULL));
-  for (PetscInt d = 0; d < 3; d++) r->center[d] = 0.5 * (sys->particles.lower[d] + sys->particles.upper[d]);
+  for (PetscInt d = 0; d < 3; d++) r->center[d] = 0.5 * (sys->disc.particles.lower[d] + sys->disc.particles.upper[d]);
   PetscCall(PeriSceneGetRealArray(s, node, "center", PETSC_FALSE, 2, 2, r->center, &n));
   r->E  = sys->model->material.E;
   r->nu = sys->model->material.nu;
@@ -85,7 +85,7 @@ void PeriReferenceDisplacement(PeriSystem sys, const PetscReal X[], PetscReal u[
     u[1] = e * x;
     break;
   case PERI_REFERENCE_BENDING:
-    k    = r->stress / (E * 0.5 * (sys->particles.upper[1] - sys->particles.lower[1]));
+    k    = r->stress / (E * 0.5 * (sys->disc.particles.upper[1] - sys->disc.particles.lower[1]));
     u[0] = k * x * y;
     u[1] = -0.5 * k * (x * x + nu * y * y);
     break;
@@ -128,9 +128,9 @@ static PetscErrorCode SmallSolve(PetscInt n, PetscReal A[3][3], PetscReal b[3])
 
 static PetscBool Interior(PeriSystem sys, PetscInt i)
 {
-  for (PetscInt d = 0; d < sys->particles.dim; d++) {
-    PetscReal x = sys->particles.x[3 * i + d];
-    if (!sys->particles.periodic[d] && (x - sys->particles.lower[d] < 2 * sys->delta || sys->particles.upper[d] - x < 2 * sys->delta)) return PETSC_FALSE;
+  for (PetscInt d = 0; d < sys->disc.particles.dim; d++) {
+    PetscReal x = sys->disc.particles.x[3 * i + d];
+    if (!sys->disc.particles.periodic[d] && (x - sys->disc.particles.lower[d] < 2 * sys->disc.delta || sys->disc.particles.upper[d] - x < 2 * sys->disc.delta)) return PETSC_FALSE;
   }
   return PETSC_TRUE;
 }
@@ -156,8 +156,8 @@ PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
   PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
   PetscCheck(ux >= 0 && uy >= 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "reference fields need the in-plane displacements ux, uy; model %s has none", sys->model->type);
   /* least squares u = a + H x' for each component, and the rigid fit of the error */
-  for (PetscInt i = 0; i < sys->particles.n; i++) {
-    const PetscReal *X = &sys->particles.x[3 * i], *u = &sys->u_all[i * bs];
+  for (PetscInt i = 0; i < sys->disc.particles.n; i++) {
+    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_all[i * bs];
     PetscReal        phi[3] = {1, X[0] - c[0], X[1] - c[1]}, ref[2], d[2], rig[3][2];
     if (!Interior(sys, i)) continue;
     n++;
@@ -188,8 +188,8 @@ PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
   sys->reference.interior_strain[0] = bx[1];
   sys->reference.interior_strain[1] = by[2];
   sys->reference.interior_strain[2] = bx[2] + by[1];
-  for (PetscInt i = 0; i < sys->particles.n; i++) {
-    const PetscReal *X = &sys->particles.x[3 * i], *u = &sys->u_all[i * bs];
+  for (PetscInt i = 0; i < sys->disc.particles.n; i++) {
+    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_all[i * bs];
     PetscReal        ref[2], e[2];
     if (!Interior(sys, i)) continue;
     PeriReferenceDisplacement(sys, X, ref);

@@ -10,8 +10,8 @@ PetscErrorCode PeriSystemSummaryModel(PeriSystem sys, PeriJSON j)
 
   PetscFunctionBeginUser;
   PetscCall(PeriJSONString(j, "model", m->type));
-  PetscCall(PeriJSONInt(j, "dim", sys->particles.dim));
-  if (sys->particles.dim == 2) PetscCall(PeriJSONString(j, "plane", m->plane_strain ? "strain" : "stress"));
+  PetscCall(PeriJSONInt(j, "dim", sys->disc.particles.dim));
+  if (sys->disc.particles.dim == 2) PetscCall(PeriJSONString(j, "plane", m->plane_strain ? "strain" : "stress"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -21,14 +21,14 @@ PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
   const PeriModel m = sys->model;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriJSONInt(j, "particles", sys->particles.n));
+  PetscCall(PeriJSONInt(j, "particles", sys->disc.particles.n));
   PetscCall(PeriJSONInt(j, "bonds", sys->log.nbonds_total));
-  PetscCall(PeriJSONInt(j, "dofs", sys->particles.n * m->dofs));
+  PetscCall(PeriJSONInt(j, "dofs", sys->disc.particles.n * m->dofs));
   PetscCall(PeriJSONInt(j, "ranks", sys->size));
   PetscCall(PeriJSONInt(j, "edge_cut", sys->log.edge_cut));
-  PetscCall(PeriJSONReal(j, "horizon", sys->delta));
-  PetscCall(PeriJSONString(j, "partial_volume", PeriPartialVolumes[sys->partial_volume]));
-  PetscCall(PeriJSONString(j, "surface_correction", PeriSurfaceCorrections[sys->surface]));
+  PetscCall(PeriJSONReal(j, "horizon", sys->disc.delta));
+  PetscCall(PeriJSONString(j, "partial_volume", PeriPartialVolumes[sys->disc.partial_volume]));
+  PetscCall(PeriJSONString(j, "surface_correction", PeriSurfaceCorrections[sys->disc.surface]));
   PetscCall(PeriJSONBeginObject(j, "material"));
   PetscCall(PeriJSONReal(j, "E", m->material.E));
   PetscCall(PeriJSONReal(j, "nu", m->material.nu));

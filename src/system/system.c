@@ -45,21 +45,21 @@ static PetscErrorCode ReadHorizon(PeriSystem sys)
   PetscCall(PeriSceneGetMap(s, s->root, "horizon", PETSC_TRUE, &h));
   PetscCall(PeriSceneCheckSection(s, h, "horizon"));
   PetscCall(PeriSceneGetReal(s, h, "m", PETSC_FALSE, &m, &hasm));
-  PetscCall(PeriSceneGetReal(s, h, "delta", PETSC_FALSE, &sys->delta, &hasd));
+  PetscCall(PeriSceneGetReal(s, h, "delta", PETSC_FALSE, &sys->disc.delta, &hasd));
   PeriInputCheck(hasm || hasd, s, h, "m", "is required (or give horizon.delta)");
   PeriInputCheck(!(hasm && hasd), s, h, "delta", "give horizon.m or horizon.delta, not both");
   if (hasm) {
     PeriInputCheck(m >= 1, s, h, "m", "must be at least 1 (the horizon may not be smaller than the spacing), got %g", (double)m);
-    sys->delta = m * sys->particles.mean_spacing;
+    sys->disc.delta = m * sys->disc.particles.mean_spacing;
   }
   {
     /* beyond the body's diagonal every particle bonds with every other: N^2 bonds, no locality */
     PetscReal diag2 = 0;
-    for (PetscInt d = 0; d < sys->particles.dim; d++) diag2 += PetscSqr(sys->particles.upper[d] - sys->particles.lower[d]);
-    PeriInputCheck(sys->delta <= PetscSqrtReal(diag2), s, h, hasm ? "m" : "delta", "the horizon %g exceeds the body's size (its diagonal %g): every particle would bond with every other; a horizon is a few spacings (m = 3 is usual)", (double)sys->delta, (double)PetscSqrtReal(diag2));
+    for (PetscInt d = 0; d < sys->disc.particles.dim; d++) diag2 += PetscSqr(sys->disc.particles.upper[d] - sys->disc.particles.lower[d]);
+    PeriInputCheck(sys->disc.delta <= PetscSqrtReal(diag2), s, h, hasm ? "m" : "delta", "the horizon %g exceeds the body's size (its diagonal %g): every particle would bond with every other; a horizon is a few spacings (m = 3 is usual)", (double)sys->disc.delta, (double)PetscSqrtReal(diag2));
   }
-  for (PetscInt k = 0; k < sys->particles.n; k++) hmax = PetscMax(hmax, sys->particles.spacing[k]);
-  PeriInputCheck(sys->delta >= hmax * (1 - 1e-10), s, h, hasm ? "m" : "delta", "the horizon %g is smaller than the particle spacing %g: particles would have no bonds", (double)sys->delta, (double)hmax);
+  for (PetscInt k = 0; k < sys->disc.particles.n; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
+  PeriInputCheck(sys->disc.delta >= hmax * (1 - 1e-10), s, h, hasm ? "m" : "delta", "the horizon %g is smaller than the particle spacing %g: particles would have no bonds", (double)sys->disc.delta, (double)hmax);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -87,8 +87,8 @@ static PetscErrorCode ReadCorrections(PeriSystem sys)
     }
     PeriInputCheck(ok, s, c, "surface", "model %s takes %s, not %s", sys->model->type, list, PeriSurfaceCorrections[sc]);
   }
-  sys->partial_volume = (PeriPartialVolume)pv;
-  sys->surface        = (PeriSurfaceCorrection)sc;
+  sys->disc.partial_volume = (PeriPartialVolume)pv;
+  sys->disc.surface        = (PeriSurfaceCorrection)sc;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -173,7 +173,7 @@ static void FoldIntoBody(const PeriParticles *pt, const PetscReal X[], PetscReal
 static PetscReal ShearModulusAt(PeriSystem sys, PetscInt nr, PeriRegion *const reg[], const PetscReal val[], const PetscReal X[])
 {
   PetscReal Y[3], mu = sys->model->material.G;
-  FoldIntoBody(&sys->particles, X, Y);
+  FoldIntoBody(&sys->disc.particles, X, Y);
   for (PetscInt k = 0; k < nr; k++)
     if (PeriRegionContains(reg[k], Y)) mu = val[k];
   return mu;
@@ -191,8 +191,8 @@ static int CompareReal(const void *a, const void *b)
 static PetscErrorCode ReadShearModuli(PeriSystem sys)
 {
   PeriScene            s  = sys->scene;
-  const PeriParticles *pt = &sys->particles;
-  const PeriBonds     *b  = &sys->bonds;
+  const PeriParticles *pt = &sys->disc.particles;
+  const PeriBonds     *b  = &sys->disc.bonds;
   PeriNode             mat, map;
   PeriRegion         **reg;
   PetscReal           *val, *cut;
@@ -206,7 +206,7 @@ static PetscErrorCode ReadShearModuli(PeriSystem sys)
   nr = map->n;
   PetscCall(PetscMalloc3(nr, &reg, nr, &val, 6 * (nr + 1) + 2, &cut));
   for (PetscInt k = 0; k < nr; k++) {
-    PetscCall(PeriRegionFind(s, map->child[k], NULL, sys->nregions, sys->regions, &reg[k]));
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, sys->disc.nregions, sys->disc.regions, &reg[k]));
     PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &val[k], NULL));
     PeriInputCheck(val[k] > 0, s, map, map->child[k]->key, "must be positive, got %g", (double)val[k]);
   }
@@ -288,27 +288,27 @@ static PetscErrorCode SetUpBonds(PeriSystem sys)
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Partition, 0, 0, 0, 0));
-  PetscCall(PeriPartition(sys->comm, &sys->particles, sys->delta, &perm, &range));
-  if (sys->size > 1) PetscCall(PeriParticlesPermute(&sys->particles, perm));
+  PetscCall(PeriPartition(sys->comm, &sys->disc.particles, sys->disc.delta, &perm, &range));
+  if (sys->size > 1) PetscCall(PeriParticlesPermute(&sys->disc.particles, perm));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Partition, 0, 0, 0, 0));
-  PetscCall(PetscMalloc1(sys->particles.n, &sys->owner));
+  PetscCall(PetscMalloc1(sys->disc.particles.n, &sys->disc.owner));
   for (PetscMPIInt r = 0; r < sys->size; r++)
-    for (PetscInt i = range[r]; i < range[r + 1]; i++) sys->owner[i] = r;
+    for (PetscInt i = range[r]; i < range[r + 1]; i++) sys->disc.owner[i] = r;
 
   PetscCall(PetscLogEventBegin(PERI_EVENT_Neighbors, 0, 0, 0, 0));
-  PetscCall(PeriNeighborSearch(&sys->particles, sys->delta, sys->partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_TRUE, &sys->bonds));
+  PetscCall(PeriNeighborSearch(&sys->disc.particles, sys->disc.delta, sys->disc.partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_TRUE, &sys->disc.bonds));
   /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
-  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&sys->particles, sys->delta, sys->partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_FALSE, &sys->family));
-  PetscCall(PetscMalloc2(sys->particles.n, &sys->family_volume, sys->particles.n, &sys->neighbor_count));
+  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&sys->disc.particles, sys->disc.delta, sys->disc.partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_FALSE, &sys->disc.family));
+  PetscCall(PetscMalloc2(sys->disc.particles.n, &sys->disc.family_volume, sys->disc.particles.n, &sys->disc.neighbor_count));
   /* a crack is geometry: the family volumes, the surface correction and the calibration see it */
   PetscCall(PeriCracksApply(sys));
-  PetscCall(PeriNeighborhoodVolumes(sys->comm, &sys->particles, &sys->bonds, sys->family_volume, sys->neighbor_count));
-  PetscCall(PeriSurfaceCorrectionApply(sys->surface, &sys->particles, sys->delta, sys->family_volume, &sys->bonds));
+  PetscCall(PeriNeighborhoodVolumes(sys->comm, &sys->disc.particles, &sys->disc.bonds, sys->disc.family_volume, sys->disc.neighbor_count));
+  PetscCall(PeriSurfaceCorrectionApply(sys->disc.surface, &sys->disc.particles, sys->disc.delta, sys->disc.family_volume, &sys->disc.bonds));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Neighbors, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
   sys->log.neighbors_s = t1 - t0;
-  PetscCallMPI(MPI_Allreduce(&sys->bonds.nbonds, &sys->log.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
-  for (PetscInt k = 0; k < sys->bonds.nbonds; k++) cut += sys->owner[sys->bonds.j[k]] != sys->rank;
+  PetscCallMPI(MPI_Allreduce(&sys->disc.bonds.nbonds, &sys->log.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
+  for (PetscInt k = 0; k < sys->disc.bonds.nbonds; k++) cut += sys->disc.owner[sys->disc.bonds.j[k]] != sys->rank;
   PetscCallMPI(MPI_Allreduce(&cut, &sys->log.edge_cut, 1, MPIU_INT, MPI_SUM, sys->comm));
   PetscCall(PetscFree(perm));
   PetscCall(PetscFree(range));
@@ -321,13 +321,13 @@ static PetscErrorCode Calibrate(PeriSystem sys)
   PeriCalibrationData cal;
 
   PetscFunctionBeginUser;
-  cal.n             = sys->particles.n;
-  cal.family_volume = sys->family_volume;
+  cal.n             = sys->disc.particles.n;
+  cal.family_volume = sys->disc.family_volume;
   cal.mu            = sys->mu;
   cal.comm          = sys->comm;
-  cal.particles     = &sys->particles;
-  cal.bonds         = &sys->bonds;
-  cal.surface       = sys->surface;
+  cal.particles     = &sys->disc.particles;
+  cal.bonds         = &sys->disc.bonds;
+  cal.surface       = sys->disc.surface;
   PetscCall(sys->model->ops.calibrate(sys->model, &cal));
   if (sys->model->warning[0]) PetscCall(PetscPrintf(sys->comm, "perilin: warning: %s\n", sys->model->warning));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -340,18 +340,18 @@ static PetscErrorCode Calibrate(PeriSystem sys)
 PetscErrorCode PeriSystemSetUp(PeriSystem sys)
 {
   PeriScene            s  = sys->scene;
-  const PeriParticles *pt = &sys->particles;
+  const PeriParticles *pt = &sys->disc.particles;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesCreateFromScene(s, sys->model->dim, sys->thickness, &sys->particles));
+  PetscCall(PeriParticlesCreateFromScene(s, sys->model->dim, sys->thickness, &sys->disc.particles));
   PetscCall(ReadHorizon(sys));
-  PetscCall(PeriModelSetFromScene(sys->model, s, sys->delta));
+  PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
   PetscCall(ReadCorrections(sys));
   PetscCall(PeriLayersAddParticles(sys));
   PetscCall(SetUpBonds(sys));
   for (PetscInt i = 0; i < pt->n; i++)
-    PetscCheck(sys->neighbor_count[i] > 0, sys->comm, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->delta, (double)pt->spacing[i]);
-  PetscCall(PeriRegionsCreateFromScene(s, &sys->particles, sys->delta, &sys->nregions, &sys->regions));
+    PetscCheck(sys->disc.neighbor_count[i] > 0, sys->comm, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->disc.delta, (double)pt->spacing[i]);
+  PetscCall(PeriRegionsCreateFromScene(s, &sys->disc.particles, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
   PetscCall(ReadShearModuli(sys));
   PetscCall(Calibrate(sys));
   PetscCall(PeriReadProbes(sys));
@@ -375,18 +375,13 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(VecDestroy(&sys->u));
   PetscCall(VecDestroy(&sys->f));
   PetscCall(PeriModelDestroy(&sys->model));
-  PetscCall(PeriBondsDestroy(&sys->bonds));
-  PetscCall(PeriBondsDestroy(&sys->family));
+  PetscCall(PeriDiscDestroy(&sys->disc));
   PetscCall(PeriLayersDestroy(&sys->layers));
   PetscCall(PetscFree(sys->mu));
   PetscCall(PetscFree(sys->bond_mu));
   PetscCall(PetscFree(sys->tau));
   PetscCall(PetscFree(sys->damage));
-  PetscCall(PeriParticlesDestroy(&sys->particles));
-  PetscCall(PetscFree(sys->regions));
   PetscCall(PetscFree(sys->probes));
-  PetscCall(PetscFree2(sys->family_volume, sys->neighbor_count));
-  PetscCall(PetscFree(sys->owner));
   PetscCall(PetscFree(sys->constrained));
   PetscCall(PetscFree(sys->constrained_value));
   PetscCall(PetscFree(sys->W));
@@ -400,7 +395,7 @@ PetscErrorCode PeriSystemCreateVec(PeriSystem sys, Vec *v)
 {
   PetscFunctionBeginUser;
   PetscCall(VecCreate(sys->comm, v));
-  PetscCall(VecSetSizes(*v, (sys->bonds.rend - sys->bonds.rstart) * sys->model->dofs, PETSC_DETERMINE));
+  PetscCall(VecSetSizes(*v, (sys->disc.bonds.rend - sys->disc.bonds.rstart) * sys->model->dofs, PETSC_DETERMINE));
   PetscCall(VecSetBlockSize(*v, sys->model->dofs));
   PetscCall(VecSetFromOptions(*v));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -423,7 +418,7 @@ static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const Pets
 PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, PeriBondGeometry *g)
 {
   PetscFunctionBeginUser;
-  FillGeometry(&sys->particles, &sys->bonds, sys->bond_mu, i, k, g);
+  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->bond_mu, i, k, g);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -442,11 +437,11 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Gathers the family of owned particle i from sys->family (state-based models). */
+/* Gathers the family of owned particle i from sys->disc.family (state-based models). */
 PetscErrorCode PeriSystemFamilyGeometry(PeriSystem sys, PetscInt i, PetscInt *n, PeriBondGeometry fam[])
 {
-  const PeriBonds     *b  = &sys->family;
-  const PeriParticles *pt = &sys->particles;
+  const PeriBonds     *b  = &sys->disc.family;
+  const PeriParticles *pt = &sys->disc.particles;
 
   PetscFunctionBeginUser;
   *n = 0;
@@ -455,10 +450,10 @@ PetscErrorCode PeriSystemFamilyGeometry(PeriSystem sys, PetscInt i, PetscInt *n,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Largest family in sys->family, for workspace. */
+/* Largest family in sys->disc.family, for workspace. */
 PetscInt PeriSystemMaxFamily(PeriSystem sys)
 {
   PetscInt nmax = 0;
-  for (PetscInt i = sys->family.rstart; i < sys->family.rend; i++) nmax = PetscMax(nmax, sys->family.offset[i - sys->family.rstart + 1] - sys->family.offset[i - sys->family.rstart]);
+  for (PetscInt i = sys->disc.family.rstart; i < sys->disc.family.rend; i++) nmax = PetscMax(nmax, sys->disc.family.offset[i - sys->disc.family.rstart + 1] - sys->disc.family.offset[i - sys->disc.family.rstart]);
   return nmax;
 }

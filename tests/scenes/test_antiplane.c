@@ -67,7 +67,7 @@ static PetscReal TorsionWarping(const PetscReal X[])
 /* Relative l2 error of u_z over the body's particles (rank 0 holds the fields; broadcast). */
 static PetscErrorCode FieldError(PeriProblem p, PetscReal (*exact)(const PetscReal[]), PetscReal *err)
 {
-  const PeriParticles *pt  = &p->sys->particles;
+  const PeriParticles *pt  = &p->sys->disc.particles;
   PetscReal            num = 0, den = 0;
 
   PetscFunctionBeginUser;
@@ -86,7 +86,7 @@ static PetscErrorCode FieldError(PeriProblem p, PetscReal (*exact)(const PetscRe
 
 static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
 {
-  const PeriParticles *pt  = &p->sys->particles;
+  const PeriParticles *pt  = &p->sys->disc.particles;
   PetscReal            num = 0, den = 0;
 
   PetscFunctionBeginUser;
@@ -106,7 +106,7 @@ static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
 /* The interior strain of the bar without layers, mu du/dy / S over |y| < 1/4 (least squares) */
 static PetscErrorCode InteriorSlope(PeriProblem p, PetscReal *slope)
 {
-  const PeriParticles *pt = &p->sys->particles;
+  const PeriParticles *pt = &p->sys->disc.particles;
   PetscReal            n = 0, sy = 0, su = 0, syy = 0, syu = 0;
 
   PetscFunctionBeginUser;

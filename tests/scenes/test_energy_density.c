@@ -47,7 +47,7 @@ int main(int argc, char **argv)
       PetscCall(PetscSNPrintf(what, sizeof(what), "npmb m=%" PetscInt_FMT ": centre W / (9 K s^2/2)", m));
       PeriTestClose(what, c->W / Wexact, 1.0, 1e-10);
       PetscCall(PetscSNPrintf(what, sizeof(what), "m=%" PetscInt_FMT ": neighbours of the centre (lattice count)", m));
-      PeriTestClose(what, (PetscReal)p->sys->neighbor_count[c->particle], (PetscReal)count, 0);
+      PeriTestClose(what, (PetscReal)p->sys->disc.neighbor_count[c->particle], (PetscReal)count, 0);
       if (m == 2) PeriTestClose("m=2: neighbours of the centre (paper: 32)", (PetscReal)count, 32, 0);
       if (m == 6) PeriTestClose("m=6: neighbours of the centre (paper: 924)", (PetscReal)count, 924, 0);
     }

@@ -55,16 +55,16 @@ int main(int argc, char **argv)
       for (PetscInt t = 0; t < 2; t++) {
         const PetscReal *damage = t ? PeriTestQuasistatic(p)->trial_damage : p->sys->damage;
         PetscReal        ymax = 0, xmin = 0, xmax = 0;
-        for (PetscInt i = 0; i < p->sys->particles.n; i++) {
-          const PetscReal *X = &p->sys->particles.x[3 * i];
+        for (PetscInt i = 0; i < p->sys->disc.particles.n; i++) {
+          const PetscReal *X = &p->sys->disc.particles.x[3 * i];
           if (damage[(PERI_NCAUSES + 1) * i] <= 0.01) continue;
           ymax = PetscMax(ymax, PetscAbsReal(X[1]));
           xmin = PetscMin(xmin, X[0]);
           xmax = PetscMax(xmax, X[0]);
         }
-        PeriTestClose(t ? "cracked bar, failed trial: damaged particles within a horizon of y = 0" : "cracked bar: damaged particles within a horizon of y = 0", ymax, 0, p->sys->delta);
-        if (t) PeriTestClose("cracked bar, failed trial: damage beyond the initial tips (x = 0.1 + delta)", (PetscReal)(xmax > 0.1 + p->sys->delta && xmin < -0.1 - p->sys->delta), 1, 0);
-        PeriTestClose(t ? "cracked bar, failed trial: the growth is symmetric" : "cracked bar: the growth is symmetric", xmax + xmin, 0, 1.01 * p->sys->particles.mean_spacing);
+        PeriTestClose(t ? "cracked bar, failed trial: damaged particles within a horizon of y = 0" : "cracked bar: damaged particles within a horizon of y = 0", ymax, 0, p->sys->disc.delta);
+        if (t) PeriTestClose("cracked bar, failed trial: damage beyond the initial tips (x = 0.1 + delta)", (PetscReal)(xmax > 0.1 + p->sys->disc.delta && xmin < -0.1 - p->sys->disc.delta), 1, 0);
+        PeriTestClose(t ? "cracked bar, failed trial: the growth is symmetric" : "cracked bar: the growth is symmetric", xmax + xmin, 0, 1.01 * p->sys->disc.particles.mean_spacing);
       }
     }
     PetscCall(PeriProblemDestroy(&p));
@@ -85,7 +85,7 @@ int main(int argc, char **argv)
       PetscCall(PeriTestSetOption("-cracks_0_to_0", tips[k]));
       PetscCall(Run(argv[4], "0.02", &p));
       if (p->rank == 0) {
-        const PeriParticles *pt  = &p->sys->particles;
+        const PeriParticles *pt  = &p->sys->disc.particles;
         PetscReal            syz = 0, sxz = 0, n = 0, best = 0, bx = 0, by = 0;
         for (PetscInt i = 0; i < pt->n; i++) {
           const PetscReal *X = &pt->x[3 * i];
@@ -94,7 +94,7 @@ int main(int argc, char **argv)
             bx   = X[0];
             by   = X[1];
           }
-          if (PetscAbsReal(PetscAbsReal(X[1]) - 0.5 * pt->mean_spacing) > 1e-9 || X[0] > tip - p->sys->delta) continue;
+          if (PetscAbsReal(PetscAbsReal(X[1]) - 0.5 * pt->mean_spacing) > 1e-9 || X[0] > tip - p->sys->disc.delta) continue;
           syz += PetscAbsReal(p->sys->tau[3 * i + 1]);
           sxz += PetscAbsReal(p->sys->tau[3 * i]);
           n += 1;
@@ -104,7 +104,7 @@ int main(int argc, char **argv)
         PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: mean |tau_yz| / mean |tau_xz| on the faces", tips[k]));
         PeriTestClose(what, syz / sxz, 0, 0.2);
         PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: distance of the peak stress from the tip", tips[k]));
-        PeriTestClose(what, PetscSqrtReal(PetscSqr(bx - tip) + by * by), 0, 2 * p->sys->delta);
+        PeriTestClose(what, PetscSqrtReal(PetscSqr(bx - tip) + by * by), 0, 2 * p->sys->disc.delta);
       }
       PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: J below the shallower crack's", tips[k]));
       PeriTestClose(what, (PetscReal)(p->sys->torsion.J < Jprev), 1, 0);

@@ -160,8 +160,8 @@ static PetscErrorCode Extremes(const char lamina[], const char tiny[])
     PetscCall(PetscStrncpy(slash + 1, "heavy_tip_static.yaml", sizeof(file) - (size_t)(slash + 1 - file)));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, file, &s));
     k = 1000.0 * 1000.0 / (2 * s->sys->strain_energy);
-    for (PetscInt r = 0; r < s->sys->nregions; r++)
-      if (!strcmp(s->sys->regions[r].name, "tip")) M = 2.5e9 * s->sys->regions[r].volume;
+    for (PetscInt r = 0; r < s->sys->disc.nregions; r++)
+      if (!strcmp(s->sys->disc.regions[r].name, "tip")) M = 2.5e9 * s->sys->disc.regions[r].volume;
     f = PetscSqrtReal(k / M) / (2 * PETSC_PI);
     PetscCall(PetscStrncpy(slash + 1, "heavy_tip_modal.yaml", sizeof(file) - (size_t)(slash + 1 - file)));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, file, &p));

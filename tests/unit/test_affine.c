@@ -22,13 +22,13 @@ static PetscErrorCode CheckAffine(const char file[])
   PetscCall(PeriSystemAssemble(p->sys));
   PetscCall(MatCreateVecs(p->sys->K, &u, &f));
   PetscCall(VecGetArray(u, &a));
-  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++)
-    for (PetscInt c = 0; c < p->sys->particles.dim; c++) {
+  for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++)
+    for (PetscInt c = 0; c < p->sys->disc.particles.dim; c++) {
       PetscReal v = b[c];
-      for (PetscInt d = 0; d < p->sys->particles.dim; d++) v += A[c][d] * p->sys->particles.x[3 * i + d];
-      a[(i - p->sys->bonds.rstart) * p->sys->model->dofs + c] = v;
+      for (PetscInt d = 0; d < p->sys->disc.particles.dim; d++) v += A[c][d] * p->sys->disc.particles.x[3 * i + d];
+      a[(i - p->sys->disc.bonds.rstart) * p->sys->model->dofs + c] = v;
       /* micropolar models: the particles turn with the field's rotation */
-      if (p->sys->model->dofs == 3 && p->sys->particles.dim == 2) a[(i - p->sys->bonds.rstart) * 3 + 2] = 0.5 * (A[1][0] - A[0][1]);
+      if (p->sys->model->dofs == 3 && p->sys->disc.particles.dim == 2) a[(i - p->sys->disc.bonds.rstart) * 3 + 2] = 0.5 * (A[1][0] - A[0][1]);
     }
   PetscCall(VecRestoreArray(u, &a));
   PetscCall(MatMult(p->sys->K, u, f));
@@ -39,19 +39,19 @@ static PetscErrorCode CheckAffine(const char file[])
     PetscCall(MatGetDiagonal(p->sys->K, dg));
     PetscCall(VecNorm(dg, NORM_INFINITY, &scale));
     PetscCall(VecDestroy(&dg));
-    scale *= 2e-3 * p->sys->particles.mean_spacing;
+    scale *= 2e-3 * p->sys->disc.particles.mean_spacing;
   }
-  reach = 2 * PeriSearchRadius(p->sys->partial_volume, p->sys->delta, p->sys->particles.mean_spacing);
+  reach = 2 * PeriSearchRadius(p->sys->disc.partial_volume, p->sys->disc.delta, p->sys->disc.particles.mean_spacing);
   PetscCall(VecGetArrayRead(f, &fa));
-  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++) {
+  for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++) {
     PetscBool inner = PETSC_TRUE;
-    for (PetscInt d = 0; d < p->sys->particles.dim; d++) {
-      PetscReal x = p->sys->particles.x[3 * i + d];
-      if (!p->sys->particles.periodic[d] && (x - p->sys->particles.lower[d] < reach || p->sys->particles.upper[d] - x < reach)) inner = PETSC_FALSE;
+    for (PetscInt d = 0; d < p->sys->disc.particles.dim; d++) {
+      PetscReal x = p->sys->disc.particles.x[3 * i + d];
+      if (!p->sys->disc.particles.periodic[d] && (x - p->sys->disc.particles.lower[d] < reach || p->sys->disc.particles.upper[d] - x < reach)) inner = PETSC_FALSE;
     }
     if (!inner) continue;
     checked++;
-    for (PetscInt c = 0; c < p->sys->model->dofs; c++) fmax = PetscMax(fmax, PetscAbsReal(PetscRealPart(fa[(i - p->sys->bonds.rstart) * p->sys->model->dofs + c])));
+    for (PetscInt c = 0; c < p->sys->model->dofs; c++) fmax = PetscMax(fmax, PetscAbsReal(PetscRealPart(fa[(i - p->sys->disc.bonds.rstart) * p->sys->model->dofs + c])));
   }
   PetscCall(VecRestoreArrayRead(f, &fa));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &fmax, 1, MPIU_REAL, MPI_MAX, p->comm));

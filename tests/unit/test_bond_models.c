@@ -30,12 +30,12 @@ static PetscErrorCode Energy(PeriProblem p, const PetscReal A[2][2], PetscReal t
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(p->sys->K, &u, &Ku));
   PetscCall(VecGetArray(u, &a));
-  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++) {
-    PetscReal x                            = p->sys->particles.x[3 * i] - 0.5 * (p->sys->particles.lower[0] + p->sys->particles.upper[0]);
-    PetscReal y                            = p->sys->particles.x[3 * i + 1] - 0.5 * (p->sys->particles.lower[1] + p->sys->particles.upper[1]);
-    a[(i - p->sys->bonds.rstart) * bs + 0] = A[0][0] * x + A[0][1] * y;
-    a[(i - p->sys->bonds.rstart) * bs + 1] = A[1][0] * x + A[1][1] * y;
-    if (bs == 3) a[(i - p->sys->bonds.rstart) * bs + 2] = th;
+  for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++) {
+    PetscReal x                                 = p->sys->disc.particles.x[3 * i] - 0.5 * (p->sys->disc.particles.lower[0] + p->sys->disc.particles.upper[0]);
+    PetscReal y                                 = p->sys->disc.particles.x[3 * i + 1] - 0.5 * (p->sys->disc.particles.lower[1] + p->sys->disc.particles.upper[1]);
+    a[(i - p->sys->disc.bonds.rstart) * bs + 0] = A[0][0] * x + A[0][1] * y;
+    a[(i - p->sys->disc.bonds.rstart) * bs + 1] = A[1][0] * x + A[1][1] * y;
+    if (bs == 3) a[(i - p->sys->disc.bonds.rstart) * bs + 2] = th;
   }
   PetscCall(VecRestoreArray(u, &a));
   PetscCall(MatMult(p->sys->K, u, Ku));
@@ -80,14 +80,14 @@ int main(int argc, char **argv)
         PetscCall(PetscSNPrintf(what, sizeof(what), "%s nu = %s: rigid rotation energy / dilatation energy", models[mo], nuv[k]));
         PeriTestClose(what, Erot / Edil, 0, 1e-12);
       } else {
-        const PeriParticles *pt = &p->sys->particles;
-        const PetscReal      E = p->sys->model->material.E, t = pt->thickness, d3 = PetscPowReal(p->sys->delta, 3);
+        const PeriParticles *pt = &p->sys->disc.particles;
+        const PetscReal      E = p->sys->model->material.E, t = pt->thickness, d3 = PetscPowReal(p->sys->disc.delta, 3);
         const PetscReal      g      = 6 * E * (1 - 3 * nu) / (PETSC_PI * t * d3 * (1 - nu * nu));
         PetscReal            expect = 0;
-        for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++)
-          for (PetscInt b = p->sys->bonds.offset[i - p->sys->bonds.rstart]; b < p->sys->bonds.offset[i - p->sys->bonds.rstart + 1]; b++) {
-            PetscInt j = p->sys->bonds.j[b];
-            expect += 0.5 * p->sys->bonds.alpha[b] * p->sys->bonds.lambda[b] * pt->volume[i] * pt->volume[j] * g * p->sys->bonds.length[b] * w * w;
+        for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++)
+          for (PetscInt b = p->sys->disc.bonds.offset[i - p->sys->disc.bonds.rstart]; b < p->sys->disc.bonds.offset[i - p->sys->disc.bonds.rstart + 1]; b++) {
+            PetscInt j = p->sys->disc.bonds.j[b];
+            expect += 0.5 * p->sys->disc.bonds.alpha[b] * p->sys->disc.bonds.lambda[b] * pt->volume[i] * pt->volume[j] * g * p->sys->disc.bonds.length[b] * w * w;
           }
         PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &expect, 1, MPIU_REAL, MPI_SUM, p->comm));
         PetscCall(PetscSNPrintf(what, sizeof(what), "pds nu = %s: rigid rotation energy / sum of (1/2) W g |xi| w^2 (nonzero: the defect)", nuv[k]));

@@ -28,14 +28,14 @@ int main(int argc, char **argv)
   PetscCall(PeriDamage(p->sys, &p->sys->damage));
   if (p->rank == 0) {
     PetscReal dmax = 0;
-    for (PetscInt i = 0; i < p->sys->particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
+    for (PetscInt i = 0; i < p->sys->disc.particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
     PeriTestClose("largest damage of the cut particles in (0, 1)", (PetscReal)(dmax > 0.2 && dmax < 1), 1, 0);
   }
   PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->sys->failure.precracked_bonds > 0), 1, 0);
   /* G: pmb, plane stress: s_c = sqrt(4 pi G / (9 E delta)) */
   p->sys->failure.stretch = 0;
   p->sys->failure.G       = 100;
-  meas[0]                 = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->sys->delta));
+  meas[0]                 = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->sys->disc.delta));
   PeriTestClose("pmb plane stress: s at s_c from G gives index 1", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1, 1e-12);
   PetscCall(PeriProblemDestroy(&p));
 
@@ -74,7 +74,7 @@ int main(int argc, char **argv)
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
     E2 = p->sys->strain_energy;
     if (p->rank == 0)
-      for (PetscInt i = 0; i < p->sys->particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
+      for (PetscInt i = 0; i < p->sys->disc.particles.n; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
     PetscCallMPI(MPI_Bcast(&dmax, 1, MPIU_REAL, 0, PETSC_COMM_WORLD));
     PeriTestClose("strip below s_0 at load 0.5: nothing softened", (PetscReal)(E1 > 0), 1, 0);
     PeriTestClose("softened strip: energy at load 4 / (64 x energy at load 0.5) below 0.95", (PetscReal)(E2 / (64 * E1) < 0.95), 1, 0);

@@ -214,7 +214,7 @@ static PetscReal TargetEnergy(PeriModel m, const PetscReal G[3][3], const PetscI
  * largest relative error of W_i over the particles two search radii inside the body. */
 static PetscErrorCode EnergyError(PeriProblem p, PetscReal norm2, const PetscReal G[3][3], PetscReal *err, PetscReal *mismatch, PetscInt *count)
 {
-  const PeriParticles *pt       = &p->sys->particles;
+  const PeriParticles *pt       = &p->sys->disc.particles;
   PeriModel            m        = p->sys->model;
   const char          *names[3] = {"ux", "uy", "uz"};
   PetscInt             comp[3];
@@ -229,10 +229,10 @@ static PetscErrorCode EnergyError(PeriProblem p, PetscReal norm2, const PetscRea
   if (!p->sys->u) PetscCall(MatCreateVecs(p->sys->K, &p->sys->u, NULL));
   PetscCall(VecSet(p->sys->u, 0));
   PetscCall(VecGetArray(p->sys->u, &u));
-  for (PetscInt i = p->sys->bonds.rstart; i < p->sys->bonds.rend; i++)
+  for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++)
     for (PetscInt a = 0; a < 3; a++)
       if (comp[a] >= 0)
-        for (PetscInt b = 0; b < pt->dim; b++) u[(i - p->sys->bonds.rstart) * m->dofs + comp[a]] += G[a][b] * (pt->x[3 * i + b] - centre[b]);
+        for (PetscInt b = 0; b < pt->dim; b++) u[(i - p->sys->disc.bonds.rstart) * m->dofs + comp[a]] += G[a][b] * (pt->x[3 * i + b] - centre[b]);
   PetscCall(VecRestoreArray(p->sys->u, &u));
   PetscCall(PeriSystemEvaluateEnergy(p->sys));
   /* the energy is evaluated from the model's blocks, bond by bond: it must be the assembled K's */
@@ -249,7 +249,7 @@ static PetscErrorCode EnergyError(PeriProblem p, PetscReal norm2, const PetscRea
     *mismatch = PetscAbsReal(p->sys->strain_energy - 0.5 * PetscRealPart(uKu)) / (0.5 * norm2 * unorm * unorm);
   }
   W      = TargetEnergy(m, G, comp);
-  reach  = 2 * PeriSearchRadius(p->sys->partial_volume, p->sys->delta, pt->mean_spacing);
+  reach  = 2 * PeriSearchRadius(p->sys->disc.partial_volume, p->sys->disc.delta, pt->mean_spacing);
   *err   = 0;
   *count = 0;
   if (p->rank == 0)

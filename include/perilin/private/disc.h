@@ -42,3 +42,21 @@ PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, Petsc
 
 /* grid, particles and regions.<name>, declared next to the code that reads them. */
 PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
+
+/* The discretization of one body: every consumer reads particle data through this one owner, so
+ * that holding only owned + ghost particles per rank (issue 17) changes src/disc/ alone. */
+typedef struct {
+  PeriParticles         particles;
+  PetscInt              nregions;
+  PeriRegion           *regions;
+  PetscReal             delta;
+  PeriPartialVolume     partial_volume;
+  PeriSurfaceCorrection surface;
+  PeriBonds             bonds;          /* once per pair, in the row of the smaller index (owned rows) */
+  PeriBonds             family;         /* state-based models: every bond of each owned particle (both directions) */
+  PetscReal            *family_volume;  /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
+  PetscInt             *neighbor_count; /* per particle (all ranks) */
+  PetscInt             *owner;          /* rank owning each particle (all ranks) */
+} PeriDisc;
+
+PETSC_EXTERN PetscErrorCode PeriDiscDestroy(PeriDisc *);

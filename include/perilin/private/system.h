@@ -106,46 +106,36 @@ typedef struct {
 
 typedef struct _p_PeriSystem *PeriSystem;
 struct _p_PeriSystem {
-  MPI_Comm              comm;
-  PetscMPIInt           rank, size;
-  PeriScene             scene;     /* borrowed from the problem: for reading sections and locating errors */
-  PetscReal             thickness; /* material.thickness (2D) */
-  PeriParticles         particles;
-  PetscInt              nregions;
-  PeriRegion           *regions;
-  PetscReal             delta;
-  PeriPartialVolume     partial_volume;
-  PeriSurfaceCorrection surface;
-  PeriBonds             bonds;
-  PetscReal            *family_volume;  /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
-  PetscInt             *neighbor_count; /* per particle (all ranks) */
-  PetscInt             *owner;          /* rank owning each particle (all ranks) */
-  PetscReal            *mu;             /* shear modulus per particle when material.mu_by_region is given, else NULL */
-  PetscReal            *bond_mu;        /* per local bond: the shear modulus across materials (eq. 60), or NULL */
-  PeriBonds             family;         /* state-based models: every bond of each owned particle (both directions) */
-  PeriLayers            layers;
-  PeriTorsion           torsion;
-  PetscReal            *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
-  PeriFailure           failure;
-  PetscReal            *damage; /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
-  PeriModel             model;
-  Mat                   K;                       /* stiffness */
-  char                  mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
-  Vec                   u, f;
-  PetscInt              nconstrained; /* owned constrained DOFs */
-  PetscInt             *constrained;  /* their global rows */
-  PetscReal            *constrained_value;
-  PetscInt              nprobes;
-  PeriProbe            *probes;
-  PetscReal            *W;     /* strain energy density per particle (rank 0, after the solve) */
-  PetscReal            *u_all; /* displacements of all particles (rank 0, after the solve) */
-  PeriSolveInfo         solve;
-  PeriRunLog            log;
-  PetscReal             strain_energy;           /* after the last solve */
-  PetscReal             max_abs_u[PERI_MAX_DOF]; /* per component, after the last solve */
-  PeriReference         reference;
-  int                   interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
-  PetscReal             residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
+  MPI_Comm      comm;
+  PetscMPIInt   rank, size;
+  PeriScene     scene;     /* borrowed from the problem: for reading sections and locating errors */
+  PetscReal     thickness; /* material.thickness (2D) */
+  PeriDisc      disc;      /* the particles, regions, bonds and volumes: their one owner */
+  PetscReal    *mu;        /* shear modulus per particle when material.mu_by_region is given, else NULL */
+  PetscReal    *bond_mu;   /* per local bond: the shear modulus across materials (eq. 60), or NULL */
+  PeriLayers    layers;
+  PeriTorsion   torsion;
+  PetscReal    *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
+  PeriFailure   failure;
+  PetscReal    *damage; /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
+  PeriModel     model;
+  Mat           K;                       /* stiffness */
+  char          mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
+  Vec           u, f;
+  PetscInt      nconstrained; /* owned constrained DOFs */
+  PetscInt     *constrained;  /* their global rows */
+  PetscReal    *constrained_value;
+  PetscInt      nprobes;
+  PeriProbe    *probes;
+  PetscReal    *W;     /* strain energy density per particle (rank 0, after the solve) */
+  PetscReal    *u_all; /* displacements of all particles (rank 0, after the solve) */
+  PeriSolveInfo solve;
+  PeriRunLog    log;
+  PetscReal     strain_energy;           /* after the last solve */
+  PetscReal     max_abs_u[PERI_MAX_DOF]; /* per component, after the last solve */
+  PeriReference reference;
+  int           interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
+  PetscReal     residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
 };
 
 PETSC_EXTERN PetscErrorCode PeriSystemCreate(MPI_Comm, PeriScene, PeriSystem *);
