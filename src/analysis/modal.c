@@ -3,13 +3,13 @@
  * DOFs are removed, so they give no spurious eigenvalues). M is lumped: rho V_i per translation,
  * rho V_i (dx^2 + dy^2)/12 per rotation (Diana & Casolo sec. 3.1, with r_i^2 for their r_i). */
 #include "perilin/private/analysis.h"
+#include <slepceps.h>
 
 /* the analysis' results (its data) */
 static inline PeriModal *Modal(PeriAnalysis an)
 {
   return (PeriModal *)an->data;
 }
-#include <slepceps.h>
 
 /* The density of each owned particle: material.rho, or material.rho_by_region {region: rho}
  * (later regions win where they overlap). */

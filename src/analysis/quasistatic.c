@@ -6,14 +6,17 @@
  * or no equilibrium is found, the body has failed: with adaptive steps the step is halved from the
  * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
 #include "perilin/private/analysis.h"
+#include <signal.h>
+#include <unistd.h>
 
 /* the analysis' results (its data) */
 static inline PeriQuasistatic *QS(PeriAnalysis an)
 {
   return (PeriQuasistatic *)an->data;
 }
-#include <signal.h>
-#include <unistd.h>
+
+/* analysis.stepping */
+static const char *const qs_steppings[] = {"increments", "events", NULL};
 
 #define PERI_MAX_LOAD_STEPS 100000
 #define PERI_MAX_BISECTION  1048576.0 /* 2^20 */
@@ -21,6 +24,7 @@ static inline PeriQuasistatic *QS(PeriAnalysis an)
 typedef struct {
   PetscReal  max, step, min_step, fraction, runaway;
   PetscBool  adaptive, all, reuse, quiet;
+  PetscBool  events; /* stepping: events (else increments) */
   PetscInt   max_iterations;
   PeriProbe *control;
 } Settings;
@@ -46,15 +50,19 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
   static const char *const policies[] = {"all", "fraction", NULL};
   PeriScene                s          = an->sys->scene;
   PeriNode                 a;
-  PetscInt                 policy              = 0;
+  PetscInt                 policy = 0, stepping = 0;
   char                     name[PERI_NAME_LEN] = "";
   PetscBool                has;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
   PeriInputCheck(an->sys->failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
+  PetscCall(PeriSceneGetChoice(s, a, "stepping", qs_steppings, &stepping, NULL));
+  st->events = stepping == 1 ? PETSC_TRUE : PETSC_FALSE;
+  PeriInputCheck(!st->events || !an->sys->disc.bonds.intact, s, a, "stepping", "events needs brittle bonds: with softening (failure.ultimate_stretch) the bonds weaken gradually; use stepping: increments");
   PetscCall(PeriSceneGetReal(s, a, "load_factor_max", PETSC_TRUE, &st->max, NULL));
-  PetscCall(PeriSceneGetReal(s, a, "load_factor_step", PETSC_TRUE, &st->step, NULL));
+  st->step = st->max;
+  PetscCall(PeriSceneGetReal(s, a, "load_factor_step", (PetscBool)!st->events, &st->step, NULL));
   PeriInputCheck(st->max > 0, s, a, "load_factor_max", "must be positive, got %g", (double)st->max);
   PeriInputCheck(st->step > 0 && st->step <= st->max, s, a, "load_factor_step", "must lie in (0, load_factor_max], got %g", (double)st->step);
   st->min_step = st->step / 64;
@@ -316,7 +324,10 @@ static PetscErrorCode PrintCriteria(PeriAnalysis an, const Settings *st)
 
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscPrintf(an->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
+  if (st->events)
+    PetscCall(PetscPrintf(an->comm, "perilin: quasistatic to lambda %g from bond break to bond break (events, %s breaking)\n", (double)st->max, st->all ? "all-violators" : "most-critical-fraction"));
+  else
+    PetscCall(PetscPrintf(an->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
   PetscCall(PetscPrintf(an->comm, "perilin: failure:"));
   if (F->stretch > 0) PetscCall(PetscPrintf(an->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
   if (F->G > 0) PetscCall(PetscPrintf(an->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, an->sys->model->type));
@@ -343,69 +354,81 @@ typedef enum {
   TRIAL_INTERRUPTED
 } TrialEnd;
 
-/* Solve, break, solve again at the load factor trial until no bond breaks (or the body fails). */
-static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscReal trial, PetscInt total, PeriStep *s, TrialEnd *end, char why[], size_t len)
+/* One solve at the load factor lam with the present bonds (pieces cut off from the constraints
+ * held in place). *end is TRIAL_SETTLED when it converged, TRIAL_FAILED (with why) when the body
+ * cannot carry the load, TRIAL_INTERRUPTED on a signal. */
+static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, PetscReal lam, PetscInt broken, PeriStep *s, TrialEnd *end, char why[], size_t len)
 {
-  PeriQuasistatic *q = QS(an);
+  PeriQuasistatic   *q = QS(an);
+  KSPConvergedReason reason;
+  PetscBool          ok, reuse;
 
+  PetscFunctionBeginUser;
+  *end = TRIAL_INTERRUPTED;
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
+  if (an->sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
+  *end = TRIAL_FAILED;
+  /* the pieces change only when bonds do */
+  if (L->stale) {
+    PetscCall(PetscFree2(L->hold, L->held));
+    PetscCall(PeriPieces(an->sys, &L->nhold, &L->hold, &L->held, &L->npieces, &L->lost));
+    L->stale = PETSC_FALSE;
+  }
+  if (L->lost) {
+    /* cut off before any bond broke: the scene's own cracks did it, at every load */
+    PetscCheck(broken > 0, an->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", an->sys->scene->file, L->npieces);
+    PetscCall(PetscSNPrintf(why, len, "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", L->npieces));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  /* a new preconditioner only when many bonds changed since the last one (or never built) */
+  reuse = (PetscBool)(L->ksp && st->reuse && L->since_setup < PetscMax(1, L->nbonds / 1000));
+  if (L->ksp) PetscCall(KSPSetReusePreconditioner(L->ksp, reuse));
+  if (!reuse) {
+    q->pc_setups++;
+    L->since_setup = 0;
+  }
+  PetscCall(PeriStaticSolve(an->sys, &L->ksp, lam, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
+  /* later solves start from the last solution: few bonds change between them */
+  PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
+  q->solves++;
+  s->ksp_iterations += an->sys->solve.iterations;
+  PetscCall(PeriStaticConverged(an->sys, L->ksp, reason, &ok));
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
+  if (an->sys->interrupted) {
+    *end = TRIAL_INTERRUPTED;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  if (!ok) {
+    /* the body as set up is linear: a solve that fails before any bond broke fails at every
+       load, so it is the solver's failure, not the body's */
+    if (broken == 0) PetscCall(PeriStaticCheckConverged(an->sys, reason));
+    PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)an->sys->solve.residual_norm));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  *end = TRIAL_SETTLED;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Solve, break, solve again at the load factor trial until no bond breaks (or the body fails).
+ * runaway: whether a cascade past st->runaway of the bonds ends the trial (adaptive increments,
+ * which then retry with a smaller step). */
+static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscReal trial, PetscInt total, PetscBool runaway, PeriStep *s, TrialEnd *end, char why[], size_t len)
+{
   PetscFunctionBeginUser;
   *end = TRIAL_FAILED;
   for (s->iterations = 0; s->iterations < st->max_iterations; s->iterations++) {
-    KSPConvergedReason reason;
-    PetscInt           nb;
-    PetscBool          ok;
-    PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
-    if (an->sys->interrupted) {
-      *end = TRIAL_INTERRUPTED;
-      PetscFunctionReturn(PETSC_SUCCESS);
-    }
-    /* the pieces change only when bonds do */
-    if (L->stale) {
-      PetscCall(PetscFree2(L->hold, L->held));
-      PetscCall(PeriPieces(an->sys, &L->nhold, &L->hold, &L->held, &L->npieces, &L->lost));
-      L->stale = PETSC_FALSE;
-    }
-    if (L->lost) {
-      /* cut off before any bond broke: the scene's own cracks did it, at every load */
-      PetscCheck(total > 0 || s->broken > 0, an->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", an->sys->scene->file, L->npieces);
-      PetscCall(PetscSNPrintf(why, len, "the load-carrying path is lost: a loaded piece is cut off (%" PetscInt_FMT " pieces)", L->npieces));
-      PetscFunctionReturn(PETSC_SUCCESS);
-    }
-    /* a new preconditioner only when many bonds changed since the last one (or never built) */
-    if (L->ksp) PetscCall(KSPSetReusePreconditioner(L->ksp, (PetscBool)(st->reuse && L->since_setup < PetscMax(1, L->nbonds / 1000))));
-    if (!L->ksp || !st->reuse || L->since_setup >= PetscMax(1, L->nbonds / 1000)) {
-      q->pc_setups++;
-      L->since_setup = 0;
-    }
-    PetscCall(PeriStaticSolve(an->sys, &L->ksp, trial, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
-    /* later solves start from the last solution: few bonds change between them */
-    PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
-    q->solves++;
-    s->ksp_iterations += an->sys->solve.iterations;
-    PetscCall(PeriStaticConverged(an->sys, L->ksp, reason, &ok));
-    PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
-    if (an->sys->interrupted) {
-      *end = TRIAL_INTERRUPTED;
-      PetscFunctionReturn(PETSC_SUCCESS);
-    }
-    if (!ok) {
-      /* the body as set up is linear: a solve that fails before any bond broke fails at every
-         load, so it is the solver's failure, not the body's */
-      if (total == 0 && s->broken == 0) PetscCall(PeriStaticCheckConverged(an->sys, reason));
-      PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)an->sys->solve.residual_norm));
-      PetscFunctionReturn(PETSC_SUCCESS);
-    }
+    PetscInt nb;
+    PetscCall(SolveAt(an, st, L, trial, total + s->broken, s, end, why, len));
+    if (*end != TRIAL_SETTLED) PetscFunctionReturn(PETSC_SUCCESS);
     PetscCall(BreakBonds(an, st, &nb));
     L->stale = (PetscBool)(nb > 0);
-    if (!nb) {
-      *end = TRIAL_SETTLED;
-      PetscFunctionReturn(PETSC_SUCCESS);
-    }
+    if (!nb) PetscFunctionReturn(PETSC_SUCCESS); /* settled */
+    *end = TRIAL_FAILED;
     s->broken += nb;
     L->since_setup += nb;
     /* a twist carried by the bonds themselves loses the broken bonds' share */
     if (an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
-    if (st->adaptive && s->broken > st->runaway * L->nbonds) {
+    if (runaway && s->broken > st->runaway * L->nbonds) {
       /* a crack running away at this load: a smaller step tells whether it would settle */
       PetscCall(PetscSNPrintf(why, len, "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s->broken, (double)st->runaway));
       PetscFunctionReturn(PETSC_SUCCESS);
@@ -470,56 +493,172 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriAnalysisRun_Quasistatic - the load-stepping loop with bond failure. The results (fields,
-  probes, energies, damage) describe the last equilibrium; a failed trial is written apart as
-  failed_trial.vtu. Collective.
-@*/
-static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
+/* The bond's failure index when its measures at unit load, meas1, are scaled by lam. */
+static PetscReal IndexAt(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas1[], PetscInt nmeas, PetscReal lam)
 {
-  Settings       st;
-  Loop           L      = {0};
-  Equilibrium    eq     = {0};
-  PetscReal      lambda = 0, dl;
-  PetscLogDouble t0, tstep, t;
+  PetscReal m[PERI_MAX_MEASURE] = {0};
+  for (PetscInt c = 0; c < nmeas && c < PERI_MAX_MEASURE; c++) m[c] = lam * meas1[c];
+  return PeriBondFailureIndex(sys, g, m, NULL);
+}
+
+/* The load factor at which a bond reaches its criterion, from its measures at unit load (the body
+ * is linear between breaks): 1/index where the index grows in proportion to the load (tension,
+ * compression, sliding, shear angle); by bisection where a cohesion makes it affine (friction,
+ * whose index still grows with the load). PETSC_INFINITY when it never fails. */
+static PetscReal BondCriticalLoad(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas1[], PetscInt nmeas)
+{
+  PetscReal i1 = IndexAt(sys, g, meas1, nmeas, 1), lo = 0, hi;
+
+  if (!(i1 > 0)) return PETSC_INFINITY;
+  hi = 1 / i1;
+  if (PetscAbsReal(IndexAt(sys, g, meas1, nmeas, hi) - 1) <= 1e-12) return hi;
+  for (PetscInt k = 0; k < 64 && IndexAt(sys, g, meas1, nmeas, hi) < 1; k++) hi *= 2;
+  if (IndexAt(sys, g, meas1, nmeas, hi) < 1) return PETSC_INFINITY;
+  for (PetscInt k = 0; k < 80 && hi - lo > 1e-13 * hi; k++) {
+    PetscReal mid = 0.5 * (lo + hi);
+    if (IndexAt(sys, g, meas1, nmeas, mid) >= 1)
+      hi = mid;
+    else
+      lo = mid;
+  }
+  return hi;
+}
+
+/* The next event: the smallest load factor at which an intact bond fails, from the present
+ * solution at load factor lam (the response to the scaled load is lam times the unit one).
+ * Collective. */
+static PetscErrorCode NextEvent(PeriAnalysis an, PetscReal lam, PetscReal *next)
+{
+  PeriBonds         *b  = &an->sys->disc.bonds;
+  PeriModel          m  = an->sys->model;
+  const PetscInt     bs = m->dofs;
+  VecScatter         scatter;
+  Vec                all;
+  const PetscScalar *u;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadSettings(an, &st));
-  {
-    PeriQuasistatic *q;
-    PetscCall(PetscNew(&q));
-    an->data = q;
-  }
-  PetscCall(PetscStrncpy(QS(an)->control, st.control ? st.control->name : "", sizeof(QS(an)->control)));
-  PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
-  PetscCall(PeriSystemAssemble(an->sys));
-  PetscCall(EquilibriumCreate(an, &eq));
-  PetscCallMPI(MPI_Allreduce(&an->sys->disc.bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
-  L.stale = PETSC_TRUE;
-  PetscCall(PetscTime(&t0));
-  dl = st.step;
-  PetscCall(PrintCriteria(an, &st));
-  while (lambda < st.max * (1 - 1e-12)) {
-    PetscReal trial = PetscMin(lambda + dl, st.max);
-    PeriStep  s     = {0};
-    TrialEnd  end;
-    char      why[160] = "";
+  *next = PETSC_INFINITY;
+  PetscCall(VecScatterCreateToAll(an->sys->u, &scatter, &all));
+  PetscCall(VecScatterBegin(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGetArrayRead(all, &u));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PeriBondGeometry g;
+      PetscReal        ui[PERI_MAX_DOF], uj[PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriSystemBondGeometry(an->sys, i, k, &g));
+      for (PetscInt c = 0; c < bs; c++) {
+        ui[c] = PetscRealPart(u[i * bs + c]) / lam;
+        uj[c] = PetscRealPart(u[g.j * bs + c]) / lam;
+      }
+      m->ops.bond_measures(m, &g, ui, uj, meas);
+      *next = PetscMin(*next, BondCriticalLoad(an->sys, &g, meas, m->nmeasures));
+    }
+  PetscCall(VecRestoreArrayRead(all, &u));
+  PetscCall(VecDestroy(&all));
+  PetscCall(VecScatterDestroy(&scatter));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, next, 1, MPIU_REAL, MPI_MIN, an->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* An equilibrium at load factor lam without a solve: the present state, whose response is linear
+ * in the load factor until the next break, scaled from the load factor it was solved at. */
+static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, Equilibrium *eq, PetscReal *at, PetscReal lam, PeriStep *solved, PetscInt nbonds)
+{
+  PeriStep  s  = {0};
+  PetscReal dl = 0;
+
+  PetscFunctionBeginUser;
+  /* the solves that found this state (the first: the intact body's) count here */
+  s.ksp_iterations       = solved->ksp_iterations;
+  solved->ksp_iterations = 0;
+  PetscCall(VecScale(an->sys->u, lam / *at));
+  *at            = lam;
+  s.lambda       = lam;
+  s.broken_total = QS(an)->broken_bonds;
+  PetscCall(Accept(an, st, eq, &s, &dl, nbonds));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Sequentially linear stepping (stepping: events): the body is linear between breaks, so the load
+ * factor of the next break is computed, not searched. From the present solution each intact
+ * bond's critical load factor follows in closed form; the smallest is the next event. The state
+ * scaled to it is an equilibrium (a step of steps.csv, the peak before the break); just past it
+ * (PERI_EVENT_WINDOW) that bond and the cascade it starts break until equilibrium (the next step)
+ * or failure. The load-displacement path comes out as its saw-tooth, event by event, with no
+ * bisection and no retries. */
+#define PERI_EVENT_WINDOW 1e-6
+static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Equilibrium *eq)
+{
+  PetscReal lambda = st->max;
+  PeriStep  s0     = {0};
+  TrialEnd  end;
+  char      why[160] = "";
+
+  PetscFunctionBeginUser;
+  /* the intact body solved once, at the largest load factor: its response at any other is a
+     multiple (no bond breaks in this solve) */
+  PetscCall(SolveAt(an, st, L, lambda, 0, &s0, &end, why, sizeof(why)));
+  while (end == TRIAL_SETTLED) {
+    PetscReal      next, trial;
+    PeriStep       s = {0};
+    PetscLogDouble tstep, t;
     PetscCall(PetscTime(&tstep));
-    PetscCall(Trial(an, &st, &L, trial, QS(an)->broken_bonds, &s, &end, why, sizeof(why)));
-    if (end == TRIAL_INTERRUPTED) {
-      PetscCall(EquilibriumRestore(an, &eq, PETSC_FALSE, PETSC_TRUE));
+    PetscCall(NextEvent(an, lambda, &next));
+    if (next * (1 + PERI_EVENT_WINDOW) >= st->max) {
+      PetscCall(AcceptScaled(an, st, eq, &lambda, st->max, &s0, L->nbonds));
       break;
     }
-    if (end == TRIAL_FAILED && st.adaptive && dl > st.min_step * (1 + 1e-12)) {
+    PetscCall(AcceptScaled(an, st, eq, &lambda, next, &s0, L->nbonds));
+    trial = next * (1 + PERI_EVENT_WINDOW);
+    PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, PETSC_TRUE, &s, &end, why, sizeof(why)));
+    if (end == TRIAL_FAILED) PetscCall(Failed(an, eq, trial, &s, why));
+    if (end != TRIAL_SETTLED) break;
+    lambda = trial;
+    PetscCall(PetscTime(&t));
+    s.lambda       = lambda;
+    s.broken_total = QS(an)->broken_bonds + s.broken;
+    s.seconds      = t - tstep;
+    {
+      PetscReal dl = 0;
+      PetscCall(Accept(an, st, eq, &s, &dl, L->nbonds));
+    }
+  }
+  if (end == TRIAL_INTERRUPTED) PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Incremental stepping (stepping: increments): steps of load_factor_step; with adaptive steps a
+ * failed trial is retried from the last equilibrium with half the step, down to min_step, so the
+ * critical load factor is bracketed. */
+static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L, Equilibrium *eq)
+{
+  PetscReal lambda = 0, dl = st->step;
+
+  PetscFunctionBeginUser;
+  while (lambda < st->max * (1 - 1e-12)) {
+    PetscReal      trial = PetscMin(lambda + dl, st->max);
+    PeriStep       s     = {0};
+    TrialEnd       end;
+    char           why[160] = "";
+    PetscLogDouble tstep, t;
+    PetscCall(PetscTime(&tstep));
+    PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, st->adaptive, &s, &end, why, sizeof(why)));
+    if (end == TRIAL_INTERRUPTED) {
+      PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
+      break;
+    }
+    if (end == TRIAL_FAILED && st->adaptive && dl > st->min_step * (1 + 1e-12)) {
       /* back to the last equilibrium, with half the step */
-      PetscCall(EquilibriumRestore(an, &eq, PETSC_TRUE, PETSC_FALSE));
-      L.stale       = PETSC_TRUE;
-      L.since_setup = L.nbonds;
-      dl            = PetscMax(0.5 * dl, st.min_step);
+      PetscCall(EquilibriumRestore(an, eq, PETSC_TRUE, PETSC_FALSE));
+      L->stale       = PETSC_TRUE;
+      L->since_setup = L->nbonds;
+      dl             = PetscMax(0.5 * dl, st->min_step);
       continue;
     }
     if (end == TRIAL_FAILED) {
-      PetscCall(Failed(an, &eq, trial, &s, why));
+      PetscCall(Failed(an, eq, trial, &s, why));
       break;
     }
     lambda = trial;
@@ -527,8 +666,41 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
     s.lambda       = lambda;
     s.broken_total = QS(an)->broken_bonds + s.broken;
     s.seconds      = t - tstep;
-    PetscCall(Accept(an, &st, &eq, &s, &dl, L.nbonds));
+    PetscCall(Accept(an, st, eq, &s, &dl, L->nbonds));
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisRun_Quasistatic - the load-stepping loop with bond failure, by increments or by
+  events. The results (fields, probes, energies, damage) describe the last equilibrium; a failed
+  trial is written apart as failed_trial.vtu. Collective.
+@*/
+static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
+{
+  Settings         st;
+  Loop             L  = {0};
+  Equilibrium      eq = {0};
+  PeriQuasistatic *q;
+  PetscLogDouble   t0, t;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReadSettings(an, &st));
+  PetscCall(PetscNew(&q));
+  an->data = q;
+  PetscCall(PetscStrncpy(q->control, st.control ? st.control->name : "", sizeof(q->control)));
+  PetscCall(PetscStrncpy(q->stepping, st.events ? "events" : "increments", sizeof(q->stepping)));
+  PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
+  PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(EquilibriumCreate(an, &eq));
+  PetscCallMPI(MPI_Allreduce(&an->sys->disc.bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
+  L.stale = PETSC_TRUE;
+  PetscCall(PetscTime(&t0));
+  PetscCall(PrintCriteria(an, &st));
+  if (st.events)
+    PetscCall(RunEvents(an, &st, &L, &eq));
+  else
+    PetscCall(RunIncrements(an, &st, &L, &eq));
   PetscCall(KSPDestroy(&L.ksp));
   PetscCall(PetscFree2(L.hold, L.held));
   PetscCall(EquilibriumDestroy(&eq));
@@ -594,6 +766,7 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONBeginObject(j, "quasistatic"));
   PetscCall(PeriJSONInt(j, "steps", q->nsteps));
   PetscCall(PeriJSONString(j, "state", "last equilibrium"));
+  PetscCall(PeriJSONString(j, "stepping", q->stepping));
   PetscCall(PeriJSONReal(j, "peak_load_factor", q->peak_load_factor));
   if (q->failed) {
     PetscCall(PeriJSONReal(j, "critical_load_factor", q->critical_load_factor));
@@ -638,7 +811,8 @@ static PetscErrorCode QSDestroy(PeriAnalysis an)
 static const char *const qs_policies[] = {"all", "fraction", NULL};
 static const PeriKey     qs_keys[]     = {
             {"load_factor_max", PERI_KEY_REAL, "required", "(0, inf)", NULL, NULL, "the largest load factor"},
-            {"load_factor_step", PERI_KEY_REAL, "required", "(0, load_factor_max]", NULL, NULL, "the load-factor step (the largest with adaptive steps)"},
+            {"stepping", PERI_KEY_CHOICE, "increments", NULL, NULL, qs_steppings, "increments: steps of load_factor_step (bisected at failure); events: straight to each next bond break, computed from the linear response (brittle bonds)"},
+            {"load_factor_step", PERI_KEY_REAL, "required (increments)", "(0, load_factor_max]", NULL, NULL, "the load-factor step (the largest with adaptive steps); stepping: increments"},
             {"min_step", PERI_KEY_REAL, "load_factor_step/64", "[load_factor_step/2^20, load_factor_step]", NULL, NULL, "the smallest step (adaptive)"},
             {"adaptive", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "halve the step on failure or runaway"},
             {"break", PERI_KEY_CHOICE, "all", NULL, NULL, qs_policies, "all | fraction: which violating bonds break per iteration"},

@@ -46,6 +46,7 @@ typedef struct {
   PetscBool  failed, complete;
   char       ending[160];
   char       control[PERI_NAME_LEN];
+  char       stepping[16]; /* increments | events */
 } PeriQuasistatic;
 
 /* An analysis type (src/analysis/<name>.c): what it does with the system, and what it adds to
