@@ -578,9 +578,12 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   if (nfree && target_hz == 0) sigma = -1e-8 * scale;
 
   PetscCall(CreateEPS(an, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
+  /* the factorization (MUMPS) and its solves run with the BLAS threads (src/sys/threads.c) */
+  PetscCall(PeriBLASThreads(PETSC_TRUE));
   PetscCall(EPSSetUp(w->eps));
   PetscCall(PetscTime(&t1));
   PetscCall(SolveModes(an, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
+  PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(PetscTime(&t2));
   md->factor_s         = t1 - t0;
   md->solve_s          = t2 - t1;

@@ -364,12 +364,18 @@ static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Vec b, PetscRea
  * GAMG's Chebyshev smoother fails (SmootherFallback). */
 static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Vec b, KSPConvergedReason *reason)
 {
-  PetscBool retry;
+  PetscBool retry, factor;
+  PC        pc;
 
   PetscFunctionBeginUser;
   if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->solve.symmetric, ksp));
   PetscCall(KSPSetOperators(*ksp, A, A));
+  /* a factorization uses the BLAS threads (src/sys/threads.c) */
+  PetscCall(KSPGetPC(*ksp, &pc));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, ""));
+  PetscCall(PeriBLASThreads(factor));
   PetscCall(KSPSolve(*ksp, b, sys->u));
+  PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(KSPGetConvergedReason(*ksp, reason));
   PetscCall(SmootherFallback(sys, *ksp, *reason, &retry));
   if (retry) {
