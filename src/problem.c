@@ -1,6 +1,5 @@
 /* PeriProblem: one run from scene to output. Each stage is one call; see include/perilin.h. */
 #include "perilin/private/problem.h"
-#include <sys/resource.h>
 #include <signal.h>
 
 PetscErrorCode PeriProblemCreate(MPI_Comm comm, PeriProblem *problem)
@@ -128,6 +127,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(ReadOutput(p, p->scene->file));
   if (p->write_output) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   PetscCall(PeriSystemSetUp(p->sys));
+  p->sys->log.memory_phase_mb[0] = PeriPeakMemoryMB();
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -152,7 +152,6 @@ static PetscErrorCode WriteSnapshot(void *ctx, const char name[])
 PetscErrorCode PeriProblemRun(PeriProblem p)
 {
   const PeriAnalysisType *type;
-  struct rusage           ru;
   PetscReal               mb;
   PetscLogDouble          t;
 
@@ -177,9 +176,10 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   if (!p->sys->interrupted) PetscCall(type->ops.run(p->analysis));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscTime(&t));
-  p->sys->log.total_s = t - p->t_start;
-  getrusage(RUSAGE_SELF, &ru);
-  mb = (PetscReal)ru.ru_maxrss / 1024.0; /* kilobytes on Linux */
+  p->sys->log.total_s            = t - p->t_start;
+  mb                             = PeriPeakMemoryMB();
+  p->sys->log.memory_phase_mb[2] = mb;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, p->sys->log.memory_phase_mb, 3, MPIU_REAL, MPI_MAX, p->comm));
   PetscCallMPI(MPI_Allreduce(&mb, &p->sys->log.memory_mb, 1, MPIU_REAL, MPI_SUM, p->comm));
   PetscCallMPI(MPI_Allreduce(&mb, &p->sys->log.memory_mb_max_rank, 1, MPIU_REAL, MPI_MAX, p->comm));
   PetscFunctionReturn(PETSC_SUCCESS);

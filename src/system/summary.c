@@ -51,6 +51,14 @@ PetscErrorCode PeriSystemSummaryCost(PeriSystem sys, PeriJSON j)
   PetscCall(PeriJSONEndObject(j));
   PetscCall(PeriJSONReal(j, "memory_mb", sys->log.memory_mb));
   PetscCall(PeriJSONReal(j, "memory_mb_max_rank", sys->log.memory_mb_max_rank));
+  /* where the peak was reached (issue 14, item 4): the largest rank's peak at the end of each
+     phase, and K's own bytes for comparison */
+  PetscCall(PeriJSONBeginObject(j, "memory_phases_mb"));
+  PetscCall(PeriJSONReal(j, "setup", sys->log.memory_phase_mb[0]));
+  if (sys->log.memory_phase_mb[1] > 0) PetscCall(PeriJSONReal(j, "assembly", sys->log.memory_phase_mb[1]));
+  PetscCall(PeriJSONReal(j, "run", sys->log.memory_phase_mb[2]));
+  PetscCall(PeriJSONEndObject(j));
+  if (sys->log.matrix_mb > 0) PetscCall(PeriJSONReal(j, "matrix_mb", sys->log.matrix_mb));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

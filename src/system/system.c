@@ -433,6 +433,17 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
   PetscCall(PeriAssembleStiffness(sys, &sys->K));
   PetscCall(PetscTime(&t1));
   sys->log.assembly_s = t1 - t0;
+  if (sys->log.matrix_mb == 0) { /* the first assembly: K's size and the memory it took */
+    MatInfo   info;
+    PetscBool blocked;
+    PetscInt  bs;
+    PetscCall(MatGetInfo(sys->K, MAT_GLOBAL_SUM, &info));
+    PetscCall(MatGetBlockSize(sys->K, &bs));
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)sys->K, &blocked, MATSEQBAIJ, MATMPIBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
+    /* PETSc 3.18 leaves info.memory 0 for AIJ: the values and the column indices (one per block) */
+    sys->log.matrix_mb          = (info.memory > 0 ? info.memory : info.nz_allocated * (sizeof(PetscScalar) + (PetscReal)sizeof(PetscInt) / (blocked ? bs * bs : 1))) / 1048576.0;
+    sys->log.memory_phase_mb[1] = PeriPeakMemoryMB();
+  }
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -15,6 +15,7 @@ PETSC_EXTERN int            PeriSignalPending(void);
 PETSC_EXTERN PetscLogEvent  PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;
 PETSC_EXTERN PetscLogStage  PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
 PETSC_EXTERN PetscErrorCode PeriInitializePackage(void);
+PETSC_EXTERN PetscReal      PeriPeakMemoryMB(void);
 
 /* BLAS threads (src/sys/threads.c): one outside factorizations, the library's own around them. */
 PETSC_EXTERN PetscErrorCode PeriBLASThreadsInitialize(void);

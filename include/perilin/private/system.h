@@ -33,8 +33,10 @@ typedef struct {
   PetscReal neighbors_s, assembly_s, solve_s, total_s;
   PetscReal memory_mb, memory_mb_max_rank;
   PetscInt  nbonds_total;
-  PetscInt  edge_cut;         /* bonds between particles of different ranks */
-  PetscBool free_modes_noted; /* the note on free motions is printed once per run */
+  PetscInt  edge_cut;           /* bonds between particles of different ranks */
+  PetscBool free_modes_noted;   /* the note on free motions is printed once per run */
+  PetscReal memory_phase_mb[3]; /* the largest rank's peak memory at the end of set-up, first assembly, run */
+  PetscReal matrix_mb;          /* the bytes PETSc holds for K (all ranks), at the first assembly */
 } PeriRunLog;
 
 typedef enum {
