@@ -25,7 +25,7 @@ typedef struct {
   PetscReal  lower[3], upper[3];
   PetscBool  periodic[3];
   PetscReal  mean_spacing;
-  /* fictitious boundary layers (src/layers.c): NULL when the scene has none */
+  /* fictitious boundary layers (src/system/layers.c): NULL when the scene has none */
   PetscInt      *image;   /* -1 for a particle of the body; else the body particle it mirrors */
   unsigned char *crossed; /* faces crossed to reach the particle: bit 2 axis + (upper face) */
   PetscInt       nfictitious;

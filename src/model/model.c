@@ -5,7 +5,7 @@
 
 static PetscFunctionList PeriModelList = NULL;
 
-/* Run by PetscFinalize: frees the list, as PETSc's own packages do (models/registry.c forgets on
+/* Run by PetscFinalize: frees the list, as PETSc's own packages do (src/model/registry.c forgets on
  * its own that it filled it). */
 static PetscErrorCode PeriModelFinalizePackage(void)
 {

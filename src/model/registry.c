@@ -1,5 +1,5 @@
 /* Registers the built-in models of models/list.h. Only PeriInitializePackage calls this;
- * src/model.c holds the list it fills and never calls back here. */
+ * src/model/model.c holds the list it fills and never calls back here. */
 #include "perilin/private/model.h"
 
 #define PERI_MODEL(id) extern const PeriModelType PeriModel_##id;

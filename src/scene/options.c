@@ -192,7 +192,7 @@ static PetscErrorCode UnreadHere(Names *unread)
 
 /*@C
   PeriOptionsCheckScene - every option that names the scene (-material_..., -bc_..., -dim) must set
-  one of its keys: a scalar or list of the file, or a documented key (src/scene.c). Call it right
+  one of its keys: a scalar or list of the file, or a documented key (src/scene/scene.c). Call it right
   after the scene is read: the overrides have read every option they use, and nothing was computed
   yet. The same error on every rank (they all read the same scene and options); with
   -options_unused_ok a warning printed by rank 0 of comm.

@@ -306,7 +306,7 @@ static PetscErrorCode AddOptionKeys(PeriScene scene)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Options that name the scene (src/options.c checks them): a root key of the schemas, alone or
+/* Options that name the scene (src/scene/options.c checks them): a root key of the schemas, alone or
  * followed by '_'. Option names ignore case, as PETSc's do. */
 PetscErrorCode PeriSceneOptionIsScene(PeriScene scene, const char opt[], PetscBool *is)
 {

@@ -385,7 +385,7 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Vec b, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* sys->results' solver fields: iterations, the true relative residual (whatever norm the KSP
+/* sys->solve: iterations, the true relative residual (whatever norm the KSP
  * monitored), the KSP and PC types and the converged reason. */
 static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConvergedReason reason)
 {
@@ -418,7 +418,7 @@ static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConv
   offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
   eliminated (A = R K T), prescribed DOFs symmetrically; a free body with balanced loads is solved
   orthogonal to its rigid motions. sys->K is kept unless inplace. *ksp is created on first use
-  (CG + GAMG, or GMRES for an unsymmetric operator, then the options). Sets sys->results' solver
+  (CG + GAMG, or GMRES for an unsymmetric operator, then the options). Sets sys->solve's solver
   fields and returns the converged reason instead of failing. Collective.
 @*/
 PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)

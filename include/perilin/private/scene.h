@@ -15,7 +15,7 @@ PETSC_EXTERN PetscErrorCode PeriSceneDocUpdate(MPI_Comm, const char[], PetscBool
 PETSC_EXTERN PetscErrorCode PeriSceneSectionKeys(PeriScene, const char[], PetscBool, const char *[PERI_SECTION_MAX_KEYS]);
 PETSC_EXTERN void           PeriSchemaPath(const PeriSchema *, const PeriKey *, char[], size_t);
 
-/* Options that name nothing (src/options.c; docs/scene.md): an option naming no scene key is an
+/* Options that name nothing (src/scene/options.c; docs/scene.md): an option naming no scene key is an
  * error before any computation, and an option nothing read is one after the analysis, both with a
  * "did you mean"; -options_unused_ok makes them warnings. */
 PETSC_EXTERN PetscErrorCode PeriSceneOptionIsScene(PeriScene, const char[], PetscBool *);

@@ -61,7 +61,7 @@ typedef struct {
   PetscReal error_l2_rel, error_max_rel;
 } PeriReference;
 
-/* Fictitious boundary layers outside the body's faces (Oterkus & Madenci sec. 6, src/layers.c):
+/* Fictitious boundary layers outside the body's faces (Oterkus & Madenci sec. 6, src/system/layers.c):
  * each fictitious particle copies its mirror image in the body, u_f = sign u_m + offset. */
 typedef enum {
   PERI_LAYER_NONE,
@@ -97,7 +97,7 @@ typedef enum {
 } PeriFailureCause;
 PETSC_EXTERN const char *const PeriFailureCauses[];
 
-/* Bond failure criteria (failure:, src/failure.c); 0 = criterion not given. */
+/* Bond failure criteria (failure:, src/system/failure.c); 0 = criterion not given. */
 typedef struct {
   PetscBool active;
   PetscReal stretch, G, compressive, sliding, friction_angle, cohesion, shear_angle;
