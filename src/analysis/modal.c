@@ -459,6 +459,8 @@ static PetscErrorCode SetUpModal(PeriAnalysis an, PetscReal target_hz, Mat *M, V
   PetscCall(ISGetSize(*isfree, &md->nfree_dofs));
   PetscCheck(md->nfree_dofs > 0, an->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", an->sys->scene->file);
   PetscCall(MatCreateSubMatrix(an->sys->K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
+  /* for an inner solve by algebraic multigrid (-st_pc_type gamg): the rigid modes on the free DOFs */
+  PetscCall(PeriSetNearNullSpace(an->sys, *Kff, *isfree));
   PetscCall(MatCreateSubMatrix(*M, *isfree, *isfree, MAT_INITIAL_MATRIX, Mff));
   PetscCall(MatSetOption(*Kff, MAT_SYMMETRIC, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);

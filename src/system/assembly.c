@@ -417,29 +417,48 @@ PetscErrorCode PeriRigidModes(PeriSystem sys, PetscInt *nmodes, Vec modes[], Pet
 }
 
 /*@C
-  PeriSetNearNullSpace - gives A the orthonormalized rigid-body modes, for algebraic multigrid.
+  PeriSetNearNullSpace - gives A the orthonormalized rigid-body modes, for algebraic multigrid;
+  with rows (an IS of the global DOFs that are A's rows), the modes restricted to them.
   Collective.
 @*/
-PetscErrorCode PeriSetNearNullSpace(PeriSystem sys, Mat A)
+PetscErrorCode PeriSetNearNullSpace(PeriSystem sys, Mat A, IS rows)
 {
-  Vec          modes[PERI_MAX_MODES];
-  PetscInt     nm;
+  Vec          modes[PERI_MAX_MODES], kept[PERI_MAX_MODES];
+  PetscInt     nm, nk = 0;
   MatNullSpace nsp;
 
   PetscFunctionBeginUser;
   PetscCall(PeriRigidModes(sys, &nm, modes, NULL));
-  /* Gram-Schmidt: MatNullSpaceCreate wants an orthonormal set */
   for (PetscInt k = 0; k < nm; k++) {
-    for (PetscInt l = 0; l < k; l++) {
-      PetscScalar dot;
-      PetscCall(VecDot(modes[k], modes[l], &dot));
-      PetscCall(VecAXPY(modes[k], -dot, modes[l]));
+    PetscReal before, after;
+    if (rows) { /* the modes on the rows of A only (the free DOFs of the modal analysis) */
+      Vec sub;
+      PetscCall(VecGetSubVector(modes[k], rows, &sub));
+      PetscCall(VecDuplicate(sub, &kept[nk]));
+      PetscCall(VecCopy(sub, kept[nk]));
+      PetscCall(VecRestoreSubVector(modes[k], rows, &sub));
+    } else {
+      PetscCall(VecDuplicate(modes[k], &kept[nk]));
+      PetscCall(VecCopy(modes[k], kept[nk]));
     }
-    PetscCall(VecNormalize(modes[k], NULL));
+    /* Gram-Schmidt: MatNullSpaceCreate wants an orthonormal set; a restricted mode that became
+       dependent on the others is dropped */
+    PetscCall(VecNorm(kept[nk], NORM_2, &before));
+    for (PetscInt l = 0; l < nk; l++) {
+      PetscScalar dot;
+      PetscCall(VecDot(kept[nk], kept[l], &dot));
+      PetscCall(VecAXPY(kept[nk], -dot, kept[l]));
+    }
+    PetscCall(VecNormalize(kept[nk], &after));
+    if (!rows || after > 1e-8 * before)
+      nk++;
+    else
+      PetscCall(VecDestroy(&kept[nk]));
   }
-  PetscCall(MatNullSpaceCreate(sys->comm, PETSC_FALSE, nm, modes, &nsp));
+  PetscCall(MatNullSpaceCreate(sys->comm, PETSC_FALSE, nk, kept, &nsp));
   PetscCall(MatSetNearNullSpace(A, nsp));
   PetscCall(MatNullSpaceDestroy(&nsp));
+  for (PetscInt k = 0; k < nk; k++) PetscCall(VecDestroy(&kept[k]));
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

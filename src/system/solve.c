@@ -317,7 +317,7 @@ static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool
     *A = sys->K;
   } else
     PetscCall(MatDuplicate(sys->K, MAT_COPY_VALUES, A));
-  PetscCall(PeriSetNearNullSpace(sys, *A));
+  PetscCall(PeriSetNearNullSpace(sys, *A, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -171,7 +171,7 @@ typedef PetscErrorCode (*PeriElementFn)(PeriSystem, const PeriElement *, void *)
 PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void *);
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
-PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat);
+PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
 
 /* boundary conditions and loads (src/system/boundary.c) */
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriSystem);
