@@ -19,7 +19,10 @@ static inline PeriQuasistatic *QS(PeriAnalysis an)
 static const char *const qs_steppings[] = {"increments", "events", NULL};
 
 #define PERI_MAX_LOAD_STEPS 100000
-#define PERI_MAX_BISECTION  1048576.0 /* 2^20 */
+/* the relative tolerance of a cascade's intermediate solves (stepping by events): the breaks need
+ * the failure indices to about this, the accepted equilibria are solved to the full tolerance */
+#define PERI_CASCADE_RTOL  1e-6
+#define PERI_MAX_BISECTION 1048576.0 /* 2^20 */
 
 typedef struct {
   PetscReal  max, step, min_step, fraction, runaway;
@@ -357,7 +360,7 @@ typedef enum {
 /* One solve at the load factor lam with the present bonds (pieces cut off from the constraints
  * held in place). *end is TRIAL_SETTLED when it converged, TRIAL_FAILED (with why) when the body
  * cannot carry the load, TRIAL_INTERRUPTED on a signal. */
-static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, PetscReal lam, PetscInt broken, PeriStep *s, TrialEnd *end, char why[], size_t len)
+static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, PetscReal lam, PetscInt broken, PetscBool loose, PeriStep *s, TrialEnd *end, char why[], size_t len)
 {
   PeriQuasistatic   *q = QS(an);
   KSPConvergedReason reason;
@@ -387,12 +390,22 @@ static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, Pets
     q->pc_setups++;
     L->since_setup = 0;
   }
-  PetscCall(PeriStaticSolve(an->sys, &L->ksp, lam, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
+  if (loose && L->ksp) { /* an intermediate solve of a cascade: its tolerance, then back */
+    PetscReal rtol, atol, dtol;
+    PetscInt  maxit;
+    PetscCall(KSPGetTolerances(L->ksp, &rtol, &atol, &dtol, &maxit));
+    PetscCall(KSPSetTolerances(L->ksp, PetscMax(rtol, PERI_CASCADE_RTOL), atol, dtol, maxit));
+    PetscCall(PeriStaticSolve(an->sys, &L->ksp, lam, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
+    PetscCall(PeriStaticConverged(an->sys, L->ksp, reason, &ok));
+    PetscCall(KSPSetTolerances(L->ksp, rtol, atol, dtol, maxit));
+  } else {
+    PetscCall(PeriStaticSolve(an->sys, &L->ksp, lam, PETSC_FALSE, L->nhold, L->hold, L->held, &reason));
+    PetscCall(PeriStaticConverged(an->sys, L->ksp, reason, &ok));
+  }
   /* later solves start from the last solution: few bonds change between them */
   PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
   q->solves++;
   s->ksp_iterations += an->sys->solve.iterations;
-  PetscCall(PeriStaticConverged(an->sys, L->ksp, reason, &ok));
   PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
   if (an->sys->interrupted) {
     *end = TRIAL_INTERRUPTED;
@@ -410,24 +423,34 @@ static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, Pets
 }
 
 /* Solve, break, solve again at the load factor trial until no bond breaks (or the body fails).
- * runaway: whether a cascade past st->runaway of the bonds ends the trial (adaptive increments,
- * which then retry with a smaller step). */
-static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscReal trial, PetscInt total, PetscBool runaway, PeriStep *s, TrialEnd *end, char why[], size_t len)
+ * runaway: whether a cascade past st->runaway of the bonds ends the trial. event: the present
+ * state is already the solution at trial (scaled from the last equilibrium, stepping by events),
+ * so the first round breaks without a solve, and the cascade's intermediate solves stop at
+ * PERI_CASCADE_RTOL; a tight solve confirms every equilibrium before it is accepted. */
+static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscReal trial, PetscInt total, PetscBool runaway, PetscBool event, PeriStep *s, TrialEnd *end, char why[], size_t len)
 {
+  PetscBool loose = PETSC_FALSE; /* the present solution is a cascade's intermediate one */
+
   PetscFunctionBeginUser;
   *end = TRIAL_FAILED;
   for (s->iterations = 0; s->iterations < st->max_iterations; s->iterations++) {
     PetscInt nb;
-    PetscCall(SolveAt(an, st, L, trial, total + s->broken, s, end, why, len));
-    if (*end != TRIAL_SETTLED) PetscFunctionReturn(PETSC_SUCCESS);
+    if (!(event && s->iterations == 0)) {
+      PetscCall(SolveAt(an, st, L, trial, total + s->broken, loose, s, end, why, len));
+      if (*end != TRIAL_SETTLED) PetscFunctionReturn(PETSC_SUCCESS);
+    }
     PetscCall(BreakBonds(an, st, &nb));
     L->stale = (PetscBool)(nb > 0);
-    if (!nb) PetscFunctionReturn(PETSC_SUCCESS); /* settled */
-    *end = TRIAL_FAILED;
+    if (!nb && !loose) {
+      *end = TRIAL_SETTLED;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    loose = (PetscBool)(event && nb > 0); /* none broke after a loose solve: confirm it tightly */
+    *end  = TRIAL_FAILED;
     s->broken += nb;
     L->since_setup += nb;
     /* a twist carried by the bonds themselves loses the broken bonds' share */
-    if (an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
+    if (nb && an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
     if (runaway && s->broken > st->runaway * L->nbonds) {
       /* a crack running away at this load: a smaller step tells whether it would settle */
       PetscCall(PetscSNPrintf(why, len, "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s->broken, (double)st->runaway));
@@ -599,7 +622,7 @@ static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Eq
   PetscFunctionBeginUser;
   /* the intact body solved once, at the largest load factor: its response at any other is a
      multiple (no bond breaks in this solve) */
-  PetscCall(SolveAt(an, st, L, lambda, 0, &s0, &end, why, sizeof(why)));
+  PetscCall(SolveAt(an, st, L, lambda, 0, PETSC_FALSE, &s0, &end, why, sizeof(why)));
   while (end == TRIAL_SETTLED) {
     PetscReal      next, trial;
     PeriStep       s = {0};
@@ -612,7 +635,8 @@ static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Eq
     }
     PetscCall(AcceptScaled(an, st, eq, &lambda, next, &s0, L->nbonds));
     trial = next * (1 + PERI_EVENT_WINDOW);
-    PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, PETSC_TRUE, &s, &end, why, sizeof(why)));
+    PetscCall(VecScale(an->sys->u, trial / lambda)); /* the same bonds: the solution at trial */
+    PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, PETSC_TRUE, PETSC_TRUE, &s, &end, why, sizeof(why)));
     if (end == TRIAL_FAILED) PetscCall(Failed(an, eq, trial, &s, why));
     if (end != TRIAL_SETTLED) break;
     lambda = trial;
@@ -644,7 +668,7 @@ static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L
     char           why[160] = "";
     PetscLogDouble tstep, t;
     PetscCall(PetscTime(&tstep));
-    PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, st->adaptive, &s, &end, why, sizeof(why)));
+    PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, st->adaptive, PETSC_FALSE, &s, &end, why, sizeof(why)));
     if (end == TRIAL_INTERRUPTED) {
       PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
       break;
