@@ -86,6 +86,9 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
   PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis_type, sizeof(p->analysis_type), NULL));
   for (PetscInt o = 0; o < s->nowners; o++)
     if (!strcmp(s->owners[o].kind, "analysis") && !strcmp(s->owners[o].name, p->analysis_type)) active = &s->owners[o];
+  /* an analysis without a schema (setup, the dry run) accepts every analysis' keys, so that any
+     scene can be checked with -analysis_type setup */
+  if (active && !active->schema) active = NULL;
   PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", active));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -844,7 +844,7 @@ static const PeriKey     qs_keys[]     = {
             {"max_iterations", PERI_KEY_INT, "100", "[1, inf)", NULL, NULL, "equilibrium iterations per step"},
             {"reuse_preconditioner", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "keep the preconditioner while few bonds changed"},
             {"control_probe", PERI_KEY_STRING, "the first probe", NULL, NULL, NULL, "the probe whose displacement steps.csv reports"},
-            {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "adaptive: more bonds than this share breaking in one step is a runaway"},
+            {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "more bonds than this share breaking at one load is a runaway: adaptive increments retry with a smaller step, events declare the failure"},
             {NULL},
 };
 /* output.every, which the run's snapshots follow (problem.c reads it with output.*) */
