@@ -107,6 +107,7 @@ void PeriModelSetCentralForce(PeriModel m)
   m->ops.nu_range                     = PeriBondBasedNuRange;
   m->ops.bond_measures                = PeriBondStretch;
   m->ops.rigid_modes                  = PeriTranslationalRigidModes;
+  m->central_force                    = PETSC_TRUE;
 }
 
 /* Translations, and rotations u = w x X, of models whose DOFs are the dim displacements. */

@@ -52,6 +52,7 @@ struct _p_PeriModel {
   PetscBool          antiplane;                /* one DOF, the out-of-plane displacement uz: stresses tau_xz, tau_yz */
   PetscBool          inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
   PetscBool          rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
+  PetscBool          central_force;            /* every bond block is k [e e^T, -e e^T; -e e^T, e e^T], k >= 0 (PeriModelSetCentralForce) */
   char               warning[256];             /* set by calibration; printed once by the problem */
   PeriMaterial       material;
   PetscReal          delta;

@@ -173,8 +173,9 @@ static PetscErrorCode InsertElements(PeriSystem sys, Mat K)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* An empty block matrix of K's layout and the given type: the options and preallocation follow. */
-static PetscErrorCode CreateBlockMatrix(PeriSystem sys, MatType type, Mat *K)
+/* An empty block matrix of K's layout and the given type: the options and preallocation follow.
+ * Collective. */
+PetscErrorCode PeriCreateBlockMatrix(PeriSystem sys, MatType type, Mat *K)
 {
   const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
 
@@ -193,10 +194,10 @@ static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
   Mat pre;
 
   PetscFunctionBeginUser;
-  PetscCall(CreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
+  PetscCall(PeriCreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
   PetscCall(MatSetUp(pre));
   PetscCall(InsertElements(sys, pre));
-  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
+  PetscCall(PeriCreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *K));
   PetscCall(MatDestroy(&pre));
@@ -217,7 +218,7 @@ static PetscErrorCode CreateBondStiffness(PeriSystem sys, Mat *K, PetscInt *maxc
   PetscCall(Preallocation(sys, &dnz, &onz, &dnzu, &onzu));
   *maxcol = 1;
   for (PetscInt i = 0; i < nloc; i++) *maxcol = PetscMax(*maxcol, dnz[i] + onz[i]);
-  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
+  PetscCall(PeriCreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatXAIJSetPreallocation(*K, sys->model->dofs, dnz, onz, dnzu, onzu));
   PetscCall(PetscFree4(dnz, onz, dnzu, onzu));

@@ -118,7 +118,7 @@ static PetscErrorCode PinFreeMotions(PeriSystem sys, PetscInt nfree, Vec v[], Pe
 
  * otherwise (a self-equilibrated free body, a bar in torsion) the loads' round-off share along them
  * is removed, enough DOFs are pinned to make A regular, and the caller projects the solution. */
-static PetscErrorCode HandleFreeMotions(PeriSystem sys, Mat A, Vec u, Vec b, PetscReal diag, PetscInt nhold, const PetscInt hold[], PetscInt *nfree, Vec free[])
+static PetscErrorCode HandleFreeMotions(PeriSystem sys, Mat A, Mat P, Vec u, Vec b, PetscReal diag, PetscInt nhold, const PetscInt hold[], PetscInt *nfree, Vec free[])
 {
   char      what[128];
   PetscReal bnorm, share = 0;
@@ -162,6 +162,7 @@ static PetscErrorCode HandleFreeMotions(PeriSystem sys, Mat A, Vec u, Vec b, Pet
   }
   PetscCall(PinFreeMotions(sys, *nfree, free, &npin, pins));
   PetscCall(MatZeroRowsColumns(A, npin, pins, diag, u, b));
+  if (P != A) PetscCall(MatZeroRowsColumns(P, npin, pins, diag, NULL, NULL));
   if (!sys->log.free_modes_noted) PetscCall(PetscPrintf(sys->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
   sys->log.free_modes_noted = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -216,7 +217,7 @@ static PetscErrorCode KSPSetInterruptible(KSP ksp, MPI_Comm comm)
  * eigen-estimates of the smoothed prolongators collapse for K ~ 1e40), so the result depended on
  * the units of E. Solving A/diag u = b/diag gives the same u with O(1) matrix entries; what no
  * scaling can help (a stiffness or a displacement scale beyond double precision) is refused. */
-static PetscErrorCode ScaleToUnits(PeriSystem sys, Mat A, Vec b, PetscReal *diag)
+static PetscErrorCode ScaleToUnits(PeriSystem sys, Mat A, Mat P, Vec b, PetscReal *diag)
 {
   PeriNode mat;
 
@@ -224,6 +225,7 @@ static PetscErrorCode ScaleToUnits(PeriSystem sys, Mat A, Vec b, PetscReal *diag
   PetscCall(PeriSceneGetNode(sys->scene->root, "material", &mat));
   PeriInputCheck(*diag > 0 && PetscIsNormalReal(*diag) && *diag < 1e250 && *diag > 1e-250, sys->scene, mat, "E", "the stiffness (mean diagonal of K: %g) is beyond what double precision can solve with: give the moduli, thickness and spacing in units that keep them within about 1e-100 to 1e100", (double)*diag);
   PetscCall(MatScale(A, 1 / *diag));
+  if (P != A) PetscCall(MatScale(P, 1 / *diag));
   PetscCall(VecScale(b, 1 / *diag));
   *diag = 1;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -300,9 +302,22 @@ static PetscErrorCode SmootherFallback(PeriSystem sys, KSP ksp, KSPConvergedReas
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The operator A and the right-hand side b = lambda f of the solve: K with the fictitious layers
- * eliminated (A = R K T), else K itself (inplace) or a copy; A carries the rigid-body modes. */
-static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool inplace, Mat *A, Vec *b)
+static PetscErrorCode ReferenceOrCopy(Mat K, PetscBool inplace, Mat *A)
+{
+  PetscFunctionBeginUser;
+  if (inplace) {
+    PetscCall(PetscObjectReference((PetscObject)K));
+    *A = K;
+  } else
+    PetscCall(MatDuplicate(K, MAT_COPY_VALUES, A));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The operator A, the preconditioning matrix P and the right-hand side b = lambda f of the solve: K
+ * with the fictitious layers eliminated (A = R K T), else K itself (inplace) or a copy; P is A,
+ * or with a matrix-free K the short-range stiffness (itself or a copy). Both carry the rigid-body
+ * modes. */
+static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool inplace, Mat *A, Mat *P, Vec *b)
 {
   PetscFunctionBeginUser;
   if (!sys->u) PetscCall(MatCreateVecs(sys->K, &sys->u, NULL));
@@ -312,19 +327,25 @@ static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool
   sys->solve.symmetric = PETSC_TRUE;
   if (sys->layers.T)
     PetscCall(PeriLayersApply(sys, lambda, A, *b));
-  else if (inplace) {
-    PetscCall(PetscObjectReference((PetscObject)sys->K));
-    *A = sys->K;
-  } else
-    PetscCall(MatDuplicate(sys->K, MAT_COPY_VALUES, A));
+  else if (sys->op)
+    PetscCall(PeriOperatorCreateMat(sys, A)); /* a fresh shell: the held DOFs are its own */
+  else
+    PetscCall(ReferenceOrCopy(sys->K, inplace, A));
+  if (sys->op)
+    PetscCall(ReferenceOrCopy(sys->Kpc, inplace, P));
+  else {
+    PetscCall(PetscObjectReference((PetscObject)*A));
+    *P = *A;
+  }
   PetscCall(PeriSetNearNullSpace(sys, *A, NULL));
+  if (*P != *A) PetscCall(PeriSetNearNullSpace(sys, *P, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Sets the prescribed (lambda times their values) and held DOFs in sys->u and eliminates them
  * symmetrically from A and b, with the system scaled to O(1) numbers first (ScaleToUnits); *diag
  * gets the value left on the eliminated rows. */
-static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Vec b, PetscReal lambda, PetscInt nhold, const PetscInt hold[], const PetscReal held[], PetscReal *diag)
+static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, PetscReal lambda, PetscInt nhold, const PetscInt hold[], const PetscReal held[], PetscReal *diag)
 {
   const PetscInt nrows = sys->nconstrained + nhold;
   PetscReal     *values;
@@ -352,24 +373,25 @@ static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Vec b, PetscRea
   PetscCall(VecGetSize(d, &N));
   PetscCall(VecDestroy(&d));
   *diag /= N;
-  PetscCall(ScaleToUnits(sys, A, b, diag));
-  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPISBAIJ, &mpisbaij));
+  PetscCall(ScaleToUnits(sys, A, P, b, diag));
+  PetscCall(PetscObjectTypeCompare((PetscObject)P, MATMPISBAIJ, &mpisbaij));
   PetscCheck(!mpisbaij, sys->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
   PetscCall(MatZeroRowsColumns(A, nrows, rows, *diag, sys->u, b));
+  if (P != A) PetscCall(MatZeroRowsColumns(P, nrows, rows, *diag, NULL, NULL));
   PetscCall(PetscFree2(rows, values));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Solves A u = b for sys->u with *ksp (created on first use), once more with SOR smoothing when
  * GAMG's Chebyshev smoother fails (SmootherFallback). */
-static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Vec b, KSPConvergedReason *reason)
+static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, Vec b, KSPConvergedReason *reason)
 {
   PetscBool retry, factor;
   PC        pc;
 
   PetscFunctionBeginUser;
   if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->solve.symmetric, ksp));
-  PetscCall(KSPSetOperators(*ksp, A, A));
+  PetscCall(KSPSetOperators(*ksp, A, P));
   /* a factorization uses the BLAS threads (src/sys/threads.c) */
   PetscCall(KSPGetPC(*ksp, &pc));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, ""));
@@ -423,18 +445,18 @@ static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConv
 @*/
 PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
 {
-  Mat       A;
+  Mat       A, P;
   Vec       b, free[PERI_MAX_MODES];
   PetscReal diag;
   PetscInt  nfree = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
-  PetscCall(StaticOperator(sys, lambda, inplace, &A, &b));
-  PetscCall(EliminatePrescribed(sys, A, b, lambda, nhold, hold, held, &diag));
+  PetscCall(StaticOperator(sys, lambda, inplace, &A, &P, &b));
+  PetscCall(EliminatePrescribed(sys, A, P, b, lambda, nhold, hold, held, &diag));
   PetscCall(CheckRightHandSide(sys, b));
-  PetscCall(HandleFreeMotions(sys, A, sys->u, b, diag, nhold, hold, &nfree, free));
-  PetscCall(SolveWithFallback(sys, ksp, A, b, reason));
+  PetscCall(HandleFreeMotions(sys, A, P, sys->u, b, diag, nhold, hold, &nfree, free));
+  PetscCall(SolveWithFallback(sys, ksp, A, P, b, reason));
   PetscCall(RecordSolve(sys, *ksp, A, b, *reason));
   /* the solution orthogonal to the free rigid motions */
   for (PetscInt q = 0; q < nfree; q++) {
@@ -446,6 +468,7 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
   PetscCall(PeriLayersComplete(sys, lambda, sys->u));
   PetscCall(VecDestroy(&b));
   PetscCall(MatDestroy(&A));
+  PetscCall(MatDestroy(&P));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

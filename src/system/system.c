@@ -22,9 +22,12 @@ static const PeriKey corrections_keys[] = {
     {"surface", PERI_KEY_CHOICE, "none", NULL, NULL, PeriSurfaceCorrections, "surface correction: volume (lambda = 2 V0 / (V(H_i) + V(H_j))); energy (antiplane models, Oterkus & Madenci eq. 53); each model names those it takes"},
     {NULL},
 };
-static const PeriKey solver_keys[] = {
-    {"residual_tol", PERI_KEY_REAL, "0", "[0, 1)", NULL, NULL, "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; 0: min(max(100 rtol, 1e-6), 1e-3)"},
-    {NULL},
+const char *const    PeriOperatorKinds[] = {"auto", "assembled", "matrix_free", NULL};
+static const PeriKey solver_keys[]       = {
+          {"operator", PERI_KEY_CHOICE, "auto", NULL, NULL, PeriOperatorKinds, "how K is applied: assembled, or matrix_free (central-force models in a static analysis: K u bond by bond, AMG on a short-range stiffness); auto: matrix_free in 3D where it applies"},
+          {"pc_radius", PERI_KEY_REAL, "1.75", "[1, inf)", NULL, NULL, "matrix_free: the bonds no longer than pc_radius times the shortest bond make the preconditioning matrix"},
+          {"residual_tol", PERI_KEY_REAL, "0", "[0, 1)", NULL, NULL, "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; 0: min(max(100 rtol, 1e-6), 1e-3)"},
+          {NULL},
 };
 const PeriSchema PeriSystemSchema[] = {
     {"model", model_keys},
@@ -103,6 +106,14 @@ static PetscErrorCode ReadSolver(PeriSystem sys)
   PetscCall(PeriSceneCheckSection(s, node, "solver"));
   PetscCall(PeriSceneGetReal(s, node, "residual_tol", PETSC_FALSE, &sys->residual_tol, NULL));
   PeriInputCheck(sys->residual_tol >= 0 && sys->residual_tol < 1, s, node, "residual_tol", "must lie in [0, 1) (0: the default, max(100 rtol, 1e-6)), got %g", (double)sys->residual_tol);
+  {
+    PetscInt kind = PERI_OPERATOR_AUTO;
+    PetscCall(PeriSceneGetChoice(s, node, "operator", PeriOperatorKinds, &kind, NULL));
+    sys->operator_kind = (PeriOperatorKind)kind;
+  }
+  sys->pc_radius = 1.75;
+  PetscCall(PeriSceneGetReal(s, node, "pc_radius", PETSC_FALSE, &sys->pc_radius, NULL));
+  PeriInputCheck(sys->pc_radius >= 1, s, node, "pc_radius", "must be at least 1 (the nearest neighbours), got %g", (double)sys->pc_radius);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -372,6 +383,8 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscFunctionBeginUser;
   if (!sys) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(MatDestroy(&sys->K));
+  PetscCall(MatDestroy(&sys->Kpc));
+  PetscCall(PeriOperatorDestroy(&sys->op));
   PetscCall(VecDestroy(&sys->u));
   PetscCall(VecDestroy(&sys->f));
   PetscCall(PeriModelDestroy(&sys->model));
@@ -422,26 +435,70 @@ PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The bytes PETSc holds for an assembled matrix, all ranks. */
+static PetscErrorCode MatrixMB(Mat K, PetscReal *mb)
+{
+  MatInfo   info;
+  PetscBool blocked;
+  PetscInt  bs;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetInfo(K, MAT_GLOBAL_SUM, &info));
+  PetscCall(MatGetBlockSize(K, &bs));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)K, &blocked, MATSEQBAIJ, MATMPIBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  /* PETSc 3.18 leaves info.memory 0 for AIJ: the values and the column indices (one per block) */
+  *mb = (info.memory > 0 ? info.memory : info.nz_allocated * (sizeof(PetscScalar) + (PetscReal)sizeof(PetscInt) / (blocked ? bs * bs : 1))) / 1048576.0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* solver.operator: matrix_free applies to central-force models solved once as assembled (the
+ * static analysis), without fictitious layers; auto takes it in 3D, where it wins
+ * (docs/performance.md), and assembled K elsewhere. */
+static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
+{
+  const char *why = NULL;
+  PeriNode    node;
+
+  PetscFunctionBeginUser;
+  if (!sys->model->central_force)
+    why = "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
+  else if (!sys->single_solve)
+    why = "the analysis changes K or needs its entries (matrix_free serves the static analysis)";
+  else if (sys->layers.T)
+    why = "fictitious layers eliminate K's rows through its entries";
+  *mf = (PetscBool)(!why && (sys->operator_kind == PERI_OPERATOR_MATRIX_FREE || (sys->operator_kind == PERI_OPERATOR_AUTO && sys->disc.particles.dim == 3)));
+  if (sys->operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetMap(sys->scene, sys->scene->root, "solver", PETSC_FALSE, &node));
+  PeriInputCheck(PETSC_FALSE, sys->scene, node, "operator", "matrix_free cannot apply here: %s; use assembled or auto", why);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriSystemAssemble(PeriSystem sys)
 {
   PetscLogDouble t0, t1;
+  PetscBool      mf;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Assembly));
   PetscCall(PetscTime(&t0));
   PetscCall(MatDestroy(&sys->K));
-  PetscCall(PeriAssembleStiffness(sys, &sys->K));
+  PetscCall(MatDestroy(&sys->Kpc));
+  PetscCall(PeriOperatorDestroy(&sys->op));
+  PetscCall(UseMatrixFree(sys, &mf));
+  if (mf) {
+    PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
+    PetscCall(PeriOperatorCreate(sys, sys->pc_radius, &sys->op, &sys->Kpc));
+    PetscCall(PeriOperatorCreateMat(sys, &sys->K));
+    PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
+  } else
+    PetscCall(PeriAssembleStiffness(sys, &sys->K));
   PetscCall(PetscTime(&t1));
   sys->log.assembly_s = t1 - t0;
   if (sys->log.matrix_mb == 0) { /* the first assembly: K's size and the memory it took */
-    MatInfo   info;
-    PetscBool blocked;
-    PetscInt  bs;
-    PetscCall(MatGetInfo(sys->K, MAT_GLOBAL_SUM, &info));
-    PetscCall(MatGetBlockSize(sys->K, &bs));
-    PetscCall(PetscObjectTypeCompareAny((PetscObject)sys->K, &blocked, MATSEQBAIJ, MATMPIBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
-    /* PETSc 3.18 leaves info.memory 0 for AIJ: the values and the column indices (one per block) */
-    sys->log.matrix_mb          = (info.memory > 0 ? info.memory : info.nz_allocated * (sizeof(PetscScalar) + (PetscReal)sizeof(PetscInt) / (blocked ? bs * bs : 1))) / 1048576.0;
+    PetscReal opmb = 0;
+    PetscCall(MatrixMB(sys->Kpc ? sys->Kpc : sys->K, &sys->log.matrix_mb));
+    if (sys->op) PetscCall(PeriOperatorMemoryMB(sys, sys->op, &opmb));
+    sys->log.matrix_mb += opmb;
     sys->log.memory_phase_mb[1] = PeriPeakMemoryMB();
   }
   PetscCall(PetscLogStagePop());

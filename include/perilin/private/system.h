@@ -106,38 +106,52 @@ typedef struct {
   PetscInt  precracked_bonds;               /* bonds the scene's cracks removed */
 } PeriFailure;
 
+/* How K is applied (solver.operator, src/system/operator.c). */
+typedef enum {
+  PERI_OPERATOR_AUTO,
+  PERI_OPERATOR_ASSEMBLED,
+  PERI_OPERATOR_MATRIX_FREE
+} PeriOperatorKind;
+PETSC_EXTERN const char *const  PeriOperatorKinds[];
+typedef struct _p_PeriOperator *PeriOperator;
+
 typedef struct _p_PeriSystem *PeriSystem;
 struct _p_PeriSystem {
-  MPI_Comm      comm;
-  PetscMPIInt   rank, size;
-  PeriScene     scene;     /* borrowed from the problem: for reading sections and locating errors */
-  PetscReal     thickness; /* material.thickness (2D) */
-  PeriDisc      disc;      /* the particles, regions, bonds and volumes: their one owner */
-  PetscReal    *mu;        /* shear modulus per particle when material.mu_by_region is given, else NULL */
-  PetscReal    *bond_mu;   /* per local bond: the shear modulus across materials (eq. 60), or NULL */
-  PeriLayers    layers;
-  PeriTorsion   torsion;
-  PetscReal    *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
-  PeriFailure   failure;
-  PetscReal    *damage; /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
-  PeriModel     model;
-  Mat           K;                       /* stiffness */
-  char          mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
-  Vec           u, f;
-  PetscInt      nconstrained; /* owned constrained DOFs */
-  PetscInt     *constrained;  /* their global rows */
-  PetscReal    *constrained_value;
-  PetscInt      nprobes;
-  PeriProbe    *probes;
-  PetscReal    *W;     /* strain energy density per particle (rank 0, after the solve) */
-  PetscReal    *u_all; /* displacements of all particles (rank 0, after the solve) */
-  PeriSolveInfo solve;
-  PeriRunLog    log;
-  PetscReal     strain_energy;           /* after the last solve */
-  PetscReal     max_abs_u[PERI_MAX_DOF]; /* per component, after the last solve */
-  PeriReference reference;
-  int           interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
-  PetscReal     residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
+  MPI_Comm         comm;
+  PetscMPIInt      rank, size;
+  PeriScene        scene;     /* borrowed from the problem: for reading sections and locating errors */
+  PetscReal        thickness; /* material.thickness (2D) */
+  PeriDisc         disc;      /* the particles, regions, bonds and volumes: their one owner */
+  PetscReal       *mu;        /* shear modulus per particle when material.mu_by_region is given, else NULL */
+  PetscReal       *bond_mu;   /* per local bond: the shear modulus across materials (eq. 60), or NULL */
+  PeriLayers       layers;
+  PeriTorsion      torsion;
+  PetscReal       *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
+  PeriFailure      failure;
+  PetscReal       *damage; /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
+  PeriModel        model;
+  Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
+  Mat              Kpc;                     /* with op: the assembled short-range stiffness that preconditions K */
+  PeriOperator     op;                      /* solver.operator: matrix_free, else NULL */
+  PeriOperatorKind operator_kind;           /* solver.operator */
+  PetscReal        pc_radius;               /* solver.pc_radius */
+  PetscBool        single_solve;            /* set by an analysis that solves with K as assembled, once: K may be matrix-free */
+  char             mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
+  Vec              u, f;
+  PetscInt         nconstrained; /* owned constrained DOFs */
+  PetscInt        *constrained;  /* their global rows */
+  PetscReal       *constrained_value;
+  PetscInt         nprobes;
+  PeriProbe       *probes;
+  PetscReal       *W;     /* strain energy density per particle (rank 0, after the solve) */
+  PetscReal       *u_all; /* displacements of all particles (rank 0, after the solve) */
+  PeriSolveInfo    solve;
+  PeriRunLog       log;
+  PetscReal        strain_energy;           /* after the last solve */
+  PetscReal        max_abs_u[PERI_MAX_DOF]; /* per component, after the last solve */
+  PeriReference    reference;
+  int              interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
+  PetscReal        residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
 };
 
 PETSC_EXTERN PetscErrorCode PeriSystemCreate(MPI_Comm, PeriScene, PeriSystem *);
@@ -172,6 +186,13 @@ PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void 
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
+PETSC_EXTERN PetscErrorCode PeriCreateBlockMatrix(PeriSystem, MatType, Mat *);
+
+/* the matrix-free operator (src/system/operator.c) */
+PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *, Mat *);
+PETSC_EXTERN PetscErrorCode PeriOperatorCreateMat(PeriSystem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriOperatorMemoryMB(PeriSystem, PeriOperator, PetscReal *);
+PETSC_EXTERN PetscErrorCode PeriOperatorDestroy(PeriOperator *);
 
 /* boundary conditions and loads (src/system/boundary.c) */
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriSystem);

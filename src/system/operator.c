@@ -1,0 +1,452 @@
+/* The matrix-free operator of central-force bond models (solver.operator: matrix_free): K u applied
+ * bond by bond from one vector per bond, w = sqrt(k) e (k the bond's spring constant, e its unit
+ * vector: the bond's block is k e e^T), 28 bytes per bond where the assembled K holds two dim x dim
+ * blocks per bond in each of two rows (about 150 bytes in 3D). AMG then works on an assembled
+ * short-range stiffness (the bonds no longer than solver.pc_radius times the nearest-neighbour
+ * distance, scaled to the full family's stiffness): a few shells instead of the whole horizon. */
+#include "perilin/private/system.h"
+
+struct _p_PeriOperator {
+  PetscInt   nloc, bs, nghost;
+  PetscInt  *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
+  PetscInt  *jl;  /* the other end: owned particle jl < nloc, or ghost jl - nloc */
+  PetscReal *w;   /* bs per bond: sqrt(k) e */
+  PetscReal *len; /* per bond: |xi|, for the preconditioner's choice of bonds; freed after it */
+  PetscInt  *ghost;
+  Vec        xg, yg, xm; /* ghost values in and contributions out; the input with held DOFs zeroed */
+  VecScatter scatter;
+  Vec        kdiag; /* the diagonal of K */
+};
+
+/* One MATSHELL over the shared bond data: y = s K_m x on free DOFs, y = hd x on held ones, where
+ * K_m is K with the held DOFs' rows and columns removed (MatZeroRowsColumns). */
+typedef struct {
+  PeriOperator op;
+  PetscReal    scale;
+  PetscInt     nheld;
+  PetscInt    *held; /* local DOFs, sorted */
+  PetscReal   *hd;   /* their diagonal values */
+} Shell;
+
+/* y_i += sum_b w_b (w_b . (u_i - u_j)), and the opposite at j: the bond loop for bs = 3. */
+static void BondLoop3(const PeriOperator op, const PetscScalar *x, const PetscScalar *xg, PetscScalar *y, PetscScalar *yg)
+{
+  for (PetscInt i = 0; i < op->nloc; i++) {
+    const PetscScalar *ui = x + 3 * i;
+    PetscScalar        a0 = 0, a1 = 0, a2 = 0;
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscInt     l  = op->jl[b];
+      const PetscReal   *w  = op->w + 3 * b;
+      const PetscScalar *uj = l < op->nloc ? x + 3 * l : xg + 3 * (l - op->nloc);
+      PetscScalar       *yj = l < op->nloc ? y + 3 * l : yg + 3 * (l - op->nloc);
+      const PetscScalar  t  = w[0] * (ui[0] - uj[0]) + w[1] * (ui[1] - uj[1]) + w[2] * (ui[2] - uj[2]);
+      a0 += t * w[0];
+      a1 += t * w[1];
+      a2 += t * w[2];
+      yj[0] -= t * w[0];
+      yj[1] -= t * w[1];
+      yj[2] -= t * w[2];
+    }
+    y[3 * i] += a0;
+    y[3 * i + 1] += a1;
+    y[3 * i + 2] += a2;
+  }
+}
+
+/* The same for any block size (2D). */
+static void BondLoop(const PeriOperator op, const PetscScalar *x, const PetscScalar *xg, PetscScalar *y, PetscScalar *yg)
+{
+  const PetscInt bs = op->bs;
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscInt     l  = op->jl[b];
+      const PetscReal   *w  = op->w + bs * b;
+      const PetscScalar *uj = l < op->nloc ? x + bs * l : xg + bs * (l - op->nloc);
+      PetscScalar       *yj = l < op->nloc ? y + bs * l : yg + bs * (l - op->nloc), t = 0;
+      for (PetscInt d = 0; d < bs; d++) t += w[d] * (x[bs * i + d] - uj[d]);
+      for (PetscInt d = 0; d < bs; d++) {
+        y[bs * i + d] += t * w[d];
+        yj[d] -= t * w[d];
+      }
+    }
+}
+
+/* y = K x (no held DOFs, no scale): ghosts in, the bond loop, ghost contributions back. */
+static PetscErrorCode ApplyK(PeriOperator op, Vec x, Vec y)
+{
+  const PetscScalar *xa, *xga;
+  PetscScalar       *ya, *yga;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecScatterBegin(op->scatter, x, op->xg, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(op->scatter, x, op->xg, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecSet(y, 0));
+  PetscCall(VecSet(op->yg, 0));
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArrayRead(op->xg, &xga));
+  PetscCall(VecGetArray(y, &ya));
+  PetscCall(VecGetArray(op->yg, &yga));
+  if (op->bs == 3)
+    BondLoop3(op, xa, xga, ya, yga);
+  else
+    BondLoop(op, xa, xga, ya, yga);
+  PetscCall(VecRestoreArray(op->yg, &yga));
+  PetscCall(VecRestoreArray(y, &ya));
+  PetscCall(VecRestoreArrayRead(op->xg, &xga));
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscCall(VecScatterBegin(op->scatter, op->yg, y, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecScatterEnd(op->scatter, op->yg, y, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(PetscLogFlops(12.0 * op->ptr[op->nloc] * op->bs));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ShellMult(Mat A, Vec x, Vec y)
+{
+  Shell             *sh;
+  const PetscScalar *xa;
+  PetscScalar       *ma, *ya;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sh));
+  PetscCall(VecCopy(x, sh->op->xm));
+  PetscCall(VecGetArray(sh->op->xm, &ma));
+  for (PetscInt k = 0; k < sh->nheld; k++) ma[sh->held[k]] = 0;
+  PetscCall(VecRestoreArray(sh->op->xm, &ma));
+  PetscCall(ApplyK(sh->op, sh->op->xm, y));
+  PetscCall(VecScale(y, sh->scale));
+  PetscCall(VecGetArrayRead(x, &xa));
+  PetscCall(VecGetArray(y, &ya));
+  for (PetscInt k = 0; k < sh->nheld; k++) ya[sh->held[k]] = sh->hd[k] * xa[sh->held[k]];
+  PetscCall(VecRestoreArray(y, &ya));
+  PetscCall(VecRestoreArrayRead(x, &xa));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ShellGetDiagonal(Mat A, Vec d)
+{
+  Shell       *sh;
+  PetscScalar *da;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sh));
+  PetscCall(VecCopy(sh->op->kdiag, d));
+  PetscCall(VecScale(d, sh->scale));
+  PetscCall(VecGetArray(d, &da));
+  for (PetscInt k = 0; k < sh->nheld; k++) da[sh->held[k]] = sh->hd[k];
+  PetscCall(VecRestoreArray(d, &da));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ShellScale(Mat A, PetscScalar a)
+{
+  Shell *sh;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sh));
+  sh->scale *= a;
+  for (PetscInt k = 0; k < sh->nheld; k++) sh->hd[k] *= a;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Appends the owned rows to the held list (sorted, without repeats), their diagonal diag. */
+static PetscErrorCode ShellHold(Mat A, Shell *sh, PetscInt n, const PetscInt rows[], PetscScalar diag)
+{
+  PetscInt   rstart, rend, *held;
+  PetscReal *hd;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetOwnershipRange(A, &rstart, &rend));
+  PetscCall(PetscMalloc2(sh->nheld + n, &held, sh->nheld + n, &hd));
+  PetscCall(PetscArraycpy(held, sh->held, sh->nheld));
+  PetscCall(PetscArraycpy(hd, sh->hd, sh->nheld));
+  for (PetscInt k = 0; k < n; k++) {
+    PetscCheck(rows[k] >= rstart && rows[k] < rend, PETSC_COMM_SELF, PETSC_ERR_SUP, "the matrix-free operator holds owned rows only (row %" PetscInt_FMT ")", rows[k]);
+    held[sh->nheld + k] = rows[k] - rstart;
+    hd[sh->nheld + k]   = diag;
+  }
+  n += sh->nheld;
+  PetscCall(PetscSortIntWithScalarArray(n, held, hd));
+  sh->nheld = 0;
+  for (PetscInt k = 0; k < n; k++) /* a row held twice is held once */
+    if (!sh->nheld || held[k] != held[sh->nheld - 1]) {
+      held[sh->nheld] = held[k];
+      hd[sh->nheld++] = hd[k];
+    }
+  PetscCall(PetscFree2(sh->held, sh->hd));
+  sh->held = held;
+  sh->hd   = hd;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* PETSc's semantics: b -= A(:, rows) x(rows), b(rows) = diag x(rows), then the rows and columns
+ * are replaced by diag on the diagonal. */
+static PetscErrorCode ShellZeroRowsColumns(Mat A, PetscInt n, const PetscInt rows[], PetscScalar diag, Vec x, Vec b)
+{
+  Shell *sh;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sh));
+  if (x && b) {
+    Vec                z, t;
+    PetscScalar       *za, *ba;
+    const PetscScalar *xa;
+    PetscInt           rstart;
+    PetscCall(MatGetOwnershipRange(A, &rstart, NULL));
+    PetscCall(VecDuplicate(x, &z));
+    PetscCall(VecDuplicate(x, &t));
+    PetscCall(VecGetArrayRead(x, &xa));
+    PetscCall(VecGetArray(z, &za));
+    for (PetscInt k = 0; k < n; k++) za[rows[k] - rstart] = xa[rows[k] - rstart];
+    PetscCall(VecRestoreArray(z, &za));
+    PetscCall(MatMult(A, z, t));
+    PetscCall(VecAXPY(b, -1, t));
+    PetscCall(VecGetArray(b, &ba));
+    for (PetscInt k = 0; k < n; k++) ba[rows[k] - rstart] = diag * xa[rows[k] - rstart];
+    PetscCall(VecRestoreArray(b, &ba));
+    PetscCall(VecRestoreArrayRead(x, &xa));
+    PetscCall(VecDestroy(&z));
+    PetscCall(VecDestroy(&t));
+  }
+  PetscCall(ShellHold(A, sh, n, rows, diag));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ShellDestroy(void *ctx)
+{
+  Shell *sh = (Shell *)ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree2(sh->held, sh->hd));
+  PetscCall(PetscFree(sh));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriOperatorCreateMat - a MATSHELL applying K from the operator's bond data (which it borrows:
+  destroy the Mat before the operator); MatScale, MatGetDiagonal and MatZeroRowsColumns work on
+  it as on an assembled K. Collective.
+@*/
+PetscErrorCode PeriOperatorCreateMat(PeriSystem sys, Mat *A)
+{
+  Shell         *sh;
+  const PetscInt n = sys->op->nloc * sys->op->bs;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&sh));
+  sh->op    = sys->op;
+  sh->scale = 1;
+  PetscCall(MatCreateShell(sys->comm, n, n, PETSC_DETERMINE, PETSC_DETERMINE, sh, A));
+  PetscCall(MatShellSetContextDestroy(*A, ShellDestroy));
+  PetscCall(MatShellSetManageScalingShifts(*A));
+  PetscCall(MatSetBlockSize(*A, sys->op->bs));
+  PetscCall(MatShellSetOperation(*A, MATOP_MULT, (void (*)(void))ShellMult));
+  PetscCall(MatShellSetOperation(*A, MATOP_MULT_TRANSPOSE, (void (*)(void))ShellMult));
+  PetscCall(MatShellSetOperation(*A, MATOP_GET_DIAGONAL, (void (*)(void))ShellGetDiagonal));
+  PetscCall(MatShellSetOperation(*A, MATOP_SCALE, (void (*)(void))ShellScale));
+  PetscCall(MatShellSetOperation(*A, MATOP_ZERO_ROWS_COLUMNS, (void (*)(void))ShellZeroRowsColumns));
+  PetscCall(MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(*A, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The spring constant k of a central-force bond block Ke = k [e e^T, -e e^T; -e e^T, e e^T]: its
+ * trace over the first dim x dim block; an error when the block is not of that form. */
+static PetscErrorCode SpringConstant(PeriModel m, const PeriBondGeometry *g, const PetscReal Ke[], PetscReal *k)
+{
+  const PetscInt n   = 2 * m->dofs;
+  PetscReal      dev = 0;
+
+  PetscFunctionBeginUser;
+  *k = 0;
+  for (PetscInt a = 0; a < m->dim; a++) *k += Ke[a * n + a];
+  for (PetscInt a = 0; a < m->dim; a++)
+    for (PetscInt c = 0; c < m->dim; c++) dev = PetscMax(dev, PetscAbsReal(Ke[a * n + c] - *k * g->xi[a] * g->xi[c] / (g->length * g->length)));
+  PetscCheck(dev <= 1e-10 * PetscAbsReal(*k) && *k >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "model %s: bond %" PetscInt_FMT "-%" PetscInt_FMT " is not a central spring with k >= 0 (k = %g, deviation %g): the matrix-free operator cannot apply it", m->type, g->i, g->j, (double)*k, (double)dev);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The live bonds of the owned particles as (jl, w, len), ghosts numbered after the owned ones. */
+static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
+{
+  const PeriBonds *b = &sys->disc.bonds;
+  PeriModel        m = sys->model;
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PeriBondGeometry g;
+  PetscInt         nb = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(op->nloc + 1, &op->ptr));
+  PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->bs, &op->w));
+  PetscCall(PetscMalloc1(b->nbonds, &op->len));
+  PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
+  op->nghost = 0;
+  for (PetscInt i = b->rstart; i < b->rend; i++) {
+    op->ptr[i - b->rstart] = nb;
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscReal kb;
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+      m->ops.bond_stiffness(m, &g, Ke);
+      PetscCall(SpringConstant(m, &g, Ke, &kb));
+      for (PetscInt d = 0; d < op->bs; d++) op->w[nb * op->bs + d] = PetscSqrtReal(kb) * g.xi[d] / g.length;
+      op->len[nb] = g.length;
+      if (g.j >= b->rstart && g.j < b->rend)
+        op->jl[nb] = g.j - b->rstart;
+      else { /* for now -1 - j: numbered below */
+        op->jl[nb]              = -1 - g.j;
+        op->ghost[op->nghost++] = g.j;
+      }
+      nb++;
+    }
+  }
+  op->ptr[op->nloc] = nb;
+  PetscCall(PetscSortRemoveDupsInt(&op->nghost, op->ghost));
+  PetscCall(PetscRealloc(sizeof(PetscInt) * (op->nghost + 1), &op->ghost));
+  for (PetscInt t = 0; t < nb; t++)
+    if (op->jl[t] < 0) {
+      PetscInt loc;
+      PetscCall(PetscFindInt(-1 - op->jl[t], op->nghost, op->ghost, &loc));
+      op->jl[t] = op->nloc + loc;
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The ghost exchange and the diagonal of K. */
+static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
+{
+  IS           from;
+  Vec          x;
+  PetscScalar *da, *ga;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemCreateVec(sys, &x));
+  PetscCall(VecCreateSeq(PETSC_COMM_SELF, op->nghost * op->bs, &op->xg));
+  PetscCall(VecDuplicate(op->xg, &op->yg));
+  PetscCall(ISCreateBlock(PETSC_COMM_SELF, op->bs, op->nghost, op->ghost, PETSC_USE_POINTER, &from));
+  PetscCall(VecScatterCreate(x, from, op->xg, NULL, &op->scatter));
+  PetscCall(ISDestroy(&from));
+  PetscCall(VecDuplicate(x, &op->xm));
+  op->kdiag = x;
+  PetscCall(VecSet(op->kdiag, 0));
+  PetscCall(VecSet(op->yg, 0));
+  PetscCall(VecGetArray(op->kdiag, &da));
+  PetscCall(VecGetArray(op->yg, &ga));
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscInt l  = op->jl[b];
+      PetscScalar   *dj = l < op->nloc ? da + op->bs * l : ga + op->bs * (l - op->nloc);
+      for (PetscInt d = 0; d < op->bs; d++) {
+        da[op->bs * i + d] += PetscSqr(op->w[op->bs * b + d]);
+        dj[d] += PetscSqr(op->w[op->bs * b + d]);
+      }
+    }
+  PetscCall(VecRestoreArray(op->yg, &ga));
+  PetscCall(VecRestoreArray(op->kdiag, &da));
+  PetscCall(VecScatterBegin(op->scatter, op->yg, op->kdiag, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecScatterEnd(op->scatter, op->yg, op->kdiag, ADD_VALUES, SCATTER_REVERSE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Inserts s w w^T of every bond not longer than rmax into P, as the 2 x 2 blocks of a spring. */
+static PetscErrorCode InsertShortBonds(PeriSystem sys, PeriOperator op, PetscReal rmax, PetscReal s, Mat P)
+{
+  const PetscInt bs = op->bs, n = 2 * bs, rstart = sys->disc.bonds.rstart;
+  PetscReal      Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscInt l      = op->jl[b];
+      PetscInt       idx[2] = {i + rstart, l < op->nloc ? l + rstart : op->ghost[l - op->nloc]};
+      if (op->len[b] > rmax) continue;
+      for (PetscInt a = 0; a < bs; a++)
+        for (PetscInt c = 0; c < bs; c++) {
+          PetscReal v               = s * op->w[bs * b + a] * op->w[bs * b + c];
+          Ke[a * n + c]             = v;
+          Ke[(a + bs) * n + c + bs] = v;
+          Ke[a * n + c + bs]        = -v;
+          Ke[(a + bs) * n + c]      = -v;
+        }
+      PetscCall(MatSetValuesBlocked(P, 2, idx, 2, idx, Ke, ADD_VALUES));
+    }
+  PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The preconditioning matrix: the bonds not longer than radius times the shortest bond, their
+ * springs scaled by s so that the energy of a uniform expansion (sum k |xi|^2 over the bonds) is
+ * the full family's. */
+static PetscErrorCode AssemblePreconditioner(PeriSystem sys, PeriOperator op, PetscReal radius, Mat *P)
+{
+  PetscReal hmin = PETSC_MAX_REAL, sum[2] = {0, 0}, rmax;
+  Mat       pre;
+
+  PetscFunctionBeginUser;
+  for (PetscInt b = 0; b < op->ptr[op->nloc]; b++) hmin = PetscMin(hmin, op->len[b]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmin, 1, MPIU_REAL, MPI_MIN, sys->comm));
+  rmax = radius * hmin * (1 + 1e-10);
+  for (PetscInt b = 0; b < op->ptr[op->nloc]; b++) {
+    PetscReal e = 0;
+    for (PetscInt d = 0; d < op->bs; d++) e += PetscSqr(op->w[op->bs * b + d] * op->len[b]);
+    sum[0] += e;
+    if (op->len[b] <= rmax) sum[1] += e;
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCheck(sum[1] > 0, sys->comm, PETSC_ERR_USER_INPUT, "solver.pc_radius %g keeps no bond: it must be at least 1 (the nearest neighbours)", (double)radius);
+  PetscCall(PeriCreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
+  PetscCall(MatSetUp(pre));
+  PetscCall(InsertShortBonds(sys, op, rmax, 1, pre));
+  PetscCall(PeriCreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, P));
+  PetscCall(MatSetFromOptions(*P));
+  PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *P));
+  PetscCall(MatDestroy(&pre));
+  PetscCall(InsertShortBonds(sys, op, rmax, sum[0] / sum[1], *P));
+  PetscCall(MatSetOption(*P, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(*P, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriOperatorCreate - the matrix-free operator of a central-force bond model from the live bonds,
+  and its preconditioning matrix *P (the bonds within radius nearest-neighbour distances).
+  Collective.
+@*/
+PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator *op, Mat *P)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(op));
+  (*op)->bs   = sys->model->dofs;
+  (*op)->nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
+  PetscCall(CollectBonds(sys, *op));
+  PetscCall(SetUpGhosts(sys, *op));
+  PetscCall(AssemblePreconditioner(sys, *op, radius, P));
+  PetscCall(PetscFree((*op)->len)); /* only the preconditioner's choice of bonds needed it */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The bytes the operator holds, all ranks. */
+PetscErrorCode PeriOperatorMemoryMB(PeriSystem sys, PeriOperator op, PetscReal *mb)
+{
+  PetscFunctionBeginUser;
+  *mb = (op->ptr[op->nloc] * (sizeof(PetscInt) + op->bs * sizeof(PetscReal)) + (op->nloc + 1 + op->nghost) * sizeof(PetscInt) + (2 * op->nghost + 2 * op->nloc) * op->bs * sizeof(PetscScalar)) / 1048576.0;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, mb, 1, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
+{
+  PetscFunctionBeginUser;
+  if (!*op) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscFree((*op)->ptr));
+  PetscCall(PetscFree2((*op)->jl, (*op)->w));
+  PetscCall(PetscFree((*op)->len));
+  PetscCall(PetscFree((*op)->ghost));
+  PetscCall(VecDestroy(&(*op)->xg));
+  PetscCall(VecDestroy(&(*op)->yg));
+  PetscCall(VecDestroy(&(*op)->xm));
+  PetscCall(VecDestroy(&(*op)->kdiag));
+  PetscCall(VecScatterDestroy(&(*op)->scatter));
+  PetscCall(PetscFree(*op));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
