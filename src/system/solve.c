@@ -24,6 +24,7 @@ static const char *Advice(KSPConvergedReason reason)
 /* What to tell the user when KSP claims convergence but the true residual is too large. */
 static const char *AdviceResidual(PeriSystem sys)
 {
+  if (sys->op && !strcmp(sys->solve.ksp_type, KSPPREONLY)) return "with solver.operator: matrix_free the preconditioner is built from the short-range stiffness only, so preonly cannot solve the system: use solver.operator: assembled (-solver_operator assembled) for a direct solve, or drop -ksp_type preonly";
   if (!strcmp(sys->solve.ksp_type, KSPPREONLY)) return "preonly applies the preconditioner once, which solves the system only when it is a direct factorization: use -pc_type cholesky (or lu), or drop -ksp_type preonly for the default CG + GAMG";
   return "tighten -ksp_rtol, or check -ksp_norm_type (the preconditioned norm can be far below the true one); a larger solver.residual_tol accepts the answer as it is";
 }

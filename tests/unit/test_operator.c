@@ -1,0 +1,261 @@
+/* The matrix-free operator (solver.operator: matrix_free, src/system/operator.c) against the
+ * assembled K of the same scene, for every registered model type whose bonds are central springs
+ * (model->central_force; no names here), on the scenes given (2D and 3D):
+ *   1. A x = K x for a random x:                    ||A x - K x|| <= TOL ||K x||;
+ *   2. the diagonals agree:                         ||diag A - diag K|| <= TOL ||diag K||;
+ *   3. after MatScale and MatZeroRowsColumns with a prescribed x, both on each: the adjusted
+ *      right-hand sides and the products agree to TOL;
+ *   4. the preconditioning matrix P (the short-range stiffness): rigid translations are null
+ *      vectors, ||P t|| <= TOL ||P||_1 ||t||, and the energy of a uniform expansion u = X is K's,
+ *      |u^T P u - u^T K u| <= TOL u^T K u (the scaling promises it);
+ *   5. the static solve of each scene (its own model) gives the same strain energy and largest
+ *      displacements with either operator, to the solver tolerance (1e-8 relative).
+ * usage: test_operator operator_2d.yaml operator_3d.yaml */
+#include "testing.h"
+
+#define TOL 1e-12
+
+static PetscErrorCode Assert(const char name[], const char check[], PetscReal got, PetscReal tol)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(got <= tol, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: %s = %.3g exceeds the tolerance %.3g", name, check, (double)got, (double)tol);
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s: %s = %.3g (tolerance %.2g)\n", name, check, (double)got, (double)tol));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* ||A x - K x|| / ||K x|| */
+static PetscErrorCode ProductError(Mat A, Mat K, Vec x, PetscReal *err)
+{
+  Vec       y, z;
+  PetscReal n;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateVecs(K, &y, &z));
+  PetscCall(MatMult(K, x, y));
+  PetscCall(MatMult(A, x, z));
+  PetscCall(VecNorm(y, NORM_2, &n));
+  PetscCall(VecAXPY(z, -1, y));
+  PetscCall(VecNorm(z, NORM_2, err));
+  *err /= n;
+  PetscCall(VecDestroy(&y));
+  PetscCall(VecDestroy(&z));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode DiagonalError(Mat A, Mat K, PetscReal *err)
+{
+  Vec       d, e;
+  PetscReal n;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateVecs(K, &d, &e));
+  PetscCall(MatGetDiagonal(K, d));
+  PetscCall(MatGetDiagonal(A, e));
+  PetscCall(VecNorm(d, NORM_2, &n));
+  PetscCall(VecAXPY(e, -1, d));
+  PetscCall(VecNorm(e, NORM_2, err));
+  *err /= n;
+  PetscCall(VecDestroy(&d));
+  PetscCall(VecDestroy(&e));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* 3: the same scaling and elimination on both, with every 5th owned DOF held at a random value. */
+static PetscErrorCode CheckElimination(const char name[], Mat A, Mat K, Vec x)
+{
+  PetscInt  rstart, rend, n = 0, *rows;
+  Vec       u, b, c;
+  PetscReal nb, err;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
+  PetscCall(PetscMalloc1(rend - rstart, &rows));
+  for (PetscInt r = rstart; r < rend; r += 5) rows[n++] = r;
+  PetscCall(VecDuplicate(x, &u));
+  PetscCall(VecDuplicate(x, &b));
+  PetscCall(VecSetRandom(u, NULL));
+  PetscCall(VecSetRandom(b, NULL));
+  PetscCall(VecDuplicate(b, &c));
+  PetscCall(VecCopy(b, c));
+  PetscCall(MatScale(K, 0.37));
+  PetscCall(MatScale(A, 0.37));
+  PetscCall(MatZeroRowsColumns(K, n, rows, 2.5, u, b));
+  PetscCall(MatZeroRowsColumns(A, n, rows, 2.5, u, c));
+  PetscCall(VecNorm(b, NORM_2, &nb));
+  PetscCall(VecAXPY(c, -1, b));
+  PetscCall(VecNorm(c, NORM_2, &err));
+  PetscCall(Assert(name, "held rows: ||b_A - b_K|| / ||b_K||", err / nb, TOL));
+  PetscCall(ProductError(A, K, x, &err));
+  PetscCall(Assert(name, "held rows: ||A x - K x|| / ||K x||", err, TOL));
+  PetscCall(DiagonalError(A, K, &err));
+  PetscCall(Assert(name, "held rows: ||diag A - diag K|| / ||diag K||", err, TOL));
+  PetscCall(PetscFree(rows));
+  PetscCall(VecDestroy(&u));
+  PetscCall(VecDestroy(&b));
+  PetscCall(VecDestroy(&c));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* u^T M u for u = X (the uniform expansion), and ||M t|| / (||M||_1 ||t||) over the translations. */
+static PetscErrorCode ExpansionAndTranslations(PeriSystem sys, Mat M, PetscReal *energy, PetscReal *trans)
+{
+  const PetscInt bs = sys->model->dofs, rstart = sys->disc.bonds.rstart;
+  Vec            u, t, y;
+  PetscScalar   *a, *ta;
+  PetscReal      norm1;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateVecs(M, &u, &y));
+  PetscCall(VecDuplicate(u, &t));
+  PetscCall(MatNorm(M, NORM_1, &norm1));
+  PetscCall(VecGetArray(u, &a));
+  for (PetscInt i = rstart; i < sys->disc.bonds.rend; i++)
+    for (PetscInt d = 0; d < bs; d++) a[(i - rstart) * bs + d] = sys->disc.particles.x[3 * i + d];
+  PetscCall(VecRestoreArray(u, &a));
+  PetscCall(MatMult(M, u, y));
+  PetscCall(VecDot(u, y, energy));
+  *trans = 0;
+  for (PetscInt c = 0; c < bs; c++) {
+    PetscReal r, n;
+    PetscCall(VecGetArray(t, &ta));
+    for (PetscInt k = 0; k < (sys->disc.bonds.rend - rstart) * bs; k++) ta[k] = k % bs == c;
+    PetscCall(VecRestoreArray(t, &ta));
+    PetscCall(MatMult(M, t, y));
+    PetscCall(VecNorm(y, NORM_2, &r));
+    PetscCall(VecNorm(t, NORM_2, &n));
+    *trans = PetscMax(*trans, r / (norm1 * n));
+  }
+  PetscCall(VecDestroy(&u));
+  PetscCall(VecDestroy(&t));
+  PetscCall(VecDestroy(&y));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode CheckPreconditioner(const char name[], PeriSystem sys, Mat K)
+{
+  PetscReal eK, eP, tP, tK;
+
+  PetscFunctionBeginUser;
+  PetscCall(ExpansionAndTranslations(sys, K, &eK, &tK));
+  PetscCall(ExpansionAndTranslations(sys, sys->Kpc, &eP, &tP));
+  PetscCall(Assert(name, "P: ||P t|| / (||P||_1 ||t||) over translations", tP, TOL));
+  PetscCall(Assert(name, "P: |X^T P X - X^T K X| / X^T K X", PetscAbsReal(eP - eK) / eK, 1e-10));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* One model on one scene: K assembled, then the matrix-free pair (A, P), compared. */
+static PetscErrorCode CheckCase(const char scene[], const char type[], const char surface[])
+{
+  PeriProblem p;
+  Mat         K;
+  Vec         x;
+  PetscReal   err;
+  char        name[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(name, sizeof(name), "%s on %s (surface %s)", type, scene, surface));
+  PetscCall(PeriTestSetOption("-model_type", type));
+  PetscCall(PeriTestSetOption("-corrections_surface", surface));
+  PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
+  PetscCall(PeriProblemLoad(p, scene));
+  PetscCall(PeriProblemSetUp(p));
+  PetscCall(PeriSystemAssemble(p->sys)); /* no analysis declared a single solve: assembled */
+  K                     = p->sys->K;
+  p->sys->K             = NULL;
+  p->sys->single_solve  = PETSC_TRUE;
+  p->sys->operator_kind = PERI_OPERATOR_MATRIX_FREE;
+  PetscCall(PeriSystemAssemble(p->sys));
+  PetscCheck(p->sys->op && p->sys->Kpc, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: solver.operator matrix_free gave no matrix-free operator", name);
+  PetscCall(MatCreateVecs(K, &x, NULL));
+  PetscCall(VecSetRandom(x, NULL));
+  PetscCall(ProductError(p->sys->K, K, x, &err));
+  PetscCall(Assert(name, "||A x - K x|| / ||K x||", err, TOL));
+  PetscCall(DiagonalError(p->sys->K, K, &err));
+  PetscCall(Assert(name, "||diag A - diag K|| / ||diag K||", err, TOL));
+  PetscCall(CheckPreconditioner(name, p->sys, K));
+  PetscCall(CheckElimination(name, p->sys->K, K, x));
+  PetscCall(VecDestroy(&x));
+  PetscCall(MatDestroy(&K));
+  PetscCall(PeriProblemDestroy(&p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether the type accepts dim (plane stress in 2D) with central-force bonds, and its surface
+ * correction for the test (volume where it takes one). */
+static PetscErrorCode Probe(const char type[], PetscInt dim, PetscBool *central, const char **surface)
+{
+  PeriModel      m = NULL;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = PeriModelCreate(type, dim, PETSC_FALSE, &m);
+  PetscCall(PetscPopErrorHandler());
+  *central = PETSC_FALSE;
+  if (ierr == PETSC_ERR_USER_INPUT) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ierr);
+  *central = m->central_force;
+  *surface = m->allows_surface_correction ? "volume" : "none";
+  PetscCall(PeriModelDestroy(&m));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* 5: the whole static run with either operator. */
+static PetscErrorCode CheckSolve(const char scene[])
+{
+  PeriProblem p, q;
+  char        what[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriTestSetOption("-solver_operator", "assembled"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, scene, &p));
+  PetscCall(PeriTestSetOption("-solver_operator", "matrix_free"));
+  PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, scene, &q));
+  PetscCall(PeriTestSetOption("-solver_operator", NULL));
+  PetscCheck(q->sys->op, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: the static run did not use the matrix-free operator", scene);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy, matrix_free vs assembled", scene));
+  PeriTestClose(what, q->sys->strain_energy, p->sys->strain_energy, 1e-8 * p->sys->strain_energy);
+  for (PetscInt c = 0; c < p->sys->model->dofs; c++) {
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s|, matrix_free vs assembled", scene, p->sys->model->components[c]));
+    PeriTestClose(what, q->sys->max_abs_u[c], p->sys->max_abs_u[c], 1e-7 * p->sys->max_abs_u[c]);
+  }
+  PetscCall(PeriProblemDestroy(&p));
+  PetscCall(PeriProblemDestroy(&q));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+int main(int argc, char **argv)
+{
+  char     list[1024], **types;
+  int      ntypes;
+  PetscInt ncases = 0;
+
+  PetscCall(PeriInitialize(&argc, &argv, NULL));
+  PetscCheck(argc >= 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_operator operator_2d.yaml operator_3d.yaml");
+  PetscCall(PeriInitializePackage());
+  PetscCall(PeriModelListTypes(list, sizeof(list)));
+  for (size_t k = 0; list[k]; k++)
+    if (list[k] == ',') list[k] = ' ';
+  PetscCall(PetscStrToArray(list, ' ', &ntypes, &types));
+  for (int s = 1; s < 3; s++)
+    for (int t = 0; t < ntypes; t++) {
+      PeriScene   scene;
+      PetscInt    dim;
+      PetscBool   central = PETSC_FALSE;
+      const char *surface = NULL;
+      PetscCall(PeriSceneCreateFromFile(argv[s], 0, NULL, &scene));
+      PetscCall(PeriSceneGetInt(scene, scene->root, "dim", PETSC_TRUE, &dim, NULL));
+      PetscCall(PeriSceneDestroy(&scene));
+      PetscCall(Probe(types[t], dim, &central, &surface));
+      if (!central) continue;
+      PetscCall(CheckCase(argv[s], types[t], surface));
+      ncases++;
+    }
+  for (int s = 1; s < 3; s++) PetscCall(CheckSolve(argv[s]));
+  PetscCheck(ncases >= 4, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "only %" PetscInt_FMT " cases ran: expected the central-force models (pmb, npmb, cpmb) in 2D and 3D", ncases);
+  PetscCall(PetscStrToArrayDestroy(ntypes, types));
+  PetscCall(PeriTestSetOption("-model_type", NULL));
+  PetscCall(PeriTestSetOption("-corrections_surface", NULL));
+  PetscCall(PeriFinalize());
+  return 0;
+}
