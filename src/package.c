@@ -30,6 +30,7 @@ PetscErrorCode PeriInitializePackage(void)
   PetscCall(PetscLogEventRegister("PeriNeighbors", id, &PERI_EVENT_Neighbors));
   PetscCall(PetscLogEventRegister("PeriAssembly", id, &PERI_EVENT_Assembly));
   PetscCall(PetscLogEventRegister("PeriSolve", id, &PERI_EVENT_Solve));
+  PetscCall(PetscLogEventRegister("PeriMatMultFree", id, &PERI_EVENT_MatMultFree));
   PetscCall(PetscLogStageRegister("Peri setup", &PERI_STAGE_Setup));
   PetscCall(PetscLogStageRegister("Peri assembly", &PERI_STAGE_Assembly));
   PetscCall(PetscLogStageRegister("Peri solve", &PERI_STAGE_Solve));

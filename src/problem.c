@@ -265,7 +265,11 @@ PetscErrorCode PeriProblemCheckUnusedOptions(PeriProblem p)
   PeriRunSolvers run = {p->comm, p->scene, p->sys->mat_type, p->sys->solve.ksp_type, p->sys->solve.pc_type, p->analysis ? p->analysis->type->eigensolver : PETSC_FALSE};
 
   PetscFunctionBeginUser;
-  if (p->sys->K) PetscCall(MatGetType(p->sys->K, &run.mat_type));
+  /* -mat_type sets the type of the assembled matrix: K, or with a matrix-free K its preconditioner */
+  if (p->sys->Kpc)
+    PetscCall(MatGetType(p->sys->Kpc, &run.mat_type));
+  else if (p->sys->K)
+    PetscCall(MatGetType(p->sys->K, &run.mat_type));
   PetscCall(PeriOptionsCheckUnused(&run));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -285,7 +289,7 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   PetscFunctionBeginUser;
   PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->disc.particles.n, sys->log.nbonds_total, sys->disc.particles.n * sys->model->dofs, p->size));
   if (sys->solve.ksp_type[0])
-    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.assembly_s, sys->log.solve_s, sys->solve.ksp_type, sys->solve.pc_type, sys->solve.iterations, sys->solve.converged_reason, (double)sys->solve.residual_norm, sys->log.memory_mb));
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.assembly_s, sys->log.solve_s, sys->solve.ksp_type, sys->solve.pc_type, sys->op ? " matrix-free" : "", sys->solve.iterations, sys->solve.converged_reason, (double)sys->solve.residual_norm, sys->log.memory_mb));
   else
     PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.memory_mb));
   if (sys->interrupted) {

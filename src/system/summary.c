@@ -79,6 +79,7 @@ PetscErrorCode PeriSystemSummarySolver(PeriSystem sys, PeriJSON j)
   /* written results passed every check; an interrupted solve did not finish */
   PetscCall(PeriJSONBool(j, "converged", sys->interrupted && !sys->u_all ? PETSC_FALSE : PETSC_TRUE));
   PetscCall(PeriJSONString(j, "operator", sys->solve.symmetric ? "symmetric" : "unsymmetric"));
+  PetscCall(PeriJSONString(j, "stiffness", sys->op ? "matrix_free" : "assembled"));
   if (sys->solve.free_modes) {
     PetscCall(PeriJSONInt(j, "free_rigid_motions", sys->solve.free_modes));
     PetscCall(PeriJSONReal(j, "load_share_removed", sys->solve.load_imbalance));

@@ -24,7 +24,7 @@ static const PeriKey corrections_keys[] = {
 };
 const char *const    PeriOperatorKinds[] = {"auto", "assembled", "matrix_free", NULL};
 static const PeriKey solver_keys[]       = {
-          {"operator", PERI_KEY_CHOICE, "auto", NULL, NULL, PeriOperatorKinds, "how K is applied: assembled, or matrix_free (central-force models in a static analysis: K u bond by bond, AMG on a short-range stiffness); auto: matrix_free in 3D with GAMG where it applies"},
+          {"operator", PERI_KEY_CHOICE, "auto", NULL, NULL, PeriOperatorKinds, "how K is applied: assembled, or matrix_free (central-force models in a static analysis: K u bond by bond, AMG on a short-range stiffness); auto: matrix_free where it applies and the preconditioner is GAMG (the default)"},
           {"pc_radius", PERI_KEY_REAL, "1.75", "[1, inf)", NULL, NULL, "matrix_free: the bonds no longer than pc_radius times the shortest bond make the preconditioning matrix"},
           {"residual_tol", PERI_KEY_REAL, "0", "[0, 1)", NULL, NULL, "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; 0: min(max(100 rtol, 1e-6), 1e-3)"},
           {NULL},
@@ -452,7 +452,7 @@ static PetscErrorCode MatrixMB(Mat K, PetscReal *mb)
 }
 
 /* solver.operator: matrix_free applies to central-force models solved once as assembled (the
- * static analysis), without fictitious layers; auto takes it in 3D with GAMG (the default), where
+ * static analysis), without fictitious layers; auto takes it with GAMG (the default), where
  * it wins (docs/performance.md), and assembled K elsewhere. */
 static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 {
@@ -466,7 +466,7 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
     why = "the analysis changes K or needs its entries (matrix_free serves the static analysis)";
   else if (sys->layers.T)
     why = "fictitious layers eliminate K's rows through its entries";
-  *mf = (PetscBool)(!why && (sys->operator_kind == PERI_OPERATOR_MATRIX_FREE || (sys->operator_kind == PERI_OPERATOR_AUTO && sys->disc.particles.dim == 3)));
+  *mf = (PetscBool)(!why && (sys->operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->operator_kind == PERI_OPERATOR_AUTO));
   if (*mf && sys->operator_kind == PERI_OPERATOR_AUTO) {
     /* the short-range stiffness serves AMG; another -pc_type (a factorization) gets K itself */
     char pc[64] = PCGAMG;

@@ -12,7 +12,7 @@ PETSC_EXTERN PetscErrorCode PeriSignalReceived(MPI_Comm, int *);
 PETSC_EXTERN int            PeriSignalPending(void);
 
 /* log events */
-PETSC_EXTERN PetscLogEvent  PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve;
+PETSC_EXTERN PetscLogEvent  PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve, PERI_EVENT_MatMultFree;
 PETSC_EXTERN PetscLogStage  PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
 PETSC_EXTERN PetscErrorCode PeriInitializePackage(void);
 PETSC_EXTERN PetscReal      PeriPeakMemoryMB(void);
