@@ -4,12 +4,23 @@
  * the elements of the energy (bonds or families) that the energy and the torsion loads share. */
 #include "perilin/private/system.h"
 
+/* Which bonds enter the matrix and how: the live bonds no longer than rmax (K itself: all),
+ * their blocks times scale. */
+typedef struct {
+  PetscReal rmax, scale;
+} BondFilter;
+
+static inline PetscBool Kept(const PeriBonds *b, PetscInt k, const BondFilter *f)
+{
+  return (PetscBool)(b->live[k] && b->length[k] <= f->rmax);
+}
+
 /* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
-static PetscInt RowPartners(const PeriBonds *b, PetscInt i, PetscInt buf[])
+static PetscInt RowPartners(const PeriBonds *b, const BondFilter *f, PetscInt i, PetscInt buf[])
 {
   PetscInt n = 0, m = 0;
   for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-    if (b->live[k] && b->j[k] != i) buf[n++] = b->j[k];
+    if (Kept(b, k, f) && b->j[k] != i) buf[n++] = b->j[k];
   PetscSortInt(n, buf);
   for (PetscInt k = 0; k < n; k++)
     if (!m || buf[k] != buf[m - 1]) buf[m++] = buf[k];
@@ -19,7 +30,7 @@ static PetscInt RowPartners(const PeriBonds *b, PetscInt i, PetscInt buf[])
 /* Block counts per owned row: diagonal/off-diagonal part, and their upper-triangular share for
  * SBAIJ. Row i sees its stored partners (j > i, upper) and the particles that store a bond to i
  * (lower), which may live on other ranks: counts for those are summed with MPI_Reduce_scatter. */
-static PetscErrorCode Preallocation(PeriSystem sys, PetscInt **dnz, PetscInt **onz, PetscInt **dnzu, PetscInt **onzu)
+static PetscErrorCode Preallocation(PeriSystem sys, const BondFilter *f, PetscInt **dnz, PetscInt **onz, PetscInt **dnzu, PetscInt **onzu)
 {
   const PeriBonds *b = &sys->disc.bonds;
   const PetscInt   n = sys->disc.particles.n, nloc = b->rend - b->rstart;
@@ -32,7 +43,7 @@ static PetscErrorCode Preallocation(PeriSystem sys, PetscInt **dnz, PetscInt **o
   for (PetscInt i = b->rstart; i < b->rend; i++) maxrow = PetscMax(maxrow, b->offset[i - b->rstart + 1] - b->offset[i - b->rstart]);
   PetscCall(PetscMalloc1(maxrow + 1, &buf));
   for (PetscInt i = b->rstart; i < b->rend; i++) {
-    PetscInt m = RowPartners(b, i, buf), du = 1, ou = 0;
+    PetscInt m = RowPartners(b, f, i, buf), du = 1, ou = 0;
     for (PetscInt k = 0; k < m; k++) {
       PetscInt  j    = buf[k];
       PetscBool same = (PetscBool)(sys->disc.owner[j] == sys->rank);
@@ -173,9 +184,8 @@ static PetscErrorCode InsertElements(PeriSystem sys, Mat K)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* An empty block matrix of K's layout and the given type: the options and preallocation follow.
- * Collective. */
-PetscErrorCode PeriCreateBlockMatrix(PeriSystem sys, MatType type, Mat *K)
+/* An empty block matrix of K's layout and the given type: the options and preallocation follow. */
+static PetscErrorCode CreateBlockMatrix(PeriSystem sys, MatType type, Mat *K)
 {
   const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
 
@@ -194,10 +204,10 @@ static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
   Mat pre;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriCreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
+  PetscCall(CreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
   PetscCall(MatSetUp(pre));
   PetscCall(InsertElements(sys, pre));
-  PetscCall(PeriCreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
+  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *K));
   PetscCall(MatDestroy(&pre));
@@ -208,17 +218,17 @@ static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
 
 /* Bond-based models: K of the default type or -mat_type, with the exact pattern from the bonds;
  * *maxcol gets the most blocks of a row (the size of the row buffers). */
-static PetscErrorCode CreateBondStiffness(PeriSystem sys, Mat *K, PetscInt *maxcol)
+static PetscErrorCode CreateBondStiffness(PeriSystem sys, const BondFilter *f, Mat *K, PetscInt *maxcol)
 {
   const PetscInt nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
   PetscInt      *dnz, *onz, *dnzu, *onzu;
   PetscBool      sym;
 
   PetscFunctionBeginUser;
-  PetscCall(Preallocation(sys, &dnz, &onz, &dnzu, &onzu));
+  PetscCall(Preallocation(sys, f, &dnz, &onz, &dnzu, &onzu));
   *maxcol = 1;
   for (PetscInt i = 0; i < nloc; i++) *maxcol = PetscMax(*maxcol, dnz[i] + onz[i]);
-  PetscCall(PeriCreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
+  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatXAIJSetPreallocation(*K, sys->model->dofs, dnz, onz, dnzu, onzu));
   PetscCall(PetscFree4(dnz, onz, dnzu, onzu));
@@ -230,10 +240,10 @@ static PetscErrorCode CreateBondStiffness(PeriSystem sys, Mat *K, PetscInt *maxc
 
 /* Whether stored bond k of owned row r points to another owned particle: then that particle's row
  * gathers the bond's lower blocks itself, without the stash. */
-static PetscBool IsIncoming(const PeriBonds *b, PetscInt r, PetscInt k)
+static PetscBool IsIncoming(const PeriBonds *b, const BondFilter *f, PetscInt r, PetscInt k)
 {
   PetscInt j = b->j[k];
-  return (PetscBool)(b->live[k] && j != r && j >= b->rstart && j < b->rend);
+  return (PetscBool)(Kept(b, k, f) && j != r && j >= b->rstart && j < b->rend);
 }
 
 /* The incoming bonds of every owned particle j as a CSR (ptr, bond, row): bond k stored at owned
@@ -243,7 +253,7 @@ typedef struct {
 } Incoming;
 
 /* Builds the incoming-bond CSR (the transpose of the owned block of the bond list). */
-static PetscErrorCode IncomingBonds(const PeriBonds *b, Incoming *in)
+static PetscErrorCode IncomingBonds(const PeriBonds *b, const BondFilter *f, Incoming *in)
 {
   const PetscInt nloc = b->rend - b->rstart, rstart = b->rstart;
   PetscInt      *fill;
@@ -252,7 +262,7 @@ static PetscErrorCode IncomingBonds(const PeriBonds *b, Incoming *in)
   PetscCall(PetscCalloc1(nloc + 1, &in->ptr));
   for (PetscInt r = rstart; r < b->rend; r++)
     for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++)
-      if (IsIncoming(b, r, k)) in->ptr[b->j[k] - rstart + 1]++;
+      if (IsIncoming(b, f, r, k)) in->ptr[b->j[k] - rstart + 1]++;
   for (PetscInt i = 0; i < nloc; i++) in->ptr[i + 1] += in->ptr[i];
   PetscCall(PetscMalloc2(in->ptr[nloc], &in->bond, in->ptr[nloc], &in->row));
   PetscCall(PetscMalloc1(nloc, &fill));
@@ -260,7 +270,7 @@ static PetscErrorCode IncomingBonds(const PeriBonds *b, Incoming *in)
   for (PetscInt r = rstart; r < b->rend; r++)
     for (PetscInt k = b->offset[r - rstart]; k < b->offset[r - rstart + 1]; k++) {
       PetscInt j = b->j[k];
-      if (!IsIncoming(b, r, k)) continue;
+      if (!IsIncoming(b, f, r, k)) continue;
       in->bond[fill[j - rstart]]  = k;
       in->row[fill[j - rstart]++] = r;
     }
@@ -274,9 +284,22 @@ typedef struct {
   PetscReal *blocks, *row;
 } RowBuffer;
 
+/* The block of bond k of owned particle i, times the filter's scale. */
+static PetscErrorCode BondBlock(PeriSystem sys, const BondFilter *f, PetscInt i, PetscInt k, PeriBondGeometry *g, PetscReal Ke[])
+{
+  const PetscInt nb = 2 * sys->model->dofs;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemBondGeometry(sys, i, k, g));
+  sys->model->ops.bond_stiffness(sys->model, g, Ke);
+  if (f->scale != 1)
+    for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= f->scale;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Gathers owned row i in w: the blocks of its stored bonds and of the bonds other owned particles
  * store towards it. Blocks of rows owned by other ranks go to K through the stash. */
-static PetscErrorCode GatherBondRow(PeriSystem sys, const Incoming *in, PetscInt i, RowBuffer *w, Mat K)
+static PetscErrorCode GatherBondRow(PeriSystem sys, const BondFilter *f, const Incoming *in, PetscInt i, RowBuffer *w, Mat K)
 {
   const PeriBonds *b  = &sys->disc.bonds;
   PeriModel        m  = sys->model;
@@ -292,9 +315,8 @@ static PetscErrorCode GatherBondRow(PeriSystem sys, const Incoming *in, PetscInt
   for (PetscInt k = b->offset[i - rstart]; k < b->offset[i - rstart + 1]; k++) {
     PetscInt j = b->j[k];
     /* a self-image bond moves both ends alike: its blocks cancel */
-    if (!b->live[k] || j == i) continue;
-    PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
-    m->ops.bond_stiffness(m, &g, Ke);
+    if (!Kept(b, k, f) || j == i) continue;
+    PetscCall(BondBlock(sys, f, i, k, &g, Ke));
     RowAdd(bs, i, &Ke[0], nb, w->slot, w->col, w->blocks, &w->ncol);
     RowAdd(bs, j, &Ke[bs], nb, w->slot, w->col, w->blocks, &w->ncol);
     if (sys->disc.owner[j] != sys->rank) {
@@ -303,8 +325,7 @@ static PetscErrorCode GatherBondRow(PeriSystem sys, const Incoming *in, PetscInt
     }
   }
   for (PetscInt t = in->ptr[i - rstart]; t < in->ptr[i - rstart + 1]; t++) {
-    PetscCall(PeriSystemBondGeometry(sys, in->row[t], in->bond[t], &g));
-    m->ops.bond_stiffness(m, &g, Ke);
+    PetscCall(BondBlock(sys, f, in->row[t], in->bond[t], &g, Ke));
     RowAdd(bs, i, &Ke[bs * nb + bs], nb, w->slot, w->col, w->blocks, &w->ncol);
     RowAdd(bs, in->row[t], &Ke[bs * nb], nb, w->slot, w->col, w->blocks, &w->ncol);
   }
@@ -330,7 +351,7 @@ static PetscErrorCode InsertRow(PetscInt bs, PetscInt i, RowBuffer *w, Mat K)
 }
 
 /* Bond-based models: each owned block row gathered in full and inserted with one call. */
-static PetscErrorCode AssembleBonds(PeriSystem sys, Mat *K)
+static PetscErrorCode AssembleBonds(PeriSystem sys, const BondFilter *f, Mat *K)
 {
   const PeriBonds *b  = &sys->disc.bonds;
   const PetscInt   bs = sys->model->dofs;
@@ -339,13 +360,13 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, Mat *K)
   RowBuffer        w;
 
   PetscFunctionBeginUser;
-  PetscCall(CreateBondStiffness(sys, K, &maxcol));
-  PetscCall(IncomingBonds(b, &in));
+  PetscCall(CreateBondStiffness(sys, f, K, &maxcol));
+  PetscCall(IncomingBonds(b, f, &in));
   PetscCall(PetscMalloc1(sys->disc.particles.n, &w.slot));
   for (PetscInt i = 0; i < sys->disc.particles.n; i++) w.slot[i] = -1;
   PetscCall(PetscMalloc4(maxcol, &w.col, maxcol, &w.perm, maxcol * bs * bs, &w.blocks, maxcol * bs * bs, &w.row));
   for (PetscInt i = b->rstart; i < b->rend; i++) {
-    PetscCall(GatherBondRow(sys, &in, i, &w, *K));
+    PetscCall(GatherBondRow(sys, f, &in, i, &w, *K));
     PetscCall(InsertRow(bs, i, &w, *K));
   }
   PetscCall(PetscFree4(w.col, w.perm, w.blocks, w.row));
@@ -368,15 +389,33 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, Mat *K)
 @*/
 PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 {
+  const BondFilter all = {PETSC_MAX_REAL, 1};
+
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
   if (sys->model->ops.family_stiffness)
     PetscCall(AssembleFamilies(sys, K));
   else
-    PetscCall(AssembleBonds(sys, K));
+    PetscCall(AssembleBonds(sys, &all, K));
   PetscCall(MatSetOption(*K, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(MatSetOption(*K, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAssembleShortRange - assembles scale times the sum of the blocks of the live bonds no longer
+  than rmax (bond-based models), as PeriAssembleStiffness does K. Collective.
+@*/
+PetscErrorCode PeriAssembleShortRange(PeriSystem sys, PetscReal rmax, PetscReal scale, Mat *P)
+{
+  const BondFilter shorter = {rmax, scale};
+
+  PetscFunctionBeginUser;
+  PetscCheck(!sys->model->ops.family_stiffness, sys->comm, PETSC_ERR_SUP, "a short-range stiffness needs a bond-based model");
+  PetscCall(AssembleBonds(sys, &shorter, P));
+  PetscCall(MatSetOption(*P, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(*P, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

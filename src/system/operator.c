@@ -322,40 +322,12 @@ static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Inserts s w w^T of every bond not longer than rmax into P, as the 2 x 2 blocks of a spring. */
-static PetscErrorCode InsertShortBonds(PeriSystem sys, PeriOperator op, PetscReal rmax, PetscReal s, Mat P)
-{
-  const PetscInt bs = op->bs, n = 2 * bs, rstart = sys->disc.bonds.rstart;
-  PetscReal      Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
-
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < op->nloc; i++)
-    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
-      const PetscInt l      = op->jl[b];
-      PetscInt       idx[2] = {i + rstart, l < op->nloc ? l + rstart : op->ghost[l - op->nloc]};
-      if (op->len[b] > rmax) continue;
-      for (PetscInt a = 0; a < bs; a++)
-        for (PetscInt c = 0; c < bs; c++) {
-          PetscReal v               = s * op->w[bs * b + a] * op->w[bs * b + c];
-          Ke[a * n + c]             = v;
-          Ke[(a + bs) * n + c + bs] = v;
-          Ke[a * n + c + bs]        = -v;
-          Ke[(a + bs) * n + c]      = -v;
-        }
-      PetscCall(MatSetValuesBlocked(P, 2, idx, 2, idx, Ke, ADD_VALUES));
-    }
-  PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The preconditioning matrix: the bonds not longer than radius times the shortest bond, their
  * springs scaled by s so that the energy of a uniform expansion (sum k |xi|^2 over the bonds) is
  * the full family's. */
 static PetscErrorCode AssemblePreconditioner(PeriSystem sys, PeriOperator op, PetscReal radius, Mat *P)
 {
   PetscReal hmin = PETSC_MAX_REAL, sum[2] = {0, 0}, rmax;
-  Mat       pre;
 
   PetscFunctionBeginUser;
   for (PetscInt b = 0; b < op->ptr[op->nloc]; b++) hmin = PetscMin(hmin, op->len[b]);
@@ -369,16 +341,8 @@ static PetscErrorCode AssemblePreconditioner(PeriSystem sys, PeriOperator op, Pe
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPIU_REAL, MPI_SUM, sys->comm));
   PetscCheck(sum[1] > 0 || PetscIsInfOrNanReal(sum[1]), sys->comm, PETSC_ERR_USER_INPUT, "solver.pc_radius %g keeps no bond: it must be at least 1 (the nearest neighbours)", (double)radius);
-  PetscCall(PeriCreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
-  PetscCall(MatSetUp(pre));
-  PetscCall(InsertShortBonds(sys, op, rmax, 1, pre));
-  PetscCall(PeriCreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, P));
-  PetscCall(MatSetFromOptions(*P));
-  PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *P));
-  PetscCall(MatDestroy(&pre));
-  PetscCall(InsertShortBonds(sys, op, rmax, sum[0] / sum[1], *P));
-  PetscCall(MatSetOption(*P, MAT_SYMMETRIC, PETSC_TRUE));
-  PetscCall(MatSetOption(*P, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  /* the bond blocks are k e e^T = w w^T: the assembly's own, restricted and scaled */
+  PetscCall(PeriAssembleShortRange(sys, rmax, sum[0] / sum[1], P));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

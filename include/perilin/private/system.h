@@ -186,7 +186,7 @@ PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void 
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
-PETSC_EXTERN PetscErrorCode PeriCreateBlockMatrix(PeriSystem, MatType, Mat *);
+PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, Mat *);
 
 /* the matrix-free operator (src/system/operator.c) */
 PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *, Mat *);
