@@ -112,12 +112,12 @@ static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *
 {
   PeriBonds         *b  = &an->sys->disc.bonds;
   PeriModel          m  = an->sys->model;
-  const PetscInt     bs = m->dofs, nb = 2 * bs;
+  const PetscInt     bs = m->dofs;
   VecScatter         scatter;
   Vec                all;
   const PetscScalar *u;
   PeriFailureCause  *cause;
-  PetscReal         *index, *soft, worst = 0, threshold = 1, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PetscReal         *index, *soft, worst = 0, threshold = 1;
   PetscInt           mine = 0;
 
   PetscFunctionBeginUser;
@@ -150,23 +150,12 @@ static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *
   if (!st->all && worst > 1) threshold = worst - st->fraction * (worst - 1);
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PeriBondGeometry g;
-      PetscInt         idx[2];
-      PetscReal        scale;
-      PetscBool        breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
+      PetscBool breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
       if (!b->live[k] || b->j[k] == i) continue;
       if (!breaks && !(b->intact && soft[k] < b->intact[k])) continue;
-      /* K changes by (new share / old share - 1) times the bond's present block (state-based
-         models: K is reassembled from the synchronized families below) */
-      if (m->ops.bond_stiffness) {
-        PetscCall(PeriSystemBondGeometry(an->sys, i, k, &g));
-        m->ops.bond_stiffness(m, &g, Ke);
-        scale = breaks ? -1 : soft[k] / b->intact[k] - 1;
-        for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
-        idx[0] = i;
-        idx[1] = g.j;
-        PetscCall(MatSetValuesBlocked(an->sys->K, 2, idx, 2, idx, Ke, ADD_VALUES));
-      }
+      /* the bond's stiffness becomes new share / old share of itself (state-based models: K is
+         reassembled from the synchronized families below) */
+      if (m->ops.bond_stiffness) PetscCall(PeriStiffnessScaleBond(an->sys, i, k, breaks ? 0 : soft[k] / b->intact[k]));
       if (breaks || soft[k] <= 0) {
         b->live[k]  = 0;
         b->cause[k] = (unsigned char)cause[k];
@@ -179,8 +168,7 @@ static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *
       }
     }
   PetscCall(PetscFree3(index, soft, cause));
-  PetscCall(MatAssemblyBegin(an->sys->K, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(an->sys->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(PeriStiffnessScaled(an->sys));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, an->comm));
   if (*nbroken && !m->ops.bond_stiffness) {
     PetscCall(PeriFamilySync(an->sys));
@@ -715,6 +703,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscCall(PetscStrncpy(q->control, st.control ? st.control->name : "", sizeof(q->control)));
   PetscCall(PetscStrncpy(q->stepping, st.events ? "events" : "increments", sizeof(q->stepping)));
   PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
+  an->sys->matrix_free_ok = PETSC_TRUE; /* K is applied, and changed through PeriStiffnessScaleBond */
   PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(EquilibriumCreate(an, &eq));
   PetscCallMPI(MPI_Allreduce(&an->sys->disc.bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));

@@ -30,7 +30,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
-  an->sys->single_solve = PETSC_TRUE; /* K may be matrix-free */
+  an->sys->matrix_free_ok = PETSC_TRUE; /* K is only applied: it may be matrix-free */
   if (!an->sys->K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscTime(&t0));
   PetscCall(VecDestroy(&an->sys->u));

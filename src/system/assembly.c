@@ -4,15 +4,15 @@
  * the elements of the energy (bonds or families) that the energy and the torsion loads share. */
 #include "perilin/private/system.h"
 
-/* Which bonds enter the matrix and how: the live bonds no longer than rmax (K itself: all),
- * their blocks times scale. */
+/* Which bonds enter the matrix and how: the bonds no longer than rmax (K itself: all), their
+ * blocks times scale; broken ones with broken_share of their block (0: left out). */
 typedef struct {
-  PetscReal rmax, scale;
+  PetscReal rmax, scale, broken_share;
 } BondFilter;
 
 static inline PetscBool Kept(const PeriBonds *b, PetscInt k, const BondFilter *f)
 {
-  return (PetscBool)(b->live[k] && b->length[k] <= f->rmax);
+  return (PetscBool)((b->live[k] || f->broken_share > 0) && b->length[k] <= f->rmax);
 }
 
 /* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
@@ -287,13 +287,14 @@ typedef struct {
 /* The block of bond k of owned particle i, times the filter's scale. */
 static PetscErrorCode BondBlock(PeriSystem sys, const BondFilter *f, PetscInt i, PetscInt k, PeriBondGeometry *g, PetscReal Ke[])
 {
-  const PetscInt nb = 2 * sys->model->dofs;
+  const PetscInt  nb    = 2 * sys->model->dofs;
+  const PetscReal scale = sys->disc.bonds.live[k] ? f->scale : f->scale * f->broken_share;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemBondGeometry(sys, i, k, g));
   sys->model->ops.bond_stiffness(sys->model, g, Ke);
-  if (f->scale != 1)
-    for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= f->scale;
+  if (scale != 1)
+    for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -389,7 +390,7 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, const BondFilter *f, Mat *K)
 @*/
 PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 {
-  const BondFilter all = {PETSC_MAX_REAL, 1};
+  const BondFilter all = {PETSC_MAX_REAL, 1, 0};
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
@@ -404,12 +405,51 @@ PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 }
 
 /*@C
-  PeriAssembleShortRange - assembles scale times the sum of the blocks of the live bonds no longer
-  than rmax (bond-based models), as PeriAssembleStiffness does K. Collective.
+  PeriStiffnessScaleBond - scales the stiffness of bond k of owned particle i (live, not a
+  self-image) by factor >= 0 in K: 0 breaks it (PeriOperatorScaleBond says what a matrix-free K's
+  preconditioning matrix does). Call PeriStiffnessScaled after the last. Not collective.
 @*/
-PetscErrorCode PeriAssembleShortRange(PeriSystem sys, PetscReal rmax, PetscReal scale, Mat *P)
+PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, PetscReal factor)
 {
-  const BondFilter shorter = {rmax, scale};
+  const BondFilter change = {PETSC_MAX_REAL, factor - 1, 0}, same = {PETSC_MAX_REAL, 1, 0};
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PeriBondGeometry g;
+  PetscInt         idx[2];
+
+  PetscFunctionBeginUser;
+  if (sys->op) {
+    PetscCall(BondBlock(sys, &same, i, k, &g, Ke));
+    PetscCall(PeriOperatorScaleBond(sys, i, k, factor, Ke));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(BondBlock(sys, &change, i, k, &g, Ke)); /* the change of the bond's block */
+  idx[0] = i;
+  idx[1] = g.j;
+  PetscCall(MatSetValuesBlocked(sys->K, 2, idx, 2, idx, Ke, ADD_VALUES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After the last PeriStiffnessScaleBond: the matrices' assembly. Collective. */
+PetscErrorCode PeriStiffnessScaled(PeriSystem sys)
+{
+  PetscFunctionBeginUser;
+  if (sys->op)
+    PetscCall(PeriOperatorScaled(sys));
+  else {
+    PetscCall(MatAssemblyBegin(sys->K, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(sys->K, MAT_FINAL_ASSEMBLY));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAssembleShortRange - assembles scale times the sum of the blocks of the bonds no longer than
+  rmax, broken ones with broken_share of theirs (bond-based models), as PeriAssembleStiffness does
+  K. Collective.
+@*/
+PetscErrorCode PeriAssembleShortRange(PeriSystem sys, PetscReal rmax, PetscReal scale, PetscReal broken_share, Mat *P)
+{
+  const BondFilter shorter = {rmax, scale, broken_share};
 
   PetscFunctionBeginUser;
   PetscCheck(!sys->model->ops.family_stiffness, sys->comm, PETSC_ERR_SUP, "a short-range stiffness needs a bond-based model");

@@ -6,15 +6,23 @@
  * distance, scaled to the full family's stiffness): a few shells instead of the whole horizon. */
 #include "perilin/private/system.h"
 
+/* The share of its block that a broken bond keeps in the preconditioning matrix. */
+#ifndef PERI_BROKEN_SHARE
+#  define PERI_BROKEN_SHARE 1e-2
+#endif
+
 struct _p_PeriOperator {
+  PetscInt   refct; /* the system's reference and one per shell: a reused preconditioner may keep a shell after the system rebuilt its operator */
   PetscInt   nloc, bs, nghost;
   PetscInt  *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
   PetscInt  *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
   PetscReal *w;   /* bs per bond: sqrt(k) e */
   PetscReal *len; /* per bond: |xi|, for the preconditioner's choice of bonds; freed after it */
   PetscInt  *ghost;
-  Vec        xm, ym; /* ghosted work vectors: the input with held DOFs zeroed, and K of it */
-  Vec        kdiag;  /* the diagonal of K */
+  PetscInt  *slot;         /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
+  PetscReal  rmax, pscale; /* the preconditioning matrix: its longest bond and its scale */
+  Vec        xm, ym;       /* ghosted work vectors: the input with held DOFs zeroed, and K of it */
+  Vec        kdiag;        /* the diagonal of K */
 };
 
 /* One MATSHELL over the shared bond data: y = s K_m x on free DOFs, y = hd x on held ones, where
@@ -199,13 +207,14 @@ static PetscErrorCode ShellDestroy(void *ctx)
 
   PetscFunctionBeginUser;
   PetscCall(PetscFree2(sh->held, sh->hd));
+  PetscCall(PeriOperatorDestroy(&sh->op));
   PetscCall(PetscFree(sh));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
-  PeriOperatorCreateMat - a MATSHELL applying K from the operator's bond data (which it borrows:
-  destroy the Mat before the operator); MatScale, MatGetDiagonal and MatZeroRowsColumns work on
+  PeriOperatorCreateMat - a MATSHELL applying K from the operator's bond data (which it keeps a
+  reference to: it applies the changes PeriOperatorScaleBond makes); MatScale, MatGetDiagonal and MatZeroRowsColumns work on
   it as on an assembled K. Collective.
 @*/
 PetscErrorCode PeriOperatorCreateMat(PeriSystem sys, Mat *A)
@@ -217,6 +226,7 @@ PetscErrorCode PeriOperatorCreateMat(PeriSystem sys, Mat *A)
   PetscCall(PetscNew(&sh));
   sh->op    = sys->op;
   sh->scale = 1;
+  sys->op->refct++;
   PetscCall(MatCreateShell(sys->comm, n, n, PETSC_DETERMINE, PETSC_DETERMINE, sh, A));
   PetscCall(MatShellSetContextDestroy(*A, ShellDestroy));
   PetscCall(MatShellSetManageScalingShifts(*A));
@@ -263,12 +273,15 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->bs, &op->w));
   PetscCall(PetscMalloc1(b->nbonds, &op->len));
   PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
+  if (sys->failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
   op->nghost = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     op->ptr[i - b->rstart] = nb;
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PetscReal kb;
+      if (op->slot) op->slot[k] = -1;
       if (!b->live[k] || b->j[k] == i) continue;
+      if (op->slot) op->slot[k] = nb;
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
       PetscCall(SpringConstant(m, &g, Ke, &kb));
@@ -295,15 +308,13 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The ghosted work vectors, and the diagonal of K: sum over the bonds at each end of w w. */
-static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
+/* op->kdiag: the diagonal of K, the sum over the bonds at each end of w w. Collective. */
+static PetscErrorCode ComputeDiagonal(PeriOperator op)
 {
   Vec          yl;
   PetscScalar *ya;
 
   PetscFunctionBeginUser;
-  PetscCall(VecCreateGhostBlock(sys->comm, op->bs, op->nloc * op->bs, PETSC_DECIDE, op->nghost, op->ghost, &op->xm));
-  PetscCall(VecDuplicate(op->xm, &op->ym));
   PetscCall(VecGhostGetLocalForm(op->ym, &yl));
   PetscCall(VecSet(yl, 0));
   PetscCall(VecGetArray(yl, &ya));
@@ -317,8 +328,18 @@ static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
   PetscCall(VecGhostRestoreLocalForm(op->ym, &yl));
   PetscCall(VecGhostUpdateBegin(op->ym, ADD_VALUES, SCATTER_REVERSE));
   PetscCall(VecGhostUpdateEnd(op->ym, ADD_VALUES, SCATTER_REVERSE));
-  PetscCall(PeriSystemCreateVec(sys, &op->kdiag));
   PetscCall(VecCopy(op->ym, op->kdiag));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The ghosted work vectors and the diagonal. */
+static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecCreateGhostBlock(sys->comm, op->bs, op->nloc * op->bs, PETSC_DECIDE, op->nghost, op->ghost, &op->xm));
+  PetscCall(VecDuplicate(op->xm, &op->ym));
+  PetscCall(PeriSystemCreateVec(sys, &op->kdiag));
+  PetscCall(ComputeDiagonal(op));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -342,7 +363,9 @@ static PetscErrorCode AssemblePreconditioner(PeriSystem sys, PeriOperator op, Pe
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPIU_REAL, MPI_SUM, sys->comm));
   PetscCheck(sum[1] > 0 || PetscIsInfOrNanReal(sum[1]), sys->comm, PETSC_ERR_USER_INPUT, "solver.pc_radius %g keeps no bond: it must be at least 1 (the nearest neighbours)", (double)radius);
   /* the bond blocks are k e e^T = w w^T: the assembly's own, restricted and scaled */
-  PetscCall(PeriAssembleShortRange(sys, rmax, sum[0] / sum[1], P));
+  op->rmax   = rmax;
+  op->pscale = sum[0] / sum[1];
+  PetscCall(PeriAssembleShortRange(sys, rmax, op->pscale, PERI_BROKEN_SHARE, P));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -355,8 +378,9 @@ PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator
 {
   PetscFunctionBeginUser;
   PetscCall(PetscNew(op));
-  (*op)->bs   = sys->model->dofs;
-  (*op)->nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
+  (*op)->refct = 1;
+  (*op)->bs    = sys->model->dofs;
+  (*op)->nloc  = sys->disc.bonds.rend - sys->disc.bonds.rstart;
   PetscCall(CollectBonds(sys, *op));
   PetscCall(SetUpGhosts(sys, *op));
   PetscCall(AssemblePreconditioner(sys, *op, radius, P));
@@ -373,14 +397,52 @@ PetscErrorCode PeriOperatorMemoryMB(PeriSystem sys, PeriOperator op, PetscReal *
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriOperatorScaleBond - bond k of owned particle i keeps factor times its stiffness: w scales by
+  sqrt(factor). In the preconditioning matrix a broken bond keeps PERI_BROKEN_SHARE of its block
+  (Ke, the block before the change), so that P stays positive definite where K was at the start
+  (without them a particle could lose every short bond and keep longer ones) while its cracks
+  are nearly K's; softening leaves P as it is. Not collective; PeriOperatorScaled follows the last.
+@*/
+PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, PetscReal factor, const PetscReal Ke[])
+{
+  PeriOperator   op = sys->op;
+  const PetscInt t = op->slot ? op->slot[k] : -1, n = 2 * op->bs;
+  PetscInt       idx[2] = {i, sys->disc.bonds.j[k]};
+  PetscReal      dP[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+
+  PetscFunctionBeginUser;
+  PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
+  for (PetscInt d = 0; d < op->bs; d++) op->w[op->bs * t + d] *= PetscSqrtReal(factor);
+  if (factor > 0 || sys->disc.bonds.length[k] > op->rmax) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * op->pscale * Ke[a];
+  PetscCall(MatSetValuesBlocked(sys->Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After the last PeriOperatorScaleBond: P assembled, the diagonal of K recomputed. Collective. */
+PetscErrorCode PeriOperatorScaled(PeriSystem sys)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatAssemblyBegin(sys->Kpc, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(sys->Kpc, MAT_FINAL_ASSEMBLY));
+  PetscCall(ComputeDiagonal(sys->op));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
 {
   PetscFunctionBeginUser;
   if (!*op) PetscFunctionReturn(PETSC_SUCCESS);
+  if (--(*op)->refct > 0) {
+    *op = NULL;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(PetscFree((*op)->ptr));
   PetscCall(PetscFree2((*op)->jl, (*op)->w));
   PetscCall(PetscFree((*op)->len));
   PetscCall(PetscFree((*op)->ghost));
+  PetscCall(PetscFree((*op)->slot));
   PetscCall(VecDestroy(&(*op)->xm));
   PetscCall(VecDestroy(&(*op)->ym));
   PetscCall(VecDestroy(&(*op)->kdiag));

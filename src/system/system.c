@@ -462,8 +462,8 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
   PetscFunctionBeginUser;
   if (!sys->model->central_force)
     why = "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
-  else if (!sys->single_solve)
-    why = "the analysis changes K or needs its entries (matrix_free serves the static analysis)";
+  else if (!sys->matrix_free_ok)
+    why = "the analysis needs K's entries (matrix_free serves the static and quasi-static analyses)";
   else if (sys->layers.T)
     why = "fictitious layers eliminate K's rows through its entries";
   *mf = (PetscBool)(!why && (sys->operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->operator_kind == PERI_OPERATOR_AUTO));

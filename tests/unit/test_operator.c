@@ -160,10 +160,10 @@ static PetscErrorCode CheckCase(const char scene[], const char type[], const cha
   PetscCall(PeriProblemLoad(p, scene));
   PetscCall(PeriProblemSetUp(p));
   PetscCall(PeriSystemAssemble(p->sys)); /* no analysis declared a single solve: assembled */
-  K                     = p->sys->K;
-  p->sys->K             = NULL;
-  p->sys->single_solve  = PETSC_TRUE;
-  p->sys->operator_kind = PERI_OPERATOR_MATRIX_FREE;
+  K                      = p->sys->K;
+  p->sys->K              = NULL;
+  p->sys->matrix_free_ok = PETSC_TRUE;
+  p->sys->operator_kind  = PERI_OPERATOR_MATRIX_FREE;
   PetscCall(PeriSystemAssemble(p->sys));
   PetscCheck(p->sys->op && p->sys->Kpc, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: solver.operator matrix_free gave no matrix-free operator", name);
   PetscCall(MatCreateVecs(K, &x, NULL));

@@ -135,7 +135,7 @@ struct _p_PeriSystem {
   PeriOperator     op;                      /* solver.operator: matrix_free, else NULL */
   PeriOperatorKind operator_kind;           /* solver.operator */
   PetscReal        pc_radius;               /* solver.pc_radius */
-  PetscBool        single_solve;            /* set by an analysis that solves with K as assembled, once: K may be matrix-free */
+  PetscBool        matrix_free_ok;          /* set by an analysis that uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free */
   char             mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
   Vec              u, f;
   PetscInt         nconstrained; /* owned constrained DOFs */
@@ -186,12 +186,16 @@ PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void 
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
-PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, Mat *);
+PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, PetscReal, Mat *);
+PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
 
 /* the matrix-free operator (src/system/operator.c) */
 PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *, Mat *);
 PETSC_EXTERN PetscErrorCode PeriOperatorCreateMat(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriOperatorMemoryMB(PeriSystem, PeriOperator, PetscReal *);
+PETSC_EXTERN PetscErrorCode PeriOperatorScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriOperatorScaled(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriOperatorDestroy(PeriOperator *);
 
 /* boundary conditions and loads (src/system/boundary.c) */
