@@ -343,38 +343,35 @@ static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The preconditioning matrix: the bonds not longer than radius times the shortest bond, their
- * springs scaled by s so that the energy of a uniform expansion (sum k |xi|^2 over the bonds) is
- * the full family's. */
-static PetscErrorCode AssemblePreconditioner(PeriSystem sys, PeriOperator op, PetscReal radius, Mat *P)
+/* The preconditioning matrix's bonds and scale: those no longer than radius times the shortest
+ * bond, their springs scaled so that a uniform expansion (sum of k |xi|^2 over the bonds) stores
+ * the full family's energy. */
+static PetscErrorCode ChooseShortRange(PeriSystem sys, PeriOperator op, PetscReal radius)
 {
-  PetscReal hmin = PETSC_MAX_REAL, sum[2] = {0, 0}, rmax;
+  PetscReal hmin = PETSC_MAX_REAL, sum[2] = {0, 0};
 
   PetscFunctionBeginUser;
   for (PetscInt b = 0; b < op->ptr[op->nloc]; b++) hmin = PetscMin(hmin, op->len[b]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmin, 1, MPIU_REAL, MPI_MIN, sys->comm));
-  rmax = radius * hmin * (1 + 1e-10);
+  op->rmax = radius * hmin * (1 + 1e-10);
   for (PetscInt b = 0; b < op->ptr[op->nloc]; b++) {
     PetscReal e = 0;
     for (PetscInt d = 0; d < op->bs; d++) e += PetscSqr(op->w[op->bs * b + d] * op->len[b]);
     sum[0] += e;
-    if (op->len[b] <= rmax) sum[1] += e;
+    if (op->len[b] <= op->rmax) sum[1] += e;
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPIU_REAL, MPI_SUM, sys->comm));
   PetscCheck(sum[1] > 0 || PetscIsInfOrNanReal(sum[1]), sys->comm, PETSC_ERR_USER_INPUT, "solver.pc_radius %g keeps no bond: it must be at least 1 (the nearest neighbours)", (double)radius);
-  /* the bond blocks are k e e^T = w w^T: the assembly's own, restricted and scaled */
-  op->rmax   = rmax;
   op->pscale = sum[0] / sum[1];
-  PetscCall(PeriAssembleShortRange(sys, rmax, op->pscale, PERI_BROKEN_SHARE, P));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
   PeriOperatorCreate - the matrix-free operator of a central-force bond model from the live bonds,
-  and its preconditioning matrix *P (the bonds within radius nearest-neighbour distances).
-  Collective.
+  and the choice of its preconditioning matrix's bonds (those within radius nearest-neighbour
+  distances; PeriOperatorPreconditioner assembles it). Collective.
 @*/
-PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator *op, Mat *P)
+PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator *op)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscNew(op));
@@ -383,8 +380,23 @@ PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator
   (*op)->nloc  = sys->disc.bonds.rend - sys->disc.bonds.rstart;
   PetscCall(CollectBonds(sys, *op));
   PetscCall(SetUpGhosts(sys, *op));
-  PetscCall(AssemblePreconditioner(sys, *op, radius, P));
-  PetscCall(PetscFree((*op)->len)); /* only the preconditioner's choice of bonds needed it */
+  PetscCall(ChooseShortRange(sys, *op, radius));
+  PetscCall(PetscFree((*op)->len)); /* only the choice of the short bonds needed it */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriOperatorPreconditioner - sys->Kpc, the preconditioning matrix of the matrix-free K, assembled
+  on first use: the short bonds' blocks (k e e^T = w w^T, the assembly's own), restricted and
+  scaled, broken ones with PERI_BROKEN_SHARE of theirs. Collective.
+@*/
+PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
+{
+  PetscFunctionBeginUser;
+  if (sys->Kpc) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
+  PetscCall(PeriAssembleShortRange(sys, sys->op->rmax, sys->op->pscale, PERI_BROKEN_SHARE, &sys->Kpc));
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -414,7 +426,7 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
   for (PetscInt d = 0; d < op->bs; d++) op->w[op->bs * t + d] *= PetscSqrtReal(factor);
-  if (factor > 0 || sys->disc.bonds.length[k] > op->rmax) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->Kpc || factor > 0 || sys->disc.bonds.length[k] > op->rmax) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * op->pscale * Ke[a];
   PetscCall(MatSetValuesBlocked(sys->Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -424,8 +436,10 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
 PetscErrorCode PeriOperatorScaled(PeriSystem sys)
 {
   PetscFunctionBeginUser;
-  PetscCall(MatAssemblyBegin(sys->Kpc, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(sys->Kpc, MAT_FINAL_ASSEMBLY));
+  if (sys->Kpc) {
+    PetscCall(MatAssemblyBegin(sys->Kpc, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(sys->Kpc, MAT_FINAL_ASSEMBLY));
+  }
   PetscCall(ComputeDiagonal(sys->op));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -249,7 +249,19 @@ static PetscErrorCode CheckRightHandSide(PeriSystem sys, Vec b)
   SETERRQ(sys->comm, PETSC_ERR_USER_INPUT, "%s: the displacements would be of the order of %g (largest prescribed value %g), beyond what double precision can solve for (1e-150 to 1e150): check the units of the moduli, the loads and the bc values", sys->scene->file, (double)norm, (double)vmax);
 }
 
-/* CG (GMRES for an unsymmetric operator) + GAMG, rtol 1e-10, then the options. */
+/* Whether the PC is the default Jacobi of a small 3D body (PeriSystemAssemble), not chosen by the
+ * options: it then gets PERI_JACOBI_BUDGET iterations, and GAMG takes over after them. */
+static PetscBool DefaultJacobi(PeriSystem sys)
+{
+  PetscBool pc, maxit;
+
+  PetscOptionsHasName(NULL, NULL, "-pc_type", &pc);
+  PetscOptionsHasName(NULL, NULL, "-ksp_max_it", &maxit);
+  return (PetscBool)(!strcmp(sys->pc_default, PCJACOBI) && !pc && !maxit);
+}
+
+/* CG (GMRES for an unsymmetric operator) + GAMG (or the default Jacobi, PERI_JACOBI_BUDGET
+ * iterations), rtol 1e-10, then the options. */
 static PetscErrorCode StaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *ksp)
 {
   PC        pc;
@@ -259,10 +271,10 @@ static PetscErrorCode StaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *
   PetscCall(KSPCreate(sys->comm, ksp));
   PetscCall(KSPSetType(*ksp, symmetric ? KSPCG : KSPGMRES));
   PetscCall(KSPGetPC(*ksp, &pc));
-  PetscCall(PCSetType(pc, PCGAMG));
+  PetscCall(PCSetType(pc, sys->pc_default[0] ? sys->pc_default : PCGAMG));
   /* no absolute tolerance: the system is scaled to O(1) numbers (ScaleToUnits), and atol = 1e-50
      would stop CG at once on a tiny right-hand side */
-  PetscCall(KSPSetTolerances(*ksp, 1e-10, 0.0, PETSC_DEFAULT, 10000));
+  PetscCall(KSPSetTolerances(*ksp, 1e-10, 0.0, PETSC_DEFAULT, DefaultJacobi(sys) ? PERI_JACOBI_BUDGET : 10000));
   PetscCall(KSPSetFromOptions(*ksp));
   /* CG monitors the preconditioned residual by default, which GAMG lets sit 10-30x above the true
    * one: make -ksp_rtol bound the true relative residual unless the user chose a norm */
@@ -303,6 +315,17 @@ static PetscErrorCode SmootherFallback(PeriSystem sys, KSP ksp, KSPConvergedReas
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the PC the static solve will use (-pc_type, else the default) needs matrix entries:
+ * all but Jacobi and none, which a matrix-free K serves itself. */
+static PetscBool NeedsPreconditioningMatrix(PeriSystem sys)
+{
+  char pc[64];
+
+  PetscStrncpy(pc, sys->pc_default[0] ? sys->pc_default : PCGAMG, sizeof(pc));
+  PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL);
+  return (PetscBool)(strcmp(pc, PCJACOBI) && strcmp(pc, PCNONE));
+}
+
 static PetscErrorCode ReferenceOrCopy(Mat K, PetscBool inplace, Mat *A)
 {
   PetscFunctionBeginUser;
@@ -332,9 +355,10 @@ static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool
     PetscCall(PeriOperatorCreateMat(sys, A)); /* a fresh shell: the held DOFs are its own */
   else
     PetscCall(ReferenceOrCopy(sys->K, inplace, A));
-  if (sys->op)
+  if (sys->op && NeedsPreconditioningMatrix(sys)) {
+    PetscCall(PeriOperatorPreconditioner(sys));
     PetscCall(ReferenceOrCopy(sys->Kpc, inplace, P));
-  else {
+  } else {
     PetscCall(PetscObjectReference((PetscObject)*A));
     *P = *A;
   }
@@ -436,15 +460,8 @@ static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConv
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriStaticSolve - solves K u = lambda f for sys->u with the prescribed values and the layers'
-  offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
-  eliminated (A = R K T), prescribed DOFs symmetrically; a free body with balanced loads is solved
-  orthogonal to its rigid motions. sys->K is kept unless inplace. *ksp is created on first use
-  (CG + GAMG, or GMRES for an unsymmetric operator, then the options). Sets sys->solve's solver
-  fields and returns the converged reason instead of failing. Collective.
-@*/
-PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
+/* One static solve with the present PC (PeriStaticSolve). */
+static PetscErrorCode SolveAttempt(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
 {
   Mat       A, P;
   Vec       b, free[PERI_MAX_MODES];
@@ -452,7 +469,6 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
   PetscInt  nfree = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(StaticOperator(sys, lambda, inplace, &A, &P, &b));
   PetscCall(EliminatePrescribed(sys, A, P, b, lambda, nhold, hold, held, &diag));
   PetscCall(CheckRightHandSide(sys, b));
@@ -470,6 +486,32 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
   PetscCall(VecDestroy(&b));
   PetscCall(MatDestroy(&A));
   PetscCall(MatDestroy(&P));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriStaticSolve - solves K u = lambda f for sys->u with the prescribed values and the layers'
+  offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
+  eliminated (A = R K T), prescribed DOFs symmetrically; a free body with balanced loads is solved
+  orthogonal to its rigid motions. sys->K is kept unless inplace. *ksp is created on first use
+  (CG + GAMG, or Jacobi for a small 3D body with a matrix-free K, or GMRES for an unsymmetric
+  operator, then the options). A default Jacobi that has not converged after PERI_JACOBI_BUDGET
+  iterations hands over to GAMG, which starts from its iterate, for this solve and the next ones.
+  Sets sys->solve's solver fields and returns the converged reason instead of failing. Collective.
+@*/
+PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));
+  if (*reason == KSP_DIVERGED_ITS && DefaultJacobi(sys)) {
+    PetscCall(PetscPrintf(sys->comm, "perilin: note: CG + Jacobi did not converge in %d iterations; GAMG on the short-range stiffness goes on from there\n", PERI_JACOBI_BUDGET));
+    PetscCall(PetscStrncpy(sys->pc_default, PCGAMG, sizeof(sys->pc_default)));
+    PetscCall(KSPDestroy(ksp));
+    PetscCall(StaticKSPCreate(sys, sys->solve.symmetric, ksp));
+    PetscCall(KSPSetInitialGuessNonzero(*ksp, PETSC_TRUE));
+    PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));
+  }
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

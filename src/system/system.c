@@ -468,15 +468,31 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
     why = "fictitious layers eliminate K's rows through its entries";
   *mf = (PetscBool)(!why && (sys->operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->operator_kind == PERI_OPERATOR_AUTO));
   if (*mf && sys->operator_kind == PERI_OPERATOR_AUTO) {
-    /* the short-range stiffness serves AMG; another -pc_type (a factorization) gets K itself */
+    /* the short-range stiffness serves AMG, the diagonal Jacobi; another -pc_type (a
+       factorization) gets K itself */
     char pc[64] = PCGAMG;
     PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
-    *mf = (PetscBool)!strcmp(pc, PCGAMG);
+    *mf = (PetscBool)(!strcmp(pc, PCGAMG) || !strcmp(pc, PCJACOBI) || !strcmp(pc, PCNONE));
   }
   if (sys->operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetMap(sys->scene, sys->scene->root, "solver", PETSC_FALSE, &node));
   PeriInputCheck(PETSC_FALSE, sys->scene, node, "operator", "matrix_free cannot apply here: %s; use assembled or auto", why);
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The static solves' default PC: GAMG, but Jacobi on a matrix-free K of a small 3D body, where CG
+ * needs a few hundred of the cheap products and no preconditioning matrix is stored: faster and
+ * lighter up to about 1e5 particles and 200 spacings across (docs/performance.md, "Matrix-free"). */
+static void DefaultPC(PeriSystem sys)
+{
+  const PeriParticles *pt     = &sys->disc.particles;
+  PetscReal            extent = 0;
+
+  for (PetscInt d = 0; d < pt->dim; d++) extent = PetscMax(extent, pt->upper[d] - pt->lower[d]);
+  if (sys->op && pt->dim == 3 && pt->n <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
+    PetscStrncpy(sys->pc_default, PCJACOBI, sizeof(sys->pc_default));
+  else
+    PetscStrncpy(sys->pc_default, PCGAMG, sizeof(sys->pc_default));
 }
 
 PetscErrorCode PeriSystemAssemble(PeriSystem sys)
@@ -490,10 +506,12 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
   PetscCall(MatDestroy(&sys->K));
   PetscCall(MatDestroy(&sys->Kpc));
   PetscCall(PeriOperatorDestroy(&sys->op));
+  sys->pc_default[0] = 0;
   PetscCall(UseMatrixFree(sys, &mf));
   if (mf) {
     PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
-    PetscCall(PeriOperatorCreate(sys, sys->pc_radius, &sys->op, &sys->Kpc));
+    PetscCall(PeriOperatorCreate(sys, sys->pc_radius, &sys->op));
+    DefaultPC(sys);
     PetscCall(PeriOperatorCreateMat(sys, &sys->K));
     PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   } else
@@ -502,8 +520,10 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
   sys->log.assembly_s = t1 - t0;
   if (sys->log.matrix_mb == 0) { /* the first assembly: K's size and the memory it took */
     PetscReal opmb = 0;
-    PetscCall(MatrixMB(sys->Kpc ? sys->Kpc : sys->K, &sys->log.matrix_mb));
-    if (sys->op) PetscCall(PeriOperatorMemoryMB(sys, sys->op, &opmb));
+    if (sys->op)
+      PetscCall(PeriOperatorMemoryMB(sys, sys->op, &opmb));
+    else
+      PetscCall(MatrixMB(sys->K, &sys->log.matrix_mb));
     sys->log.matrix_mb += opmb;
     sys->log.memory_phase_mb[1] = PeriPeakMemoryMB();
   }

@@ -165,6 +165,7 @@ static PetscErrorCode CheckCase(const char scene[], const char type[], const cha
   p->sys->matrix_free_ok = PETSC_TRUE;
   p->sys->operator_kind  = PERI_OPERATOR_MATRIX_FREE;
   PetscCall(PeriSystemAssemble(p->sys));
+  PetscCall(PeriOperatorPreconditioner(p->sys));
   PetscCheck(p->sys->op && p->sys->Kpc, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: solver.operator matrix_free gave no matrix-free operator", name);
   PetscCall(MatCreateVecs(K, &x, NULL));
   PetscCall(VecSetRandom(x, NULL));

@@ -106,7 +106,11 @@ typedef struct {
   PetscInt  precracked_bonds;               /* bonds the scene's cracks removed */
 } PeriFailure;
 
-/* How K is applied (solver.operator, src/system/operator.c). */
+/* How K is applied (solver.operator, src/system/operator.c), and the bodies small enough for
+ * CG + Jacobi on a matrix-free K (PeriSystemAssemble). */
+#define PERI_JACOBI_MAX_PARTICLES 100000
+#define PERI_JACOBI_MAX_SPAN      200
+#define PERI_JACOBI_BUDGET        400 /* iterations, about the cost of GAMG's set-up and solve */
 typedef enum {
   PERI_OPERATOR_AUTO,
   PERI_OPERATOR_ASSEMBLED,
@@ -135,6 +139,7 @@ struct _p_PeriSystem {
   PeriOperator     op;                      /* solver.operator: matrix_free, else NULL */
   PeriOperatorKind operator_kind;           /* solver.operator */
   PetscReal        pc_radius;               /* solver.pc_radius */
+  char             pc_default[16];          /* the static solve's PC unless -pc_type: gamg, or jacobi (matrix-free K on a small 3D body) */
   PetscBool        matrix_free_ok;          /* set by an analysis that uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free */
   char             mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
   Vec              u, f;
@@ -191,7 +196,8 @@ PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscIn
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
 
 /* the matrix-free operator (src/system/operator.c) */
-PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *, Mat *);
+PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *);
+PETSC_EXTERN PetscErrorCode PeriOperatorPreconditioner(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriOperatorCreateMat(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriOperatorMemoryMB(PeriSystem, PeriOperator, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriOperatorScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[]);
