@@ -482,7 +482,7 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 
 /* The static solves' default PC: GAMG, but Jacobi on a matrix-free K of a small 3D body, where CG
  * needs a few hundred of the cheap products and no preconditioning matrix is stored: faster and
- * lighter up to about 1e5 particles and 200 spacings across (docs/performance.md, "Matrix-free"). */
+ * lighter up to about 5e5 particles and 200 spacings across (docs/performance.md, "Matrix-free"). */
 static void DefaultPC(PeriSystem sys)
 {
   const PeriParticles *pt     = &sys->disc.particles;

@@ -108,7 +108,7 @@ typedef struct {
 
 /* How K is applied (solver.operator, src/system/operator.c), and the bodies small enough for
  * CG + Jacobi on a matrix-free K (PeriSystemAssemble). */
-#define PERI_JACOBI_MAX_PARTICLES 100000
+#define PERI_JACOBI_MAX_PARTICLES 500000
 #define PERI_JACOBI_MAX_SPAN      200
 #define PERI_JACOBI_BUDGET        400 /* iterations, about the cost of GAMG's set-up and solve */
 typedef enum {
