@@ -49,6 +49,7 @@ PetscErrorCode PeriInitialize(int *argc, char ***argv, const char help[])
 {
   PetscFunctionBeginUser;
   PetscCall(SlepcInitialize(argc, argv, NULL, help));
+  PetscCall(PeriMallocInitialize());
   PetscCall(PeriSignalsInstall());
   PetscCall(PeriBLASThreadsInitialize());
   PetscCall(PeriInitializePackage());

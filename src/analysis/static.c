@@ -12,6 +12,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   PetscInt           nc;
   KSPConvergedReason reason;
   PetscLogDouble     t0, t1;
+  PetscBool          released = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Allreduce(&an->sys->nconstrained, &nc, 1, MPIU_INT, MPI_SUM, an->comm));
@@ -42,6 +43,8 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscCall(PeriPieces(an->sys, &nhold, &hold, &held, &npieces, &lost));
     PetscCheck(!lost, an->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", an->sys->scene->file, npieces);
     if (npieces > 1) PetscCall(PetscPrintf(an->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
+    /* the solve reads K only: the bonds' geometry makes room for GAMG, and comes back after it */
+    PetscCall(PeriSystemReleaseBondGeometry(an->sys, &released));
     PetscCall(PeriStaticSolve(an->sys, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));
     PetscCall(PetscFree2(hold, held));
   }
@@ -49,6 +52,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   if (an->sys->interrupted) {
     /* an unfinished solve is no result: the output will say so and hold no fields */
     PetscCall(KSPDestroy(&ksp));
+    PetscCall(PeriSystemRestoreBondGeometry(an->sys, released));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   {
@@ -56,6 +60,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscCall(PeriStaticConverged(an->sys, ksp, reason, &ok));
   }
   PetscCall(KSPDestroy(&ksp));
+  PetscCall(PeriSystemRestoreBondGeometry(an->sys, released));
   PetscCall(PeriStaticCheckConverged(an->sys, reason));
   PetscCall(PetscTime(&t1));
   an->sys->log.solve_s = t1 - t0;

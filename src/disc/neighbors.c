@@ -248,3 +248,58 @@ PetscErrorCode PeriBondsDestroy(PeriBonds *b)
   b->nbonds = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriBondsReleaseGeometry - frees the bond vectors, lengths and partial-volume factors (40 of the
+  53 bytes a bond holds), and the surface factors when all are 1 (8 more), while nothing reads
+  them; PeriBondsRestoreGeometry recomputes them. Only for bodies without periodic axes, whose
+  bonds never join images (*released says whether it freed them). Not collective.
+@*/
+PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *p, PeriBonds *b, PetscBool *released)
+{
+  PetscFunctionBeginUser;
+  *released = PETSC_FALSE;
+  for (PetscInt d = 0; d < 3; d++)
+    if (p->periodic[d]) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscFree(b->xi));
+  PetscCall(PetscFree(b->length));
+  PetscCall(PetscFree(b->alpha));
+  {
+    PetscInt k = 0;
+    while (k < b->nbonds && b->lambda[k] == 1) k++;
+    if (k == b->nbonds) PetscCall(PetscFree(b->lambda));
+  }
+  *released = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriBondsRestoreGeometry - recomputes what PeriBondsReleaseGeometry freed, with the arithmetic
+  of the search (ParticleBonds with no image shift), so every value is the same to the bit; the
+  arrays are sized to the bonds exactly. Not collective.
+@*/
+PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PeriBonds *b)
+{
+  PetscFunctionBeginUser;
+  if (!b->lambda) {
+    PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
+    for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
+  }
+  PetscCall(PetscMalloc1(3 * b->nbonds, &b->xi));
+  PetscCall(PetscMalloc1(b->nbonds, &b->length));
+  PetscCall(PetscMalloc1(b->nbonds, &b->alpha));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      const PetscInt j    = b->j[k];
+      PetscReal      len2 = 0;
+      for (PetscInt d = 0; d < 3; d++) {
+        /* the search's x_j + wrap L - x_i with wrap = 0 (+ 0.0 keeps the sign of a zero alike) */
+        PetscReal x      = p->x[3 * j + d] + 0.0 - p->x[3 * i + d];
+        b->xi[3 * k + d] = x;
+        len2 += x * x;
+      }
+      b->length[k] = PetscSqrtReal(len2);
+      b->alpha[k]  = PeriPartialVolumeFactor(pv, b->length[k], delta, 0.5 * (p->spacing[i] + p->spacing[j]));
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -231,3 +231,34 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
   PetscCall(PetscInfo(NULL, "memory estimate: %g bytes on the fullest node, %g available (%g particles, %g bonds)\n", (double)e.need, (double)e.have, (double)e.n, (double)e.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriSystemReleaseBondGeometry - frees the bonds' vectors, lengths and partial-volume factors
+  before a solve on the assembled K, which then reads only K (issue 14, item 4: the solver's
+  hierarchy takes their place at the peak). Kept for periodic bodies, fictitious layers, a K that
+  is not assembled (a shell) and with -peri_release_bond_geometry false. *released says whether
+  PeriSystemRestoreBondGeometry must give them back. Not collective.
+@*/
+PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released)
+{
+  PetscBool release = PETSC_TRUE, shell = PETSC_TRUE;
+
+  PetscFunctionBeginUser;
+  *released = PETSC_FALSE;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_release_bond_geometry", &release, NULL));
+  if (sys->K) PetscCall(PetscObjectTypeCompare((PetscObject)sys->K, MATSHELL, &shell));
+  if (!release || shell || sys->layers.T || !sys->disc.bonds.xi) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriBondsReleaseGeometry(&sys->disc.particles, &sys->disc.bonds, released));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemRestoreBondGeometry - recomputes, bit for bit, what PeriSystemReleaseBondGeometry
+  freed (when released). Not collective.
+@*/
+PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem sys, PetscBool released)
+{
+  PetscFunctionBeginUser;
+  if (released) PetscCall(PeriBondsRestoreGeometry(&sys->disc.particles, sys->disc.delta, sys->disc.partial_volume, &sys->disc.bonds));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

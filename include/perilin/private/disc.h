@@ -34,6 +34,8 @@ PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscRe
 
 PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsDestroy(PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *, PeriBonds *, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *, PetscReal, PeriPartialVolume, PeriBonds *);
 PETSC_EXTERN PetscReal      PeriPartialVolumeFactor(PeriPartialVolume, PetscReal, PetscReal, PetscReal);
 PETSC_EXTERN PetscReal      PeriSearchRadius(PeriPartialVolume, PetscReal, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm, const PeriParticles *, const PeriBonds *, PetscReal[], PetscInt[]);

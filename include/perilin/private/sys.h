@@ -16,6 +16,7 @@ PETSC_EXTERN PetscLogEvent  PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVE
 PETSC_EXTERN PetscLogStage  PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
 PETSC_EXTERN PetscErrorCode PeriInitializePackage(void);
 PETSC_EXTERN PetscReal      PeriPeakMemoryMB(void);
+PETSC_EXTERN PetscErrorCode PeriMallocInitialize(void);
 
 /* BLAS threads (src/sys/threads.c): one outside factorizations, the library's own around them. */
 PETSC_EXTERN PetscErrorCode PeriBLASThreadsInitialize(void);

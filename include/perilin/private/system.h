@@ -235,6 +235,8 @@ PETSC_EXTERN PetscErrorCode PeriLayersDestroy(PeriLayers *);
 PETSC_EXTERN PetscErrorCode PeriTorsionEvaluate(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriTorsionLoads(PeriSystem, Vec);
 PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel);
+PETSC_EXTERN PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem, PetscBool);
 
 /* summary.json sections (src/system/summary.c) */
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryModel(PeriSystem, PeriJSON);
