@@ -435,8 +435,8 @@ PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The bytes PETSc holds for an assembled matrix, all ranks. */
-static PetscErrorCode MatrixMB(Mat K, PetscReal *mb)
+/* The bytes PETSc holds for an assembled matrix, all ranks. Collective. */
+PetscErrorCode PeriMatrixMB(Mat K, PetscReal *mb)
 {
   MatInfo   info;
   PetscBool blocked;
@@ -523,7 +523,7 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
     if (sys->op)
       PetscCall(PeriOperatorMemoryMB(sys, sys->op, &opmb));
     else
-      PetscCall(MatrixMB(sys->K, &sys->log.matrix_mb));
+      PetscCall(PeriMatrixMB(sys->K, &sys->log.matrix_mb));
     sys->log.matrix_mb += opmb;
     sys->log.memory_phase_mb[1] = PeriPeakMemoryMB();
   }

@@ -36,7 +36,8 @@ typedef struct {
   PetscInt  edge_cut;           /* bonds between particles of different ranks */
   PetscBool free_modes_noted;   /* the note on free motions is printed once per run */
   PetscReal memory_phase_mb[3]; /* the largest rank's peak memory at the end of set-up, first assembly, run */
-  PetscReal matrix_mb;          /* the bytes PETSc holds for K (all ranks), at the first assembly */
+  PetscBool pc_matrix_counted;  /* matrix_mb includes the first preconditioning matrix of a matrix-free K */
+  PetscReal matrix_mb;          /* the bytes of K (all ranks) at the first assembly: PETSc's, or the matrix-free operator's and its preconditioning matrix's */
 } PeriRunLog;
 
 typedef enum {
@@ -191,6 +192,7 @@ PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void 
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
+PETSC_EXTERN PetscErrorCode PeriMatrixMB(Mat, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, PetscReal, Mat *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
