@@ -81,6 +81,25 @@ static PetscErrorCode AnalysisType(PeriScene s, char type[], size_t len)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the run will apply K matrix-free (PeriSystemAssemble's rule, solver.operator): central
+ * springs, a static or quasi-static analysis, and operator matrix_free, or auto with the default
+ * or a diagonal PC. Fictitious layers (which turn it off) are not looked at: the estimate is then
+ * low by the matrix. */
+static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const char analysis[], PetscBool *mf)
+{
+  PeriNode solver;
+  char     op[32] = "auto", pc[64] = PCGAMG;
+
+  PetscFunctionBeginUser;
+  *mf = PETSC_FALSE;
+  if (!m->central_force || !strcmp(analysis, "modal") || !strcmp(analysis, "setup")) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &solver));
+  if (solver) PetscCall(PeriSceneGetString(s, solver, "operator", PETSC_FALSE, op, sizeof(op), NULL));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
+  *mf = (PetscBool)(!strcmp(op, "matrix_free") || (!strcmp(op, "auto") && (!strcmp(pc, PCGAMG) || !strcmp(pc, PCJACOBI) || !strcmp(pc, PCNONE))));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Lattice points within r spacings of a particle, itself excluded. */
 static PetscReal BallCount(PetscInt dim, PetscReal r)
 {
@@ -102,7 +121,7 @@ static PetscReal SurfaceShare(PetscInt dim, PetscReal r, const PetscReal cells[]
  * nonzero; BAIJ: 8, and an index per block) and the solver, for n particles of dofs DOFs, a
  * search radius of r spacings and the share of pairs the faces leave. State-based models also list
  * each family in full and couple particles up to 2 delta apart. */
-static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const char analysis[], MemoryEstimate *e)
+static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const char analysis[], PetscBool mf, MemoryEstimate *e)
 {
   const PetscReal dofs = m->dofs, ball = BallCount(m->dim, r);
   PetscReal       reserved, per_bond, blocks, nnz, matrix;
@@ -121,9 +140,13 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
      gets lambda, and with failure the cause and the softening share */
   reserved = 1.05 * n * ball / 2 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1);
   per_bond = sizeof(PetscReal) + (failure ? 1 + sizeof(PetscReal) : 0);
-  blocks   = 1 + share * (m->ops.family_stiffness ? BallCount(m->dim, 2 * r) : ball);
-  nnz      = n * blocks * dofs * dofs;
-  matrix   = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
+  /* a matrix-free K: its matrix is the short-range one (1.75 spacings, PeriOperatorPreconditioner)
+     beside the operator's partner and sqrt(k) e per bond */
+  blocks = 1 + share * (mf ? BallCount(m->dim, 1.75) : m->ops.family_stiffness ? BallCount(m->dim, 2 * r)
+                                                                               : ball);
+  nnz    = n * blocks * dofs * dofs;
+  matrix = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
+  if (mf) reserved += e->nbonds * (sizeof(PetscInt) + dofs * sizeof(PetscReal));
   /* GAMG's scalar graph (matrix / dofs^2), its coarse levels and prolongators and CG's vectors:
      PERI_MEMORY_SOLVER graphs, fitted to the peaks of 2D plates (2 DOFs, 1e4-1e6 particles, where
      the whole run peaks at 2.5x the matrix as in docs/performance.md) and 3D blocks (3 DOFs) */
@@ -201,7 +224,7 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
 {
   MemoryEstimate e = {0};
   PetscReal      h = 0, r = 0, cells[3];
-  PetscBool      run                     = PETSC_TRUE, failure, periodic[3];
+  PetscBool      run                     = PETSC_TRUE, failure, periodic[3], mf;
   char           analysis[PERI_NAME_LEN] = "static";
   PeriNode       grid;
   PetscErrorCode ierr;
@@ -224,7 +247,8 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
   if (ierr || !(e.n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
   failure = grid ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, analysis, &e));
+  PetscCall(MatrixFree(s, m, analysis, &mf));
+  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, analysis, mf, &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));
@@ -235,19 +259,26 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
 /*@C
   PeriSystemReleaseBondGeometry - frees the bonds' vectors, lengths and partial-volume factors
   before a solve on the assembled K, which then reads only K (issue 14, item 4: the solver's
-  hierarchy takes their place at the peak). Kept for periodic bodies, fictitious layers, a K that
-  is not assembled (a shell) and with -peri_release_bond_geometry false. *released says whether
-  PeriSystemRestoreBondGeometry must give them back. Not collective.
+  hierarchy takes their place at the peak). A matrix-free K keeps its own bond data; its
+  preconditioning matrix is assembled here first when the PC is the default GAMG, and with the
+  default Jacobi (which may hand over to GAMG, assembling it then) nothing is freed. Kept for
+  periodic bodies, fictitious layers, another PC on a matrix-free K and with
+  -peri_release_bond_geometry false. *released says whether PeriSystemRestoreBondGeometry must
+  give them back. Collective.
 @*/
 PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released)
 {
-  PetscBool release = PETSC_TRUE, shell = PETSC_TRUE;
+  PetscBool release = PETSC_TRUE, pc_set;
 
   PetscFunctionBeginUser;
   *released = PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_release_bond_geometry", &release, NULL));
-  if (sys->K) PetscCall(PetscObjectTypeCompare((PetscObject)sys->K, MATSHELL, &shell));
-  if (!release || shell || sys->layers.T || !sys->disc.bonds.xi) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-pc_type", &pc_set));
+  if (!release || !sys->K || sys->layers.T || !sys->disc.bonds.xi) PetscFunctionReturn(PETSC_SUCCESS);
+  if (sys->op) {
+    if (pc_set || strcmp(sys->pc_default, PCGAMG)) PetscFunctionReturn(PETSC_SUCCESS);
+    PetscCall(PeriOperatorPreconditioner(sys));
+  }
   PetscCall(PeriBondsReleaseGeometry(&sys->disc.particles, &sys->disc.bonds, released));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
