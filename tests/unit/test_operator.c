@@ -256,13 +256,14 @@ int main(int argc, char **argv)
       PetscCall(CheckCase(argv[s], types[t], surface));
       ncases++;
     }
+  /* the scenes' own models and corrections from here on */
+  PetscCall(PeriTestSetOption("-model_type", NULL));
+  PetscCall(PeriTestSetOption("-corrections_surface", NULL));
   PetscCall(CheckSolve(argv[1], PCGAMG));   /* 2D: GAMG */
   PetscCall(CheckSolve(argv[2], PCJACOBI)); /* a small 3D body: Jacobi */
   PetscCall(CheckSolve(argv[3], PCGAMG));   /* slender: Jacobi, then GAMG */
   PetscCheck(ncases >= 4, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "only %" PetscInt_FMT " cases ran: expected the central-force models (pmb, npmb, cpmb) in 2D and 3D", ncases);
   PetscCall(PetscStrToArrayDestroy(ntypes, types));
-  PetscCall(PeriTestSetOption("-model_type", NULL));
-  PetscCall(PeriTestSetOption("-corrections_surface", NULL));
   PetscCall(PeriFinalize());
   return 0;
 }
