@@ -260,23 +260,25 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
   PeriSystemReleaseBondGeometry - frees the bonds' vectors, lengths and partial-volume factors
   before a solve on the assembled K, which then reads only K (issue 14, item 4: the solver's
   hierarchy takes their place at the peak). A matrix-free K keeps its own bond data; its
-  preconditioning matrix is assembled here first when the PC is the default GAMG, and with the
-  default Jacobi (which may hand over to GAMG, assembling it then) nothing is freed. Kept for
+  preconditioning matrix is assembled here first when the PC is GAMG, and with another (the
+  default Jacobi may hand over to GAMG, assembling it then) nothing is freed. Kept for
   periodic bodies, fictitious layers, another PC on a matrix-free K and with
   -peri_release_bond_geometry false. *released says whether PeriSystemRestoreBondGeometry must
   give them back. Collective.
 @*/
 PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released)
 {
-  PetscBool release = PETSC_TRUE, pc_set;
+  PetscBool release = PETSC_TRUE;
+  char      pc[64];
 
   PetscFunctionBeginUser;
   *released = PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_release_bond_geometry", &release, NULL));
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-pc_type", &pc_set));
+  PetscCall(PetscStrncpy(pc, sys->pc_default, sizeof(pc)));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
   if (!release || !sys->K || sys->layers.T || !sys->disc.bonds.xi) PetscFunctionReturn(PETSC_SUCCESS);
   if (sys->op) {
-    if (pc_set || strcmp(sys->pc_default, PCGAMG)) PetscFunctionReturn(PETSC_SUCCESS);
+    if (strcmp(pc, PCGAMG)) PetscFunctionReturn(PETSC_SUCCESS);
     PetscCall(PeriOperatorPreconditioner(sys));
   }
   PetscCall(PeriBondsReleaseGeometry(&sys->disc.particles, &sys->disc.bonds, released));
