@@ -11,8 +11,10 @@
  *   5. the static solve of each scene (its own model) gives the same strain energy and largest
  *      displacements with either operator, to the solver tolerance (1e-8 relative);
  *   6. on the slender beam (third scene) the default CG + Jacobi of a small 3D body hands over to
- *      GAMG after PERI_JACOBI_BUDGET iterations, and the answer is still the assembled K's (5).
- * usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml */
+ *      GAMG after PERI_JACOBI_BUDGET iterations, and the answer is still the assembled K's (5);
+ *   7. the same for a periodic body narrower than the horizon (fourth scene): bonds to several
+ *      images of a particle and to its own.
+ * usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml */
 #include "testing.h"
 
 #define TOL 1e-12
@@ -236,7 +238,7 @@ int main(int argc, char **argv)
   PetscInt ncases = 0;
 
   PetscCall(PeriInitialize(&argc, &argv, NULL));
-  PetscCheck(argc >= 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml");
+  PetscCheck(argc >= 5, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml");
   PetscCall(PeriInitializePackage());
   PetscCall(PeriModelListTypes(list, sizeof(list)));
   for (size_t k = 0; list[k]; k++)
@@ -262,6 +264,7 @@ int main(int argc, char **argv)
   PetscCall(CheckSolve(argv[1], PCGAMG));   /* 2D: GAMG */
   PetscCall(CheckSolve(argv[2], PCJACOBI)); /* a small 3D body: Jacobi */
   PetscCall(CheckSolve(argv[3], PCGAMG));   /* slender: Jacobi, then GAMG */
+  PetscCall(CheckSolve(argv[4], PCGAMG));   /* periodic */
   PetscCheck(ncases >= 4, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "only %" PetscInt_FMT " cases ran: expected the central-force models (pmb, npmb, cpmb) in 2D and 3D", ncases);
   PetscCall(PetscStrToArrayDestroy(ntypes, types));
   PetscCall(PeriFinalize());
