@@ -504,37 +504,6 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The bond's failure index when its measures at unit load, meas1, are scaled by lam. */
-static PetscReal IndexAt(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas1[], PetscInt nmeas, PetscReal lam)
-{
-  PetscReal m[PERI_MAX_MEASURE] = {0};
-  for (PetscInt c = 0; c < nmeas && c < PERI_MAX_MEASURE; c++) m[c] = lam * meas1[c];
-  return PeriBondFailureIndex(sys, g, m, NULL);
-}
-
-/* The load factor at which a bond reaches its criterion, from its measures at unit load (the body
- * is linear between breaks): 1/index where the index grows in proportion to the load (tension,
- * compression, sliding, shear angle); by bisection where a cohesion makes it affine (friction,
- * whose index still grows with the load). PETSC_INFINITY when it never fails. */
-static PetscReal BondCriticalLoad(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas1[], PetscInt nmeas)
-{
-  PetscReal i1 = IndexAt(sys, g, meas1, nmeas, 1), lo = 0, hi;
-
-  if (!(i1 > 0)) return PETSC_INFINITY;
-  hi = 1 / i1;
-  if (PetscAbsReal(IndexAt(sys, g, meas1, nmeas, hi) - 1) <= 1e-12) return hi;
-  for (PetscInt k = 0; k < 64 && IndexAt(sys, g, meas1, nmeas, hi) < 1; k++) hi *= 2;
-  if (IndexAt(sys, g, meas1, nmeas, hi) < 1) return PETSC_INFINITY;
-  for (PetscInt k = 0; k < 80 && hi - lo > 1e-13 * hi; k++) {
-    PetscReal mid = 0.5 * (lo + hi);
-    if (IndexAt(sys, g, meas1, nmeas, mid) >= 1)
-      hi = mid;
-    else
-      lo = mid;
-  }
-  return hi;
-}
-
 /* The next event: the smallest load factor at which an intact bond fails, from the present
  * solution at load factor lam (the response to the scaled load is lam times the unit one).
  * Collective. */
@@ -564,7 +533,7 @@ static PetscErrorCode NextEvent(PeriAnalysis an, PetscReal lam, PetscReal *next)
         uj[c] = PetscRealPart(u[g.j * bs + c]) / lam;
       }
       m->ops.bond_measures(m, &g, ui, uj, meas);
-      *next = PetscMin(*next, BondCriticalLoad(an->sys, &g, meas, m->nmeasures));
+      *next = PetscMin(*next, PeriBondCriticalLoad(an->sys, &g, meas, m->nmeasures));
     }
   PetscCall(VecRestoreArrayRead(all, &u));
   PetscCall(VecDestroy(&all));

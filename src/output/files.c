@@ -128,7 +128,7 @@ static int RemoveTree(const char path[])
 /* Whether a file name is one perilin writes into an output directory. */
 static PetscBool IsOutputName(const char name[])
 {
-  static const char *const exact[]       = {"summary.json", "particles.vtu", "particles.pvd", "steps.csv", "modes.csv", "modes.pvd", "failed_trial.vtu", PERI_OUTPUT_MARKER, NULL};
+  static const char *const exact[]       = {"summary.json", "particles.vtu", "particles.pvd", "steps.csv", "modes.csv", "modes.pvd", "failed_trial.vtu", "anisotropy.csv", PERI_OUTPUT_MARKER, NULL};
   static const char *const prefixed[][2] = {{"particles_", ".vtu"}, {"mode_", ".vtu"}};
   size_t                   n             = strlen(name);
 

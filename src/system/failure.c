@@ -211,6 +211,40 @@ PetscReal PeriBondFailureIndex(PeriSystem sys, const PeriBondGeometry *g, const 
   return idx;
 }
 
+/* The bond's failure index when its measures at unit load, meas1, are scaled by lam. */
+static PetscReal IndexAt(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas1[], PetscInt nmeas, PetscReal lam)
+{
+  PetscReal m[PERI_MAX_MEASURE] = {0};
+  for (PetscInt c = 0; c < nmeas && c < PERI_MAX_MEASURE; c++) m[c] = lam * meas1[c];
+  return PeriBondFailureIndex(sys, g, m, NULL);
+}
+
+/*@C
+  PeriBondCriticalLoad - the load factor at which a bond reaches the scene's criteria, from its
+  measures at unit load (a linear response): 1/index where the index grows in proportion to the
+  load (tension, compression, sliding, shear angle); by bisection where a cohesion makes it affine
+  (friction, whose index still grows with the load). PETSC_INFINITY when it never fails. Not
+  collective.
+@*/
+PetscReal PeriBondCriticalLoad(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas1[], PetscInt nmeas)
+{
+  PetscReal i1 = IndexAt(sys, g, meas1, nmeas, 1), lo = 0, hi;
+
+  if (!(i1 > 0)) return PETSC_INFINITY;
+  hi = 1 / i1;
+  if (PetscAbsReal(IndexAt(sys, g, meas1, nmeas, hi) - 1) <= 1e-12) return hi;
+  for (PetscInt k = 0; k < 64 && IndexAt(sys, g, meas1, nmeas, hi) < 1; k++) hi *= 2;
+  if (IndexAt(sys, g, meas1, nmeas, hi) < 1) return PETSC_INFINITY;
+  for (PetscInt k = 0; k < 80 && hi - lo > 1e-13 * hi; k++) {
+    PetscReal mid = 0.5 * (lo + hi);
+    if (IndexAt(sys, g, meas1, nmeas, mid) >= 1)
+      hi = mid;
+    else
+      lo = mid;
+  }
+  return hi;
+}
+
 /*@C
   PeriBondSoftening - the share of its stiffness a bond keeps at stretch s (Diana & Casolo eqs.
   45-46): 1 below the critical stretch, falling linearly to 0 at the ultimate stretch, in tension

@@ -223,6 +223,7 @@ PETSC_EXTERN PetscErrorCode PeriRigidMotionFree(PeriSystem, PetscInt *, char[], 
 PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
+PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriSystem, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriDamage(PeriSystem, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriComponents(PeriSystem, PetscInt[]);
