@@ -71,7 +71,8 @@ static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal uni
 }
 
 /* sys->failure with only criterion c of the scene's (0 stretch: tension and compression, 1
- * sliding, 2 frictional sliding), the other limits cleared. */
+ * sliding, 2 frictional sliding with the stretch limits as its cut-offs, as Diana & Casolo pair
+ * them: without them a bond in compression never fails), the other limits cleared. */
 static PetscErrorCode OnlyCriterion(PeriAnalysis an, const PeriFailure *all, PetscInt c)
 {
   PeriFailure *F = &an->sys->failure;
@@ -80,7 +81,7 @@ static PetscErrorCode OnlyCriterion(PeriAnalysis an, const PeriFailure *all, Pet
   PetscFunctionBeginUser;
   *F   = *all;
   F->G = F->sliding = F->friction_angle = F->cohesion = F->shear_angle = F->ultimate = F->ultimate_compressive = 0;
-  if (c != 0) F->stretch = F->compressive = 0;
+  if (c == 1) F->stretch = F->compressive = 0;
   if (c == 1) F->sliding = all->sliding;
   if (c == 2) {
     F->friction_angle = all->friction_angle;
@@ -208,7 +209,7 @@ static PetscErrorCode Destroy_Anisotropy(PeriAnalysis an)
 }
 
 static const PeriKey anisotropy_keys[] = {
-    {"criteria", PERI_KEY_LIST, "required", NULL, NULL, NULL, "the criteria studied, one at a time: stretch (failure.critical_stretch, failure.compressive_stretch), sliding (failure.sliding), frictional (failure.friction_angle, failure.cohesion)"},
+    {"criteria", PERI_KEY_LIST, "required", NULL, NULL, NULL, "the criteria studied, one at a time: stretch (failure.critical_stretch, failure.compressive_stretch), sliding (failure.sliding), frictional (failure.friction_angle, failure.cohesion, with the stretch limits as cut-offs)"},
     {"paths", PERI_KEY_LIST, "required", NULL, NULL, NULL, "principal stretches [s1, s2] of the unit cell, in units of failure.critical_stretch (Diana & Casolo eq. 68)"},
     {"m", PERI_KEY_REALS, "required", "[1, 20]", NULL, NULL, "horizon ratios of the unit cells: the bonds n = (i, j) with |n| <= m"},
     {"orientations", PERI_KEY_INT, "101", "[2, inf)", NULL, NULL, "orientations Theta of each path, evenly over [0, 90] degrees (101: Diana & Casolo's 0.9-degree steps)"},
