@@ -96,7 +96,7 @@ static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const char analysis[]
   PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &solver));
   if (solver) PetscCall(PeriSceneGetString(s, solver, "operator", PETSC_FALSE, op, sizeof(op), NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
-  *mf = (PetscBool)(!strcmp(op, "matrix_free") || (!strcmp(op, "auto") && (!strcmp(pc, PCGAMG) || !strcmp(pc, PCJACOBI) || !strcmp(pc, PCNONE))));
+  *mf = (PetscBool)(!strcmp(op, "matrix_free") || (!strcmp(op, "auto") && PeriOperatorServesPC(pc)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -366,6 +366,19 @@ static PetscErrorCode ChooseShortRange(PeriSystem sys, PeriOperator op, PetscRea
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The PCs a matrix-free K serves: those that need no entries (Jacobi from its diagonal, none) and
+ * GAMG (on the preconditioning matrix). solver.operator: auto takes matrix_free for them only. */
+PetscBool PeriOperatorServesPC(const char pc[])
+{
+  return (PetscBool)(!strcmp(pc, PCGAMG) || PeriOperatorPCWithoutMatrix(pc));
+}
+
+/* Whether the PC works from the matrix-free K alone, without a preconditioning matrix. */
+PetscBool PeriOperatorPCWithoutMatrix(const char pc[])
+{
+  return (PetscBool)(!strcmp(pc, PCJACOBI) || !strcmp(pc, PCNONE));
+}
+
 /*@C
   PeriOperatorCreate - the matrix-free operator of a central-force bond model from the live bonds,
   and the choice of its preconditioning matrix's bonds (those within radius nearest-neighbour

@@ -323,7 +323,7 @@ static PetscBool NeedsPreconditioningMatrix(PeriSystem sys)
 
   PetscStrncpy(pc, sys->pc_default[0] ? sys->pc_default : PCGAMG, sizeof(pc));
   PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL);
-  return (PetscBool)(strcmp(pc, PCJACOBI) && strcmp(pc, PCNONE));
+  return (PetscBool)!PeriOperatorPCWithoutMatrix(pc);
 }
 
 static PetscErrorCode ReferenceOrCopy(Mat K, PetscBool inplace, Mat *A)

@@ -472,7 +472,7 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
        factorization) gets K itself */
     char pc[64] = PCGAMG;
     PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
-    *mf = (PetscBool)(!strcmp(pc, PCGAMG) || !strcmp(pc, PCJACOBI) || !strcmp(pc, PCNONE));
+    *mf = PeriOperatorServesPC(pc);
   }
   if (sys->operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetMap(sys->scene, sys->scene->root, "solver", PETSC_FALSE, &node));

@@ -200,6 +200,8 @@ PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
 /* the matrix-free operator (src/system/operator.c) */
 PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *);
 PETSC_EXTERN PetscErrorCode PeriOperatorPreconditioner(PeriSystem);
+PETSC_EXTERN PetscBool      PeriOperatorServesPC(const char[]);
+PETSC_EXTERN PetscBool      PeriOperatorPCWithoutMatrix(const char[]);
 PETSC_EXTERN PetscErrorCode PeriOperatorCreateMat(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriOperatorMemoryMB(PeriSystem, PeriOperator, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriOperatorScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[]);
