@@ -19,14 +19,15 @@ static const char *const corrections_bond[] = {"none", "volume", "energy", NULL}
 static const char *const corrections_os[]   = {"none", "energy", NULL};
 
 typedef struct {
-  PetscReal  c;             /* per unit shear modulus: 6/(pi l delta^3) (bond-based), 2/(pi l delta^3) (b, state-based) */
-  PetscInt   n;             /* particles */
-  PetscReal *gx, *gy;       /* energy surface correction per particle (bond-based), or NULL */
-  PetscReal *mu;            /* shear modulus per particle (state-based), or NULL: the material's */
-  PetscBool  energy;        /* state-based: the correction g_k of eq. 53, computed from the family */
-  PetscReal  stabilization; /* state-based: weight of the misfit energy (model.stabilization) */
-  PetscReal *work;          /* state-based: workspace of the family kernel */
-  PetscInt   nwork;
+  PetscReal   c;             /* per unit shear modulus: 6/(pi l delta^3) (bond-based), 2/(pi l delta^3) (b, state-based) */
+  PetscInt    n;             /* particles */
+  PetscReal  *gx, *gy;       /* energy surface correction per particle (bond-based), or NULL */
+  PetscReal  *mu;            /* shear modulus per particle (state-based), or NULL: the material's */
+  PetscBool   energy;        /* state-based: the correction g_k of eq. 53, computed from the family */
+  PetscReal   stabilization; /* state-based: weight of the misfit energy (model.stabilization) */
+  PetscReal  *work;          /* state-based: workspace of the family kernel */
+  PetscInt    nwork;
+  PeriLattice lat; /* bond-based, model.calibration: lattice, else NULL */
 } Antiplane;
 
 /* The model.* keys of antiplane_os (SetFromSceneState); antiplane has none. */
@@ -120,6 +121,8 @@ static PetscErrorCode CalibrateBond(PeriModel m, const PeriCalibrationData *data
   ap->n = data->n;
   PetscCall(PetscFree2(ap->gx, ap->gy));
   if (data->surface == PERI_SURFACE_ENERGY) PetscCall(EnergyCorrection(m, data));
+  /* the shear angle (u_j - u_k)/|xi| = e . grad u is linear in e: moments of degree 2 */
+  PetscCall(PeriLatticeCreate(m, data, 2, PeriProfileLength, &ap->lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -139,7 +142,7 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 {
   const Antiplane *ap = (const Antiplane *)m->data;
   PetscReal        mu = b->mu > 0 ? b->mu : m->material.G;
-  PetscReal        k  = ap->c * mu * BondCorrection(ap, b) * b->Vi * b->Vj * b->weight / b->length;
+  PetscReal        k  = ap->c * mu * BondCorrection(ap, b) * PeriLatticeFactor(ap->lat, b) * b->Vi * b->Vj * b->weight / b->length;
   Ke[0]               = k;
   Ke[1]               = -k;
   Ke[2]               = -k;
@@ -273,6 +276,7 @@ static PetscErrorCode Destroy(PeriModel m)
   PetscCall(PetscFree2(ap->gx, ap->gy));
   PetscCall(PetscFree(ap->mu));
   PetscCall(PetscFree(ap->work));
+  PetscCall(PeriLatticeDestroy(&ap->lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -304,6 +308,7 @@ static PetscErrorCode PeriModelCreate_Antiplane(PeriModel m)
   m->surface_corrections = corrections_bond;
   m->ops.calibrate       = CalibrateBond;
   m->ops.bond_stiffness  = BondStiffness;
+  m->takes_lattice       = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -8,16 +8,23 @@
 #include <perilin/model.h>
 
 typedef struct {
-  PetscReal c;
+  PetscReal   c;
+  PeriLattice lat; /* model.calibration: lattice, else NULL */
 } CPMB;
+
+/* the spring's |xi| profile omega |xi| for the lattice calibration */
+static PetscReal Profile(PeriModel m, PetscReal L)
+{
+  return PetscMax(1 - L / m->delta, 0) * L;
+}
 
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {
   CPMB *cp = (CPMB *)m->data;
 
   PetscFunctionBeginUser;
-  (void)data;
   cp->c = 4 * PeriModelIsotropicEnergy(m) / (PeriModelHorizonMoment(m, 1) - PeriModelHorizonMoment(m, 2) / m->delta);
+  PetscCall(PeriLatticeCreate(m, data, 4, Profile, &cp->lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -26,7 +33,14 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 {
   const CPMB     *cp    = (const CPMB *)m->data;
   const PetscReal omega = PetscMax(1 - b->length / m->delta, 0);
-  PeriCentralBondBlock(m, b, cp->c * omega * b->Vi * b->Vj * b->weight / b->length, Ke);
+  PeriCentralBondBlock(m, b, cp->c * PeriLatticeFactor(cp->lat, b) * omega * b->Vi * b->Vj * b->weight / b->length, Ke);
+}
+
+static PetscErrorCode Destroy(PeriModel m)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriLatticeDestroy(&((CPMB *)m->data)->lat));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode PeriModelCreate_CPMB(PeriModel m)
@@ -39,6 +53,8 @@ static PetscErrorCode PeriModelCreate_CPMB(PeriModel m)
   PeriModelSetCentralForce(m);
   m->ops.calibrate      = Calibrate;
   m->ops.bond_stiffness = BondStiffness;
+  m->ops.destroy        = Destroy;
+  m->takes_lattice      = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -130,3 +130,18 @@ PetscInt PeriTranslationalRigidModes(PeriModel m, const PetscReal X[], PetscReal
   modes[5][1] = X[0];
   return 6;
 }
+
+/* Length profiles of springs for the lattice calibration (PeriLatticeCreate): the factor of |xi|
+ * in a spring's pair energy per unit V_i V_j (measure)^2 / 2. */
+PetscReal PeriProfileLength(PeriModel m, PetscReal L)
+{
+  (void)m;
+  return L;
+}
+
+PetscReal PeriProfileOne(PeriModel m, PetscReal L)
+{
+  (void)m;
+  (void)L;
+  return 1;
+}

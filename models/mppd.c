@@ -15,9 +15,10 @@
 #include <perilin/model.h>
 
 typedef struct {
-  PetscBool gerstle;
-  PetscReal c, g, d;
-  PetscReal k_theta, k_theta_factor; /* mppd: absolute value when >= 0, else the factor applies */
+  PetscBool   gerstle;
+  PetscReal   c, g, d;
+  PetscReal   k_theta, k_theta_factor; /* mppd: absolute value when >= 0, else the factor applies */
+  PeriLattice normal, shear;           /* model.calibration: lattice, else NULL; gerstle's shear springs have their own */
 } MPPD;
 
 static const char *const components[] = {"ux", "uy", "theta"};
@@ -39,29 +40,42 @@ static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* gerstle's shear spring k_t |xi| = 12 d / |xi| */
+static PetscReal ProfileGerstleShear(PeriModel m, PetscReal L)
+{
+  (void)m;
+  return 1 / L;
+}
+
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {
   MPPD *mp = (MPPD *)m->data;
 
   PetscFunctionBeginUser;
-  (void)data;
   PeriPlaneMicromoduli(m, &mp->c, &mp->g);
   mp->d = mp->g * m->delta * m->delta / 36;
+  PetscCall(PeriLatticeCreate(m, data, 4, PeriProfileLength, &mp->normal));
+  if (mp->gerstle) PetscCall(PeriLatticeCreate(m, data, 4, ProfileGerstleShear, &mp->shear));
   /* at the bond-based Poisson ratio the shear springs vanish and theta no longer acts on the
    * displacements: it is held at 0 rather than left singular */
   m->inactive[2] = (PetscBool)(PetscAbsReal(mp->g) <= 1e-12 * mp->c);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static void Springs(const MPPD *mp, PetscReal delta, PetscReal L, PetscReal *kn, PetscReal *kt, PetscReal *kth)
+/* The lattice factors: mppd's three springs all weigh |xi| in a homogeneous strain (k_theta in the
+ * curvature state theta = kappa . X), so one family's factor scales them; gerstle's shear and
+ * rotational springs keep their beam ratio k_t = 12 k_theta / |xi| and take the shear family's. */
+static void Springs(const MPPD *mp, PetscReal delta, const PeriBondGeometry *b, PetscReal *kn, PetscReal *kt, PetscReal *kth)
 {
-  *kn = mp->c;
+  const PetscReal L = b->length, fn = PeriLatticeFactor(mp->normal, b);
+  *kn = mp->c * fn;
   if (mp->gerstle) {
-    *kt  = 12 * mp->d / (L * L);
-    *kth = mp->d / L;
+    const PetscReal ft = PeriLatticeFactor(mp->shear, b);
+    *kt                = 12 * mp->d * ft / (L * L);
+    *kth               = mp->d * ft / L;
   } else {
-    *kt  = mp->g;
-    *kth = mp->k_theta >= 0 ? mp->k_theta : mp->k_theta_factor * mp->c * delta * delta / (36 * L);
+    *kt  = mp->g * fn;
+    *kth = fn * (mp->k_theta >= 0 ? mp->k_theta : mp->k_theta_factor * mp->c * delta * delta / (36 * L));
   }
 }
 
@@ -84,7 +98,7 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
   const MPPD *mp = (const MPPD *)m->data;
   PetscReal   bs[6], bg[6], bt[6], kn, kt, kth, w = b->Vi * b->Vj * b->weight;
   Vectors(b, bs, bg, bt);
-  Springs(mp, m->delta, b->length, &kn, &kt, &kth);
+  Springs(mp, m->delta, b, &kn, &kt, &kth);
   for (PetscInt a = 0; a < 36; a++) Ke[a] = 0;
   PeriAddSpring(6, bs, w * kn * b->length, Ke);
   PeriAddSpring(6, bg, w * kt * b->length, Ke);
@@ -94,8 +108,18 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 /* the normal springs' critical stretch (the shear and rotational springs are left out of the energy balance) */
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
-  (void)b;
-  return PeriCriticalStretchSpring(m, ((const MPPD *)m->data)->c, G);
+  const MPPD *mp = (const MPPD *)m->data;
+  return PeriCriticalStretchSpring(m, mp->c * PeriLatticeFactor(mp->normal, b), G);
+}
+
+static PetscErrorCode Destroy(PeriModel m)
+{
+  MPPD *mp = (MPPD *)m->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriLatticeDestroy(&mp->normal));
+  PetscCall(PeriLatticeDestroy(&mp->shear));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[], const PetscReal uj[], PetscReal h[])
@@ -148,6 +172,8 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->ops.bond_measures   = BondMeasures;
   m->ops.critical_from_G = CriticalFromG;
   m->ops.rigid_modes     = RigidModes;
+  m->ops.destroy         = Destroy;
+  m->takes_lattice       = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

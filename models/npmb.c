@@ -6,8 +6,9 @@
 #include <perilin/model.h>
 
 typedef struct {
-  PetscInt   n;
-  PetscReal *c; /* per particle (global index) */
+  PetscInt    n;
+  PetscReal  *c;   /* per particle (global index) */
+  PeriLattice lat; /* model.calibration: lattice (which then holds the normalization), else NULL */
 } NPMB;
 
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
@@ -19,7 +20,12 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
   PetscCall(PetscFree(np->c));
   PetscCall(PetscMalloc1(data->n, &np->c));
   np->n = data->n;
+  PetscCall(PeriLatticeCreate(m, data, 4, PeriProfileOne, &np->lat));
   for (PetscInt i = 0; i < data->n; i++) {
+    if (np->lat) { /* the lattice factor normalizes by the family and makes it isotropic */
+      np->c[i] = 4 * W0 / PeriModelHorizonMoment(m, 0);
+      continue;
+    }
     PetscCheck(data->family_volume[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "npmb: particle %" PetscInt_FMT " has no neighbours, its micromodulus is undefined (is the horizon smaller than the spacing?)", i);
     np->c[i] = 4 * W0 / data->family_volume[i];
   }
@@ -30,7 +36,7 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[])
 {
   const NPMB *np = (const NPMB *)m->data;
-  PetscReal   c  = 0.5 * (np->c[b->i] + np->c[b->j]);
+  PetscReal   c  = 0.5 * (np->c[b->i] + np->c[b->j]) * PeriLatticeFactor(np->lat, b);
   PeriCentralBondBlock(m, b, c * b->Vi * b->Vj * b->weight / (b->length * b->length), Ke);
 }
 
@@ -43,7 +49,7 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
   const NPMB *np = (const NPMB *)m->data;
-  PetscReal   c  = 0.5 * (np->c[b->i] + np->c[b->j]);
+  PetscReal   c  = 0.5 * (np->c[b->i] + np->c[b->j]) * PeriLatticeFactor(np->lat, b);
   if (m->dim == 3) return PetscSqrtReal(8 * G / (PETSC_PI * c * PetscPowReal(m->delta, 4)));
   return PetscSqrtReal(3 * G / (c * m->material.thickness * PetscPowReal(m->delta, 3)));
 }
@@ -52,6 +58,7 @@ static PetscErrorCode Destroy(PeriModel m)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscFree(((NPMB *)m->data)->c));
+  PetscCall(PeriLatticeDestroy(&((NPMB *)m->data)->lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -69,6 +76,7 @@ static PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
   m->ops.bond_stiffness        = BondStiffness;
   m->ops.destroy               = Destroy;
   m->ops.critical_from_G       = CriticalFromG;
+  m->takes_lattice             = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

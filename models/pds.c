@@ -7,7 +7,8 @@
 #include <perilin/model.h>
 
 typedef struct {
-  PetscReal c, g;
+  PetscReal   c, g;
+  PeriLattice lat; /* model.calibration: lattice, else NULL */
 } PDS;
 
 static const char *const components[] = {"ux", "uy"};
@@ -18,8 +19,9 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
   PDS *pds = (PDS *)m->data;
 
   PetscFunctionBeginUser;
-  (void)data;
   PeriPlaneMicromoduli(m, &pds->c, &pds->g);
+  /* both springs weigh |xi|: one family */
+  PetscCall(PeriLatticeCreate(m, data, 4, PeriProfileLength, &pds->lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -40,7 +42,7 @@ static void Vectors(const PeriBondGeometry *b, PetscReal bs[4], PetscReal bg[4])
 static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[])
 {
   const PDS *pds = (const PDS *)m->data;
-  PetscReal  bs[4], bg[4], w = b->Vi * b->Vj * b->weight * b->length;
+  PetscReal  bs[4], bg[4], w = b->Vi * b->Vj * b->weight * b->length * PeriLatticeFactor(pds->lat, b);
   Vectors(b, bs, bg);
   for (PetscInt a = 0; a < 16; a++) Ke[a] = 0;
   PeriAddSpring(4, bs, w * pds->c, Ke);
@@ -50,8 +52,15 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 /* the normal springs' critical stretch (the shear springs are left out of the energy balance) */
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
-  (void)b;
-  return PeriCriticalStretchSpring(m, ((const PDS *)m->data)->c, G);
+  const PDS *pds = (const PDS *)m->data;
+  return PeriCriticalStretchSpring(m, pds->c * PeriLatticeFactor(pds->lat, b), G);
+}
+
+static PetscErrorCode Destroy(PeriModel m)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriLatticeDestroy(&((PDS *)m->data)->lat));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static void BondMeasures(PeriModel m, const PeriBondGeometry *b, const PetscReal ui[], const PetscReal uj[], PetscReal h[])
@@ -83,6 +92,8 @@ static PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   m->ops.bond_stiffness  = BondStiffness;
   m->ops.bond_measures   = BondMeasures;
   m->ops.critical_from_G = CriticalFromG;
+  m->ops.destroy         = Destroy;
+  m->takes_lattice       = PETSC_TRUE;
   /* the rotation is not a zero-energy mode for g != 0, but it is the near-null space AMG wants */
   m->ops.rigid_modes = PeriTranslationalRigidModes;
   PetscFunctionReturn(PETSC_SUCCESS);

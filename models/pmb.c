@@ -5,7 +5,8 @@
 #include <perilin/model.h>
 
 typedef struct {
-  PetscReal c;
+  PetscReal   c;
+  PeriLattice lat; /* model.calibration: lattice, else NULL */
 } PMB;
 
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
@@ -13,8 +14,8 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
   PMB *pmb = (PMB *)m->data;
 
   PetscFunctionBeginUser;
-  (void)data;
   pmb->c = 4 * PeriModelIsotropicEnergy(m) / PeriModelHorizonMoment(m, 1);
+  PetscCall(PeriLatticeCreate(m, data, 4, PeriProfileLength, &pmb->lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -22,13 +23,20 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[])
 {
   const PMB *pmb = (const PMB *)m->data;
-  PeriCentralBondBlock(m, b, pmb->c * b->Vi * b->Vj * b->weight / b->length, Ke);
+  PeriCentralBondBlock(m, b, pmb->c * PeriLatticeFactor(pmb->lat, b) * b->Vi * b->Vj * b->weight / b->length, Ke);
 }
 
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
-  (void)b;
-  return PeriCriticalStretchSpring(m, ((const PMB *)m->data)->c, G);
+  const PMB *pmb = (const PMB *)m->data;
+  return PeriCriticalStretchSpring(m, pmb->c * PeriLatticeFactor(pmb->lat, b), G);
+}
+
+static PetscErrorCode Destroy(PeriModel m)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriLatticeDestroy(&((PMB *)m->data)->lat));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode PeriModelCreate_PMB(PeriModel m)
@@ -42,6 +50,8 @@ static PetscErrorCode PeriModelCreate_PMB(PeriModel m)
   m->ops.calibrate       = Calibrate;
   m->ops.bond_stiffness  = BondStiffness;
   m->ops.critical_from_G = CriticalFromG;
+  m->ops.destroy         = Destroy;
+  m->takes_lattice       = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -16,6 +16,15 @@ typedef struct {
 } PeriCalibrationData;
 
 typedef struct _p_PeriModel *PeriModel;
+
+/* model.calibration: the micromoduli from the continuous horizon (the papers'), or with every
+ * particle's discrete family made to reproduce the continuum's moments (models/lattice.c) */
+typedef enum {
+  PERI_CALIBRATION_CONTINUUM,
+  PERI_CALIBRATION_LATTICE
+} PeriCalibrationKind;
+PETSC_EXTERN const char *const PeriCalibrationKinds[];
+typedef struct _n_PeriLattice *PeriLattice;
 typedef struct {
   /* Reads the model's own scene keys (model.*); may be NULL. */
   PetscErrorCode (*setfromscene)(PeriModel, PeriScene, PeriNode);
@@ -39,24 +48,26 @@ typedef struct {
 } PeriModelOps;
 
 struct _p_PeriModel {
-  char               type[PERI_NAME_LEN];
-  PeriModelOps       ops;
-  PetscInt           dim;
-  PetscBool          plane_strain;
-  PetscInt           dofs;
-  const char *const *components; /* dofs names, e.g. "ux", "uy" */
-  PetscInt           nmeasures;
-  const char *const *measure_names;
-  PetscBool          allows_surface_correction;
-  const char *const *surface_corrections;      /* allowed corrections.surface values; NULL: none, volume */
-  PetscBool          antiplane;                /* one DOF, the out-of-plane displacement uz: stresses tau_xz, tau_yz */
-  PetscBool          inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
-  PetscBool          rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
-  PetscBool          central_force;            /* every bond block is k [e e^T, -e e^T; -e e^T, e e^T], k >= 0 (PeriModelSetCentralForce) */
-  char               warning[256];             /* set by calibration; printed once by the problem */
-  PeriMaterial       material;
-  PetscReal          delta;
-  void              *data;
+  char                type[PERI_NAME_LEN];
+  PeriModelOps        ops;
+  PetscInt            dim;
+  PetscBool           plane_strain;
+  PetscInt            dofs;
+  const char *const  *components; /* dofs names, e.g. "ux", "uy" */
+  PetscInt            nmeasures;
+  const char *const  *measure_names;
+  PetscBool           allows_surface_correction;
+  const char *const  *surface_corrections;      /* allowed corrections.surface values; NULL: none, volume */
+  PetscBool           antiplane;                /* one DOF, the out-of-plane displacement uz: stresses tau_xz, tau_yz */
+  PetscBool           inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
+  PetscBool           rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
+  PetscBool           central_force;            /* every bond block is k [e e^T, -e e^T; -e e^T, e e^T], k >= 0 (PeriModelSetCentralForce) */
+  PetscBool           takes_lattice;            /* the model implements model.calibration: lattice */
+  PeriCalibrationKind calibration;              /* set before calibrate */
+  char                warning[256];             /* set by calibration; printed once by the problem */
+  PeriMaterial        material;
+  PetscReal           delta;
+  void               *data;
 };
 
 PETSC_EXTERN PetscReal      PeriModelIsotropicEnergy(PeriModel);
@@ -71,6 +82,11 @@ PETSC_EXTERN void           PeriBondBasedNuRange(PeriModel, PetscReal *, PetscRe
 PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);
 PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
 PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriLatticeCreate(PeriModel, const PeriCalibrationData *, PetscInt, PetscReal (*)(PeriModel, PetscReal), PeriLattice *);
+PETSC_EXTERN PetscReal      PeriLatticeFactor(PeriLattice, const PeriBondGeometry *);
+PETSC_EXTERN PetscReal      PeriProfileLength(PeriModel, PetscReal);
+PETSC_EXTERN PetscReal      PeriProfileOne(PeriModel, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriLatticeDestroy(PeriLattice *);
 
 /* A built-in model type. Each model file (models/) ends with its descriptor(s) PeriModel_<id>,
  * whose create function stays static; models/list.h names them and src/model/registry.c registers

@@ -5,6 +5,8 @@
 
 static PetscFunctionList PeriModelList = NULL;
 
+const char *const PeriCalibrationKinds[] = {"continuum", "lattice", NULL};
+
 /* Run by PetscFinalize: frees the list, as PETSc's own packages do (src/model/registry.c forgets on
  * its own that it filled it). */
 static PetscErrorCode PeriModelFinalizePackage(void)

@@ -12,6 +12,7 @@ PetscErrorCode PeriSystemSummaryModel(PeriSystem sys, PeriJSON j)
   PetscCall(PeriJSONString(j, "model", m->type));
   PetscCall(PeriJSONInt(j, "dim", sys->disc.particles.dim));
   if (sys->disc.particles.dim == 2) PetscCall(PeriJSONString(j, "plane", m->plane_strain ? "strain" : "stress"));
+  PetscCall(PeriJSONString(j, "calibration", PeriCalibrationKinds[m->calibration]));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

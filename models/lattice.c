@@ -1,0 +1,299 @@
+/* Lattice-consistent calibration (model.calibration: lattice), shared by the bond models.
+ *
+ * A model calibrated on the continuous horizon gets the energy of a homogeneous strain right only
+ * where its discrete family sums equal the horizon integrals. Every energy of a homogeneous strain
+ * is a moment of the family: the sum over the bonds of w = alpha lambda V_j p(|xi|) times a
+ * polynomial of the bond direction e, of degree 4 for displacement vectors (stretch^2 and
+ * sliding^2 are quartic in e) and of degree 2 for one antiplane component. p is the spring's
+ * length profile (pmb: |xi|). The continuum's moments are isotropic, S times the mean of the
+ * monomial over the unit circle or sphere, with S = int_H p dV. A grid's are not: they miss S by a
+ * few per cent and carry the grid's anisotropy (5 % in the fourth moments at m = 3 in 2D).
+ *
+ * So each particle i gets a multiplier for its bonds, scale_i mu_i(e): mu_i is the polynomial of
+ * that degree in e closest to 1 (least squares with the weights w) that makes the family's moments
+ * isotropic with the family's own sum S_i, and scale_i = S / S_i. A bond's factor is the mean of
+ * its two ends' multipliers (the bond stays symmetric). The family's moments then equal the
+ * continuum's, so the continuum micromoduli reproduce the target elasticity exactly for every
+ * homogeneous strain wherever a particle and its neighbours share a family shape, at surfaces,
+ * corners and cracks too (docs/models/lattice.md). Where no polynomial of the degree makes the
+ * family isotropic, or it would turn a bond's multiplier below a tenth (a family too lopsided, as
+ * at a corner), the particle keeps mu = 1, its scale only, as npmb, and the calibration warns how
+ * many did. */
+#include <perilin/model.h>
+#include <petscblaslapack.h>
+
+#define LATTICE_MAX_BASIS 15 /* degree-4 monomials in 3D */
+#define LATTICE_MAX_MOM   45 /* degree-8 monomials in 3D */
+#define LATTICE_MIN_MU    0.1
+
+struct _n_PeriLattice {
+  PetscInt   n, dim, degree, nbasis;
+  PetscReal *scale; /* per particle (global index) */
+  PetscReal *coef;  /* per particle: nbasis coefficients of mu_i */
+  PetscInt   kept;  /* particles that kept mu = 1 */
+};
+
+/* monomials of total degree D in dim variables, in a fixed order: exponents of the k-th */
+static PetscInt NumMonomials(PetscInt dim, PetscInt D)
+{
+  return dim == 2 ? D + 1 : (D + 1) * (D + 2) / 2;
+}
+
+static void Exponents(PetscInt dim, PetscInt D, PetscInt k, PetscInt a[3])
+{
+  PetscInt idx = 0;
+  a[0] = a[1] = a[2] = 0;
+  if (dim == 2) {
+    a[0] = D - k;
+    a[1] = k;
+    return;
+  }
+  for (PetscInt x = D; x >= 0; x--)
+    for (PetscInt y = D - x; y >= 0; y--, idx++)
+      if (idx == k) {
+        a[0] = x;
+        a[1] = y;
+        a[2] = D - x - y;
+        return;
+      }
+}
+
+static PetscInt MonomialIndex(PetscInt dim, PetscInt D, const PetscInt a[3])
+{
+  if (dim == 2) return a[1];
+  /* rows x = D, D-1, ... hold D - x + 1 monomials each */
+  return (D - a[0]) * (D - a[0] + 1) / 2 + (D - a[0] - a[1]);
+}
+
+static PetscReal Power(PetscReal x, PetscInt p)
+{
+  PetscReal r = 1;
+  for (PetscInt k = 0; k < p; k++) r *= x;
+  return r;
+}
+
+static PetscReal Monomial(const PetscReal e[3], const PetscInt a[3])
+{
+  return Power(e[0], a[0]) * Power(e[1], a[1]) * Power(e[2], a[2]);
+}
+
+static PetscReal DoubleFactorial(PetscInt n)
+{
+  PetscReal r = 1;
+  for (PetscInt k = n; k > 1; k -= 2) r *= k;
+  return r;
+}
+
+/* the mean of e^a over the unit circle (dim 2) or sphere (dim 3): (a-1)!!(b-1)!!(c-1)!!/(|a|+dim-2)!! */
+static PetscReal IsotropicMean(PetscInt dim, const PetscInt a[3])
+{
+  if (a[0] % 2 || a[1] % 2 || a[2] % 2) return 0;
+  return DoubleFactorial(a[0] - 1) * DoubleFactorial(a[1] - 1) * DoubleFactorial(a[2] - 1) / DoubleFactorial(a[0] + a[1] + a[2] + dim - 2);
+}
+
+/* the multinomial coefficient of e^a in (e.e)^(D/2): sum_a coef e^a = 1 on the unit sphere */
+static PetscReal UnitCoefficient(const PetscInt a[3])
+{
+  PetscInt  h[3] = {a[0] / 2, a[1] / 2, a[2] / 2};
+  PetscReal r    = 1;
+  if (a[0] % 2 || a[1] % 2 || a[2] % 2) return 0;
+  for (PetscInt k = 1; k <= h[0] + h[1] + h[2]; k++) r *= k;
+  for (PetscInt d = 0; d < 3; d++)
+    for (PetscInt k = 1; k <= h[d]; k++) r /= k;
+  return r;
+}
+
+/* int_H p(|xi|) dV by 8-point Gauss-Legendre on [0, delta] (exact for the polynomial profiles times
+ * the radial measure r dr or r^2 dr; 1/|xi| times r is constant) */
+static PetscReal HorizonIntegral(PeriModel m, PetscReal (*profile)(PeriModel, PetscReal))
+{
+  static const PetscReal x[4] = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267, 0.9602898564975363};
+  static const PetscReal w[4] = {0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+  PetscReal              s = 0, h = 0.5 * m->delta;
+  for (PetscInt k = 0; k < 8; k++) {
+    PetscReal r = h * (1 + (k < 4 ? -x[k] : x[k - 4])), wk = w[k % 4] * h;
+    s += wk * profile(m, r) * (m->dim == 2 ? 2 * PETSC_PI * r * m->material.thickness : 4 * PETSC_PI * r * r);
+  }
+  return s;
+}
+
+/* the degree-2D moments of every particle's family, summed over both ends of this rank's bonds and
+ * then over the ranks; mom is n x nmom */
+static PetscErrorCode FamilyMoments(PeriModel m, const PeriCalibrationData *data, PetscInt D2, PetscReal (*profile)(PeriModel, PetscReal), PetscReal mom[])
+{
+  const PeriBonds     *b    = data->bonds;
+  const PeriParticles *pt   = data->particles;
+  const PetscInt       nmom = NumMonomials(m->dim, D2);
+  PetscInt             a[LATTICE_MAX_MOM][3];
+
+  PetscFunctionBeginUser;
+  for (PetscInt q = 0; q < nmom; q++) Exponents(m->dim, D2, q, a[q]);
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      const PetscInt  j = b->j[k];
+      const PetscReal L = b->length[k], w = b->alpha[k] * b->lambda[k] * profile(m, L);
+      PetscReal       e[3] = {b->xi[3 * k] / L, b->xi[3 * k + 1] / L, m->dim == 3 ? b->xi[3 * k + 2] / L : 0};
+      if (j == i) continue; /* a periodic self-image: no energy in a periodic field */
+      for (PetscInt q = 0; q < nmom; q++) {
+        PetscReal v = Monomial(e, a[q]);
+        mom[i * nmom + q] += w * pt->volume[j] * v;
+        mom[j * nmom + q] += w * pt->volume[i] * v;
+      }
+    }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, mom, (PetscMPIInt)(data->n * nmom), MPIU_REAL, MPI_SUM, data->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The minimum-norm least-squares solution of the nb x nb system G c = r (LAPACK's SVD solver; G
+ * is singular where the family has fewer directions than the basis has monomials, a small horizon,
+ * and the system may still be consistent). False when it is not: no polynomial of the basis makes
+ * this family isotropic. */
+static PetscBool SolveSmall(PetscInt nb, const PetscReal G[], PetscReal r[])
+{
+  PetscReal    A[LATTICE_MAX_BASIS * LATTICE_MAX_BASIS], x[LATTICE_MAX_BASIS], sv[LATTICE_MAX_BASIS], work[64 * LATTICE_MAX_BASIS], rcond = 1e-12, res = 0, rn = 0;
+  PetscBLASInt n = (PetscBLASInt)nb, one = 1, rank, lwork = 64 * LATTICE_MAX_BASIS, info;
+
+  for (PetscInt k = 0; k < nb * nb; k++) A[k] = G[k];
+  for (PetscInt k = 0; k < nb; k++) x[k] = r[k];
+  LAPACKgelss_(&n, &n, &one, A, &n, x, &n, sv, &rcond, &rank, work, &lwork, &info);
+  if (info) return PETSC_FALSE;
+  for (PetscInt k = 0; k < nb; k++) {
+    PetscReal t = -r[k];
+    for (PetscInt l = 0; l < nb; l++) t += G[k * nb + l] * x[l];
+    res += t * t;
+    rn += r[k] * r[k];
+  }
+  if (res > 1e-16 * rn) return PETSC_FALSE;
+  for (PetscInt k = 0; k < nb; k++) r[k] = x[k];
+  return PETSC_TRUE;
+}
+
+/* mu = 1 written in the basis: the coefficients of (e.e)^(D/2) */
+static void UnitPolynomial(PeriLattice lat, PetscReal coef[])
+{
+  PetscInt a[3];
+  for (PetscInt k = 0; k < lat->nbasis; k++) {
+    Exponents(lat->dim, lat->degree, k, a);
+    coef[k] = UnitCoefficient(a);
+  }
+}
+
+/* particle i's polynomial from its moments: the weighted least-squares fit
+ * sum_l G_kl c_l = S_i <e^a_k>, G_kl = sum_j w_j e^(a_k + a_l) */
+static PetscBool ParticlePolynomial(PeriLattice lat, const PetscReal mom[], PetscReal coef[], PetscReal *S)
+{
+  const PetscInt nb = lat->nbasis, D2 = 2 * lat->degree;
+  PetscReal      G[LATTICE_MAX_BASIS * LATTICE_MAX_BASIS];
+  PetscInt       a[3], c[3], s[3];
+
+  *S = 0;
+  for (PetscInt q = 0; q < NumMonomials(lat->dim, D2); q++) {
+    Exponents(lat->dim, D2, q, a);
+    *S += UnitCoefficient(a) * mom[q];
+  }
+  for (PetscInt k = 0; k < nb; k++) {
+    Exponents(lat->dim, lat->degree, k, a);
+    coef[k] = *S * IsotropicMean(lat->dim, a);
+    for (PetscInt l = 0; l < nb; l++) {
+      Exponents(lat->dim, lat->degree, l, c);
+      for (PetscInt d = 0; d < 3; d++) s[d] = a[d] + c[d];
+      G[k * nb + l] = mom[MonomialIndex(lat->dim, D2, s)];
+    }
+  }
+  if (SolveSmall(nb, G, coef)) return PETSC_TRUE;
+  UnitPolynomial(lat, coef);
+  return PETSC_FALSE;
+}
+
+static PetscReal Multiplier(PeriLattice lat, PetscInt i, const PetscReal e[3])
+{
+  PetscReal mu = 0;
+  PetscInt  a[3];
+  for (PetscInt k = 0; k < lat->nbasis; k++) {
+    Exponents(lat->dim, lat->degree, k, a);
+    mu += lat->coef[i * lat->nbasis + k] * Monomial(e, a);
+  }
+  return mu;
+}
+
+/* a particle some of whose bonds the polynomial would nearly switch off keeps mu = 1 */
+static PetscErrorCode KeepLopsided(PeriLattice lat, const PeriCalibrationData *data)
+{
+  const PeriBonds *b = data->bonds;
+  PetscInt        *bad;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(lat->n, &bad));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      const PetscInt  j = b->j[k];
+      const PetscReal L = b->length[k], e[3] = {b->xi[3 * k] / L, b->xi[3 * k + 1] / L, lat->dim == 3 ? b->xi[3 * k + 2] / L : 0};
+      if (j == i) continue;
+      if (Multiplier(lat, i, e) < LATTICE_MIN_MU) bad[i] = 1;
+      if (Multiplier(lat, j, e) < LATTICE_MIN_MU) bad[j] = 1;
+    }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, bad, (PetscMPIInt)lat->n, MPIU_INT, MPI_MAX, data->comm));
+  for (PetscInt i = 0; i < lat->n; i++)
+    if (bad[i]) {
+      UnitPolynomial(lat, lat->coef + i * lat->nbasis);
+      lat->kept++;
+    }
+  PetscCall(PetscFree(bad));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriLatticeCreate - the lattice calibration of one spring family: for every particle the scale
+  and the angular polynomial (of degree 4, or 2 for a scalar field) that make the discrete moments
+  of the weights alpha lambda V_j profile(|xi|) equal the continuum's. Frees *lattice first; leaves
+  it NULL (factor 1) unless model.calibration is lattice. Collective on data->comm.
+@*/
+PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, PetscInt degree, PetscReal (*profile)(PeriModel, PetscReal), PeriLattice *lattice)
+{
+  PeriLattice lat;
+  PetscReal  *mom, Scont = HorizonIntegral(m, profile);
+  PetscInt    nmom = NumMonomials(m->dim, 2 * degree);
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriLatticeDestroy(lattice));
+  if (m->calibration != PERI_CALIBRATION_LATTICE) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscNew(&lat));
+  lat->n      = data->n;
+  lat->dim    = m->dim;
+  lat->degree = degree;
+  lat->nbasis = NumMonomials(m->dim, degree);
+  PetscCall(PetscMalloc2(lat->n, &lat->scale, lat->n * lat->nbasis, &lat->coef));
+  PetscCall(PetscCalloc1(lat->n * nmom, &mom));
+  PetscCall(FamilyMoments(m, data, 2 * degree, profile, mom));
+  for (PetscInt i = 0; i < lat->n; i++) {
+    PetscReal S;
+    if (!ParticlePolynomial(lat, mom + i * nmom, lat->coef + i * lat->nbasis, &S)) lat->kept++;
+    PetscCheck(S > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the particle at (%g, %g) has no bonds, so its lattice calibration is undefined (is the horizon smaller than the spacing?)", m->type, (double)data->particles->x[3 * i], (double)data->particles->x[3 * i + 1]);
+    lat->scale[i] = Scont / S;
+  }
+  PetscCall(PetscFree(mom));
+  PetscCall(KeepLopsided(lat, data));
+  if (lat->kept)
+    PetscCall(PetscSNPrintf(m->warning, sizeof(m->warning), "lattice calibration: %" PetscInt_FMT " of %" PetscInt_FMT " particles have families that cannot be made isotropic gently (too few directions, or a bond's multiplier would fall below %g, as at corners); they keep their scale only, as npmb", lat->kept, lat->n, (double)LATTICE_MIN_MU));
+  *lattice = lat;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The factor of a bond's continuum stiffness: the mean of its two ends' multipliers; 1 without a
+ * lattice calibration (lat NULL). */
+PetscReal PeriLatticeFactor(PeriLattice lat, const PeriBondGeometry *b)
+{
+  PetscReal e[3];
+  if (!lat) return 1;
+  for (PetscInt d = 0; d < 3; d++) e[d] = d < lat->dim ? b->xi[d] / b->length : 0;
+  return 0.5 * (lat->scale[b->i] * Multiplier(lat, b->i, e) + lat->scale[b->j] * Multiplier(lat, b->j, e));
+}
+
+PetscErrorCode PeriLatticeDestroy(PeriLattice *lat)
+{
+  PetscFunctionBeginUser;
+  if (!*lat) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscFree2((*lat)->scale, (*lat)->coef));
+  PetscCall(PetscFree(*lat));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
