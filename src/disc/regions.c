@@ -11,8 +11,9 @@ static const PeriKey     region_keys[] = {
 };
 const PeriSchema PeriRegionsSchema[] = {{"regions.<name>", region_keys}, {NULL}};
 
-/* Points on a region's boundary belong to it: tolerance relative to the body size. */
-static PetscReal Tolerance(const PeriParticles *p)
+/* Points on a region's boundary belong to it: every box is widened by this tolerance, relative to
+ * the body size. */
+PetscReal PeriRegionTolerance(const PeriParticles *p)
 {
   PetscReal L = 0;
   for (PetscInt d = 0; d < p->dim; d++) L = PetscMax(L, p->upper[d] - p->lower[d]);
@@ -29,7 +30,7 @@ PetscBool PeriRegionContains(const PeriRegion *r, const PetscReal x[])
 
 static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const PeriParticles *p, PetscReal delta, PeriRegion *r)
 {
-  PetscReal tol = Tolerance(p);
+  PetscReal tol = PeriRegionTolerance(p);
   PetscInt  n, dim = p->dim, side = -1;
   PeriNode  lower, sidenode;
 
@@ -98,8 +99,8 @@ PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *
   PetscCall(PetscStrncpy(r[0].name, "all", sizeof(r[0].name)));
   r[0].kind = PERI_REGION_ALL;
   for (PetscInt d = 0; d < 3; d++) {
-    r[0].lower[d] = p->lower[d] - Tolerance(p);
-    r[0].upper[d] = p->upper[d] + Tolerance(p);
+    r[0].lower[d] = p->lower[d] - PeriRegionTolerance(p);
+    r[0].upper[d] = p->upper[d] + PeriRegionTolerance(p);
   }
   for (PetscInt k = 0; k < p->n; k++)
     if (!PeriParticleIsFictitious(p, k)) {

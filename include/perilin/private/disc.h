@@ -31,6 +31,7 @@ typedef struct {
 PETSC_EXTERN PetscErrorCode PeriRegionsCreateFromScene(PeriScene, const PeriParticles *, PetscReal, PetscInt *, PeriRegion **);
 PETSC_EXTERN PetscErrorCode PeriRegionFind(PeriScene, PeriNode, const char[], PetscInt, PeriRegion *, PeriRegion **);
 PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscReal[]);
+PETSC_EXTERN PetscReal      PeriRegionTolerance(const PeriParticles *);
 
 PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsDestroy(PeriBonds *);
