@@ -174,6 +174,7 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->ops.rigid_modes     = RigidModes;
   m->ops.destroy         = Destroy;
   m->takes_lattice       = PETSC_TRUE;
+  m->calibration         = PERI_CALIBRATION_LATTICE; /* the default: it wins on every lamina benchmark (docs/models/lattice.md) */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

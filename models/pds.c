@@ -94,6 +94,7 @@ static PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   m->ops.critical_from_G = CriticalFromG;
   m->ops.destroy         = Destroy;
   m->takes_lattice       = PETSC_TRUE;
+  m->calibration         = PERI_CALIBRATION_LATTICE; /* the default: it wins on every lamina benchmark (docs/models/lattice.md) */
   /* the rotation is not a zero-energy mode for g != 0, but it is the near-null space AMG wants */
   m->ops.rigid_modes = PeriTranslationalRigidModes;
   PetscFunctionReturn(PETSC_SUCCESS);

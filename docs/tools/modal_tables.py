@@ -3,7 +3,7 @@
 square lamina, sec. 3.1) and the free-bar sound speed of Ganzenmueller et al. (sec. 3.1.2).
 
 Runs, from the repository root,
-    build/perilin examples/lamina/modal.yaml -model_type M -material_nu NU -output_dir TMP
+    build/perilin examples/lamina/modal.yaml -model_type M -material_nu NU -model_calibration continuum -corrections_surface volume -output_dir TMP
 for M in pds, mppd, gerstle and NU in -0.5, 0, 0.1, 0.25, 1/3 (15 runs, ~1.5 s each), and
     build/perilin examples/pmb/bar_modes.yaml -model_type M -output_dir TMP
 for M in npmb, pmb, reads each TMP/summary.json and prints a markdown document.
@@ -216,7 +216,7 @@ def generate(tmp):
     maxres = 0.0
     for m in MODELS:
         for nu in NUS:
-            s, _ = run(lam, ["-model_type", m, "-material_nu", nu], tmp)
+            s, _ = run(lam, ["-model_type", m, "-material_nu", nu, "-model_calibration", "continuum", "-corrections_surface", "volume"], tmp)
             res[m, nu] = s["modal"]["modes"]
             maxres = max([maxres] + [x["residual"] for x in s["modal"]["modes"]])
     bars = {}
@@ -237,7 +237,7 @@ def generate(tmp):
       "ρ = 2500 kg/m³, plane stress, the bottom 30 mm (three rows) clamped, ux, uy and θ (θ only "
       "for mppd/gerstle: `optional: true`). Each row is one run")
     w("")
-    w("    build/perilin examples/lamina/modal.yaml -model_type M -material_nu NU -output_dir TMP")
+    w("    build/perilin examples/lamina/modal.yaml -model_type M -material_nu NU -model_calibration continuum -corrections_surface volume -output_dir TMP")
     w("")
     w("Our modes are taken from `modal.modes` of `summary.json` in ascending frequency: f_I is the "
       "first mode of kind `flexural`, f_II the first `axial`, f_III the second `flexural`. "

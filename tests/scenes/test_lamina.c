@@ -12,7 +12,18 @@
  * plate's own distance to its lattice value + 2 %; bending within the issue's 5 % of exact
  * elasticity for mppd, and for gerstle within 5 % of the elastic solution with its lattice's
  * constants (its 1/|xi|^2 shear springs homogenize to nu_eff = 0.08 at nu = 0 on this lattice,
- * docs/models/mppd.md); pds off by more than 30 % (the paper: 51-200 %). */
+ * docs/models/mppd.md); pds off by more than 30 % (the paper: 51-200 %). These run with the papers'
+ * calibration (model.calibration: continuum, corrections.surface: volume).
+ *
+ * model.calibration: lattice (perilin's default for these models) against an exact isotropic
+ * continuum loaded and measured exactly as these scenes (docs/tools/lamina_static_fem.py, an
+ * independent Q9 FEM converged to 4-5 digits; its numbers are typed in below). The scenes' own
+ * loading biases every exact material (G_eff 6 % low, nu_eff -0.4855 at -0.5: the loaded layers
+ * are delta deep), so that FEM, not E, nu, G, is what an exact lattice must give. Asserted for mppd
+ * and gerstle at every nu: nu_eff within 0.003 of the FEM's, E_eff and G_eff within 0.3 %, and
+ * bending error.l2_rel within 0.3 percentage points of the FEM's own (all measured within half of
+ * that, docs/models/lattice.md) and below the issue's 3 %; pds (not rotation invariant: its shear
+ * and bending are its own) nu_eff within 0.006. */
 #include "testing.h"
 #include <slepcsys.h>
 
@@ -151,6 +162,55 @@ static PetscErrorCode Extremes(const char dir[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* the exact continuum on the scenes at dx = 0.01 (docs/tools/lamina_static_fem.py): per nu
+ * -0.5, 0, 0.1, 0.25, 1/3: E_eff / E - 1, nu_eff, G_eff / G - 1, bending l2_rel */
+static const PetscReal fem_scene[5][4] = {
+    {0.011187, -0.48546, -0.06947, 0.0143},
+    {0.0, 0.0, -0.06172, 0.0},
+    {-0.001611, 0.09732, -0.06101, 0.00252},
+    {-0.003645, 0.24370, -0.06016, 0.00612},
+    {-0.004579, 0.32530, -0.05977, 0.00804}};
+
+static PetscErrorCode LatticeTargets(const char dir[])
+{
+  const char *const nus[] = {"-0.5", "0", "0.1", "0.25", "1/3"}, *const models[] = {"pds", "mppd", "gerstle"};
+  const PetscReal E = 7e10;
+  PeriProblem     p;
+  PetscMPIInt     rank;
+  char            what[160];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+  PetscCall(PeriTestSetOption("-model_calibration", NULL));
+  PetscCall(PeriTestSetOption("-corrections_surface", NULL));
+  for (int k = 0; k < 5; k++) {
+    PetscReal nu = k == 4 ? 1.0 / 3 : (PetscReal)atof(nus[k]), G = E / (2 * (1 + nu));
+    for (int mo = 0; mo < 3; mo++) {
+      PetscCall(Run(dir, "traction", models[mo], nus[k], &p));
+      if (!rank) {
+        PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=%s traction: nu_eff vs the scene's exact continuum", models[mo], nus[k]));
+        PeriTestClose(what, p->sys->reference.effective_nu, fem_scene[k][1], mo ? 0.003 : 0.006);
+        PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=%s traction: E_eff / E - 1 vs the scene's exact continuum", models[mo], nus[k]));
+        if (mo) PeriTestClose(what, p->sys->reference.effective_E / E - 1, fem_scene[k][0], 0.003);
+      }
+      PetscCall(PeriProblemDestroy(&p));
+      if (!mo) continue;
+      PetscCall(Run(dir, "shear", models[mo], nus[k], &p));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=%s shear: G_eff / G - 1 vs the scene's exact continuum", models[mo], nus[k]));
+      if (!rank) PeriTestClose(what, p->sys->reference.effective_G / G - 1, fem_scene[k][2], 0.003);
+      PetscCall(PeriProblemDestroy(&p));
+      PetscCall(Run(dir, "bending", models[mo], nus[k], &p));
+      PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=%s bending: l2_rel vs the scene's exact continuum's", models[mo], nus[k]));
+      if (!rank) {
+        PeriTestClose(what, p->sys->reference.error_l2_rel, fem_scene[k][3], 0.003);
+        PetscCheck(p->sys->reference.error_l2_rel <= 0.03, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s: above 3 %%", what);
+      }
+      PetscCall(PeriProblemDestroy(&p));
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode Run(const char dir[], const char scene[], const char model[], const char nu[], PeriProblem *p)
 {
   char file[PETSC_MAX_PATH_LEN];
@@ -178,6 +238,8 @@ int main(int argc, char **argv)
   PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 2, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_lamina examples/lamina");
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
+  PetscCall(PeriTestSetOption("-model_calibration", "continuum"));
+  PetscCall(PeriTestSetOption("-corrections_surface", "volume"));
 
   /* what the finite plate costs: pmb (= pds at nu = 1/3) against its own lattice */
   Lattice(LATTICE_PMB, 1.0 / 3, 3, &lnu, &lE, &lG);
@@ -236,6 +298,7 @@ int main(int argc, char **argv)
   }
   (void)sigma;
   PetscCall(Extremes(argv[1]));
+  PetscCall(LatticeTargets(argv[1]));
   PetscCall(PeriFinalize());
   return 0;
 }

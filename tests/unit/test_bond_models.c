@@ -13,6 +13,8 @@ static PetscErrorCode Setup(const char file[], const char model[], const char nu
   PetscCall(PeriTestSetOption("-model_type", model));
   PetscCall(PeriTestSetOption("-material_nu", nu));
   PetscCall(PeriTestSetOption("-model_plane", plane));
+  /* the statements are about the continuum constants of eqs. 7, 21, 43 */
+  PetscCall(PeriTestSetOption("-model_calibration", "continuum"));
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, p));
   PetscCall(PeriProblemLoad(*p, file));
   PetscCall(PeriProblemSetUp(*p));
