@@ -25,12 +25,17 @@
 #define LATTICE_MAX_BASIS 15 /* degree-4 monomials in 3D */
 #define LATTICE_MAX_MOM   45 /* degree-8 monomials in 3D */
 #define LATTICE_MIN_MU    0.1
+#define LATTICE_DEGREE    4 /* the largest degree */
 
 struct _n_PeriLattice {
   PetscInt   n, dim, degree, nbasis;
-  PetscReal *scale; /* per particle (global index) */
-  PetscReal *coef;  /* per particle: nbasis coefficients of mu_i */
-  PetscInt   kept;  /* particles that kept mu = 1 */
+  PetscInt   a[LATTICE_MAX_BASIS][3];                    /* the basis's exponents */
+  PetscInt   gram[LATTICE_MAX_BASIS][LATTICE_MAX_BASIS]; /* the moment of a_k + a_l */
+  PetscReal  iso[LATTICE_MAX_BASIS];                     /* <e^a_k> */
+  PetscReal  unit[LATTICE_MAX_MOM];                      /* (e.e)^degree in the moments' monomials */
+  PetscReal *scale;                                      /* per particle (global index) */
+  PetscReal *coef;                                       /* per particle: nbasis coefficients of mu_i */
+  PetscInt   kept;                                       /* particles that kept mu = 1 */
 };
 
 /* monomials of total degree D in dim variables, in a fixed order: exponents of the k-th */
@@ -65,16 +70,13 @@ static PetscInt MonomialIndex(PetscInt dim, PetscInt D, const PetscInt a[3])
   return (D - a[0]) * (D - a[0] + 1) / 2 + (D - a[0] - a[1]);
 }
 
-static PetscReal Power(PetscReal x, PetscInt p)
+/* pw[d][p] = e_d^p for p <= D */
+static void Powers(const PetscReal e[3], PetscInt D, PetscReal pw[3][2 * LATTICE_DEGREE + 1])
 {
-  PetscReal r = 1;
-  for (PetscInt k = 0; k < p; k++) r *= x;
-  return r;
-}
-
-static PetscReal Monomial(const PetscReal e[3], const PetscInt a[3])
-{
-  return Power(e[0], a[0]) * Power(e[1], a[1]) * Power(e[2], a[2]);
+  for (PetscInt d = 0; d < 3; d++) {
+    pw[d][0] = 1;
+    for (PetscInt p = 1; p <= D; p++) pw[d][p] = pw[d][p - 1] * e[d];
+  }
 }
 
 static PetscReal DoubleFactorial(PetscInt n)
@@ -132,10 +134,11 @@ static PetscErrorCode FamilyMoments(PeriModel m, const PeriCalibrationData *data
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       const PetscInt  j = b->j[k];
       const PetscReal L = b->length[k], w = b->alpha[k] * b->lambda[k] * profile(m, L);
-      PetscReal       e[3] = {b->xi[3 * k] / L, b->xi[3 * k + 1] / L, m->dim == 3 ? b->xi[3 * k + 2] / L : 0};
+      PetscReal       e[3] = {b->xi[3 * k] / L, b->xi[3 * k + 1] / L, m->dim == 3 ? b->xi[3 * k + 2] / L : 0}, pw[3][2 * LATTICE_DEGREE + 1];
       if (j == i) continue; /* a periodic self-image: no energy in a periodic field */
+      Powers(e, D2, pw);
       for (PetscInt q = 0; q < nmom; q++) {
-        PetscReal v = Monomial(e, a[q]);
+        PetscReal v = pw[0][a[q][0]] * pw[1][a[q][1]] * pw[2][a[q][2]];
         mom[i * nmom + q] += w * pt->volume[j] * v;
         mom[j * nmom + q] += w * pt->volume[i] * v;
       }
@@ -178,41 +181,71 @@ static void UnitPolynomial(PeriLattice lat, PetscReal coef[])
   }
 }
 
+/* the tables ParticlePolynomial uses: exponents, Gram indices, isotropic means, unit polynomial */
+static void Tables(PeriLattice lat)
+{
+  const PetscInt D2 = 2 * lat->degree;
+  PetscInt       a[3], s[3];
+  for (PetscInt k = 0; k < lat->nbasis; k++) {
+    Exponents(lat->dim, lat->degree, k, lat->a[k]);
+    lat->iso[k] = IsotropicMean(lat->dim, lat->a[k]);
+  }
+  for (PetscInt k = 0; k < lat->nbasis; k++)
+    for (PetscInt l = 0; l < lat->nbasis; l++) {
+      for (PetscInt d = 0; d < 3; d++) s[d] = lat->a[k][d] + lat->a[l][d];
+      lat->gram[k][l] = MonomialIndex(lat->dim, D2, s);
+    }
+  for (PetscInt q = 0; q < NumMonomials(lat->dim, D2); q++) {
+    Exponents(lat->dim, D2, q, a);
+    lat->unit[q] = UnitCoefficient(a);
+  }
+}
+
+/* Cholesky, the fast path for a well-conditioned G (LAPACK dpotrf/dpotrs); false when G is not
+ * safely positive definite */
+static PetscBool SolveCholesky(PetscInt nb, const PetscReal G[], PetscReal r[])
+{
+  PetscReal    A[LATTICE_MAX_BASIS * LATTICE_MAX_BASIS], x[LATTICE_MAX_BASIS], dmin = PETSC_MAX_REAL, gmax = 0;
+  PetscBLASInt n = (PetscBLASInt)nb, one = 1, info;
+
+  for (PetscInt k = 0; k < nb * nb; k++) A[k] = G[k];
+  for (PetscInt k = 0; k < nb; k++) x[k] = r[k];
+  LAPACKpotrf_("L", &n, A, &n, &info);
+  if (info) return PETSC_FALSE;
+  for (PetscInt k = 0; k < nb; k++) {
+    dmin = PetscMin(dmin, A[k * nb + k] * A[k * nb + k]);
+    gmax = PetscMax(gmax, G[k * nb + k]);
+  }
+  if (dmin <= 1e-10 * gmax) return PETSC_FALSE;
+  LAPACKpotrs_("L", &n, &one, A, &n, x, &n, &info);
+  if (info) return PETSC_FALSE;
+  for (PetscInt k = 0; k < nb; k++) r[k] = x[k];
+  return PETSC_TRUE;
+}
+
 /* particle i's polynomial from its moments: the weighted least-squares fit
  * sum_l G_kl c_l = S_i <e^a_k>, G_kl = sum_j w_j e^(a_k + a_l) */
 static PetscBool ParticlePolynomial(PeriLattice lat, const PetscReal mom[], PetscReal coef[], PetscReal *S)
 {
-  const PetscInt nb = lat->nbasis, D2 = 2 * lat->degree;
+  const PetscInt nb = lat->nbasis;
   PetscReal      G[LATTICE_MAX_BASIS * LATTICE_MAX_BASIS];
-  PetscInt       a[3], c[3], s[3];
 
   *S = 0;
-  for (PetscInt q = 0; q < NumMonomials(lat->dim, D2); q++) {
-    Exponents(lat->dim, D2, q, a);
-    *S += UnitCoefficient(a) * mom[q];
-  }
+  for (PetscInt q = 0; q < NumMonomials(lat->dim, 2 * lat->degree); q++) *S += lat->unit[q] * mom[q];
   for (PetscInt k = 0; k < nb; k++) {
-    Exponents(lat->dim, lat->degree, k, a);
-    coef[k] = *S * IsotropicMean(lat->dim, a);
-    for (PetscInt l = 0; l < nb; l++) {
-      Exponents(lat->dim, lat->degree, l, c);
-      for (PetscInt d = 0; d < 3; d++) s[d] = a[d] + c[d];
-      G[k * nb + l] = mom[MonomialIndex(lat->dim, D2, s)];
-    }
+    coef[k] = *S * lat->iso[k];
+    for (PetscInt l = 0; l < nb; l++) G[k * nb + l] = mom[lat->gram[k][l]];
   }
-  if (SolveSmall(nb, G, coef)) return PETSC_TRUE;
+  if (SolveCholesky(nb, G, coef) || SolveSmall(nb, G, coef)) return PETSC_TRUE;
   UnitPolynomial(lat, coef);
   return PETSC_FALSE;
 }
 
-static PetscReal Multiplier(PeriLattice lat, PetscInt i, const PetscReal e[3])
+static PetscReal Multiplier(PeriLattice lat, PetscInt i, const PetscReal pw[3][2 * LATTICE_DEGREE + 1])
 {
-  PetscReal mu = 0;
-  PetscInt  a[3];
-  for (PetscInt k = 0; k < lat->nbasis; k++) {
-    Exponents(lat->dim, lat->degree, k, a);
-    mu += lat->coef[i * lat->nbasis + k] * Monomial(e, a);
-  }
+  const PetscReal *c  = lat->coef + i * lat->nbasis;
+  PetscReal        mu = 0;
+  for (PetscInt k = 0; k < lat->nbasis; k++) mu += c[k] * pw[0][lat->a[k][0]] * pw[1][lat->a[k][1]] * pw[2][lat->a[k][2]];
   return mu;
 }
 
@@ -228,9 +261,11 @@ static PetscErrorCode KeepLopsided(PeriLattice lat, const PeriCalibrationData *d
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       const PetscInt  j = b->j[k];
       const PetscReal L = b->length[k], e[3] = {b->xi[3 * k] / L, b->xi[3 * k + 1] / L, lat->dim == 3 ? b->xi[3 * k + 2] / L : 0};
+      PetscReal       pw[3][2 * LATTICE_DEGREE + 1];
       if (j == i) continue;
-      if (Multiplier(lat, i, e) < LATTICE_MIN_MU) bad[i] = 1;
-      if (Multiplier(lat, j, e) < LATTICE_MIN_MU) bad[j] = 1;
+      Powers(e, lat->degree, pw);
+      if (Multiplier(lat, i, pw) < LATTICE_MIN_MU) bad[i] = 1;
+      if (Multiplier(lat, j, pw) < LATTICE_MIN_MU) bad[j] = 1;
     }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, bad, (PetscMPIInt)lat->n, MPIU_INT, MPI_MAX, data->comm));
   for (PetscInt i = 0; i < lat->n; i++)
@@ -257,11 +292,13 @@ PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, P
   PetscFunctionBeginUser;
   PetscCall(PeriLatticeDestroy(lattice));
   if (m->calibration != PERI_CALIBRATION_LATTICE) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(degree == 2 || degree == LATTICE_DEGREE, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "lattice calibration: degree %" PetscInt_FMT " (2 or 4)", degree);
   PetscCall(PetscNew(&lat));
   lat->n      = data->n;
   lat->dim    = m->dim;
   lat->degree = degree;
   lat->nbasis = NumMonomials(m->dim, degree);
+  Tables(lat);
   PetscCall(PetscMalloc2(lat->n, &lat->scale, lat->n * lat->nbasis, &lat->coef));
   PetscCall(PetscCalloc1(lat->n * nmom, &mom));
   PetscCall(FamilyMoments(m, data, 2 * degree, profile, mom));
@@ -283,10 +320,11 @@ PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, P
  * lattice calibration (lat NULL). */
 PetscReal PeriLatticeFactor(PeriLattice lat, const PeriBondGeometry *b)
 {
-  PetscReal e[3];
+  PetscReal e[3], pw[3][2 * LATTICE_DEGREE + 1];
   if (!lat) return 1;
   for (PetscInt d = 0; d < 3; d++) e[d] = d < lat->dim ? b->xi[d] / b->length : 0;
-  return 0.5 * (lat->scale[b->i] * Multiplier(lat, b->i, e) + lat->scale[b->j] * Multiplier(lat, b->j, e));
+  Powers(e, lat->degree, pw);
+  return 0.5 * (lat->scale[b->i] * Multiplier(lat, b->i, pw) + lat->scale[b->j] * Multiplier(lat, b->j, pw));
 }
 
 PetscErrorCode PeriLatticeDestroy(PeriLattice *lat)
