@@ -16,9 +16,10 @@
  * continuum's, so the continuum micromoduli reproduce the target elasticity exactly for every
  * homogeneous strain wherever a particle and its neighbours share a family shape, at surfaces,
  * corners and cracks too (docs/models/lattice.md). Where no polynomial of the degree makes the
- * family isotropic, or it would turn a bond's multiplier below a tenth (a family too lopsided, as
- * at a corner), the particle keeps mu = 1, its scale only, as npmb, and the calibration warns how
- * many did. */
+ * family isotropic (too few directions), the particle keeps mu = 1, its scale only, as npmb; where
+ * the polynomial would turn a bond's multiplier below a tenth (a lopsided family, as at a corner),
+ * the particle takes the largest part of it that keeps them all at a tenth. The calibration warns
+ * how many did either. */
 #include <perilin/model.h>
 #include <petscblaslapack.h>
 
@@ -35,7 +36,8 @@ struct _n_PeriLattice {
   PetscReal  unit[LATTICE_MAX_MOM];                      /* (e.e)^degree in the moments' monomials */
   PetscReal *scale;                                      /* per particle (global index) */
   PetscReal *coef;                                       /* per particle: nbasis coefficients of mu_i */
-  PetscInt   kept;                                       /* particles that kept mu = 1 */
+  PetscInt   kept;                                       /* particles that kept mu = 1: no polynomial of the degree makes them isotropic */
+  PetscInt   damped;                                     /* particles that took part of their polynomial */
 };
 
 /* monomials of total degree D in dim variables, in a fixed order: exponents of the k-th */
@@ -249,14 +251,17 @@ static PetscReal Multiplier(PeriLattice lat, PetscInt i, const PetscReal pw[3][2
   return mu;
 }
 
-/* a particle some of whose bonds the polynomial would nearly switch off keeps mu = 1 */
-static PetscErrorCode KeepLopsided(PeriLattice lat, const PeriCalibrationData *data)
+/* A particle some of whose bonds the polynomial would nearly switch off takes only part of it:
+ * mu_t = 1 + t (mu - 1) with the largest t that keeps every bond's multiplier at LATTICE_MIN_MU
+ * (mu is linear in its coefficients, and both 1 and mu keep the family's sum S_i). */
+static PetscErrorCode DampLopsided(PeriLattice lat, const PeriCalibrationData *data)
 {
   const PeriBonds *b = data->bonds;
-  PetscInt        *bad;
+  PetscReal       *low, unit[LATTICE_MAX_BASIS];
 
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc1(lat->n, &bad));
+  PetscCall(PetscMalloc1(lat->n, &low));
+  for (PetscInt i = 0; i < lat->n; i++) low[i] = 1;
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       const PetscInt  j = b->j[k];
@@ -264,16 +269,19 @@ static PetscErrorCode KeepLopsided(PeriLattice lat, const PeriCalibrationData *d
       PetscReal       pw[3][2 * LATTICE_DEGREE + 1];
       if (j == i) continue;
       Powers(e, lat->degree, pw);
-      if (Multiplier(lat, i, pw) < LATTICE_MIN_MU) bad[i] = 1;
-      if (Multiplier(lat, j, pw) < LATTICE_MIN_MU) bad[j] = 1;
+      low[i] = PetscMin(low[i], Multiplier(lat, i, pw));
+      low[j] = PetscMin(low[j], Multiplier(lat, j, pw));
     }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, bad, (PetscMPIInt)lat->n, MPIU_INT, MPI_MAX, data->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, low, (PetscMPIInt)lat->n, MPIU_REAL, MPI_MIN, data->comm));
+  UnitPolynomial(lat, unit);
   for (PetscInt i = 0; i < lat->n; i++)
-    if (bad[i]) {
-      UnitPolynomial(lat, lat->coef + i * lat->nbasis);
-      lat->kept++;
+    if (low[i] < LATTICE_MIN_MU) {
+      const PetscReal t = (1 - LATTICE_MIN_MU) / (1 - low[i]);
+      PetscReal      *c = lat->coef + i * lat->nbasis;
+      for (PetscInt k = 0; k < lat->nbasis; k++) c[k] = unit[k] + t * (c[k] - unit[k]);
+      lat->damped++;
     }
-  PetscCall(PetscFree(bad));
+  PetscCall(PetscFree(low));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -309,9 +317,9 @@ PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, P
     lat->scale[i] = Scont / S;
   }
   PetscCall(PetscFree(mom));
-  PetscCall(KeepLopsided(lat, data));
-  if (lat->kept)
-    PetscCall(PetscSNPrintf(m->warning, sizeof(m->warning), "lattice calibration: %" PetscInt_FMT " of %" PetscInt_FMT " particles have families that cannot be made isotropic gently (too few directions, or a bond's multiplier would fall below %g, as at corners); they keep their scale only, as npmb", lat->kept, lat->n, (double)LATTICE_MIN_MU));
+  PetscCall(DampLopsided(lat, data));
+  if (lat->kept || lat->damped)
+    PetscCall(PetscSNPrintf(m->warning, sizeof(m->warning), "lattice calibration: %" PetscInt_FMT " of %" PetscInt_FMT " particles (at corners and edges) are not made exactly isotropic: %" PetscInt_FMT " have too few bond directions (scale only, as npmb), %" PetscInt_FMT " take part of the correction so that no bond's multiplier falls below %g", lat->kept + lat->damped, lat->n, lat->kept, lat->damped, (double)LATTICE_MIN_MU));
   *lattice = lat;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
