@@ -62,6 +62,7 @@ static const PeriKey analysis_keys[] = {
 static const PeriKey output_keys[] = {
     {"dir", PERI_KEY_STRING, "<scene file name without directory and last extension>-out", NULL, NULL, NULL, "output directory"},
     {"vtk", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "write particles.vtu"},
+    {"stress", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "per-particle stress and strain (vector models): arrays stress, strain, elastic_stress in particles.vtu and sigma, epsilon, sigma_elastic in the probes (docs/stress.md); costs a pass over the bonds and 27 numbers per particle"},
     {NULL},
 };
 const PeriSchema PeriProblemSchema[] = {
@@ -109,6 +110,7 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneCheckSection(s, o, "output"));
   PetscCall(PeriSceneGetString(s, o, "dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
   PetscCall(PeriSceneGetBool(s, o, "vtk", &p->vtk, NULL));
+  PetscCall(PeriSceneGetBool(s, o, "stress", &p->sys->stress_output, NULL));
   PetscCall(PeriSceneGetInt(s, o, "every", PETSC_FALSE, &p->output_every, NULL));
   PeriInputCheck(p->output_every >= 0, s, o, "every", "must not be negative (0: only the end), got %" PetscInt_FMT, p->output_every);
   PetscCall(ReadAnalysis(p));

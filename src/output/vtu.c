@@ -35,7 +35,7 @@ typedef struct {
   VTUKind          kind;
   PetscInt         ncomp;
   const PetscReal *real;
-  PetscInt         stride, map[3];
+  PetscInt         stride, map[9]; /* up to a tensor's 9 components */
   const PetscInt  *ints;
   int64_t          first;
   uint8_t          byte;
@@ -107,7 +107,7 @@ PetscErrorCode PeriFieldListAddReal(PeriFieldList fl, const char name[], PetscIn
 
   PetscFunctionBeginUser;
   PetscCheck(real, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write field %s: no data", name);
-  PetscCheck(ncomp >= 1 && ncomp <= 3, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Field %s: %" PetscInt_FMT " components (1 to 3)", name, ncomp);
+  PetscCheck((ncomp >= 1 && ncomp <= 3) || ncomp == 9, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Field %s: %" PetscInt_FMT " components (1 to 3, or 9: a tensor)", name, ncomp);
   PetscCall(FieldListPush(fl, VTU_POINT_DATA, name, VTU_FLOAT64, ncomp, &a));
   a->real   = real;
   a->stride = stride;

@@ -165,6 +165,7 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   PetscCallMPI(MPI_Allreduce(&E.energy, &sys->strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
   PetscCallMPI(MPI_Reduce(sys->rank ? W : MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, 0, sys->comm));
   if (m->antiplane) PetscCall(ShearStresses(sys, u));
+  PetscCall(PeriSystemEvaluateStress(sys, u));
   PetscCall(PetscFree(sys->W));
   PetscCall(PetscFree(sys->u_all));
   if (sys->rank == 0) {
@@ -214,6 +215,11 @@ PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
     PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
     PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau, 3, &nmap));
   }
+  if (sys->stress) {
+    PetscCall(PeriFieldListAddReal(fl, "stress", 9, sys->stress, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "strain", 9, sys->strain, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "elastic_stress", 9, sys->elastic_stress, 9, NULL));
+  }
   PetscCall(PeriFailureAddFields(sys, fl));
   PetscCall(PeriLayersAddFields(sys, fl));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -237,6 +243,20 @@ PetscErrorCode PeriSystemWriteVTU(PeriSystem sys, const PetscReal *u, const char
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* a symmetric tensor by its components: xx, yy, xy in 2D; xx, yy, zz, yz, xz, xy in 3D */
+static PetscErrorCode ProbeTensor(PeriJSON j, const char name[], PetscInt dim, const PetscReal T[9])
+{
+  static const char *const names[] = {"xx", "yy", "zz", "yz", "xz", "xy"};
+  static const PetscInt    idx[]   = {0, 4, 8, 5, 2, 1};
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriJSONBeginObject(j, name));
+  for (PetscInt k = 0; k < 6; k++)
+    if (dim == 3 || k == 0 || k == 1 || k == 5) PetscCall(PeriJSONReal(j, names[k], T[idx[k]]));
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* probes: the values at the nearest particle of each point, when there is a solution. */
 PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
 {
@@ -250,6 +270,11 @@ PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
     PetscCall(PeriJSONString(j, "sampling", "nearest particle"));
     PetscCall(PeriJSONRealArray(j, "u", sys->model->dofs, pr->u));
     PetscCall(PeriJSONReal(j, "W", pr->W));
+    if (sys->stress) {
+      PetscCall(ProbeTensor(j, "sigma", sys->disc.particles.dim, &sys->stress[9 * pr->particle]));
+      PetscCall(ProbeTensor(j, "epsilon", sys->disc.particles.dim, &sys->strain[9 * pr->particle]));
+      PetscCall(ProbeTensor(j, "sigma_elastic", sys->disc.particles.dim, &sys->elastic_stress[9 * pr->particle]));
+    }
     PetscCall(PeriJSONEndObject(j));
   }
   PetscCall(PeriJSONEndObject(j));

@@ -411,6 +411,7 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PetscFree(sys->mu));
   PetscCall(PetscFree(sys->bond_mu));
   PetscCall(PetscFree(sys->tau));
+  PetscCall(PetscFree3(sys->stress, sys->strain, sys->elastic_stress));
   PetscCall(PetscFree(sys->damage));
   PetscCall(PetscFree(sys->probes));
   PetscCall(PetscFree(sys->constrained));

@@ -1,9 +1,43 @@
 /* An affine displacement u = A X + b (with the microrotation theta = the field's rotation for
  * micropolar models) produces zero internal force K u on every particle whose horizon (and its
  * neighbours' horizons, on which npmb's c_ij and the surface factors depend) lies inside the body.
+ * Also the per-particle fields of src/system/stress.c: the least-squares strain is sym(A) at every
+ * particle, corners included (1e-10 relative); with model.calibration: lattice, whose energy is
+ * exact for every homogeneous strain, the bond-force stress of every interior particle is the
+ * elastic C : sym(A) (1e-10 relative, in-plane components).
  * Run with a scene and -model_type. */
 #include "testing.h"
 #include <slepcsys.h>
+
+/* the strain at every particle and, where the energy is exact, the stress in the interior */
+static PetscErrorCode CheckFields(PeriProblem p, Vec u, const PetscReal A[3][3], PetscReal reach)
+{
+  const PeriParticles *pt   = &p->sys->disc.particles;
+  const PetscInt       dim  = pt->dim;
+  PetscReal            eerr = 0, serr = 0, snorm = 0, anorm = 0;
+
+  PetscFunctionBeginUser;
+  if (!p->sys->u) PetscCall(VecDuplicate(u, &p->sys->u));
+  PetscCall(VecCopy(u, p->sys->u));
+  PetscCall(PeriSystemEvaluateEnergy(p->sys));
+  if (p->rank || !p->sys->strain) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt a = 0; a < dim; a++)
+    for (PetscInt b = 0; b < dim; b++) anorm = PetscMax(anorm, PetscAbsReal(A[a][b]));
+  for (PetscInt i = 0; i < pt->n; i++) {
+    PetscBool inner = PETSC_TRUE;
+    for (PetscInt d = 0; d < dim; d++) inner = (PetscBool)(inner && (pt->periodic[d] || (pt->x[3 * i + d] - pt->lower[d] >= reach && pt->upper[d] - pt->x[3 * i + d] >= reach)));
+    for (PetscInt a = 0; a < dim; a++)
+      for (PetscInt b = 0; b < dim; b++) {
+        eerr = PetscMax(eerr, PetscAbsReal(p->sys->strain[9 * i + 3 * a + b] - 0.5 * (A[a][b] + A[b][a])));
+        if (!inner) continue;
+        serr  = PetscMax(serr, PetscAbsReal(p->sys->stress[9 * i + 3 * a + b] - p->sys->elastic_stress[9 * i + 3 * a + b]));
+        snorm = PetscMax(snorm, PetscAbsReal(p->sys->elastic_stress[9 * i + 3 * a + b]));
+      }
+  }
+  PeriTestClose("least-squares strain of an affine field, every particle (relative to |A|)", eerr / anorm, 0.0, 1e-10);
+  if (p->sys->model->calibration == PERI_CALIBRATION_LATTICE) PeriTestClose("bond-force stress against C : eps, interior (lattice calibration, relative)", serr / snorm, 0.0, 1e-10);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 static PetscErrorCode CheckAffine(const char file[])
 {
@@ -16,6 +50,7 @@ static PetscErrorCode CheckAffine(const char file[])
   PetscInt           checked = 0, total;
 
   PetscFunctionBeginUser;
+  PetscCall(PeriTestSetOption("-output_stress", "true"));
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
   PetscCall(PeriProblemLoad(p, file));
   PetscCall(PeriProblemSetUp(p));
@@ -59,6 +94,7 @@ static PetscErrorCode CheckAffine(const char file[])
   PetscCheck(total > 0, p->comm, PETSC_ERR_PLIB, "no particle with a full horizon: enlarge the scene");
   PetscCall(PetscPrintf(p->comm, "%s, model %s: %" PetscInt_FMT " interior particles, max |K u| / force scale = %g\n", file, p->sys->model->type, total, (double)(fmax / scale)));
   PeriTestClose("interior residual force of an affine field (relative)", fmax / scale, 0.0, 1e-11);
+  PetscCall(CheckFields(p, u, A, reach));
   PetscCall(VecDestroy(&u));
   PetscCall(VecDestroy(&f));
   PetscCall(PeriProblemDestroy(&p));

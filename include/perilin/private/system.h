@@ -131,7 +131,11 @@ struct _p_PeriSystem {
   PetscReal       *bond_mu;   /* per local bond: the shear modulus across materials (eq. 60), or NULL */
   PeriLayers       layers;
   PeriTorsion      torsion;
-  PetscReal       *tau; /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
+  PetscReal       *tau;            /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
+  PetscReal       *stress;         /* vector models, rank 0: the bond-force stress per particle, 3 x 3 row-major (stress.c) */
+  PetscReal       *strain;         /* vector models, rank 0: the least-squares strain per particle, 3 x 3 row-major */
+  PetscReal       *elastic_stress; /* vector models, rank 0: C : strain of the target elasticity */
+  PetscBool        stress_output;  /* output.stress: evaluate the three above after each solve */
   PeriFailure      failure;
   PetscReal       *damage; /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
   PeriModel        model;
@@ -173,6 +177,7 @@ PETSC_EXTERN PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemFindProbe(PeriSystem, const char[], PeriProbe **);
 PETSC_EXTERN PetscReal      PeriResidualTolerance(PeriSystem, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriReadProbes(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemEvaluateStress(PeriSystem, const PetscScalar[]);
 PETSC_EXTERN PetscErrorCode PeriSystemAddFields(PeriSystem, PeriFieldList);
 PETSC_EXTERN PetscErrorCode PeriSystemWriteVTU(PeriSystem, const PetscReal *, const char[]);
 
