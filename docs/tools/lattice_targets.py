@@ -17,7 +17,8 @@ frequencies are the converged Q9 values of docs/modal.md (docs/tools/lamina_fem.
 Each run is, from the repository root,
     build/perilin examples/lamina/SCENE.yaml -model_type M -material_nu NU -horizon_m m
         -grid_spacing DX [-model_calibration C] -output_dir TMP
-(with lattice also -corrections_surface none: the lattice calibration corrects surfaces itself)
+(and -corrections_surface volume with continuum, the paper's setting; none with lattice, which
+corrects surfaces itself)
 reading TMP/summary.json; TMP lives in a temporary directory removed at the end. When the binary
 does not know model.calibration (perilin -help), continuum runs omit the option and lattice runs
 are refused: use --calibrations continuum.
@@ -99,9 +100,9 @@ def command(run, out, explicit):
         args += ["-grid_spacing", run.spacing]
     if explicit:
         args += ["-model_calibration", run.calibration]
-    if run.calibration == "lattice":
-        # the scenes' volume surface correction would correct surfaces twice (perilin refuses it)
-        args += ["-corrections_surface", "none"]
+    # continuum: the paper's setting, with the volume surface correction; lattice corrects surfaces
+    # itself (perilin refuses both at once)
+    args += ["-corrections_surface", "none" if run.calibration == "lattice" else "volume"]
     return args
 
 
