@@ -7,7 +7,7 @@
  *    (all with the papers' calibration: model.calibration continuum, surface correction volume).
  *    With perilin's default lattice calibration, mppd and gerstle: the three modes within 1.5 % of
  *    the converged plane-stress FEM (docs/tools/lamina_fem.py, docs/modal.md) for nu < 1/3; at
- *    nu = 1/3 f_I is 1.64 % low at dx = 10 mm (the issue's 1.5 % missed, docs/models/lattice.md),
+ *    nu = 1/3 f_I is 1.65 % low at dx = 10 mm (the issue's 1.5 % missed, docs/models/lattice.md),
  *    so there the error is asserted to shrink at dx = 5 mm (measured 1.06 %).
  *  - examples/pmb/bar_modes.yaml (Ganzenmueller sec. 3.1.2): the longitudinal speed of a free bar
  *    equals sqrt(C11/rho) of the cubic lattice, C11 from the lattice sums computed here (npmb:
