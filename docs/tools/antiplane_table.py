@@ -5,30 +5,12 @@ paper's resolutions, for both models: prints the Markdown table of docs/models/a
     /usr/bin/python3 docs/tools/antiplane_table.py [build/perilin]
 
 The exact solutions are the same series as tests/scenes/test_antiplane.c (independent of perilin)."""
-import json, os, struct, subprocess, sys, tempfile
+import json, os, subprocess, sys, tempfile
 import numpy as np
+from common import read_vtu
 
 EXE = sys.argv[1] if len(sys.argv) > 1 else "build/perilin"
 S, MU = 12000.0, 12e6
-
-
-def read_vtu(path):
-    """The arrays of perilin's particles.vtu (raw appended, UInt64 headers) by name."""
-    data = open(path, "rb").read()
-    head, _, tail = data.partition(b"<AppendedData encoding=\"raw\">")
-    start = tail.index(b"_") + 1
-    arrays = {}
-    for line in head.decode().splitlines():
-        if "<DataArray" not in line:
-            continue
-        attr = dict(part.split("=", 1) for part in line.strip()[11:-2].split(" ") if "=" in part)
-        attr = {k: v.strip('"') for k, v in attr.items()}
-        off = start + int(attr["offset"])
-        nbytes = struct.unpack("<Q", tail[off:off + 8])[0]
-        dtype = {"Float64": "<f8", "Int32": "<i4", "Int64": "<i8", "UInt8": "u1"}[attr["type"]]
-        a = np.frombuffer(tail[off + 8:off + 8 + nbytes], dtype=dtype)
-        arrays[attr["Name"]] = a.reshape(-1, int(attr["NumberOfComponents"]))
-    return arrays
 
 
 def square_bar(x, y):

@@ -24,6 +24,8 @@ import sys
 import tempfile
 from fractions import Fraction
 
+from common import write_atomically
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PERILIN = os.environ.get("PERILIN", os.path.join(ROOT, "build", "perilin"))
 MODELS = ["pds", "mppd", "gerstle"]
@@ -302,16 +304,7 @@ def main():
         shutil.rmtree(tmp, ignore_errors=True)
     text = document(res, notes)
     if len(sys.argv) > 1:
-        dest = os.path.abspath(sys.argv[1])
-        fd, part = tempfile.mkstemp(prefix=".lamina_tables_", suffix=".md", dir=os.path.dirname(dest))
-        try:
-            with os.fdopen(fd, "w") as f:
-                f.write(text)
-            os.chmod(part, 0o644)
-            os.replace(part, dest)
-        except BaseException:
-            os.unlink(part)
-            raise
+        write_atomically(sys.argv[1], text)
     else:
         sys.stdout.write(text)
 

@@ -46,6 +46,8 @@ import tempfile
 import time
 from fractions import Fraction
 
+from common import write_atomically
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 PERILIN = os.environ.get("PERILIN", os.path.join(ROOT, "build", "perilin"))
 CALIBRATIONS = ["continuum", "lattice"]
@@ -466,19 +468,6 @@ def document(rep, notes, meta):
 
 
 # ---------------------------------------------------------------- main
-
-def write_atomically(dest, text):
-    dest = os.path.abspath(dest)
-    fd, part = tempfile.mkstemp(prefix=".lattice_targets_", suffix=".md", dir=os.path.dirname(dest))
-    try:
-        with os.fdopen(fd, "w") as f:
-            f.write(text)
-        os.chmod(part, 0o644)
-        os.replace(part, dest)
-    except BaseException:
-        os.unlink(part)
-        raise
-
 
 def arguments():
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
