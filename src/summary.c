@@ -22,6 +22,7 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   if (p->analysis && p->analysis->type->ops.summary) PetscCall(p->analysis->type->ops.summary(p->analysis, j));
   PetscCall(PeriTorsionSummary(sys, j));
   PetscCall(PeriSystemSummaryFields(sys, j));
+  PetscCall(PeriReactionsSummary(sys, j));
   PetscCall(PeriReferenceSummary(sys, j));
   PetscCall(PeriProbesSummary(sys, j));
   PetscFunctionReturn(PETSC_SUCCESS);

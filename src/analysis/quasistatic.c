@@ -30,6 +30,7 @@ typedef struct {
   PetscBool  events; /* stepping: events (else increments) */
   PetscInt   max_iterations;
   PeriProbe *control;
+  PetscInt   component, reaction; /* the control probe's component; the reaction region (index of disc.regions) or -1 */
 } Settings;
 
 /* The load factor scales the loads, the prescribed values, the layers' values and the twist:
@@ -45,6 +46,49 @@ static PetscErrorCode CheckSomethingLoaded(PeriAnalysis an, PeriNode a)
   if (an->sys->torsion.active) v = PetscMax(v, PetscAbsReal(an->sys->torsion.twist));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_REAL, MPI_MAX, an->comm));
   PeriInputCheck(fnorm > 0 || v > 0, an->sys->scene, a, "type", "a quasistatic analysis scales the loads and prescribed values, and this scene has none (no loads, every bc value 0): give loads or a bc value");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The bc region a load-displacement curve reads when the scene names none: the first that
+ * prescribes a nonzero value along the control component (the grip that moves), else the first
+ * that holds that component, else none (-1). */
+static PetscInt DefaultReactionRegion(PeriSystem sys, PetscInt c)
+{
+  const PeriReactions *R = &sys->reactions;
+  for (PetscInt r = 0; r < R->nregions; r++)
+    if (R->holds[r * PERI_MAX_DOF + c] && R->moves[r]) return r;
+  for (PetscInt r = 0; r < R->nregions; r++)
+    if (R->holds[r * PERI_MAX_DOF + c]) return r;
+  return -1;
+}
+
+/* analysis.control_component and analysis.reaction_region: the displacement and the force of
+ * steps.csv's load-displacement columns. */
+static PetscErrorCode ReadLoadDisplacement(PeriAnalysis an, PeriNode a, Settings *st)
+{
+  PeriScene s                   = an->sys->scene;
+  PeriModel m                   = an->sys->model;
+  char      name[PERI_NAME_LEN] = "", list[128] = "";
+  PetscBool has;
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < m->dofs; c++) PeriListAppend(list, sizeof(list), m->components[c]);
+  st->component = 0;
+  PetscCall(PeriSceneGetString(s, a, "control_component", PETSC_FALSE, name, sizeof(name), &has));
+  if (has) PetscCall(PeriModelComponentIndex(m, name, &st->component));
+  PeriInputCheck(st->component >= 0, s, a, "control_component", "'%s' is not a component of model %s; its components are: %s", name, m->type, list);
+  st->reaction = DefaultReactionRegion(an->sys, st->component);
+  PetscCall(PeriSceneGetString(s, a, "reaction_region", PETSC_FALSE, name, sizeof(name), &has));
+  if (!has) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriReactionsFindRegion(an->sys, name, &st->reaction));
+  list[0] = 0;
+  for (PetscInt r = 0; r < an->sys->reactions.nregions; r++) {
+    PetscInt k;
+    PetscCall(PeriReactionsFindRegion(an->sys, an->sys->disc.regions[r].name, &k));
+    if (k == r) PeriListAppend(list, sizeof(list), an->sys->disc.regions[r].name);
+  }
+  PeriInputCheck(st->reaction >= 0, s, a, "reaction_region", "no bc item holds a region named '%s', so it has no reaction; the regions with one are: %s", name, list[0] ? list : "none (the scene has no bc)");
+  PeriInputCheck(an->sys->reactions.holds[st->reaction * PERI_MAX_DOF + st->component], s, a, "reaction_region", "the bc items on region '%s' do not hold %s (the control component), so its reaction has no %s force: hold it there or choose another region or control_component", name, m->components[st->component], m->components[st->component]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -98,6 +142,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
       if (!strcmp(an->sys->probes[k].name, name)) st->control = &an->sys->probes[k];
     PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", name);
   }
+  PetscCall(ReadLoadDisplacement(an, a, st));
   PetscCall(CheckSomethingLoaded(an, a));
   st->quiet = PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-quiet", &st->quiet, NULL));
@@ -177,30 +222,37 @@ static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode RecordStep(PeriQuasistatic *q, const PeriStep *s)
+/* Appends the step and every region's reaction at it (sys->reactions, just evaluated). */
+static PetscErrorCode RecordStep(PeriQuasistatic *q, const PeriStep *s, const PeriReactions *R)
 {
+  const PetscInt w = R->nregions * PERI_MAX_DOF;
+
   PetscFunctionBeginUser;
   if (q->nsteps == q->cap) {
-    PeriStep *n;
+    PeriStep  *n;
+    PetscReal *r;
     q->cap = PetscMax(64, 2 * q->cap);
-    PetscCall(PetscMalloc1(q->cap, &n));
+    PetscCall(PetscMalloc2(q->cap, &n, q->cap * w, &r));
     if (q->nsteps) PetscCall(PetscArraycpy(n, q->steps, q->nsteps));
-    PetscCall(PetscFree(q->steps));
-    q->steps = n;
+    if (q->nsteps) PetscCall(PetscArraycpy(r, q->reactions, q->nsteps * w));
+    PetscCall(PetscFree2(q->steps, q->reactions));
+    q->steps     = n;
+    q->reactions = r;
   }
+  PetscCall(PetscArraycpy(&q->reactions[q->nsteps * w], R->force, w));
   q->steps[q->nsteps++] = *s;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The control probe's first component at the current solution (collective). */
-static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscReal *v)
+/* The control probe's control component at the current solution (collective). */
+static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscInt component, PetscReal *v)
 {
   PetscInt row;
 
   PetscFunctionBeginUser;
   *v = 0;
   if (!probe) PetscFunctionReturn(PETSC_SUCCESS);
-  row = probe->particle * an->sys->model->dofs;
+  row = probe->particle * an->sys->model->dofs + component;
   if (an->sys->disc.owner[probe->particle] == an->rank) {
     PetscScalar x;
     PetscCall(VecGetValues(an->sys->u, 1, &row, &x));
@@ -473,8 +525,12 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, Equilibrium *e
   PeriQuasistatic *q = QS(an);
 
   PetscFunctionBeginUser;
-  PetscCall(ControlValue(an, st->control, &s->control_u));
-  PetscCall(RecordStep(q, s));
+  PetscCall(ControlValue(an, st->control, st->component, &s->control_u));
+  /* the reactions of this equilibrium (and the check that they balance the loads) */
+  PetscCall(PeriSystemEvaluateReactions(an->sys, s->lambda));
+  s->imbalance = an->sys->reactions.relative_imbalance;
+  if (st->reaction >= 0) s->reaction = an->sys->reactions.force[st->reaction * PERI_MAX_DOF + st->component];
+  PetscCall(RecordStep(q, s, &an->sys->reactions));
   q->peak_load_factor = s->lambda;
   q->broken_bonds     = s->broken_total;
   PetscCall(EquilibriumSave(an, eq));
@@ -497,6 +553,7 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   else if (!q->failed)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st->max));
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  PetscCall(PeriSystemEvaluateReactions(an->sys, q->peak_load_factor));
   PetscCall(PeriDamage(an->sys, &an->sys->damage));
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(an->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
@@ -670,6 +727,8 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscCall(PetscNew(&q));
   an->data = q;
   PetscCall(PetscStrncpy(q->control, st.control ? st.control->name : "", sizeof(q->control)));
+  q->control_component = st.component;
+  q->reaction_region   = st.reaction;
   PetscCall(PetscStrncpy(q->stepping, st.events ? "events" : "increments", sizeof(q->stepping)));
   PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
   an->sys->matrix_free_ok = PETSC_TRUE; /* K is applied, and changed through PeriStiffnessScaleBond */
@@ -692,6 +751,28 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* steps.csv's reaction columns: the load-displacement force, the relative imbalance, then
+ * R_<region>_<component> for every component a bc item holds on a region; step k's values, or
+ * the header when k < 0. Returns nonzero when a write failed. */
+static int ReactionColumns(PeriAnalysis an, FILE *fp, PetscInt k)
+{
+  const PeriQuasistatic *q   = QS(an);
+  const PeriReactions   *R   = &an->sys->reactions;
+  int                    bad = 0;
+
+  if (q->reaction_region >= 0) bad |= (k < 0 ? fprintf(fp, ",reaction") : fprintf(fp, ",%.10g", (double)q->steps[k].reaction)) < 0;
+  bad |= (k < 0 ? fprintf(fp, ",relative_imbalance") : fprintf(fp, ",%.3g", (double)q->steps[k].imbalance)) < 0;
+  for (PetscInt r = 0; r < R->nregions; r++)
+    for (PetscInt c = 0; c < an->sys->model->dofs; c++) {
+      if (!R->holds[r * PERI_MAX_DOF + c]) continue;
+      if (k < 0)
+        bad |= fprintf(fp, ",R_%s_%s", an->sys->disc.regions[r].name, an->sys->model->components[c]) < 0;
+      else
+        bad |= fprintf(fp, ",%.10g", (double)q->reactions[(k * R->nregions + r) * PERI_MAX_DOF + c]) < 0;
+    }
+  return bad;
+}
+
 /*@C
   PeriWriteStepsCSV - one row per load step. Rank 0 writes (temporary name, then rename). Collective.
 @*/
@@ -704,10 +785,14 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
   PetscFunctionBeginUser;
   if (an->rank || !QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,equilibrium_iterations,ksp_iterations,seconds\n") < 0;
+  bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,equilibrium_iterations,ksp_iterations,seconds") < 0;
+  bad |= ReactionColumns(an, fp, -1);
+  bad |= fprintf(fp, "\n") < 0;
   for (PetscInt k = 0; k < QS(an)->nsteps; k++) {
     const PeriStep *s = &QS(an)->steps[k];
-    bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f\n", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
+    bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
+    bad |= ReactionColumns(an, fp, k);
+    bad |= fprintf(fp, "\n") < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -763,6 +848,8 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONInt(j, "solves", q->solves));
   PetscCall(PeriJSONInt(j, "preconditioner_setups", q->pc_setups));
   if (q->control[0]) PetscCall(PeriJSONString(j, "control_probe", q->control));
+  PetscCall(PeriJSONString(j, "control_component", an->sys->model->components[q->control_component]));
+  if (q->reaction_region >= 0) PetscCall(PeriJSONString(j, "reaction_region", an->sys->disc.regions[q->reaction_region].name));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -784,7 +871,7 @@ static PetscErrorCode QSFiles(PeriAnalysis an, const char dir[])
 static PetscErrorCode QSDestroy(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscFree(QS(an)->steps));
+  PetscCall(PetscFree2(QS(an)->steps, QS(an)->reactions));
   PetscCall(PetscFree(QS(an)->trial_damage));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -801,7 +888,9 @@ static const PeriKey     qs_keys[]     = {
             {"break_fraction", PERI_KEY_REAL, "0.1", "(0, 1]", NULL, NULL, "break: fraction: those within this top fraction of [1, worst index]"},
             {"max_iterations", PERI_KEY_INT, "100", "[1, inf)", NULL, NULL, "equilibrium iterations per step"},
             {"reuse_preconditioner", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "keep the preconditioner while few bonds changed"},
-            {"control_probe", PERI_KEY_STRING, "the first probe", NULL, NULL, NULL, "the probe whose displacement steps.csv reports"},
+            {"control_probe", PERI_KEY_STRING, "the first probe", NULL, NULL, NULL, "the probe whose displacement steps.csv reports (control_u)"},
+            {"control_component", PERI_KEY_STRING, "the first component (ux)", NULL, NULL, NULL, "the component of the control probe's displacement in steps.csv's control_u (ux, uy, uz, theta: the model's)"},
+            {"reaction_region", PERI_KEY_STRING, "the first bc region with a nonzero value, else the first holding the component", NULL, NULL, NULL, "the bc region whose reaction along control_component steps.csv reports (reaction): the force of the load-displacement curve"},
             {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "more bonds than this share breaking at one load is a runaway: adaptive increments retry with a smaller step, events declare the failure"},
             {NULL},
 };

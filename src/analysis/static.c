@@ -27,6 +27,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscCall(PetscStrncpy(an->sys->solve.pc_type, "none", sizeof(an->sys->solve.pc_type)));
     PetscCall(PetscStrncpy(an->sys->solve.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(an->sys->solve.converged_reason)));
     PetscCall(PeriSystemEvaluateEnergy(an->sys));
+    PetscCall(PeriSystemEvaluateReactions(an->sys, 1.0));
     PetscCall(PeriReferenceEvaluate(an->sys));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -65,6 +66,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   PetscCall(PetscTime(&t1));
   an->sys->log.solve_s = t1 - t0;
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  PetscCall(PeriSystemEvaluateReactions(an->sys, 1.0));
   PetscCall(PeriReferenceEvaluate(an->sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

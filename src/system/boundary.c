@@ -81,8 +81,9 @@ static PetscErrorCode ParseAffine(PeriSystem sys, PeriNode node, const char sect
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* value[] and set[] over the owned DOFs; later conditions override earlier ones. */
-static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal value[], PetscBool set[])
+/* value[], set[] and region[] (the condition's region, for its reaction) over the owned DOFs;
+ * later conditions override earlier ones. */
+static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal value[], PetscBool set[], PetscInt region[])
 {
   PeriScene      s  = sys->scene;
   PeriModel      m  = sys->model;
@@ -142,8 +143,9 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
       }
     for (PetscInt c = 0; c < bs; c++)
       if (use[c]) {
-        value[(i - sys->disc.bonds.rstart) * bs + c] = v[c];
-        set[(i - sys->disc.bonds.rstart) * bs + c]   = PETSC_TRUE;
+        value[(i - sys->disc.bonds.rstart) * bs + c]  = v[c];
+        set[(i - sys->disc.bonds.rstart) * bs + c]    = PETSC_TRUE;
+        region[(i - sys->disc.bonds.rstart) * bs + c] = (PetscInt)(r - sys->disc.regions);
       }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -159,16 +161,17 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   PeriNode       bc;
   PetscReal     *value;
   PetscBool     *set;
-  PetscInt       n    = 0;
+  PetscInt       n    = 0, *region;
   PetscErrorCode ierr = PETSC_SUCCESS;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "bc", &bc));
   PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
-  PetscCall(PetscCalloc2(nloc, &value, nloc, &set));
+  PetscCall(PetscCalloc3(nloc, &value, nloc, &set, nloc, &region));
+  for (PetscInt k = 0; k < nloc; k++) region[k] = -1; /* held by no bc item (an inactive component) */
   /* a bad condition is an input error, not an exit: free the work arrays before passing it on */
-  for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(sys, bc->child[k], value, set);
-  if (ierr) PetscCall(PetscFree2(value, set));
+  for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(sys, bc->child[k], value, set, region);
+  if (ierr) PetscCall(PetscFree3(value, set, region));
   PetscCall(ierr);
   for (PetscInt c = 0; c < bs; c++) {
     if (!sys->model->inactive[c]) continue;
@@ -182,14 +185,17 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   sys->nconstrained = n;
   PetscCall(PetscMalloc1(n, &sys->constrained));
   PetscCall(PetscMalloc1(n, &sys->constrained_value));
+  PetscCall(PetscMalloc1(n, &sys->constrained_region));
   n = 0;
   for (PetscInt k = 0; k < nloc; k++)
     if (set[k]) {
-      sys->constrained[n]       = sys->disc.bonds.rstart * bs + k;
-      sys->constrained_value[n] = value[k];
+      sys->constrained[n]        = sys->disc.bonds.rstart * bs + k;
+      sys->constrained_value[n]  = value[k];
+      sys->constrained_region[n] = region[k];
       n++;
     }
-  PetscCall(PetscFree2(value, set));
+  PetscCall(PetscFree3(value, set, region));
+  PetscCall(PeriReactionsSetUp(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -369,8 +369,8 @@ static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool
 
 /* Sets the prescribed (lambda times their values) and held DOFs in sys->u and eliminates them
  * symmetrically from A and b, with the system scaled to O(1) numbers first (ScaleToUnits); *diag
- * gets the value left on the eliminated rows. */
-static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, PetscReal lambda, PetscInt nhold, const PetscInt hold[], const PetscReal held[], PetscReal *diag)
+ * gets the value left on the eliminated rows, *scale the factor b was divided by. */
+static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, PetscReal lambda, PetscInt nhold, const PetscInt hold[], const PetscReal held[], PetscReal *diag, PetscReal *scale)
 {
   const PetscInt nrows = sys->nconstrained + nhold;
   PetscReal     *values;
@@ -398,6 +398,7 @@ static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, P
   PetscCall(VecGetSize(d, &N));
   PetscCall(VecDestroy(&d));
   *diag /= N;
+  *scale = *diag;
   PetscCall(ScaleToUnits(sys, A, P, b, diag));
   PetscCall(PetscObjectTypeCompare((PetscObject)P, MATMPISBAIJ, &mpisbaij));
   PetscCheck(!mpisbaij, sys->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
@@ -451,6 +452,7 @@ static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConv
   PetscCall(VecNorm(b, NORM_2, &fnorm));
   PetscCall(VecDestroy(&r));
   sys->solve.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
+  sys->solve.rhs_norm      = fnorm; /* of the scaled system: SolveAttempt restores the units */
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pt));
@@ -465,16 +467,20 @@ static PetscErrorCode SolveAttempt(PeriSystem sys, KSP *ksp, PetscReal lambda, P
 {
   Mat       A, P;
   Vec       b, free[PERI_MAX_MODES];
-  PetscReal diag;
+  PetscReal diag, scale = 1;
   PetscInt  nfree = 0;
 
   PetscFunctionBeginUser;
   PetscCall(StaticOperator(sys, lambda, inplace, &A, &P, &b));
-  PetscCall(EliminatePrescribed(sys, A, P, b, lambda, nhold, hold, held, &diag));
+  PetscCall(EliminatePrescribed(sys, A, P, b, lambda, nhold, hold, held, &diag, &scale));
   PetscCall(CheckRightHandSide(sys, b));
   PetscCall(HandleFreeMotions(sys, A, P, sys->u, b, diag, nhold, hold, &nfree, free));
   PetscCall(SolveWithFallback(sys, ksp, A, P, b, reason));
   PetscCall(RecordSolve(sys, *ksp, A, b, *reason));
+  /* the residual's scale in the scene's units and the load factor: the equilibrium check of the
+     reactions (reactions.c) allows what this residual explains */
+  sys->solve.rhs_norm *= scale;
+  sys->solve.load_factor = lambda;
   /* the solution orthogonal to the free rigid motions */
   for (PetscInt q = 0; q < nfree; q++) {
     PetscScalar dot;

@@ -416,6 +416,8 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PetscFree(sys->probes));
   PetscCall(PetscFree(sys->constrained));
   PetscCall(PetscFree(sys->constrained_value));
+  PetscCall(PetscFree(sys->constrained_region));
+  PetscCall(PeriReactionsDestroy(&sys->reactions));
   PetscCall(PetscFree(sys->W));
   PetscCall(PetscFree(sys->u_all));
   PetscCall(PetscFree(sys));

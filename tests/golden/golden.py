@@ -26,7 +26,10 @@ the numbers in one JSON container (path without list indices, e.g. probes.a.u,
 modal.modes.energy_share, max_abs_u); a scalar of the top level is its own family. Two families can
 be all round-off in the goldens' scenes, so they get a physical floor: modal.modes.effective_mass
 (bar_modes: zero for every elastic mode of a free bar) has S >= modal.total_mass, and
-modal.modes.energy_share (shares sum to 1) has S >= 1.
+modal.modes.energy_share (shares sum to 1) has S >= 1. Forces vanish by balance in several scenes (a
+pin's reaction, a self-equilibrated load): the families reactions.*, applied_load and
+equilibrium.imbalance have S >= equilibrium.force_scale, and steps.csv's reaction and R_* columns
+share the largest of them as S.
 1e-12 rather than 1e-14: a refactoring that reorders sums moves a value that is zero by symmetry by
 round-off times the condition of the solve, which can reach ~1e-13 of the family scale.
 
@@ -38,6 +41,7 @@ grow by at most two orders of magnitude (it may fall freely).
   modal.modes.residual, modes.csv residual   eigenpair residuals
   interior_strain                mean strain of the interior particles: zero by antisymmetry in the
                                  only reference scene of the goldens (pure bending), 1e-16
+  equilibrium.relative_imbalance, steps.csv relative_imbalance   the reactions' and loads' sum
 
 Degenerate modes: modes whose frequencies agree to 1e-6 (bar_modes: the transverse pairs in y and
 z) span a subspace in which the eigensolver's basis is arbitrary, so round-off may rotate it. For
@@ -57,8 +61,8 @@ import sys
 VOLATILE = [("scene",), ("timing",), ("memory_mb",), ("memory_mb_max_rank",), ("memory_phases_mb",), ("matrix_mb",),
             ("modal", "factorization_s"), ("modal", "eigensolve_s")]
 ROUNDOFF_JSON = {"solver.residual_norm", "solver.load_share_removed", "modal.modes.residual",
-                 "interior_strain"}
-ROUNDOFF_CSV = {"residual"}
+                 "interior_strain", "equilibrium.relative_imbalance"}
+ROUNDOFF_CSV = {"residual", "relative_imbalance"}
 STEPS_VOLATILE = {"seconds"}  # wall time of each step
 REL = 1e-9
 ZERO = 1e-12
@@ -207,6 +211,13 @@ def compare_json(exp, got, errs):
     if isnum(tm):
         scale["modal.modes.effective_mass"] = max(scale.get("modal.modes.effective_mass", 0.0), abs(tm))
     scale["modal.modes.energy_share"] = max(scale.get("modal.modes.energy_share", 0.0), 1.0)
+    # forces: the reactions, the applied load and the imbalance are round-off where they vanish
+    # (a pin, a self-equilibrated load); their floor is the run's force scale (sum of particle forces)
+    fs = exp.get("equilibrium", {}).get("force_scale") if isinstance(exp.get("equilibrium"), dict) else None
+    if isnum(fs):
+        for k in list(scale) + ["applied_load", "equilibrium.imbalance"]:
+            if k.startswith("reactions.") or k in ("applied_load", "equilibrium.imbalance"):
+                scale[k] = max(scale.get(k, 0.0), abs(fs))
     invariant_modes(exp)
     invariant_modes(got)
 
@@ -302,6 +313,11 @@ def compare_csv(name, exp_path, got_path, errs):
             for c, (v, u) in row.items():
                 if isinstance(v, float):
                     scale[c] = max(scale.get(c, 0.0), abs(v))
+    # reaction columns: a held component that carries no force is round-off of the largest reaction
+    forces = max([scale[c] for c in scale if c.startswith("R_") or c == "reaction"] + [0.0])
+    for c in scale:
+        if c.startswith("R_") or c == "reaction":
+            scale[c] = forces
     for i, (a, b) in enumerate(zip(et, gt)):
         for c in eh:
             (x, ux), (y, uy) = a.get(c, ("", 0.0)), b.get(c, ("", 0.0))

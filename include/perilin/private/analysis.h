@@ -33,6 +33,7 @@ typedef struct {
 typedef struct {
   PetscReal lambda, control_u, seconds;
   PetscInt  broken, broken_total, iterations, ksp_iterations;
+  PetscReal reaction, imbalance; /* the reaction region's force along the control component; the relative imbalance */
 } PeriStep;
 
 typedef struct {
@@ -46,7 +47,9 @@ typedef struct {
   PetscBool  failed, complete;
   char       ending[160];
   char       control[PERI_NAME_LEN];
-  char       stepping[16]; /* increments | events */
+  char       stepping[16];                       /* increments | events */
+  PetscInt   control_component, reaction_region; /* the model's component; index of disc.regions, or -1 */
+  PetscReal *reactions;                          /* per step, every region's reaction: nregions x PERI_MAX_DOF */
 } PeriQuasistatic;
 
 /* An analysis type (src/analysis/<name>.c): what it does with the system, and what it adds to

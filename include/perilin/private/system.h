@@ -26,6 +26,8 @@ typedef struct {
   PetscBool symmetric;      /* the operator solved was symmetric */
   PetscInt  free_modes;     /* rigid motions left free with balanced loads: solved orthogonal to them */
   PetscReal load_imbalance; /* share of the load along those motions, removed */
+  PetscReal rhs_norm;       /* ||b|| of the last solve in the scene's units (the residual's scale) */
+  PetscReal load_factor;    /* the load factor it was solved at */
 } PeriSolveInfo;
 
 /* What the run cost and how large it was. */
@@ -120,6 +122,23 @@ typedef enum {
 PETSC_EXTERN const char *const  PeriOperatorKinds[];
 typedef struct _p_PeriOperator *PeriOperator;
 
+/* Reactions of the constrained regions and the global equilibrium (src/system/reactions.c): per
+ * region of the scene (index of disc.regions), the sum of K u - lambda f over the DOFs a bc item on
+ * it constrains, K the unconstrained stiffness. */
+typedef struct {
+  PetscInt   nregions;                /* disc.nregions */
+  PetscBool *holds;                   /* [nregions][PERI_MAX_DOF]: a bc item on the region constrains component c */
+  PetscBool *moves;                   /* [nregions]: a nonzero value is prescribed on it */
+  PetscReal *force;                   /* [nregions][PERI_MAX_DOF]: the reaction, after the last evaluation */
+  PetscReal  applied[PERI_MAX_DOF];   /* lambda times the total of loads: per component */
+  PetscReal  imbalance[PERI_MAX_DOF]; /* sum of the reactions + applied, translational components */
+  PetscReal  relative_imbalance;      /* |imbalance| / sum over particles of |reaction| + |load| */
+  PetscReal  scale;                   /* that sum: the force scale of the check */
+  PetscReal  allowed;                 /* the largest relative imbalance the solve's residual tolerance explains */
+  PetscReal  load_factor;             /* of the evaluated state */
+  PetscBool  evaluated, checked;      /* checked: false with fictitious layers (their faces carry no reaction) */
+} PeriReactions;
+
 typedef struct _p_PeriSystem *PeriSystem;
 struct _p_PeriSystem {
   MPI_Comm         comm;
@@ -151,6 +170,8 @@ struct _p_PeriSystem {
   PetscInt         nconstrained; /* owned constrained DOFs */
   PetscInt        *constrained;  /* their global rows */
   PetscReal       *constrained_value;
+  PetscInt        *constrained_region; /* the region (index of disc.regions) of the bc item that set each, or -1 */
+  PeriReactions    reactions;
   PetscInt         nprobes;
   PeriProbe       *probes;
   PetscReal       *W;     /* strain energy density per particle (rank 0, after the solve) */
@@ -216,6 +237,13 @@ PETSC_EXTERN PetscErrorCode PeriOperatorDestroy(PeriOperator *);
 /* boundary conditions and loads (src/system/boundary.c) */
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriLoadsAssemble(PeriSystem, Vec);
+
+/* reactions and global equilibrium (src/system/reactions.c) */
+PETSC_EXTERN PetscErrorCode PeriReactionsSetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemEvaluateReactions(PeriSystem, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriReactionsFindRegion(PeriSystem, const char[], PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriReactionsSummary(PeriSystem, PeriJSON);
+PETSC_EXTERN PetscErrorCode PeriReactionsDestroy(PeriReactions *);
 
 /* reference solutions (src/system/reference.c) */
 PETSC_EXTERN PetscErrorCode PeriReferenceSetUp(PeriSystem);
