@@ -29,6 +29,9 @@ typedef struct {
   PetscInt      *image;   /* -1 for a particle of the body; else the body particle it mirrors */
   unsigned char *crossed; /* faces crossed to reach the particle: bit 2 axis + (upper face) */
   PetscInt       nfictitious;
+  /* the named physical groups of particles.mesh (src/disc/mesh.c): NULL otherwise */
+  PetscInt                 ngroups;
+  struct _n_PeriMeshGroup *groups;
 } PeriParticles;
 
 #define PeriParticleIsFictitious(pt, k) ((pt)->image && (pt)->image[k] >= 0)

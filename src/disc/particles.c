@@ -1,4 +1,5 @@
-/* Particles: a cell-centred grid in a box, or a CSV file of positions and volumes. */
+/* Particles: a cell-centred grid in a box, a CSV file of positions and volumes, or the elements of
+ * a Gmsh mesh (src/disc/mesh.c). */
 #include "perilin/private/disc.h"
 #include <errno.h>
 
@@ -20,7 +21,10 @@ static const PeriKey grid_keys[] = {
     {NULL},
 };
 static const PeriKey particles_keys[] = {
-    {"file", PERI_KEY_STRING, "required", NULL, NULL, NULL, "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid"},
+    {"file", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid; give file or mesh"},
+    {"mesh", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "Gmsh mesh (.msh, any version Gmsh reads) or geometry (.geo, meshed with size), relative to the scene file: one particle per element of dimension dim, named physical groups as regions (docs/mesh.md)"},
+    {"size", PERI_KEY_REAL, "required for a .geo", "(0, inf)", "[length]", NULL, "the largest element size Gmsh meshes a .geo with (Mesh.MeshSizeMax; smaller sizes in the .geo still refine)"},
+    {"verbose", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "let Gmsh print its messages while it reads or meshes particles.mesh"},
     {NULL},
 };
 const PeriSchema PeriParticlesSchema[] = {
@@ -80,7 +84,6 @@ static PetscErrorCode CSVPath(PeriScene scene, PeriNode node, char path[], size_
   char name[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneCheckSection(scene, node, "particles"));
   PetscCall(PeriSceneGetString(scene, node, "file", PETSC_TRUE, name, sizeof(name), NULL));
   if (name[0] == '/')
     PetscCall(PetscStrncpy(path, name, size));
@@ -237,6 +240,22 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* One particle per element of a Gmsh mesh; the spacing of each is sqrt(area) or cbrt(volume), as
+ * for the CSV particles. */
+static PetscErrorCode MeshCreate(PeriScene scene, PeriNode node, PetscInt dim, PeriParticles *p)
+{
+  PetscInt   n, *src;
+  PetscReal *x, *vol;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriMeshRead(scene, node, dim, p->thickness, &n, &x, &vol, &p->ngroups, &p->groups));
+  PetscCall(PetscCalloc1(n, &src));
+  PetscCall(CSVFill(p, dim, n, x, vol, src));
+  PetscCall(PetscFree2(x, vol));
+  PetscCall(PetscFree(src));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriParticlesCreateFromScene - generates the particles from the scene's grid or particles
   section. Not collective: every rank builds the same set.
@@ -251,12 +270,22 @@ PetscErrorCode PeriParticlesCreateFromScene(PeriScene scene, PetscInt dim, Petsc
   p->thickness = dim == 2 ? thickness : 1;
   PetscCall(PeriSceneGetMap(scene, scene->root, "grid", PETSC_FALSE, &grid));
   PetscCall(PeriSceneGetMap(scene, scene->root, "particles", PETSC_FALSE, &csv));
-  PeriInputCheck(grid || csv, scene, scene->root, "grid", "is required (or give particles.file)");
+  PeriInputCheck(grid || csv, scene, scene->root, "grid", "is required (or give particles.file or particles.mesh)");
   PeriInputCheck(!(grid && csv), scene, csv, NULL, "give either grid or particles, not both");
-  if (grid)
+  if (grid) {
     PetscCall(GridCreate(scene, grid, dim, p));
-  else
-    PetscCall(CSVCreate(scene, csv, dim, p));
+  } else {
+    PeriNode file, mesh;
+    PetscCall(PeriSceneCheckSection(scene, csv, "particles"));
+    PetscCall(PeriSceneGetNode(csv, "file", &file));
+    PetscCall(PeriSceneGetNode(csv, "mesh", &mesh));
+    PeriInputCheck(file || mesh, scene, csv, "file", "is required (or give particles.mesh)");
+    PeriInputCheck(!(file && mesh), scene, csv, "mesh", "give either particles.file or particles.mesh, not both");
+    if (mesh)
+      PetscCall(MeshCreate(scene, csv, dim, p));
+    else
+      PetscCall(CSVCreate(scene, csv, dim, p));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -286,6 +315,8 @@ PetscErrorCode PeriParticlesPermute(PeriParticles *p, const PetscInt perm[])
     }
     PetscCall(PetscFree(inv));
   }
+  p->ngroups = 0; /* the groups hold positions, not indices: q keeps them as they are */
+  p->groups  = NULL;
   PetscCall(PeriParticlesDestroy(p));
   *p = q;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -297,5 +328,6 @@ PetscErrorCode PeriParticlesDestroy(PeriParticles *p)
   PetscCall(PetscFree(p->x));
   PetscCall(PetscFree3(p->volume, p->spacing, p->source_line));
   PetscCall(PetscFree2(p->image, p->crossed));
+  PetscCall(PeriMeshGroupsDestroy(&p->ngroups, &p->groups));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

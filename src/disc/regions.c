@@ -1,4 +1,5 @@
-/* Named regions: boxes, and boundary layers of a given depth along a face of the body. */
+/* Named regions: boxes, boundary layers of a given depth along a face of the body, and the particle
+ * sets of a mesh's physical groups. */
 #include "perilin/private/disc.h"
 
 static const char *const sides[]       = {"x-", "x+", "y-", "y+", "z-", "z+", NULL};
@@ -7,6 +8,7 @@ static const PeriKey     region_keys[] = {
         {"upper", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a box region: its upper corner, at least lower"},
         {"side", PERI_KEY_CHOICE, NULL, NULL, NULL, sides, "a boundary layer instead: the face it lies along (z- and z+ in 3D only)"},
         {"depth", PERI_KEY_REAL, "horizon delta", "(0, inf)", "[length]", NULL, "a boundary layer's depth"},
+        {"group", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "a physical group of particles.mesh under another name (every named group is a region already; docs/mesh.md)"},
         {NULL},
 };
 const PeriSchema PeriRegionsSchema[] = {{"regions.<name>", region_keys}, {NULL}};
@@ -22,17 +24,69 @@ PetscReal PeriRegionTolerance(const PeriParticles *p)
 
 PetscBool PeriRegionContains(const PeriRegion *r, const PetscReal x[])
 {
+  PetscInt lo = 0, hi;
+
   /* "all" is the body's box too: fictitious layer particles lie outside it */
   for (PetscInt d = 0; d < 3; d++)
     if (x[d] < r->lower[d] || x[d] > r->upper[d]) return PETSC_FALSE;
-  return PETSC_TRUE;
+  if (r->kind != PERI_REGION_SET) return PETSC_TRUE;
+  /* a mesh group: positions are copied, never recomputed, so equality is exact */
+  for (hi = r->nset; lo < hi;) {
+    PetscInt         mid = (lo + hi) / 2, c = 0;
+    const PetscReal *y = &r->set[3 * mid];
+    for (PetscInt d = 0; d < 3 && !c; d++) c = x[d] < y[d] ? -1 : x[d] > y[d] ? 1
+                                                                              : 0;
+    if (!c) return PETSC_TRUE;
+    if (c < 0)
+      hi = mid;
+    else
+      lo = mid + 1;
+  }
+  return PETSC_FALSE;
+}
+
+/* A region of the particles of a mesh's physical group, bounded by their box for a quick reject. */
+static void RegionFromGroup(const PeriMeshGroup *g, PetscReal tol, PeriRegion *r)
+{
+  r->kind      = PERI_REGION_SET;
+  r->set       = g->x; /* read only */
+  r->nset      = g->count;
+  r->face_area = g->measure;
+  for (PetscInt d = 0; d < 3; d++) {
+    r->lower[d] = PETSC_MAX_REAL;
+    r->upper[d] = -PETSC_MAX_REAL;
+  }
+  for (PetscInt k = 0; k < g->count; k++)
+    for (PetscInt d = 0; d < 3; d++) {
+      r->lower[d] = PetscMin(r->lower[d], g->x[3 * k + d] - tol);
+      r->upper[d] = PetscMax(r->upper[d], g->x[3 * k + d] + tol);
+    }
+}
+
+/* regions.<name>.group: the named physical group, or an error that lists them. */
+static PetscErrorCode RegionGroup(PeriScene scene, PeriNode node, const PeriParticles *p, PeriRegion *r)
+{
+  char name[PERI_NAME_LEN], list[512] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetString(scene, node, "group", PETSC_TRUE, name, sizeof(name), NULL));
+  PeriInputCheck(p->groups, scene, node, "group", "names a physical group, but the particles come from no mesh (particles.mesh)");
+  for (PetscInt k = 0; k < p->ngroups; k++) {
+    if (!strcmp(p->groups[k].name, name)) {
+      RegionFromGroup(&p->groups[k], PeriRegionTolerance(p), r);
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+    PeriListAppend(list, sizeof(list), p->groups[k].name);
+  }
+  PeriInputCheck(PETSC_FALSE, scene, node, "group", "no physical group named '%s' in particles.mesh; its named groups are: %s", name, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const PeriParticles *p, PetscReal delta, PeriRegion *r)
 {
   PetscReal tol = PeriRegionTolerance(p);
   PetscInt  n, dim = p->dim, side = -1;
-  PeriNode  lower, sidenode;
+  PeriNode  lower, sidenode, group;
 
   PetscFunctionBeginUser;
   PeriInputCheck(node->kind == PERI_NODE_MAP, scene, node, NULL, "a region is a box {lower: [..], upper: [..]} or a layer {side: x-, depth: d}");
@@ -41,13 +95,16 @@ static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const Peri
   r->node = node;
   PetscCall(PeriSceneGetNode(node, "lower", &lower));
   PetscCall(PeriSceneGetNode(node, "side", &sidenode));
-  PeriInputCheck(lower || sidenode, scene, node, NULL, "give lower and upper (a box) or side (a boundary layer)");
-  PeriInputCheck(!(lower && sidenode), scene, node, NULL, "give either lower/upper (a box) or side (a layer), not both");
+  PetscCall(PeriSceneGetNode(node, "group", &group));
+  PeriInputCheck(lower || sidenode || group, scene, node, NULL, "give lower and upper (a box), side (a boundary layer) or group (a mesh's physical group)");
+  PeriInputCheck((lower ? 1 : 0) + (sidenode ? 1 : 0) + (group ? 1 : 0) == 1, scene, node, NULL, "give one of lower/upper (a box), side (a layer) or group (a mesh's physical group)");
   for (PetscInt d = 0; d < 3; d++) {
     r->lower[d] = d < dim ? p->lower[d] - tol : -PETSC_MAX_REAL;
     r->upper[d] = d < dim ? p->upper[d] + tol : PETSC_MAX_REAL;
   }
-  if (lower) {
+  if (group) {
+    PetscCall(RegionGroup(scene, node, p, r));
+  } else if (lower) {
     PetscReal lo[3], hi[3];
     r->kind = PERI_REGION_BOX;
     PetscCall(PeriSceneGetRealArray(scene, node, "lower", PETSC_TRUE, dim, dim, lo, &n));
@@ -83,6 +140,25 @@ static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const Peri
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Every named physical group of the mesh is a region of its name, r[1 .. ngroups]. */
+static PetscErrorCode RegionsFromGroups(PeriScene scene, const PeriParticles *p, PeriRegion r[])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt g = 0; g < p->ngroups; g++) {
+    PeriRegion *rg = &r[1 + g];
+    PeriInputCheck(strcmp(p->groups[g].name, "all"), scene, scene->root, "particles", "the mesh's physical group 'all' clashes with the region 'all' (every particle): rename it");
+    PetscCall(PetscStrncpy(rg->name, p->groups[g].name, sizeof(rg->name)));
+    rg->node = scene->root;
+    RegionFromGroup(&p->groups[g], PeriRegionTolerance(p), rg);
+    for (PetscInt k = 0; k < p->n; k++)
+      if (PeriRegionContains(rg, &p->x[3 * k])) {
+        rg->count++;
+        rg->volume += p->volume[k];
+      }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriRegionsCreateFromScene - reads the regions map; region "all" always exists. Not collective.
 @*/
@@ -94,7 +170,7 @@ PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(scene, scene->root, "regions", PETSC_FALSE, &map));
-  n = 1 + (map ? map->n : 0);
+  n = 1 + p->ngroups + (map ? map->n : 0);
   PetscCall(PetscCalloc1(n, &r));
   PetscCall(PetscStrncpy(r[0].name, "all", sizeof(r[0].name)));
   r[0].kind = PERI_REGION_ALL;
@@ -107,9 +183,12 @@ PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *
       r[0].count++;
       r[0].volume += p->volume[k];
     }
-  for (PetscInt k = 1; k < n; k++) {
-    PeriInputCheck(strcmp(map->child[k - 1]->key, "all"), scene, map->child[k - 1], NULL, "'all' is reserved: it always names every particle");
-    PetscCall(RegionFromScene(scene, map->child[k - 1], p, delta, &r[k]));
+  PetscCall(RegionsFromGroups(scene, p, r));
+  for (PetscInt k = 1 + p->ngroups; k < n; k++) {
+    PeriNode node = map->child[k - 1 - p->ngroups];
+    PeriInputCheck(strcmp(node->key, "all"), scene, node, NULL, "'all' is reserved: it always names every particle");
+    for (PetscInt g = 0; g < p->ngroups; g++) PeriInputCheck(strcmp(node->key, p->groups[g].name), scene, node, NULL, "'%s' is a physical group of particles.mesh already, and so a region: name this one otherwise", node->key);
+    PetscCall(RegionFromScene(scene, node, p, delta, &r[k]));
   }
   *nregions = n;
   *regions  = r;

@@ -9,11 +9,26 @@ PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, Pe
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
 
+/* ------------------------------------------------------------------ Gmsh meshes (src/mesh.c) */
+/* A named physical group: the positions of its particles, sorted lexicographically (positions,
+ * not indices, so that the partition's renumbering leaves the set valid). */
+typedef struct _n_PeriMeshGroup {
+  char       name[PERI_NAME_LEN];
+  PetscInt   dim;     /* the group's own dimension: the scene's, or lower for a boundary */
+  PetscInt   count;   /* its particles */
+  PetscReal *x;       /* 3 per particle, sorted */
+  PetscReal  measure; /* a group of dimension dim - 1: its length x thickness (2D) or area (3D); else 0 */
+} PeriMeshGroup;
+
+PETSC_EXTERN PetscErrorCode PeriMeshRead(PeriScene, PeriNode, PetscInt, PetscReal, PetscInt *, PetscReal **, PetscReal **, PetscInt *, PeriMeshGroup **);
+PETSC_EXTERN PetscErrorCode PeriMeshGroupsDestroy(PetscInt *, PeriMeshGroup **);
+
 /* ------------------------------------------------------------------ regions (src/regions.c) */
 typedef enum {
   PERI_REGION_ALL,
   PERI_REGION_BOX,
-  PERI_REGION_LAYER
+  PERI_REGION_LAYER,
+  PERI_REGION_SET
 } PeriRegionKind;
 
 typedef struct {
@@ -22,9 +37,11 @@ typedef struct {
   PetscReal      lower[3], upper[3]; /* the box, or the layer's slab */
   PetscInt       axis, side;         /* layers: axis 0..2, side -1 (lower face) or +1 (upper face) */
   PetscReal      depth;              /* layers */
-  PetscReal      face_area;          /* layers: area of the body's face the layer lies on */
-  PetscInt       count;              /* particles inside */
-  PetscReal      volume;             /* their total volume */
+  PetscReal      face_area;          /* layers: area of the body's face the layer lies on; sets: the mesh boundary group's measure */
+  PetscReal     *set;                /* sets: the sorted positions of a mesh group (owned by the particles) */
+  PetscInt       nset;
+  PetscInt       count;  /* particles inside */
+  PetscReal      volume; /* their total volume */
   PeriNode       node;
 } PeriRegion;
 

@@ -1,0 +1,482 @@
+/* Particles and regions from a Gmsh mesh, through Gmsh's own C API (gmshc.h): a .msh file of any
+ * version Gmsh reads, or a .geo file meshed here. One particle per element of the scene's
+ * dimension, at its centroid, with its exact measure; named physical groups become particle sets
+ * (docs/mesh.md). Every rank reads the same file: Gmsh is not MPI-aware, and meshing on one thread
+ * is deterministic, so every rank builds the same particles without a broadcast. */
+#include "perilin/private/disc.h"
+#include <gmshc.h>
+#include <unistd.h>
+#include <errno.h>
+
+static PetscBool gmsh_started = PETSC_FALSE;
+
+/* Gmsh holds global state: it is initialized once per process and finalized with PETSc. */
+static PetscErrorCode GmshFinalizeOnce(void)
+{
+  int ierr = 0;
+
+  PetscFunctionBeginUser;
+  if (gmsh_started) gmshFinalize(&ierr);
+  gmsh_started = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Starts Gmsh (once) with an empty model; silent unless verbose, and on one thread so that every
+ * rank meshes a .geo into the very same elements. */
+static PetscErrorCode GmshStart(PetscBool verbose)
+{
+  int ierr = 0;
+
+  PetscFunctionBeginUser;
+  if (!gmsh_started) {
+    gmshInitialize(0, NULL, 0, &ierr);
+    PetscCheck(!ierr, PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh failed to initialize");
+    gmsh_started = PETSC_TRUE;
+    PetscCall(PetscRegisterFinalize(GmshFinalizeOnce));
+  }
+  gmshOptionSetNumber("General.Terminal", verbose ? 1 : 0, &ierr);
+  gmshOptionSetNumber("General.Verbosity", verbose ? 5 : 0, &ierr);
+  gmshOptionSetNumber("General.NumThreads", 1, &ierr);
+  gmshOptionSetNumber("Mesh.MaxNumThreads2D", 1, &ierr);
+  gmshOptionSetNumber("Mesh.MaxNumThreads3D", 1, &ierr);
+  gmshClear(&ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Gmsh's last error message, for errors that name the file. */
+static void GmshLastError(char msg[], size_t size)
+{
+  char *e    = NULL;
+  int   ierr = 0;
+
+  gmshLoggerGetLastError(&e, &ierr);
+  (void)PetscStrncpy(msg, !ierr && e && e[0] ? e : "unknown Gmsh error", size);
+  if (e) gmshFree(e);
+}
+
+#define GmshCheck(ierr, what)                                                          \
+  do {                                                                                 \
+    if (PetscUnlikely(ierr)) {                                                         \
+      char peri_msg_[256];                                                             \
+      GmshLastError(peri_msg_, sizeof(peri_msg_));                                     \
+      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh: %s failed: %s", what, peri_msg_); \
+    }                                                                                  \
+  } while (0)
+
+/* The corners of Gmsh's linear elements: type -> (dimension, corners, simplex); 0 corners when
+ * perilin does not read the type. */
+static void ElementShape(int type, PetscInt *dim, PetscInt *corners, PetscBool *simplex)
+{
+  static const PetscInt  d[] = {0, 1, 2, 2, 3, 3}, c[] = {0, 2, 3, 4, 4, 8};
+  static const PetscBool s[] = {PETSC_TRUE, PETSC_TRUE, PETSC_TRUE, PETSC_FALSE, PETSC_TRUE, PETSC_FALSE};
+
+  if (type == 15) { /* a point */
+    *dim = 0, *corners = 1, *simplex = PETSC_TRUE;
+  } else if (type >= 1 && type <= 5) {
+    *dim = d[type], *corners = c[type], *simplex = s[type];
+  } else {
+    *dim = -1, *corners = 0, *simplex = PETSC_FALSE;
+  }
+}
+
+/* sqrt(det(J^T J)) of the k columns J (k <= 3) in 3D: length, area or volume scale, also for
+ * lines and faces embedded in 3D. */
+static PetscReal GramRoot(PetscInt k, PetscReal J[3][3])
+{
+  PetscReal G[3][3] = {{0}}, det;
+
+  for (PetscInt a = 0; a < k; a++)
+    for (PetscInt b = 0; b < k; b++)
+      for (PetscInt r = 0; r < 3; r++) G[a][b] += J[r][a] * J[r][b];
+  if (k == 0) return 1;
+  if (k == 1)
+    det = G[0][0];
+  else if (k == 2)
+    det = G[0][0] * G[1][1] - G[0][1] * G[1][0];
+  else
+    det = G[0][0] * (G[1][1] * G[2][2] - G[1][2] * G[2][1]) - G[0][1] * (G[1][0] * G[2][2] - G[1][2] * G[2][0]) + G[0][2] * (G[1][0] * G[2][1] - G[1][1] * G[2][0]);
+  return PetscSqrtReal(PetscMax(det, 0));
+}
+
+/* The exact measure (length, area, volume) and centroid of a linear element from its corners X.
+ * Simplices have a constant Jacobian; quadrangles and hexahedra are bi- and trilinear, whose
+ * |det J| and x |det J| the 2-point Gauss rule per axis integrates exactly (valid elements). */
+static void ElementMeasure(PetscInt dim, PetscInt corners, PetscBool simplex, const PetscReal X[][3], PetscReal *measure, PetscReal c[3])
+{
+  static const PetscReal ref[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}, {-1, -1, 1}, {1, -1, 1}, {1, 1, 1}, {-1, 1, 1}};
+  PetscReal              J[3][3] = {{0}}, g = 1 / PetscSqrtReal(3);
+
+  *measure = 0;
+  c[0] = c[1] = c[2] = 0;
+  if (simplex) {
+    PetscReal fact = dim == 3 ? 6 : dim == 2 ? 2
+                                             : 1;
+    for (PetscInt k = 0; k < dim; k++)
+      for (PetscInt r = 0; r < 3; r++) J[r][k] = X[k + 1][r] - X[0][r];
+    *measure = GramRoot(dim, J) / fact;
+    for (PetscInt a = 0; a < corners; a++)
+      for (PetscInt r = 0; r < 3; r++) c[r] += X[a][r] / corners;
+    return;
+  }
+  for (PetscInt q = 0; q < (1 << dim); q++) {
+    PetscReal xi[3], x[3] = {0, 0, 0}, w;
+    for (PetscInt k = 0; k < 3; k++) xi[k] = k < dim ? ((q >> k) & 1 ? g : -g) : 0;
+    for (PetscInt r = 0; r < 3; r++)
+      for (PetscInt k = 0; k < 3; k++) J[r][k] = 0;
+    for (PetscInt a = 0; a < corners; a++) {
+      PetscReal N = 1;
+      for (PetscInt k = 0; k < dim; k++) N *= (1 + ref[a][k] * xi[k]) / 2;
+      for (PetscInt k = 0; k < dim; k++) {
+        PetscReal dN = ref[a][k] / 2;
+        for (PetscInt l = 0; l < dim; l++)
+          if (l != k) dN *= (1 + ref[a][l] * xi[l]) / 2;
+        for (PetscInt r = 0; r < 3; r++) J[r][k] += dN * X[a][r];
+      }
+      for (PetscInt r = 0; r < 3; r++) x[r] += N * X[a][r];
+    }
+    w = GramRoot(dim, J);
+    *measure += w;
+    for (PetscInt r = 0; r < 3; r++) c[r] += w * x[r];
+  }
+  for (PetscInt r = 0; r < 3; r++) c[r] /= *measure;
+}
+
+/* The model's nodes: their coordinates by tag (index[tag] into xyz, -1 when absent). */
+typedef struct {
+  size_t    maxtag;
+  PetscInt *index;
+  double   *xyz;
+  size_t   *tags, n;
+} MeshNodes;
+
+static PetscErrorCode NodesGet(MeshNodes *nodes)
+{
+  size_t  nc, np;
+  double *param;
+  int     ierr = 0;
+
+  PetscFunctionBeginUser;
+  gmshModelMeshGetNodes(&nodes->tags, &nodes->n, &nodes->xyz, &nc, &param, &np, -1, -1, 0, 0, &ierr);
+  GmshCheck(ierr, "reading the nodes");
+  gmshFree(param);
+  nodes->maxtag = 0;
+  for (size_t k = 0; k < nodes->n; k++) nodes->maxtag = PetscMax(nodes->maxtag, nodes->tags[k]);
+  PetscCall(PetscMalloc1(nodes->maxtag + 1, &nodes->index));
+  for (size_t t = 0; t <= nodes->maxtag; t++) nodes->index[t] = -1;
+  for (size_t k = 0; k < nodes->n; k++) nodes->index[nodes->tags[k]] = (PetscInt)k;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode NodesDestroy(MeshNodes *nodes)
+{
+  PetscFunctionBeginUser;
+  gmshFree(nodes->tags);
+  gmshFree(nodes->xyz);
+  PetscCall(PetscFree(nodes->index));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The corner coordinates of one element from its node tags. */
+static void ElementCorners(const MeshNodes *nodes, const size_t tags[], PetscInt corners, PetscReal X[8][3])
+{
+  for (PetscInt a = 0; a < corners; a++)
+    for (PetscInt r = 0; r < 3; r++) X[a][r] = nodes->xyz[3 * nodes->index[tags[a]] + r];
+}
+
+/* The elements of one dimension (all entities when tag < 0): Gmsh's arrays, freed by ElementsFree. */
+typedef struct {
+  int     *types;
+  size_t   ntypes, **etags, *netags, nn, **ntags, *nntags, nn2;
+  PetscInt count;
+} MeshElements;
+
+static PetscErrorCode ElementsGet(PetscInt dim, int tag, MeshElements *e)
+{
+  int ierr = 0;
+
+  PetscFunctionBeginUser;
+  gmshModelMeshGetElements(&e->types, &e->ntypes, &e->etags, &e->netags, &e->nn, &e->ntags, &e->nntags, &e->nn2, (int)dim, tag, &ierr);
+  GmshCheck(ierr, "reading the elements");
+  e->count = 0;
+  for (size_t t = 0; t < e->ntypes; t++) e->count += (PetscInt)e->netags[t];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static void ElementsFree(MeshElements *e)
+{
+  for (size_t t = 0; t < e->ntypes; t++) {
+    gmshFree(e->etags[t]);
+    gmshFree(e->ntags[t]);
+  }
+  gmshFree(e->types);
+  gmshFree(e->etags);
+  gmshFree(e->netags);
+  gmshFree(e->ntags);
+  gmshFree(e->nntags);
+}
+
+/* The mesh file's path (absolute, or relative to the scene file's folder), whether it is a .geo
+ * and the characteristic length a .geo needs. */
+static PetscErrorCode MeshSource(PeriScene scene, PeriNode node, char path[], size_t size, PetscBool *geo, PetscReal *lc)
+{
+  char      name[PETSC_MAX_PATH_LEN];
+  size_t    len;
+  PetscBool has;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetString(scene, node, "mesh", PETSC_TRUE, name, sizeof(name), NULL));
+  if (name[0] == '/')
+    PetscCall(PetscStrncpy(path, name, size));
+  else
+    PetscCall(PetscSNPrintf(path, size, "%s/%s", scene->dir, name));
+  PeriInputCheck(access(path, R_OK) == 0, scene, node, "mesh", "cannot read %s: %s", path, strerror(errno));
+  PetscCall(PetscStrlen(path, &len));
+  *geo = len > 4 && !strcmp(path + len - 4, ".geo") ? PETSC_TRUE : PETSC_FALSE;
+  *lc  = 0;
+  PetscCall(PeriSceneGetReal(scene, node, "size", PETSC_FALSE, lc, &has));
+  PeriInputCheck(!*geo || has, scene, node, "mesh", "%s is a .geo file: give particles.size, the characteristic length Gmsh meshes it with", path);
+  PeriInputCheck(*geo || !has, scene, node, "size", "applies to a .geo file only; %s is a mesh already", path);
+  PeriInputCheck(!has || *lc > 0, scene, node, "size", "must be positive, got %g", (double)*lc);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Opens the file in Gmsh, meshing a .geo in the scene's dimension with the largest element size lc,
+ * and checks that the mesh's highest element dimension is the scene's. */
+static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[], PetscBool geo, PetscReal lc, PetscInt dim)
+{
+  char      msg[256];
+  int       ierr = 0, *types;
+  size_t    ntypes;
+  PetscInt  top = -1, ed, ec;
+  PetscBool simplex, verbose = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetBool(scene, node, "verbose", &verbose, NULL));
+  PetscCall(GmshStart(verbose));
+  gmshOpen(path, &ierr);
+  if (ierr) GmshLastError(msg, sizeof(msg));
+  PeriInputCheck(!ierr, scene, node, "mesh", "Gmsh cannot read %s: %s", path, msg);
+  if (geo) {
+    gmshOptionSetNumber("Mesh.MeshSizeMax", lc, &ierr);
+    gmshModelMeshGenerate((int)dim, &ierr);
+    if (ierr) GmshLastError(msg, sizeof(msg));
+    PeriInputCheck(!ierr, scene, node, "mesh", "Gmsh cannot mesh %s in %" PetscInt_FMT "D: %s", path, dim, msg);
+  }
+  gmshModelMeshGetElementTypes(&types, &ntypes, -1, -1, &ierr);
+  GmshCheck(ierr, "reading the element types");
+  for (size_t t = 0; t < ntypes; t++) {
+    ElementShape(types[t], &ed, &ec, &simplex);
+    if (ec)
+      top = PetscMax(top, ed);
+    else {
+      char   *name = NULL, errname[64];
+      int     d, order, nn, np;
+      double *lcoord;
+      size_t  nl;
+      gmshModelMeshGetElementProperties(types[t], &name, &d, &order, &nn, &lcoord, &nl, &np, &ierr);
+      PetscCall(PetscStrncpy(errname, name ? name : "?", sizeof(errname)));
+      gmshFree(name);
+      gmshFree(lcoord);
+      gmshFree(types);
+      PeriInputCheck(PETSC_FALSE, scene, node, "mesh", "%s holds elements of type '%s', which perilin does not read: it reads linear points, lines, triangles, quadrangles, tetrahedra and hexahedra (Mesh.ElementOrder = 1, no prisms or pyramids)", path, errname);
+    }
+  }
+  gmshFree(types);
+  PeriInputCheck(top >= dim, scene, node, "mesh", "%s has no elements of dimension %" PetscInt_FMT " (the scene's dim; its highest is %" PetscInt_FMT ")", path, dim, top);
+  PeriInputCheck(top == dim, scene, node, "mesh", "%s is a %" PetscInt_FMT "D mesh but the scene's dim is %" PetscInt_FMT, path, top, dim);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* One particle per element of dimension dim: centroid, measure (x thickness in 2D); elem[tag] is
+ * the particle of each element tag (-1 for none). */
+static PetscErrorCode MeshParticles(PeriScene scene, PeriNode node, const char path[], const MeshNodes *nodes, PetscInt dim, PetscReal thickness, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt **elem, size_t *maxelem)
+{
+  MeshElements e;
+  PetscInt     k = 0, ed, ec;
+  PetscBool    simplex;
+
+  PetscFunctionBeginUser;
+  PetscCall(ElementsGet(dim, -1, &e));
+  *n       = e.count;
+  *maxelem = 0;
+  for (size_t t = 0; t < e.ntypes; t++)
+    for (size_t i = 0; i < e.netags[t]; i++) *maxelem = PetscMax(*maxelem, e.etags[t][i]);
+  PetscCall(PetscMalloc2(3 * e.count, x, e.count, vol));
+  PetscCall(PetscMalloc1(*maxelem + 1, elem));
+  for (size_t t = 0; t <= *maxelem; t++) (*elem)[t] = -1;
+  for (size_t t = 0; t < e.ntypes; t++) {
+    ElementShape(e.types[t], &ed, &ec, &simplex);
+    for (size_t i = 0; i < e.netags[t]; i++, k++) {
+      PetscReal X[8][3], m;
+      ElementCorners(nodes, &e.ntags[t][i * ec], ec, X);
+      ElementMeasure(dim, ec, simplex, X, &m, &(*x)[3 * k]);
+      (*vol)[k]              = dim == 2 ? m * thickness : m;
+      (*elem)[e.etags[t][i]] = k;
+      if (dim == 2 && (*x)[3 * k + 2] != 0) ElementsFree(&e);
+      PeriInputCheck(dim == 3 || (*x)[3 * k + 2] == 0, scene, node, "mesh", "%s: a 2D mesh must lie in the plane z = 0 (element %zu is at z = %g)", path, e.etags[t][i], (double)(*x)[3 * k + 2]);
+      if (!(m > 0)) ElementsFree(&e);
+      PeriInputCheck(m > 0, scene, node, "mesh", "%s: element %zu is degenerate (measure %g)", path, e.etags[t][i], (double)m);
+    }
+  }
+  ElementsFree(&e);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static int ComparePositions(const void *a, const void *b)
+{
+  const PetscReal *x = (const PetscReal *)a, *y = (const PetscReal *)b;
+  for (int d = 0; d < 3; d++)
+    if (x[d] != y[d]) return x[d] < y[d] ? -1 : 1;
+  return 0;
+}
+
+/* The particles of the group's own elements (a group of the mesh's dimension), and the measure of
+ * the elements of a lower-dimensional group (length x thickness of a 2D boundary curve, area of a
+ * 3D boundary surface): the face area a traction on it acts on. */
+static PetscErrorCode GroupEntities(PetscInt dim, PetscReal thickness, const MeshNodes *nodes, int gd, int gt, const PetscInt elem[], PetscInt *members, PetscInt *m, PetscReal *measure)
+{
+  int      *tags, ierr = 0;
+  size_t    ntags;
+  PetscInt  ed, ec;
+  PetscBool simplex;
+
+  PetscFunctionBeginUser;
+  *measure = 0;
+  gmshModelGetEntitiesForPhysicalGroup(gd, gt, &tags, &ntags, &ierr);
+  GmshCheck(ierr, "reading a physical group's entities");
+  for (size_t k = 0; k < ntags; k++) {
+    MeshElements e;
+    PetscCall(ElementsGet(gd, tags[k], &e));
+    for (size_t t = 0; t < e.ntypes; t++) {
+      ElementShape(e.types[t], &ed, &ec, &simplex);
+      for (size_t i = 0; i < e.netags[t]; i++) {
+        PetscReal X[8][3], c[3], w;
+        if (gd == dim) {
+          members[(*m)++] = elem[e.etags[t][i]];
+          continue;
+        }
+        ElementCorners(nodes, &e.ntags[t][i * ec], ec, X);
+        ElementMeasure(gd, ec, simplex, X, &w, c);
+        *measure += gd == dim - 1 ? (dim == 2 ? w * thickness : w) : 0;
+      }
+    }
+    ElementsFree(&e);
+  }
+  gmshFree(tags);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The group's particles: its own elements (a group of the mesh's dimension), or the elements with
+ * at least gd + 1 corners on its nodes (a group of lower dimension gd: a side on a boundary curve or
+ * surface, a corner at a point). Their positions are sorted so that membership is a binary search
+ * that survives the renumbering of the partition. */
+static PetscErrorCode GroupMembers(const MeshNodes *nodes, PetscInt dim, PetscReal thickness, int gd, int gt, const PetscInt elem[], PetscInt nparticles, const PetscReal x[], PeriMeshGroup *g)
+{
+  MeshElements e;
+  size_t      *ntags, nn, nc;
+  double      *coord;
+  char        *on;
+  PetscInt     ed, ec, *members, m = 0;
+  PetscBool    simplex;
+  int          ierr = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(nparticles, &members));
+  PetscCall(GroupEntities(dim, thickness, nodes, gd, gt, elem, members, &m, &g->measure));
+  if (gd < dim) {
+    PetscCall(PetscCalloc1(nodes->maxtag + 1, &on));
+    gmshModelMeshGetNodesForPhysicalGroup(gd, gt, &ntags, &nn, &coord, &nc, &ierr);
+    GmshCheck(ierr, "reading a physical group's nodes");
+    for (size_t k = 0; k < nn; k++) on[ntags[k]] = 1;
+    gmshFree(ntags);
+    gmshFree(coord);
+    PetscCall(ElementsGet(dim, -1, &e));
+    for (size_t t = 0; t < e.ntypes; t++) {
+      ElementShape(e.types[t], &ed, &ec, &simplex);
+      for (size_t i = 0; i < e.netags[t]; i++) {
+        PetscInt hits = 0;
+        for (PetscInt a = 0; a < ec; a++) hits += on[e.ntags[t][i * ec + a]];
+        if (hits >= gd + 1) members[m++] = elem[e.etags[t][i]];
+      }
+    }
+    ElementsFree(&e);
+    PetscCall(PetscFree(on));
+  }
+  g->count = m;
+  PetscCall(PetscMalloc1(3 * PetscMax(m, 1), &g->x));
+  for (PetscInt k = 0; k < m; k++)
+    for (PetscInt d = 0; d < 3; d++) g->x[3 * k + d] = x[3 * members[k] + d];
+  qsort(g->x, (size_t)m, 3 * sizeof(PetscReal), ComparePositions);
+  PetscCall(PetscFree(members));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Every named physical group of dimension <= dim, as a particle set. */
+static PetscErrorCode MeshGroups(PeriScene scene, PeriNode node, const char path[], const MeshNodes *nodes, PetscInt dim, PetscReal thickness, const PetscInt elem[], PetscInt n, const PetscReal x[], PetscInt *ngroups, PeriMeshGroup **groups)
+{
+  int   *dimtags, ierr = 0;
+  size_t nd;
+
+  PetscFunctionBeginUser;
+  gmshModelGetPhysicalGroups(&dimtags, &nd, -1, &ierr);
+  GmshCheck(ierr, "reading the physical groups");
+  PetscCall(PetscCalloc1(nd / 2 + 1, groups));
+  *ngroups = 0;
+  for (size_t k = 0; k < nd / 2; k++) {
+    PeriMeshGroup *g    = &(*groups)[*ngroups];
+    char          *name = NULL;
+    size_t         len;
+    gmshModelGetPhysicalName(dimtags[2 * k], dimtags[2 * k + 1], &name, &ierr);
+    len = name ? strlen(name) : 0;
+    if (!len || dimtags[2 * k] > dim || len >= sizeof(g->name)) {
+      if (len >= sizeof(g->name)) gmshFree(dimtags);
+      PeriInputCheck(len < sizeof(g->name), scene, node, "mesh", "%s: the physical group name '%s' is too long (at most %d characters)", path, name, PERI_NAME_LEN - 1);
+      gmshFree(name);
+      continue; /* unnamed groups have no region name */
+    }
+    PetscCall(PetscStrncpy(g->name, name, sizeof(g->name)));
+    gmshFree(name);
+    g->dim = dimtags[2 * k];
+    PetscCall(GroupMembers(nodes, dim, thickness, dimtags[2 * k], dimtags[2 * k + 1], elem, n, x, g));
+    (*ngroups)++;
+  }
+  gmshFree(dimtags);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriMeshRead - reads particles.mesh (a Gmsh mesh, or a .geo meshed with particles.size): one
+  particle per element of dimension dim at its centroid with its exact volume (area x thickness in
+  2D), and the named physical groups. x, vol are allocated with PetscMalloc2; groups with
+  PetscCalloc1 (free with PeriMeshGroupsDestroy). Not collective: every rank reads the same file.
+@*/
+PetscErrorCode PeriMeshRead(PeriScene scene, PeriNode node, PetscInt dim, PetscReal thickness, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt *ngroups, PeriMeshGroup **groups)
+{
+  char      path[PETSC_MAX_PATH_LEN];
+  PetscBool geo = PETSC_FALSE;
+  PetscReal lc  = 0;
+  MeshNodes nodes;
+  PetscInt *elem;
+  size_t    maxelem;
+  int       ierr = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshSource(scene, node, path, sizeof(path), &geo, &lc));
+  PetscCall(MeshOpen(scene, node, path, geo, lc, dim));
+  PetscCall(NodesGet(&nodes));
+  PetscCall(MeshParticles(scene, node, path, &nodes, dim, thickness, n, x, vol, &elem, &maxelem));
+  PetscCall(MeshGroups(scene, node, path, &nodes, dim, thickness, elem, *n, *x, ngroups, groups));
+  PetscCall(PetscFree(elem));
+  PetscCall(NodesDestroy(&nodes));
+  gmshClear(&ierr); /* the model is not needed any more: free its memory now */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriMeshGroupsDestroy(PetscInt *ngroups, PeriMeshGroup **groups)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < *ngroups; k++) PetscCall(PetscFree((*groups)[k].x));
+  PetscCall(PetscFree(*groups));
+  *ngroups = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
