@@ -242,7 +242,7 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
       PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
                                                                           : "body_force",
                                       PETSC_TRUE, dim, ncomp, F, &n));
-    PeriInputCheck(!(traction || field) || r->face_area > 0, s, item, traction ? "traction" : "traction_field", "needs a layer region (side: ..) or a mesh's boundary group, whose face area converts traction to force; region '%s' is not one", r->name);
+    PeriInputCheck(!(traction || field) || r->face_area > 0, s, item, traction ? "traction" : "traction_field", "needs a layer region (side: ..), whose face area converts traction to force, or a mesh's boundary group; region '%s' is not one", r->name);
     /* particle i receives (A X_i + F) scale V_i */
     scale = body ? 1.0 : (traction || field ? r->face_area : 1.0) / r->volume;
     for (PetscInt d = 0; d < ncomp; d++) {
