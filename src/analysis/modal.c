@@ -683,31 +683,45 @@ static PetscErrorCode ModalAddFields(PeriAnalysis an, PeriFieldList fl)
 
 /*@C
   WriteModeShapes - mode_NN.vtu, one file per stored mode shape with the shape as its
-  "displacement", and modes.pvd listing them by mode number (ParaView steps through the modes
-  like time steps). Collective; rank 0 writes.
+  "displacement" (NN: the mode number of modes.csv), and modes.pvd listing them with each mode's
+  frequency in Hz as its time, so that ParaView's time controls step through the modes and show
+  the frequency. The frames are in ascending frequency (with analysis.target_hz the modes come by
+  distance to the target instead); equal frequencies stay in mode order, PeriWritePVD makes their
+  times distinct by 1e-12 relative. Collective; rank 0 writes.
 @*/
 static PetscErrorCode WriteModeShapes(PeriAnalysis an, const char dir[])
 {
   PeriModal     *md = Modal(an);
   PetscReal     *times;
+  PetscInt      *order;
   char         **files, path[PETSC_MAX_PATH_LEN];
   const PetscInt nd = an->sys->disc.particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   if (an->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc2(md->nshapes, &times, md->nshapes, &files));
+  PetscCall(PetscMalloc3(md->nshapes, &times, md->nshapes, &files, md->nshapes, &order));
   /* each file is particles.vtu's layout with the mode as the displacement field */
   for (PetscInt k = 0; k < md->nshapes; k++) {
-    times[k] = (PetscReal)(k + 1);
     PetscCall(PetscMalloc1(32, &files[k]));
     PetscCall(PetscSNPrintf(files[k], 32, "mode_%02" PetscInt_FMT ".vtu", k + 1));
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", dir, files[k]));
     PetscCall(PeriSystemWriteVTU(an->sys, &md->shapes[k * nd], path));
   }
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
-  PetscCall(PeriWritePVD(path, md->nshapes, times, (const char *const *)files));
+  /* stable insertion sort of the mode numbers by frequency: few shapes (at most 12) */
+  for (PetscInt k = 0; k < md->nshapes; k++) {
+    PetscInt i = k;
+    for (; i > 0 && md->modes[order[i - 1]].f_hz > md->modes[k].f_hz; i--) order[i] = order[i - 1];
+    order[i] = k;
+  }
+  for (PetscInt k = 0; k < md->nshapes; k++) times[k] = md->modes[order[k]].f_hz;
+  {
+    const char *sorted[PERI_MAX_VTU_MODES];
+    for (PetscInt k = 0; k < md->nshapes; k++) sorted[k] = files[order[k]];
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
+    PetscCall(PeriWritePVD(path, md->nshapes, times, sorted));
+  }
   for (PetscInt k = 0; k < md->nshapes; k++) PetscCall(PetscFree(files[k]));
-  PetscCall(PetscFree2(times, files));
+  PetscCall(PetscFree3(times, files, order));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -800,7 +800,9 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
 
 /*@C
   WriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
-  (output.every) by load factor. Rank 0 writes. Collective.
+  (output.every) with the load factor as the time, and, when the last equilibrium is not one of
+  them, particles.vtu (which describes it) as the last frame, so that the series ends where the
+  run did. failed_trial.vtu is no equilibrium and stays out. Rank 0 writes. Collective.
 @*/
 static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
 {
@@ -810,12 +812,16 @@ static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
   PetscInt         n = 0;
 
   PetscFunctionBeginUser;
-  if (an->rank || !q || !an->every || !an->vtk || q->nsteps < an->every) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc2(q->nsteps, &times, q->nsteps, &files));
+  if (an->rank || !q || !an->every || !an->vtk || q->nsteps < 1) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc2(q->nsteps + 1, &times, q->nsteps + 1, &files));
   for (PetscInt k = an->every; k <= q->nsteps; k += an->every) {
     times[n] = q->steps[k - 1].lambda;
     PetscCall(PetscMalloc1(32, &files[n]));
     PetscCall(PetscSNPrintf(files[n++], 32, "particles_%04" PetscInt_FMT ".vtu", k));
+  }
+  if (q->nsteps % an->every) {
+    times[n] = q->steps[q->nsteps - 1].lambda;
+    PetscCall(PetscStrallocpy("particles.vtu", &files[n++]));
   }
   PetscCall(PeriWritePVD(path, n, times, (const char *const *)files));
   for (PetscInt k = 0; k < n; k++) PetscCall(PetscFree(files[k]));
