@@ -266,6 +266,20 @@ static PetscErrorCode InnerSolveCheck(KSP ksp, Vec b, Vec y, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The status line's solver slot (src/sys/progress.c): the eigenpairs converged so far of those
+ * asked for (nev, plus the rigid-body modes of a free body) and the eigensolver's iteration.
+ * Installed only where the line is drawn. */
+static PetscErrorCode ProgressMonitor(EPS eps, PetscInt its, PetscInt nconv, PetscScalar *eigr, PetscScalar *eigi, PetscReal *errest, PetscInt nest, void *ctx)
+{
+  PetscInt nreq;
+
+  PetscFunctionBeginUser;
+  (void)eigr, (void)eigi, (void)errest, (void)nest;
+  PetscCall(EPSGetDimensions(eps, &nreq, NULL, NULL));
+  PetscCall(PeriProgressUpdate((PeriProgress)ctx, PERI_PROGRESS_SOLVER, "%" PetscInt_FMT " of %" PetscInt_FMT " eigenpairs converged, iteration %" PetscInt_FMT, nconv, nreq, its));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Krylov-Schur, shift-and-invert at sigma with a direct factorization, the nreq pairs nearest
  * sigma; then every -eps_* and -st_* option; then the check of the inner solves. */
 static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
@@ -293,6 +307,7 @@ static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sig
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
 #endif
   PetscCall(EPSSetFromOptions(*eps));
+  if (PeriProgressActive(an->sys->progress)) PetscCall(EPSMonitorSet(*eps, ProgressMonitor, an->sys->progress, NULL));
   /* STPRECOND (Davidson methods) solves only approximately by design: there only the modes
    * themselves are checked */
   PetscCall(PetscObjectTypeCompare((PetscObject)st, STPRECOND, &precond));
@@ -582,8 +597,10 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   PetscCall(CreateEPS(an, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
   /* the factorization (MUMPS) and its solves run with the BLAS threads (src/sys/threads.c) */
   PetscCall(PeriBLASThreads(PETSC_TRUE));
+  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_PHASE, "factorization"));
   PetscCall(EPSSetUp(w->eps));
   PetscCall(PetscTime(&t1));
+  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_PHASE, "eigensolve"));
   PetscCall(SolveModes(an, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
   PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(PetscTime(&t2));

@@ -7,7 +7,6 @@
  * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
 #include "perilin/private/analysis.h"
 #include <signal.h>
-#include <unistd.h>
 
 /* the analysis' results (its data) */
 static inline PeriQuasistatic *QS(PeriAnalysis an)
@@ -266,7 +265,8 @@ static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriSt
 {
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
-  if (isatty(STDOUT_FILENO)) {
+  /* the bar where the status line would be drawn: a terminal of the user's (src/sys/progress.c) */
+  if (PeriProgressActive(an->sys->progress)) {
     char     bar[41];
     PetscInt fill = (PetscInt)(40 * s->lambda / st->max);
     for (PetscInt k = 0; k < 40; k++) bar[k] = k < fill ? '#' : '.';
@@ -411,6 +411,7 @@ static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, Pets
   PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
   if (an->sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
   *end = TRIAL_FAILED;
+  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", load factor %g, %" PetscInt_FMT " bonds broken", q->nsteps + 1, (double)lam, broken));
   /* the pieces change only when bonds do */
   if (L->stale) {
     PetscCall(PetscFree2(L->hold, L->held));
