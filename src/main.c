@@ -106,7 +106,8 @@ int main(int argc, char **argv)
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
     if (rank == 0) PeriOutputSetDiscard(); /* the previous results stay as they were */
     all = size == 1 ? PETSC_TRUE : EveryRankFailed();
-    if (rank == 0 || !all) fprintf(stderr, "perilin: error: %s\n", first_error[0] ? first_error : "unknown error");
+    /* through PETSc's printer, which first erases a status line on the terminal (src/sys/progress.c) */
+    if (rank == 0 || !all) (void)PetscFPrintf(PETSC_COMM_SELF, stderr, "perilin: error: %s\n", first_error[0] ? first_error : "unknown error");
     if (!all) MPI_Abort(PETSC_COMM_WORLD, 1);
     /* every rank is here: free what the run held, so that -malloc_dump shows real leaks only */
     PetscCall(PetscPushErrorHandler(PetscIgnoreErrorHandler, NULL));

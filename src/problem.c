@@ -128,6 +128,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
   PetscCall(PeriSceneCheckSection(p->scene, p->scene->root, ""));
   PetscCall(PeriSystemCreate(p->comm, p->scene, &p->sys));
+  PetscCall(PeriProgressUpdate(p->sys->progress, PERI_PROGRESS_PHASE, "setup"));
   PetscCall(PeriSystemSetFromScene(p->sys));
   PetscCall(ReadOutput(p, p->scene->file));
   if (p->write_output) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
@@ -218,6 +219,8 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Output));
+  PetscCall(PeriProgressUpdate(p->sys->progress, PERI_PROGRESS_ANALYSIS, NULL));
+  PetscCall(PeriProgressUpdate(p->sys->progress, PERI_PROGRESS_PHASE, "output"));
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   /* an analysis stopped before it had a state writes no fields: only the summary saying so */
   if (p->vtk && (!p->sys->interrupted || p->sys->u_all)) {

@@ -266,6 +266,20 @@ static PetscErrorCode InnerSolveCheck(KSP ksp, Vec b, Vec y, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The status line's solver slot (src/sys/progress.c): the eigenpairs converged so far of those
+ * asked for (nev, plus the rigid-body modes of a free body) and the eigensolver's iteration.
+ * Installed only where the line is drawn. */
+static PetscErrorCode ProgressMonitor(EPS eps, PetscInt its, PetscInt nconv, PetscScalar *eigr, PetscScalar *eigi, PetscReal *errest, PetscInt nest, void *ctx)
+{
+  PetscInt nreq;
+
+  PetscFunctionBeginUser;
+  (void)eigr, (void)eigi, (void)errest, (void)nest;
+  PetscCall(EPSGetDimensions(eps, &nreq, NULL, NULL));
+  PetscCall(PeriProgressUpdate((PeriProgress)ctx, PERI_PROGRESS_SOLVER, "%" PetscInt_FMT " of %" PetscInt_FMT " eigenpairs converged, iteration %" PetscInt_FMT, nconv, nreq, its));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Krylov-Schur, shift-and-invert at sigma with a direct factorization, the nreq pairs nearest
  * sigma; then every -eps_* and -st_* option; then the check of the inner solves. */
 static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
@@ -293,6 +307,7 @@ static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sig
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
 #endif
   PetscCall(EPSSetFromOptions(*eps));
+  if (PeriProgressActive(an->sys->progress)) PetscCall(EPSMonitorSet(*eps, ProgressMonitor, an->sys->progress, NULL));
   /* STPRECOND (Davidson methods) solves only approximately by design: there only the modes
    * themselves are checked */
   PetscCall(PetscObjectTypeCompare((PetscObject)st, STPRECOND, &precond));
@@ -582,8 +597,10 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   PetscCall(CreateEPS(an, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
   /* the factorization (MUMPS) and its solves run with the BLAS threads (src/sys/threads.c) */
   PetscCall(PeriBLASThreads(PETSC_TRUE));
+  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_PHASE, "factorization"));
   PetscCall(EPSSetUp(w->eps));
   PetscCall(PetscTime(&t1));
+  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_PHASE, "eigensolve"));
   PetscCall(SolveModes(an, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
   PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(PetscTime(&t2));
@@ -683,31 +700,45 @@ static PetscErrorCode ModalAddFields(PeriAnalysis an, PeriFieldList fl)
 
 /*@C
   WriteModeShapes - mode_NN.vtu, one file per stored mode shape with the shape as its
-  "displacement", and modes.pvd listing them by mode number (ParaView steps through the modes
-  like time steps). Collective; rank 0 writes.
+  "displacement" (NN: the mode number of modes.csv), and modes.pvd listing them with each mode's
+  frequency in Hz as its time, so that ParaView's time controls step through the modes and show
+  the frequency. The frames are in ascending frequency (with analysis.target_hz the modes come by
+  distance to the target instead); equal frequencies stay in mode order, PeriWritePVD makes their
+  times distinct by 1e-12 relative. Collective; rank 0 writes.
 @*/
 static PetscErrorCode WriteModeShapes(PeriAnalysis an, const char dir[])
 {
   PeriModal     *md = Modal(an);
   PetscReal     *times;
+  PetscInt      *order;
   char         **files, path[PETSC_MAX_PATH_LEN];
   const PetscInt nd = an->sys->disc.particles.n * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   if (an->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc2(md->nshapes, &times, md->nshapes, &files));
+  PetscCall(PetscMalloc3(md->nshapes, &times, md->nshapes, &files, md->nshapes, &order));
   /* each file is particles.vtu's layout with the mode as the displacement field */
   for (PetscInt k = 0; k < md->nshapes; k++) {
-    times[k] = (PetscReal)(k + 1);
     PetscCall(PetscMalloc1(32, &files[k]));
     PetscCall(PetscSNPrintf(files[k], 32, "mode_%02" PetscInt_FMT ".vtu", k + 1));
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", dir, files[k]));
     PetscCall(PeriSystemWriteVTU(an->sys, &md->shapes[k * nd], path));
   }
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
-  PetscCall(PeriWritePVD(path, md->nshapes, times, (const char *const *)files));
+  /* stable insertion sort of the mode numbers by frequency: few shapes (at most 12) */
+  for (PetscInt k = 0; k < md->nshapes; k++) {
+    PetscInt i = k;
+    for (; i > 0 && md->modes[order[i - 1]].f_hz > md->modes[k].f_hz; i--) order[i] = order[i - 1];
+    order[i] = k;
+  }
+  for (PetscInt k = 0; k < md->nshapes; k++) times[k] = md->modes[order[k]].f_hz;
+  {
+    const char *sorted[PERI_MAX_VTU_MODES];
+    for (PetscInt k = 0; k < md->nshapes; k++) sorted[k] = files[order[k]];
+    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
+    PetscCall(PeriWritePVD(path, md->nshapes, times, sorted));
+  }
   for (PetscInt k = 0; k < md->nshapes; k++) PetscCall(PetscFree(files[k]));
-  PetscCall(PetscFree2(times, files));
+  PetscCall(PetscFree3(times, files, order));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

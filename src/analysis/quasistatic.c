@@ -7,7 +7,6 @@
  * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
 #include "perilin/private/analysis.h"
 #include <signal.h>
-#include <unistd.h>
 
 /* the analysis' results (its data) */
 static inline PeriQuasistatic *QS(PeriAnalysis an)
@@ -266,7 +265,8 @@ static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriSt
 {
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
-  if (isatty(STDOUT_FILENO)) {
+  /* the bar where the status line would be drawn: a terminal of the user's (src/sys/progress.c) */
+  if (PeriProgressActive(an->sys->progress)) {
     char     bar[41];
     PetscInt fill = (PetscInt)(40 * s->lambda / st->max);
     for (PetscInt k = 0; k < 40; k++) bar[k] = k < fill ? '#' : '.';
@@ -411,6 +411,7 @@ static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, Pets
   PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
   if (an->sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
   *end = TRIAL_FAILED;
+  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", load factor %g, %" PetscInt_FMT " bonds broken", q->nsteps + 1, (double)lam, broken));
   /* the pieces change only when bonds do */
   if (L->stale) {
     PetscCall(PetscFree2(L->hold, L->held));
@@ -800,7 +801,9 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
 
 /*@C
   WriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
-  (output.every) by load factor. Rank 0 writes. Collective.
+  (output.every) with the load factor as the time, and, when the last equilibrium is not one of
+  them, particles.vtu (which describes it) as the last frame, so that the series ends where the
+  run did. failed_trial.vtu is no equilibrium and stays out. Rank 0 writes. Collective.
 @*/
 static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
 {
@@ -810,12 +813,16 @@ static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
   PetscInt         n = 0;
 
   PetscFunctionBeginUser;
-  if (an->rank || !q || !an->every || !an->vtk || q->nsteps < an->every) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc2(q->nsteps, &times, q->nsteps, &files));
+  if (an->rank || !q || !an->every || !an->vtk || q->nsteps < 1) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc2(q->nsteps + 1, &times, q->nsteps + 1, &files));
   for (PetscInt k = an->every; k <= q->nsteps; k += an->every) {
     times[n] = q->steps[k - 1].lambda;
     PetscCall(PetscMalloc1(32, &files[n]));
     PetscCall(PetscSNPrintf(files[n++], 32, "particles_%04" PetscInt_FMT ".vtu", k));
+  }
+  if (q->nsteps % an->every) {
+    times[n] = q->steps[q->nsteps - 1].lambda;
+    PetscCall(PetscStrallocpy("particles.vtu", &files[n++]));
   }
   PetscCall(PeriWritePVD(path, n, times, (const char *const *)files));
   for (PetscInt k = 0; k < n; k++) PetscCall(PetscFree(files[k]));

@@ -6,6 +6,7 @@
 #include "perilin/private/output.h"
 
 #include <errno.h>
+#include <float.h>
 #include <inttypes.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -313,18 +314,29 @@ PetscErrorCode PeriWriteVTU(PeriFieldList fl, const char path[])
 
 /*@C
   PeriWritePVD - a ParaView collection (.pvd) listing files[k] at time times[k], so that a series
-  (load steps, mode shapes) opens as one data set. Not collective: call it on the writing rank.
+  (load steps, mode shapes) opens as one data set. The caller gives the times in ascending order;
+  ParaView needs them strictly increasing (equal times collapse into one frame), so a time not
+  above the one before it is written as that one x (1 + 1e-12) (or the smallest normal number
+  above 0): equal load factors of an event's peak and cascade, degenerate frequencies. The times
+  are printed to 17 digits, so that a reader gets the value back to the last bit. Not collective:
+  call it on the writing rank.
 @*/
 PetscErrorCode PeriWritePVD(const char path[], PetscInt n, const PetscReal times[], const char *const files[])
 {
-  char  tmp[PETSC_MAX_PATH_LEN];
-  FILE *fp;
-  int   bad = 0;
+  char      tmp[PETSC_MAX_PATH_LEN];
+  FILE     *fp;
+  int       bad  = 0;
+  PetscReal prev = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n") < 0;
-  for (PetscInt k = 0; k < n; k++) bad |= fprintf(fp, "    <DataSet timestep=\"%.10g\" group=\"\" part=\"0\" file=\"%s\"/>\n", (double)times[k], files[k]) < 0;
+  for (PetscInt k = 0; k < n; k++) {
+    PetscReal t = times[k];
+    if (k && !(t > prev)) t = prev != 0 ? prev + 1e-12 * PetscAbsReal(prev) : (PetscReal)DBL_MIN;
+    bad |= fprintf(fp, "    <DataSet timestep=\"%.17g\" group=\"\" part=\"0\" file=\"%s\"/>\n", (double)t, files[k]) < 0;
+    prev = t;
+  }
   bad |= fprintf(fp, "  </Collection>\n</VTKFile>\n") < 0;
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscFunctionReturn(PETSC_SUCCESS);

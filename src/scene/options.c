@@ -23,13 +23,13 @@ static const char *const read_later[] = {
     "malloc_view_threshold", /* PetscFinalize, with -malloc_view */
     "get_total_flops",       /* PetscFinalize */
     "nox",                   /* PetscFinalize (X windows off) */
-    "quiet",                 /* perilin: quasi-static runs read it; harmless elsewhere */
+    "quiet",                 /* perilin: the status line and the quasi-static step log read it */
     NULL,
 };
 
 /* Common options that no object prints under -help (global ones, solver packages set up only at
  * factorization): candidates for "did you mean" only. */
-static const char *const more_names[] = {"-help", "-version", "-info", "-log_view", "-log_trace", "-log_all", "-malloc_debug", "-malloc_dump", "-malloc_view", "-malloc_test", "-memory_view", "-options_left", "-options_file", "-options_view", "-objects_dump", "-on_error_abort", "-on_error_attach_debugger", "-start_in_debugger", "-fp_trap", "-quiet", "-options_unused_ok", "-scene_doc_update", "-scene_doc_check", "-mat_mumps_icntl_4", "-mat_mumps_icntl_7", "-mat_mumps_icntl_14", "-mat_mumps_icntl_24", "-mat_mumps_cntl_1", "-mat_mumps_cntl_3", NULL};
+static const char *const more_names[] = {"-help", "-version", "-info", "-log_view", "-log_trace", "-log_all", "-malloc_debug", "-malloc_dump", "-malloc_view", "-malloc_test", "-memory_view", "-options_left", "-options_file", "-options_view", "-objects_dump", "-on_error_abort", "-on_error_attach_debugger", "-start_in_debugger", "-fp_trap", "-quiet", "-progress", "-options_unused_ok", "-scene_doc_update", "-scene_doc_check", "-mat_mumps_icntl_4", "-mat_mumps_icntl_7", "-mat_mumps_icntl_14", "-mat_mumps_icntl_24", "-mat_mumps_cntl_1", "-mat_mumps_cntl_3", NULL};
 
 #define PERI_OPTION_LEN 256
 

@@ -260,6 +260,17 @@ static PetscBool DefaultJacobi(PeriSystem sys)
   return (PetscBool)(!strcmp(sys->pc_default, PCJACOBI) && !pc && !maxit);
 }
 
+/* The status line's solver slot (src/sys/progress.c): the iteration and the residual norm KSP
+ * monitors, of the system scaled to O(1) numbers (ScaleToUnits). Installed beside the options'
+ * monitors, and only where the line is drawn: it reads, and changes nothing of the solve. */
+static PetscErrorCode ProgressMonitor(KSP ksp, PetscInt it, PetscReal rnorm, void *ctx)
+{
+  PetscFunctionBeginUser;
+  (void)ksp;
+  PetscCall(PeriProgressUpdate((PeriProgress)ctx, PERI_PROGRESS_SOLVER, "KSP iteration %" PetscInt_FMT ", residual norm %.3e", it, (double)rnorm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* CG (GMRES for an unsymmetric operator) + GAMG (or the default Jacobi, PERI_JACOBI_BUDGET
  * iterations), rtol 1e-10, then the options. */
 static PetscErrorCode StaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *ksp)
@@ -283,6 +294,7 @@ static PetscErrorCode StaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *
   if (cg && !set) PetscCall(KSPSetNormType(*ksp, KSP_NORM_UNPRECONDITIONED));
   PetscCall(DefaultFactorSolver(*ksp));
   PetscCall(KSPSetInterruptible(*ksp, sys->comm));
+  if (PeriProgressActive(sys->progress)) PetscCall(KSPMonitorSet(*ksp, ProgressMonitor, sys->progress, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -422,6 +434,7 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, 
   PetscCall(KSPGetPC(*ksp, &pc));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, ""));
   PetscCall(PeriBLASThreads(factor));
+  PetscCall(PeriProgressUpdate(sys->progress, PERI_PROGRESS_PHASE, "solve"));
   PetscCall(KSPSolve(*ksp, b, sys->u));
   PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(KSPGetConvergedReason(*ksp, reason));

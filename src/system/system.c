@@ -281,6 +281,7 @@ PetscErrorCode PeriSystemCreate(MPI_Comm comm, PeriScene scene, PeriSystem *syst
   sys->scene = scene;
   PetscCallMPI(MPI_Comm_rank(comm, &sys->rank));
   PetscCallMPI(MPI_Comm_size(comm, &sys->size));
+  PetscCall(PeriProgressCreate(comm, &sys->progress));
   *system = sys;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -420,6 +421,7 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PeriReactionsDestroy(&sys->reactions));
   PetscCall(PetscFree(sys->W));
   PetscCall(PetscFree(sys->u_all));
+  PetscCall(PeriProgressDestroy(&sys->progress));
   PetscCall(PetscFree(sys));
   *system = NULL;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -523,6 +525,7 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Assembly));
+  PetscCall(PeriProgressUpdate(sys->progress, PERI_PROGRESS_PHASE, "assembly"));
   PetscCall(PetscTime(&t0));
   PetscCall(MatDestroy(&sys->K));
   PetscCall(MatDestroy(&sys->Kpc));

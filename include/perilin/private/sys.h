@@ -18,6 +18,19 @@ PETSC_EXTERN PetscErrorCode PeriInitializePackage(void);
 PETSC_EXTERN PetscReal      PeriPeakMemoryMB(void);
 PETSC_EXTERN PetscErrorCode PeriMallocInitialize(void);
 
+/* the status line of a long run on a terminal (src/sys/progress.c): its slots, left to right */
+typedef enum {
+  PERI_PROGRESS_ANALYSIS, /* e.g. the quasi-static step and load factor */
+  PERI_PROGRESS_PHASE,    /* setup, assembly, solve, eigensolve, output */
+  PERI_PROGRESS_SOLVER,   /* KSP iteration and residual, converged eigenpairs */
+  PERI_PROGRESS_SLOTS
+} PeriProgressSlot;
+typedef struct _p_PeriProgress *PeriProgress;
+PETSC_EXTERN PetscErrorCode     PeriProgressCreate(MPI_Comm, PeriProgress *);
+PETSC_EXTERN PetscErrorCode     PeriProgressUpdate(PeriProgress, PeriProgressSlot, const char[], ...);
+PETSC_EXTERN PetscBool          PeriProgressActive(PeriProgress);
+PETSC_EXTERN PetscErrorCode     PeriProgressDestroy(PeriProgress *);
+
 /* BLAS threads (src/sys/threads.c): one outside factorizations, the library's own around them. */
 PETSC_EXTERN PetscErrorCode PeriBLASThreadsInitialize(void);
 PETSC_EXTERN PetscErrorCode PeriBLASThreads(PetscBool);

@@ -183,6 +183,7 @@ struct _p_PeriSystem {
   PeriReference    reference;
   int              interrupted;  /* the signal (SIGINT, SIGTERM) that stopped the analysis early, or 0 */
   PetscReal        residual_tol; /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
+  PeriProgress     progress;     /* the status line on a terminal (src/sys/progress.c) */
 };
 
 PETSC_EXTERN PetscErrorCode PeriSystemCreate(MPI_Comm, PeriScene, PeriSystem *);
