@@ -219,16 +219,11 @@ static void ElementsFree(MeshElements *e)
  * and the characteristic length a .geo needs. */
 static PetscErrorCode MeshSource(PeriScene scene, PeriNode node, char path[], size_t size, PetscBool *geo, PetscReal *lc)
 {
-  char      name[PETSC_MAX_PATH_LEN];
   size_t    len;
   PetscBool has;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetString(scene, node, "mesh", PETSC_TRUE, name, sizeof(name), NULL));
-  if (name[0] == '/')
-    PetscCall(PetscStrncpy(path, name, size));
-  else
-    PetscCall(PetscSNPrintf(path, size, "%s/%s", scene->dir, name));
+  PetscCall(PeriParticlesInputPath(scene, node, "mesh", path, size));
   PeriInputCheck(access(path, R_OK) == 0, scene, node, "mesh", "cannot read %s: %s", path, strerror(errno));
   PetscCall(PetscStrlen(path, &len));
   *geo = len > 4 && !strcmp(path + len - 4, ".geo") ? PETSC_TRUE : PETSC_FALSE;

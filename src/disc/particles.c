@@ -79,12 +79,14 @@ static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, P
 }
 
 /* The particles file's path from the section's one key: absolute as given, else relative to the scene file's folder. */
-static PetscErrorCode CSVPath(PeriScene scene, PeriNode node, char path[], size_t size)
+/* The file named by node.key (required), relative to the scene file's directory unless absolute:
+ * particles.file and particles.mesh. */
+PetscErrorCode PeriParticlesInputPath(PeriScene scene, PeriNode node, const char key[], char path[], size_t size)
 {
   char name[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetString(scene, node, "file", PETSC_TRUE, name, sizeof(name), NULL));
+  PetscCall(PeriSceneGetString(scene, node, key, PETSC_TRUE, name, sizeof(name), NULL));
   if (name[0] == '/')
     PetscCall(PetscStrncpy(path, name, size));
   else
@@ -231,7 +233,7 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
   PetscInt  *src;
 
   PetscFunctionBeginUser;
-  PetscCall(CSVPath(scene, node, path, sizeof(path)));
+  PetscCall(PeriParticlesInputPath(scene, node, "file", path, sizeof(path)));
   PetscCall(CSVRead(scene, node, path, dim, &n, &x, &vol, &src));
   if (!n) PetscCall(PetscFree3(x, vol, src));
   PeriInputCheck(n > 0, scene, node, "file", "%s holds no particles", path);

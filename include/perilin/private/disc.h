@@ -8,6 +8,7 @@
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
+PETSC_EXTERN PetscErrorCode PeriParticlesInputPath(PeriScene, PeriNode, const char[], char[], size_t);
 
 /* ------------------------------------------------------------------ Gmsh meshes (src/mesh.c) */
 /* A named physical group: the positions of its particles, sorted lexicographically (positions,
