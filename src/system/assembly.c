@@ -149,6 +149,21 @@ static PetscErrorCode BondsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The element's DOFs u_e (all particles' DOFs u, global numbering) into el->work[0, N) and its
+ * forces f = K_e u_e into el->work[N, 2N), N = el->n dofs: what the stress and the reactions of an
+ * element share. */
+void PeriElementForces(PeriSystem sys, const PeriElement *el, const PetscScalar u[])
+{
+  const PetscInt bs = sys->model->dofs, N = el->n * bs;
+  PetscReal     *ue = el->work, *f = el->work + N;
+  for (PetscInt t = 0; t < el->n; t++)
+    for (PetscInt c = 0; c < bs; c++) ue[t * bs + c] = PetscRealPart(u[el->idx[t] * bs + c]);
+  for (PetscInt a = 0; a < N; a++) {
+    f[a] = 0;
+    for (PetscInt c = 0; c < N; c++) f[a] += el->K[a * N + c] * ue[c];
+  }
+}
+
 /*@C
   PeriElementsForEach - calls fn on every element of this rank's energy with its stiffness block:
   each live bond of an owned particle (bond-based models), or each owned particle's family

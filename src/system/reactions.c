@@ -80,20 +80,14 @@ typedef struct {
 /* f_e = K_e u_e added to the element's particles */
 static PetscErrorCode ElementForce(PeriSystem sys, const PeriElement *el, void *ctx)
 {
-  ForceCtx      *F  = (ForceCtx *)ctx;
-  const PetscInt bs = sys->model->dofs, N = el->n * bs;
-  PetscReal     *ue = el->work, *f = el->work + N;
+  ForceCtx        *F  = (ForceCtx *)ctx;
+  const PetscInt   bs = sys->model->dofs, N = el->n * bs;
+  const PetscReal *f = el->work + N;
 
   PetscFunctionBeginUser;
+  PeriElementForces(sys, el, F->u);
   for (PetscInt t = 0; t < el->n; t++)
-    for (PetscInt c = 0; c < bs; c++) {
-      ue[t * bs + c]      = PetscRealPart(F->u[el->idx[t] * bs + c]);
-      F->rows[t * bs + c] = el->idx[t] * bs + c;
-    }
-  for (PetscInt a = 0; a < N; a++) {
-    f[a] = 0;
-    for (PetscInt c = 0; c < N; c++) f[a] += el->K[a * N + c] * ue[c];
-  }
+    for (PetscInt c = 0; c < bs; c++) F->rows[t * bs + c] = el->idx[t] * bs + c;
   PetscCall(VecSetValues(F->fint, N, F->rows, f, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -24,17 +24,12 @@ typedef struct {
 
 static PetscErrorCode ElementStress(PeriSystem sys, const PeriElement *el, void *ctx)
 {
-  StressCtx     *sc = (StressCtx *)ctx;
-  const PetscInt bs = sys->model->dofs, N = el->n * bs, dim = sys->disc.particles.dim;
-  PetscReal     *ue = el->work, *f = el->work + N;
+  StressCtx       *sc = (StressCtx *)ctx;
+  const PetscInt   bs = sys->model->dofs, N = el->n * bs, dim = sys->disc.particles.dim;
+  const PetscReal *f = el->work + N;
 
   PetscFunctionBeginUser;
-  for (PetscInt t = 0; t < el->n; t++)
-    for (PetscInt c = 0; c < bs; c++) ue[t * bs + c] = PetscRealPart(sc->u[el->idx[t] * bs + c]);
-  for (PetscInt a = 0; a < N; a++) {
-    f[a] = 0;
-    for (PetscInt c = 0; c < N; c++) f[a] += el->K[a * N + c] * ue[c];
-  }
+  PeriElementForces(sys, el, sc->u);
   for (PetscInt s = 0; s < el->nshare; s++) {
     const PetscInt  p = el->idx[s];
     PetscReal      *S = &sc->S[9 * p];

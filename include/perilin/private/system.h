@@ -216,6 +216,7 @@ typedef struct {
 } PeriElement;
 typedef PetscErrorCode (*PeriElementFn)(PeriSystem, const PeriElement *, void *);
 PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void *);
+PETSC_EXTERN void           PeriElementForces(PeriSystem, const PeriElement *, const PetscScalar[]);
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
