@@ -138,17 +138,16 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The analysis' snapshot callback: the system's present state as NAME in the output set,
- * which is opened here if the run has not opened it yet (a test drives the library without it). */
-static PetscErrorCode WriteSnapshot(void *ctx, const char name[])
+/* The analysis' snapshot callback: the system's present state as BASE.vtu (BASE.pvtu on several
+ * ranks) in the output set, which is opened here if the run has not opened it yet (a test drives
+ * the library without it). */
+static PetscErrorCode WriteSnapshot(void *ctx, const char base[])
 {
   PeriProblem p = (PeriProblem)ctx;
-  char        path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", p->staging_dir, name));
-  PetscCall(PeriSystemWriteVTU(p->sys, p->sys->u_all, path));
+  PetscCall(PeriSystemWriteParticles(p->sys, p->sys->u_owned, p->staging_dir, base));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -191,19 +190,19 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* particles.vtu: the solution, the analysis' fields (mode shapes), the system's fields. */
-static PetscErrorCode WriteParticles(PeriProblem p, const char path[])
+/* particles.vtu (particles.pvtu and its pieces on several ranks): the solution, the analysis'
+ * fields (mode shapes), the system's fields, each rank its own particles'. Collective. */
+static PetscErrorCode WriteParticles(PeriProblem p)
 {
   PeriSystem    sys = p->sys;
   PeriFieldList fl;
 
   PetscFunctionBeginUser;
-  if (p->rank) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFieldListCreate(sys->disc.particles.n, sys->disc.particles.x, &fl));
-  if (sys->u_all) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->u_all));
+  PetscCall(PeriSystemFieldListCreate(sys, &fl));
+  if (sys->u_owned) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->u_owned));
   if (p->analysis && p->analysis->type->ops.fields) PetscCall(p->analysis->type->ops.fields(p->analysis, fl));
   PetscCall(PeriSystemAddFields(sys, fl));
-  PetscCall(PeriWriteVTU(fl, path));
+  PetscCall(PeriWriteParticles(p->comm, fl, p->staging_dir, "particles"));
   PetscCall(PeriFieldListDestroy(&fl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -223,9 +222,8 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
   PetscCall(PeriProgressUpdate(p->sys->progress, PERI_PROGRESS_PHASE, "output"));
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   /* an analysis stopped before it had a state writes no fields: only the summary saying so */
-  if (p->vtk && (!p->sys->interrupted || p->sys->u_all)) {
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.vtu", p->staging_dir));
-    PetscCall(WriteParticles(p, path));
+  if (p->vtk && (!p->sys->interrupted || p->sys->u_owned)) {
+    PetscCall(WriteParticles(p));
   }
   if (p->analysis && p->analysis->type->ops.files) PetscCall(p->analysis->type->ops.files(p->analysis, p->staging_dir));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/summary.json", p->staging_dir));
@@ -298,7 +296,7 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   else
     PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.memory_mb));
   if (sys->interrupted) {
-    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->u_all ? "the last complete state was written" : "no result was reached", p->output_dir));
+    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->u_owned ? "the last complete state was written" : "no result was reached", p->output_dir));
   } else if (p->analysis && p->analysis->type->ops.report) {
     PetscCall(p->analysis->type->ops.report(p->analysis));
   } else {

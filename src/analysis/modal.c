@@ -188,31 +188,27 @@ static PetscErrorCode Classify(PeriAnalysis an, Vec x, Vec mdiag, PeriMode *mode
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Gathers the full mode vector to rank 0, scaled to max |u| = 1. */
+/* Keeps this rank's part of the mode vector (its particles' DOFs: its piece of the output, no
+ * gather), scaled to max |u| = 1 over the body. Collective. */
 static PetscErrorCode StoreShape(PeriAnalysis an, Vec full, PetscInt k)
 {
-  VecScatter         sc;
-  Vec                all;
   const PetscScalar *a;
-  const PetscInt     nd = an->sys->disc.particles.n * an->sys->model->dofs;
+  PetscInt           nl;
+  PetscReal          amax  = 0, *s;
+  PetscBool          trans = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(VecScatterCreateToZero(full, &sc, &all));
-  PetscCall(VecScatterBegin(sc, full, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(sc, full, all, INSERT_VALUES, SCATTER_FORWARD));
-  if (an->rank == 0) {
-    PetscReal amax = 0, *s = &Modal(an)->shapes[k * nd];
-    PetscBool trans = PETSC_FALSE;
-    for (PetscInt c = 0; c < an->sys->model->dofs; c++) trans = (PetscBool)(trans || !an->sys->model->rotational[c]);
-    PetscCall(VecGetArrayRead(all, &a));
-    /* the largest displacement is 1 (rotations, in radians, do not set the scale) */
-    for (PetscInt i = 0; i < nd; i++)
-      if (!trans || !an->sys->model->rotational[i % an->sys->model->dofs]) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
-    for (PetscInt i = 0; i < nd; i++) s[i] = PetscRealPart(a[i]) / (amax > 0 ? amax : 1);
-    PetscCall(VecRestoreArrayRead(all, &a));
-  }
-  PetscCall(VecScatterDestroy(&sc));
-  PetscCall(VecDestroy(&all));
+  PetscCall(VecGetLocalSize(full, &nl));
+  s = &Modal(an)->shapes[k * nl];
+  for (PetscInt c = 0; c < an->sys->model->dofs; c++) trans = (PetscBool)(trans || !an->sys->model->rotational[c]);
+  PetscCall(VecGetArrayRead(full, &a));
+  /* the largest displacement is 1 (rotations, in radians, do not set the scale); the local
+     vector starts at a particle, so i % dofs is the component */
+  for (PetscInt i = 0; i < nl; i++)
+    if (!trans || !an->sys->model->rotational[i % an->sys->model->dofs]) amax = PetscMax(amax, PetscAbsReal(PetscRealPart(a[i])));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &amax, 1, MPIU_REAL, MPI_MAX, an->comm));
+  for (PetscInt i = 0; i < nl; i++) s[i] = PetscRealPart(a[i]) / (amax > 0 ? amax : 1);
+  PetscCall(VecRestoreArrayRead(full, &a));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -486,16 +482,17 @@ static PetscErrorCode CollectModes(PeriAnalysis an, EPS eps, Mat Kff, Mat Mff, I
 {
   PeriModal *md = Modal(an);
   Vec        x, r, y, full;
-  PetscInt   nd = an->sys->disc.particles.n * an->sys->model->dofs;
+  PetscInt   nl;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(Kff, &x, &r));
   PetscCall(VecDuplicate(r, &y));
   PetscCall(PeriSystemCreateVec(an->sys, &full));
+  PetscCall(VecGetLocalSize(full, &nl));
   /* no more modes than free DOFs, whatever nev asks for */
   PetscCall(PetscCalloc1(PetscMin(nev, md->nfree_dofs), &md->modes));
   md->nshapes = PetscMin(PetscMin(nev, md->nfree_dofs), PERI_MAX_VTU_MODES);
-  if (an->rank == 0) PetscCall(PetscCalloc1(md->nshapes * nd, &md->shapes));
+  PetscCall(PetscCalloc1(md->nshapes * nl, &md->shapes)); /* the owned particles' DOFs of each shape */
   for (PetscInt s = 0; s < npairs && md->nmodes < nev; s++) {
     PeriMode *mode = &md->modes[md->nmodes];
     PetscReal l    = pairs[s].lam;
@@ -683,11 +680,12 @@ static PetscErrorCode PeriWriteModesCSV(PeriAnalysis an, const char path[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The stored mode shapes as fields of particles.vtu: mode_1, mode_1_theta, ... */
+/* The stored mode shapes as fields of particles.vtu: mode_1, mode_1_theta, ... (this rank's
+ * particles: its piece) */
 static PetscErrorCode ModalAddFields(PeriAnalysis an, PeriFieldList fl)
 {
   const PeriModal *md = Modal(an);
-  const PetscInt   nd = an->sys->disc.particles.n * an->sys->model->dofs;
+  const PetscInt   nd = (an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart) * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; md && k < md->nshapes; k++) {
@@ -699,30 +697,31 @@ static PetscErrorCode ModalAddFields(PeriAnalysis an, PeriFieldList fl)
 }
 
 /*@C
-  WriteModeShapes - mode_NN.vtu, one file per stored mode shape with the shape as its
-  "displacement" (NN: the mode number of modes.csv), and modes.pvd listing them with each mode's
+  WriteModeShapes - mode_NN.vtu (mode_NN.pvtu and its pieces on several ranks), one file per
+  stored mode shape with the shape as its "displacement" (NN: the mode number of modes.csv), and
+  modes.pvd listing them with each mode's
   frequency in Hz as its time, so that ParaView's time controls step through the modes and show
   the frequency. The frames are in ascending frequency (with analysis.target_hz the modes come by
   distance to the target instead); equal frequencies stay in mode order, PeriWritePVD makes their
-  times distinct by 1e-12 relative. Collective; rank 0 writes.
+  times distinct by 1e-12 relative. Collective: every rank writes its pieces, rank 0 the index.
 @*/
 static PetscErrorCode WriteModeShapes(PeriAnalysis an, const char dir[])
 {
   PeriModal     *md = Modal(an);
   PetscReal     *times;
   PetscInt      *order;
-  char         **files, path[PETSC_MAX_PATH_LEN];
-  const PetscInt nd = an->sys->disc.particles.n * an->sys->model->dofs;
+  char         **files, path[PETSC_MAX_PATH_LEN], base[32];
+  const PetscInt nd = (an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart) * an->sys->model->dofs;
 
   PetscFunctionBeginUser;
-  if (an->rank || !md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!md || !md->nshapes) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc3(md->nshapes, &times, md->nshapes, &files, md->nshapes, &order));
   /* each file is particles.vtu's layout with the mode as the displacement field */
   for (PetscInt k = 0; k < md->nshapes; k++) {
-    PetscCall(PetscMalloc1(32, &files[k]));
-    PetscCall(PetscSNPrintf(files[k], 32, "mode_%02" PetscInt_FMT ".vtu", k + 1));
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", dir, files[k]));
-    PetscCall(PeriSystemWriteVTU(an->sys, &md->shapes[k * nd], path));
+    PetscCall(PetscSNPrintf(base, sizeof(base), "mode_%02" PetscInt_FMT, k + 1));
+    PetscCall(PetscMalloc1(40, &files[k]));
+    PetscCall(PeriParticlesFileName(an->comm, base, files[k], 40));
+    PetscCall(PeriSystemWriteParticles(an->sys, &md->shapes[k * nd], dir, base));
   }
   /* stable insertion sort of the mode numbers by frequency: few shapes (at most 12) */
   for (PetscInt k = 0; k < md->nshapes; k++) {
@@ -735,7 +734,7 @@ static PetscErrorCode WriteModeShapes(PeriAnalysis an, const char dir[])
     const char *sorted[PERI_MAX_VTU_MODES];
     for (PetscInt k = 0; k < md->nshapes; k++) sorted[k] = files[order[k]];
     PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.pvd", dir));
-    PetscCall(PeriWritePVD(path, md->nshapes, times, sorted));
+    if (an->rank == 0) PetscCall(PeriWritePVD(path, md->nshapes, times, sorted));
   }
   for (PetscInt k = 0; k < md->nshapes; k++) PetscCall(PetscFree(files[k]));
   PetscCall(PetscFree3(times, files, order));

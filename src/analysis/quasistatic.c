@@ -340,8 +340,9 @@ static PetscErrorCode EquilibriumDestroy(Equilibrium *e)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* particles_NNNN.vtu (or another name) of the present state, in the output set, through the
- * snapshot callback the problem installed (the analysis does not know where the set lives). */
+/* particles_NNNN.vtu (or another name; .pvtu on several ranks) of the present state, in the output
+ * set, through the snapshot callback the problem installed (the analysis does not know where the
+ * set lives). */
 static PetscErrorCode WriteState(PeriAnalysis an, const char name[])
 {
   PetscFunctionBeginUser;
@@ -356,7 +357,7 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an)
   char name[64];
 
   PetscFunctionBeginUser;
-  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT ".vtu", QS(an)->nsteps));
+  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT, QS(an)->nsteps));
   PetscCall(WriteState(an, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -514,7 +515,7 @@ static PetscErrorCode Failed(PeriAnalysis an, Equilibrium *eq, PetscReal trial, 
   q->failure_step         = q->nsteps + 1;
   q->failed_trial_broken  = s->broken;
   PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
-  if (an->vtk && an->sys->u) PetscCall(WriteState(an, "failed_trial.vtu"));
+  if (an->vtk && an->sys->u) PetscCall(WriteState(an, "failed_trial"));
   PetscCall(PeriDamage(an->sys, &q->trial_damage)); /* where the failure went, for the caller */
   PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -803,7 +804,8 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
   WriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
   (output.every) with the load factor as the time, and, when the last equilibrium is not one of
   them, particles.vtu (which describes it) as the last frame, so that the series ends where the
-  run did. failed_trial.vtu is no equilibrium and stays out. Rank 0 writes. Collective.
+  run did (on several ranks the frames are the .pvtu indexes). failed_trial.vtu is no equilibrium
+  and stays out. Rank 0 writes. Collective.
 @*/
 static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
 {
@@ -811,18 +813,21 @@ static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
   PetscReal       *times;
   char           **files;
   PetscInt         n = 0;
+  char             base[32];
 
   PetscFunctionBeginUser;
   if (an->rank || !q || !an->every || !an->vtk || q->nsteps < 1) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc2(q->nsteps + 1, &times, q->nsteps + 1, &files));
   for (PetscInt k = an->every; k <= q->nsteps; k += an->every) {
     times[n] = q->steps[k - 1].lambda;
-    PetscCall(PetscMalloc1(32, &files[n]));
-    PetscCall(PetscSNPrintf(files[n++], 32, "particles_%04" PetscInt_FMT ".vtu", k));
+    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, k));
+    PetscCall(PetscMalloc1(40, &files[n]));
+    PetscCall(PeriParticlesFileName(an->comm, base, files[n++], 40));
   }
   if (q->nsteps % an->every) {
     times[n] = q->steps[q->nsteps - 1].lambda;
-    PetscCall(PetscStrallocpy("particles.vtu", &files[n++]));
+    PetscCall(PetscMalloc1(40, &files[n]));
+    PetscCall(PeriParticlesFileName(an->comm, "particles", files[n++], 40));
   }
   PetscCall(PeriWritePVD(path, n, times, (const char *const *)files));
   for (PetscInt k = 0; k < n; k++) PetscCall(PetscFree(files[k]));

@@ -13,7 +13,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#define VTK_VERTEX 1
+#define VTK_VERTEX     1
+#define PERI_PIECE_FMT "piece_%04d.vtu" /* a rank's piece, in the directory named as the .pvtu */
 
 typedef enum {
   VTU_POINT_DATA,
@@ -261,17 +262,29 @@ static PetscErrorCode PeriFieldListAddGeometry(PeriFieldList fl)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriWriteVTU - the fields of the list, the points and one vertex cell per point, written to
-  path through a temporary file (nothing is left behind on failure). Not collective: the rank that
-  holds every particle's data calls it.
-@*/
-PetscErrorCode PeriWriteVTU(PeriFieldList fl, const char path[])
+/* Sizes and offsets of the arrays (the geometry added first), and the largest array in bytes. */
+static PetscErrorCode VTULayout(PeriFieldList fl, uint64_t *maxbytes)
 {
-  VTUArray      *a;
-  PetscInt       na, n = fl->n;
-  uint64_t       offset = 0, maxbytes = 0;
-  char           tmp[PETSC_MAX_PATH_LEN];
+  uint64_t offset = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriFieldListAddGeometry(fl));
+  *maxbytes = 0;
+  for (PetscInt k = 0; k < fl->na; k++) {
+    VTUArray *a = &fl->a[k];
+    a->nbytes   = (uint64_t)fl->n * (uint64_t)a->ncomp * VTUTypeSizes[a->kind];
+    a->offset   = offset;
+    offset += sizeof(uint64_t) + a->nbytes;
+    *maxbytes = PetscMax(*maxbytes, a->nbytes);
+  }
+  PetscCheck(*maxbytes <= SIZE_MAX, PETSC_COMM_SELF, PETSC_ERR_MEM, "VTU array of %" PRIu64 " bytes is too large", *maxbytes);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The whole file as tmp (path.tmp), closed; on failure tmp is removed. Not collective. */
+static PetscErrorCode VTUWriteTemporary(PeriFieldList fl, const char path[], char tmp[], size_t len)
+{
+  uint64_t       maxbytes = 0;
   FILE          *fp;
   double        *buf; /* double for alignment; also holds the Int32/Int64/UInt8 arrays */
   PetscErrorCode ierr;
@@ -279,26 +292,17 @@ PetscErrorCode PeriWriteVTU(PeriFieldList fl, const char path[])
 
   PetscFunctionBeginUser;
   PetscCheck(path && path[0], PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Empty VTU file name");
-  PetscCheck(strlen(path) + sizeof(".tmp") <= sizeof(tmp), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "VTU file name is too long: %s", path);
-  PetscCall(PeriFieldListAddGeometry(fl));
-  a  = fl->a;
-  na = fl->na;
-  for (PetscInt k = 0; k < na; k++) {
-    a[k].nbytes = (uint64_t)n * (uint64_t)a[k].ncomp * VTUTypeSizes[a[k].kind];
-    a[k].offset = offset;
-    offset += sizeof(uint64_t) + a[k].nbytes;
-    maxbytes = PetscMax(maxbytes, a[k].nbytes);
-  }
-  PetscCheck(maxbytes <= SIZE_MAX, PETSC_COMM_SELF, PETSC_ERR_MEM, "VTU array of %" PRIu64 " bytes is too large", maxbytes);
+  PetscCheck(strlen(path) + sizeof(".tmp") <= len, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "VTU file name is too long: %s", path);
+  PetscCall(VTULayout(fl, &maxbytes));
   PetscCall(PetscMalloc1((size_t)(maxbytes / sizeof(double) + 1), &buf));
-  PetscCall(PetscSNPrintf(tmp, sizeof(tmp), "%s.tmp", path));
+  PetscCall(PetscSNPrintf(tmp, len, "%s.tmp", path));
   fp = fopen(tmp, "wb");
   if (!fp) {
     err = errno;
     PetscCall(PetscFree(buf));
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot open %s for writing: %s", tmp, strerror(err));
   }
-  ierr = VTUWriteFile(fp, tmp, n, na, a, buf);
+  ierr = VTUWriteFile(fp, tmp, fl->n, fl->na, fl->a, buf);
   /* Buffered write errors (e.g. a full disk) only surface at fclose(). */
   rc  = fclose(fp);
   err = errno;
@@ -308,7 +312,110 @@ PetscErrorCode PeriWriteVTU(PeriFieldList fl, const char path[])
     PetscCall(ierr);
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Error writing %s: %s", tmp, strerror(err));
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteVTU - the fields of the list, the points and one vertex cell per point, written to
+  path through a temporary file (nothing is left behind on failure). Not collective: one rank
+  writes the particles of its list (PeriWriteParticles writes a set of them).
+@*/
+PetscErrorCode PeriWriteVTU(PeriFieldList fl, const char path[])
+{
+  char tmp[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(VTUWriteTemporary(fl, path, tmp, sizeof(tmp)));
   PetscCall(PeriFileCommit(tmp, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The parallel index: the arrays' names, types and components (those of every piece: each rank
+ * builds the same list over its own particles) and the pieces, relative to the .pvtu. */
+static PetscErrorCode WritePVTU(PeriFieldList fl, const char path[], const char base[], PetscMPIInt size)
+{
+  const uint16_t    one   = 1;
+  const char *const order = *(const unsigned char *)&one ? "LittleEndian" : "BigEndian";
+  char              tmp[PETSC_MAX_PATH_LEN];
+  FILE             *fp;
+  int               bad = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriFieldListAddGeometry(fl));
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  bad |= fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n    <PPointData>\n", order) < 0;
+  for (PetscInt k = 0; k < fl->na; k++) {
+    const VTUArray *a = &fl->a[k];
+    if (a->section == VTU_POINTS) bad |= fprintf(fp, "    </PPointData>\n    <PPoints>\n") < 0;
+    if (a->section == VTU_CELLS) break; /* the cells come from the pieces */
+    bad |= fprintf(fp, "      <PDataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%" PetscInt_FMT "\"/>\n", VTUTypeNames[a->kind], a->name, a->ncomp) < 0;
+  }
+  bad |= fprintf(fp, "    </PPoints>\n") < 0;
+  for (PetscMPIInt r = 0; r < size; r++) bad |= fprintf(fp, "    <Piece Source=\"%s/" PERI_PIECE_FMT "\"/>\n", base, r) < 0;
+  bad |= fprintf(fp, "  </PUnstructuredGrid>\n</VTKFile>\n") < 0;
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Every rank learns whether any failed (ierr) and which (the highest): a file set is renamed
+ * only when all ranks wrote their part, and then all ranks fail together (none waits in a
+ * collective call), removing their own temporary file tmp (or NULL). */
+static PetscErrorCode Agree(MPI_Comm comm, PetscErrorCode ierr, const char tmp[], const char what[], const char path[])
+{
+  PetscMPIInt rank, bad;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  bad = ierr ? rank + 1 : 0;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, comm));
+  if (bad && tmp && tmp[0]) (void)remove(tmp);
+  PetscCall(ierr); /* the failing rank reports its own cause */
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write %s: rank %d failed to %s", path, bad - 1, what);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The name of the particle file base.vtu (one rank) or base.pvtu (several). */
+PetscErrorCode PeriParticlesFileName(MPI_Comm comm, const char base[], char name[], size_t len)
+{
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscSNPrintf(name, len, "%s.%s", base, size > 1 ? "pvtu" : "vtu"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteParticles - the particles of every rank's list as dir/base.vtu (one rank) or, without
+  gathering them, as VTK's parallel format: each rank writes its own particles to
+  dir/base/piece_RRRR.vtu and rank 0 the index dir/base.pvtu. Every file goes through a temporary
+  name; the pieces are renamed only after all ranks wrote theirs, and the index after all pieces
+  were renamed, so a failure on any rank leaves no base.pvtu (and the run's set is discarded).
+  Collective.
+@*/
+PetscErrorCode PeriWriteParticles(MPI_Comm comm, PeriFieldList fl, const char dir[], const char base[])
+{
+  char           path[PETSC_MAX_PATH_LEN], piece[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN] = "";
+  PetscMPIInt    rank, size;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s.%s", dir, base, size > 1 ? "pvtu" : "vtu"));
+  if (size == 1) {
+    PetscCall(PeriWriteVTU(fl, path));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscSNPrintf(piece, sizeof(piece), "%s/%s", dir, base));
+  ierr = PeriOutputDirCreate(piece); /* every rank: mkdir -p tolerates the others' */
+  PetscCall(PetscSNPrintf(piece, sizeof(piece), "%s/%s/" PERI_PIECE_FMT, dir, base, rank));
+  if (!ierr) ierr = VTUWriteTemporary(fl, piece, tmp, sizeof(tmp));
+  PetscCall(Agree(comm, ierr, tmp, "write its piece", path));
+  ierr = PeriFileCommit(tmp, piece);
+  PetscCall(Agree(comm, ierr, NULL, "rename its piece", path));
+  ierr = rank ? PETSC_SUCCESS : WritePVTU(fl, path, base, size);
+  PetscCall(Agree(comm, ierr, NULL, "write the index", path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -263,8 +263,8 @@ PetscReal PeriBondSoftening(PeriSystem sys, const PetscReal meas[])
 /*@C
   PeriDamage - phi_i = 1 - (sum of live alpha V_j) / (sum over every bond found, the pre-cracked
   included) (Oterkus & Madenci eq. 79), softened bonds weighed by their remaining share; and per
-  criterion (Diana & Casolo eqs. 47, 48, 51) the share of the family lost to it. Rank 0 gets
-  PERI_NCAUSES + 1 values per particle: the total, then one per PeriFailureCause. Collective.
+  criterion (Diana & Casolo eqs. 47, 48, 51) the share of the family lost to it. Every rank gets
+  (all particles until issue 17 item 3; each writes its own particles' piece) PERI_NCAUSES + 1 values per particle: the total, then one per PeriFailureCause. Collective.
 @*/
 PetscErrorCode PeriDamage(PeriSystem sys, PetscReal **damage)
 {
@@ -286,9 +286,9 @@ PetscErrorCode PeriDamage(PeriSystem sys, PetscReal **damage)
         a[2 + (b->cause ? b->cause[k] : 0)] += (1 - left) * V;
       }
     }
-  PetscCallMPI(MPI_Reduce(sys->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(w * pt->n), MPIU_REAL, MPI_SUM, 0, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, acc, (PetscMPIInt)(w * pt->n), MPIU_REAL, MPI_SUM, sys->comm));
   PetscCall(PetscFree(*damage));
-  if (sys->rank == 0) {
+  {
     PetscCall(PetscMalloc1((PERI_NCAUSES + 1) * pt->n, damage));
     for (PetscInt i = 0; i < pt->n; i++) {
       const PetscReal *a                = &acc[w * i];
@@ -473,13 +473,13 @@ PetscErrorCode PeriFailureAddFields(PeriSystem sys, PeriFieldList fl)
 
   PetscFunctionBeginUser;
   if (!sys->damage) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage, PERI_NCAUSES + 1, &map0));
+  PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage + (PERI_NCAUSES + 1) * sys->disc.bonds.rstart, PERI_NCAUSES + 1, &map0));
   for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
     char           name[32];
     const PetscInt map = 1 + c;
     if (!used[c]) continue;
     PetscCall(PetscSNPrintf(name, sizeof(name), "damage_%s", PeriFailureCauses[c]));
-    PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage, PERI_NCAUSES + 1, &map));
+    PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage + (PERI_NCAUSES + 1) * sys->disc.bonds.rstart, PERI_NCAUSES + 1, &map));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -79,8 +79,10 @@ static PetscErrorCode ElementEnergy(PeriSystem sys, const PeriElement *el, void 
 
 /* Antiplane models: the corrected shear angles grad uz = M^-1 R with M = sum w alpha xi xi^T V_j
  * and R = sum w alpha (u_j - u_i) xi V_j (w = 1/|xi|^2), exact for every linear field (eq. 53 with
- * the full 2x2 moment, so also at corners), and tau = mu (grad uz + twist terms). Rank 0 gets
- * tau_xz, tau_yz and |tau| of every particle. */
+ * the full 2x2 moment, so also at corners), and tau = mu (grad uz + twist terms). Every rank gets
+ * tau_xz, tau_yz and |tau| of every particle: rank 0 for the torsion results, each rank its own
+ * particles' for its piece of the output (the whole array until the per-rank data of issue 17
+ * item 3 replaces it). */
 static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
 {
   const PeriBonds     *b  = &sys->disc.bonds;
@@ -105,9 +107,9 @@ static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
         A[4] += w * e * xi[1] * V;
       }
     }
-  PetscCallMPI(MPI_Reduce(sys->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, 0, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, sys->comm));
   PetscCall(PetscFree(sys->tau));
-  if (sys->rank == 0) {
+  {
     PetscCall(PetscMalloc1(3 * n, &sys->tau));
     for (PetscInt i = 0; i < n; i++) {
       const PetscReal *A   = &acc[5 * i];
@@ -132,10 +134,29 @@ static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* sys->u_owned: this rank's particles' DOFs, from the distributed sys->u (no gather), so that its
+ * piece of the output shows the state the other results describe. */
+static PetscErrorCode KeepOwnedSolution(PeriSystem sys)
+{
+  const PetscScalar *u;
+  PetscInt           nl;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(sys->u, &nl));
+  PetscCheck(nl == (sys->disc.bonds.rend - sys->disc.bonds.rstart) * sys->model->dofs, PETSC_COMM_SELF, PETSC_ERR_PLIB, "The solution's local size %" PetscInt_FMT " is not the owned particles' DOFs", nl);
+  PetscCall(PetscFree(sys->u_owned));
+  PetscCall(PetscMalloc1(nl, &sys->u_owned));
+  PetscCall(VecGetArrayRead(sys->u, &u));
+  for (PetscInt k = 0; k < nl; k++) sys->u_owned[k] = PetscRealPart(u[k]);
+  PetscCall(VecRestoreArrayRead(sys->u, &u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriSystemEvaluateEnergy - from the solution sys->u: the strain energy of the body, the energy
-  density W_i = (1/2) sum_j (pair energy) / V_i of every particle (rank 0), the displacements of
-  all particles (rank 0), the probes, the largest displacement per component, and for antiplane
+  density W_i = (1/2) sum_j (pair energy) / V_i of every particle (every rank, all particles: the
+  accumulation spans them until issue 17 item 3), the displacements of all particles (rank 0,
+  u_all) and of the owned ones (every rank, u_owned), the probes, the largest displacement per component, and for antiplane
   models the shear stresses and the torsion results. Collective.
 @*/
 PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
@@ -163,13 +184,14 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
     for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(pt, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
   PetscCallMPI(MPI_Allreduce(umax, sys->max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
   PetscCallMPI(MPI_Allreduce(&E.energy, &sys->strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
-  PetscCallMPI(MPI_Reduce(sys->rank ? W : MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, 0, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, sys->comm));
   if (m->antiplane) PetscCall(ShearStresses(sys, u));
   PetscCall(PeriSystemEvaluateStress(sys, u));
   PetscCall(PetscFree(sys->W));
   PetscCall(PetscFree(sys->u_all));
+  PetscCall(KeepOwnedSolution(sys));
+  sys->W = W;
   if (sys->rank == 0) {
-    sys->W = W;
     PetscCall(PetscMalloc1(n * bs, &sys->u_all));
     for (PetscInt k = 0; k < n * bs; k++) sys->u_all[k] = PetscRealPart(u[k]);
     for (PetscInt k = 0; k < sys->nprobes; k++) {
@@ -178,8 +200,7 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
       pr->W = W[pr->particle];
     }
     PetscCall(PeriTorsionEvaluate(sys));
-  } else
-    PetscCall(PetscFree(W));
+  }
   if (sys->torsion.active) PetscCallMPI(MPI_Bcast(&sys->torsion.torque, 6, MPIU_REAL, 0, sys->comm));
   PetscCall(VecRestoreArrayRead(all, &u));
   PetscCall(VecDestroy(&all));
@@ -198,47 +219,61 @@ PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe 
 }
 
 /*@C
-  PeriSystemAddFields - the system's per-particle fields besides the solution: volume, neighbours,
-  rank, and where they exist strain energy density and antiplane shear stresses; then the
-  features' own (damage: PeriFailureAddFields; mirror images: PeriLayersAddFields). Rank 0, after
-  the fields were gathered.
+  PeriSystemAddFields - the system's per-particle fields besides the solution, over this rank's
+  particles (a list of PeriSystemFieldListCreate): volume, neighbours, rank, and where they exist
+  strain energy density and antiplane shear stresses; then the features' own (damage:
+  PeriFailureAddFields; mirror images: PeriLayersAddFields). Every rank: the arrays hold all
+  particles today (issue 17 item 1), each rank's piece is its owned range of them.
 @*/
 PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
 {
+  const PetscInt r0 = sys->disc.bonds.rstart;
+
   PetscFunctionBeginUser;
-  PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->disc.particles.volume, 1, NULL));
-  PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count));
-  PetscCall(PeriFieldListAddInt(fl, "rank", sys->disc.owner));
-  if (sys->W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->W, 1, NULL));
+  PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->disc.particles.volume + r0, 1, NULL));
+  PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count + r0));
+  PetscCall(PeriFieldListAddInt(fl, "rank", sys->disc.owner + r0));
+  if (sys->W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->W + r0, 1, NULL));
   if (sys->tau) {
     const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
-    PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
-    PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau, 3, &nmap));
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau + 3 * r0, 3, tmap)); /* tau_xz, tau_yz, 0 */
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau + 3 * r0, 3, &nmap));
   }
   if (sys->stress) {
-    PetscCall(PeriFieldListAddReal(fl, "stress", 9, sys->stress, 9, NULL));
-    PetscCall(PeriFieldListAddReal(fl, "strain", 9, sys->strain, 9, NULL));
-    PetscCall(PeriFieldListAddReal(fl, "elastic_stress", 9, sys->elastic_stress, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "stress", 9, sys->stress + 9 * r0, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "strain", 9, sys->strain + 9 * r0, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "elastic_stress", 9, sys->elastic_stress + 9 * r0, 9, NULL));
   }
   PetscCall(PeriFailureAddFields(sys, fl));
   PetscCall(PeriLayersAddFields(sys, fl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* An empty field list over this rank's particles: its piece of the output (no gather). */
+PetscErrorCode PeriSystemFieldListCreate(PeriSystem sys, PeriFieldList *fl)
+{
+  const PeriBonds *b = &sys->disc.bonds;
+
+  PetscFunctionBeginUser;
+  /* the coordinates of all particles are on every rank today (issue 17 item 1): the owned range */
+  PetscCall(PeriFieldListCreate(b->rend - b->rstart, sys->disc.particles.x + 3 * b->rstart, fl));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriSystemWriteVTU - path holds u (all particles' DOFs, or NULL: no solution) and the system's
-  fields. Collective; rank 0 writes.
+  PeriSystemWriteParticles - dir/base.vtu (one rank) or dir/base.pvtu and its pieces (several)
+  with u (the owned particles' DOFs, or NULL: no solution) and the system's fields. Collective;
+  every rank writes its own particles.
 @*/
-PetscErrorCode PeriSystemWriteVTU(PeriSystem sys, const PetscReal *u, const char path[])
+PetscErrorCode PeriSystemWriteParticles(PeriSystem sys, const PetscReal *u, const char dir[], const char base[])
 {
   PeriFieldList fl;
 
   PetscFunctionBeginUser;
-  if (sys->rank) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFieldListCreate(sys->disc.particles.n, sys->disc.particles.x, &fl));
+  PetscCall(PeriSystemFieldListCreate(sys, &fl));
   if (u) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, u));
   PetscCall(PeriSystemAddFields(sys, fl));
-  PetscCall(PeriWriteVTU(fl, path));
+  PetscCall(PeriWriteParticles(sys->comm, fl, dir, base));
   PetscCall(PeriFieldListDestroy(&fl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -433,6 +433,6 @@ PetscErrorCode PeriLayersSummary(PeriSystem sys, PeriJSON j)
 PetscErrorCode PeriLayersAddFields(PeriSystem sys, PeriFieldList fl)
 {
   PetscFunctionBeginUser;
-  if (sys->disc.particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->disc.particles.image));
+  if (sys->disc.particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->disc.particles.image + sys->disc.bonds.rstart)); /* the owned range: the piece */
   PetscFunctionReturn(PETSC_SUCCESS);
 }

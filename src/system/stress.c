@@ -119,8 +119,8 @@ static void ElasticStress(PeriModel m, PetscInt dim, const PetscReal eps[9], Pet
 }
 
 /*@C
-  PeriSystemEvaluateStress - sys->stress, sys->strain and sys->elastic_stress (rank 0, 9 per
-  particle, row-major 3 x 3, symmetric) from all particles' DOFs u (every rank), when output.stress
+  PeriSystemEvaluateStress - sys->stress, sys->strain and sys->elastic_stress (every rank, all
+  particles until issue 17 item 3; each rank writes its own particles' piece; 9 per particle, row-major 3 x 3, symmetric) from all particles' DOFs u (every rank), when output.stress
   asks for them. Nothing for the antiplane models. Collective.
 @*/
 PetscErrorCode PeriSystemEvaluateStress(PeriSystem sys, const PetscScalar u[])
@@ -137,9 +137,9 @@ PetscErrorCode PeriSystemEvaluateStress(PeriSystem sys, const PetscScalar u[])
   sc.S = S;
   PetscCall(PeriElementsForEach(sys, ElementStress, &sc));
   PetscCall(GradientMoments(sys, u, acc));
-  PetscCallMPI(MPI_Reduce(sys->rank ? S : MPI_IN_PLACE, S, (PetscMPIInt)(9 * n), MPIU_REAL, MPI_SUM, 0, sys->comm));
-  PetscCallMPI(MPI_Reduce(sys->rank ? acc : MPI_IN_PLACE, acc, (PetscMPIInt)(18 * n), MPIU_REAL, MPI_SUM, 0, sys->comm));
-  if (sys->rank == 0) {
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, S, (PetscMPIInt)(9 * n), MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, acc, (PetscMPIInt)(18 * n), MPIU_REAL, MPI_SUM, sys->comm));
+  {
     PetscCall(PetscMalloc3(9 * n, &sys->stress, 9 * n, &sys->strain, 9 * n, &sys->elastic_stress));
     for (PetscInt i = 0; i < n; i++) {
       for (PetscInt a = 0; a < 3; a++)

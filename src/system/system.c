@@ -421,6 +421,7 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PeriReactionsDestroy(&sys->reactions));
   PetscCall(PetscFree(sys->W));
   PetscCall(PetscFree(sys->u_all));
+  PetscCall(PetscFree(sys->u_owned));
   PetscCall(PeriProgressDestroy(&sys->progress));
   PetscCall(PetscFree(sys));
   *system = NULL;

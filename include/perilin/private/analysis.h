@@ -6,7 +6,7 @@
 typedef struct _p_PeriAnalysis *PeriAnalysis;
 /* Writes the system's present state as NAME (a .vtu) into the output set: installed by the
  * problem, which owns the set, so that an analysis can write a series while it runs. */
-typedef PetscErrorCode (*PeriSnapshotFn)(void *ctx, const char name[]);
+typedef PetscErrorCode (*PeriSnapshotFn)(void *ctx, const char base[]); /* base.vtu, or base.pvtu on several ranks */
 
 #define PERI_MAX_VTU_MODES 12
 

@@ -24,6 +24,8 @@ PETSC_EXTERN PetscErrorCode      PeriFieldListAddInt(PeriFieldList, const char[]
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddSolution(PeriFieldList, const char[], PetscInt, const char *const[], const PetscReal *);
 PETSC_EXTERN PetscErrorCode      PeriFieldListDestroy(PeriFieldList *);
 PETSC_EXTERN PetscErrorCode      PeriWriteVTU(PeriFieldList, const char[]);
+PETSC_EXTERN PetscErrorCode      PeriWriteParticles(MPI_Comm, PeriFieldList, const char[], const char[]);
+PETSC_EXTERN PetscErrorCode      PeriParticlesFileName(MPI_Comm, const char[], char[], size_t);
 PETSC_EXTERN PetscErrorCode      PeriWritePVD(const char[], PetscInt, const PetscReal[], const char *const[]);
 PETSC_EXTERN PetscErrorCode      PeriOutputDirCreate(const char[]);
 PETSC_EXTERN PetscErrorCode      PeriFileCommit(const char[], const char[]);

@@ -150,13 +150,13 @@ struct _p_PeriSystem {
   PetscReal       *bond_mu;   /* per local bond: the shear modulus across materials (eq. 60), or NULL */
   PeriLayers       layers;
   PeriTorsion      torsion;
-  PetscReal       *tau;            /* antiplane models, rank 0: tau_xz, tau_yz, |tau| per particle after the solve */
-  PetscReal       *stress;         /* vector models, rank 0: the bond-force stress per particle, 3 x 3 row-major (stress.c) */
-  PetscReal       *strain;         /* vector models, rank 0: the least-squares strain per particle, 3 x 3 row-major */
-  PetscReal       *elastic_stress; /* vector models, rank 0: C : strain of the target elasticity */
+  PetscReal       *tau;            /* antiplane models, every rank (all particles): tau_xz, tau_yz, |tau| per particle after the solve */
+  PetscReal       *stress;         /* vector models, every rank (all particles): the bond-force stress per particle, 3 x 3 row-major (stress.c) */
+  PetscReal       *strain;         /* vector models, every rank (all particles): the least-squares strain per particle, 3 x 3 row-major */
+  PetscReal       *elastic_stress; /* vector models, every rank (all particles): C : strain of the target elasticity */
   PetscBool        stress_output;  /* output.stress: evaluate the three above after each solve */
   PeriFailure      failure;
-  PetscReal       *damage; /* rank 0, scenes with failure: per particle phi, then phi per PeriFailureCause */
+  PetscReal       *damage; /* every rank (all particles), scenes with failure: per particle phi, then phi per PeriFailureCause */
   PeriModel        model;
   Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
   Mat              Kpc;                     /* with op: the assembled short-range stiffness that preconditions K */
@@ -174,8 +174,9 @@ struct _p_PeriSystem {
   PeriReactions    reactions;
   PetscInt         nprobes;
   PeriProbe       *probes;
-  PetscReal       *W;     /* strain energy density per particle (rank 0, after the solve) */
-  PetscReal       *u_all; /* displacements of all particles (rank 0, after the solve) */
+  PetscReal       *W;       /* strain energy density per particle (every rank, all particles, after the solve) */
+  PetscReal       *u_all;   /* displacements of all particles (rank 0, after the solve) */
+  PetscReal       *u_owned; /* the same state's DOFs of this rank's particles (every rank): its piece of the output */
   PeriSolveInfo    solve;
   PeriRunLog       log;
   PetscReal        strain_energy;           /* after the last solve */
@@ -201,7 +202,8 @@ PETSC_EXTERN PetscReal      PeriResidualTolerance(PeriSystem, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriReadProbes(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemEvaluateStress(PeriSystem, const PetscScalar[]);
 PETSC_EXTERN PetscErrorCode PeriSystemAddFields(PeriSystem, PeriFieldList);
-PETSC_EXTERN PetscErrorCode PeriSystemWriteVTU(PeriSystem, const PetscReal *, const char[]);
+PETSC_EXTERN PetscErrorCode PeriSystemFieldListCreate(PeriSystem, PeriFieldList *);
+PETSC_EXTERN PetscErrorCode PeriSystemWriteParticles(PeriSystem, const PetscReal *, const char[], const char[]);
 
 /* assembly (src/system/assembly.c) */
 /* One element of the energy, as PeriElementsForEach visits it: a live bond of a bond-based model,
