@@ -1,24 +1,42 @@
 """perilin's VTK output read by VTK's own readers (issue 16, item 7), checked against the run's
-other outputs: summary.json, steps.csv, modes.csv.
+other outputs: summary.json, steps.csv, modes.csv; and a run on several ranks (VTK's parallel
+format, issue 17 item 4) against the same run on one.
 
-usage: vtk_read.py static|modal|quasistatic OUTPUT_DIR
+usage: vtk_read.py static|modal|quasistatic OUTPUT_DIR EVERY RANKS [ONE_RANK_OUTPUT_DIR]
 
 VTK has no PVD reader outside ParaView (vtkPVDReader is ParaView's), so a .pvd collection is
-parsed with Python's xml module, as its format is plain XML, and every .vtu it names is opened
-with vtkXMLUnstructuredGridReader. The expectations come from files VTK does not read: a .vtu
-that VTK reads differently from what perilin meant (byte order, offsets, header type, the
-appended block) fails here.
+parsed with Python's xml module, as its format is plain XML, and every file it names is opened
+with vtkXMLUnstructuredGridReader (.vtu: one rank) or vtkXMLPUnstructuredGridReader (.pvtu: one
+piece per rank). The expectations come from files VTK does not read: a file that VTK reads
+differently from what perilin meant (byte order, offsets, header type, the appended block, the
+pieces) fails here. On RANKS > 1 every piece must hold exactly its rank's particles (each rank
+wrote its own, nothing was gathered), and with ONE_RANK_OUTPUT_DIR every array must equal the
+one-rank run's after sorting the particles by position (the partition renumbers them).
 """
 import csv
 import json
 import os
+import re
 import sys
 import xml.etree.ElementTree as ET
 
 from vtkmodules.util.numpy_support import vtk_to_numpy
-from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+import numpy as np
+from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader, vtkXMLUnstructuredGridReader
 
 failures = 0
+RANKS = 1
+EXT = "vtu"
+# Arrays that differ between partitions by design: the owner, and particle numbers.
+NUMBERING = ("rank", "mirror_of")
+# How far a run on several ranks may differ from the same run on one, relative to each array's
+# largest value. Static and quasi-static: every solve ends at a true relative residual of 1e-10
+# (perilin's default -ksp_rtol, src/system/solve.c) from a different ordering of the same sums, so
+# the fields agree to a small multiple of it; 1e-8 leaves the conditioning of K a factor 100.
+# Modal: the shapes come from shift-and-invert solved by a direct factorization and converge to
+# SLEPc's default tolerance 1e-8 in the residual, which bounds a shape's error by about that over
+# the relative gap to the next frequency (a few per cent in lamina/modal.yaml): 1e-6.
+RTOL = {"static": 1e-8, "quasistatic": 1e-8, "modal": 1e-6}
 
 
 def check(ok, what):
@@ -32,13 +50,29 @@ def close(a, b, rel=1e-12):
 
 
 def read_vtu(path):
-    """The grid as VTK reads it; an error (a malformed file) is a failure, not a crash."""
-    r = vtkXMLUnstructuredGridReader()
+    """The grid as VTK reads it (a .pvtu with its pieces); an error (a malformed file) is a
+    failure, not a crash."""
+    r = vtkXMLPUnstructuredGridReader() if path.endswith(".pvtu") else vtkXMLUnstructuredGridReader()
     r.SetFileName(path)
     r.Update()
     if r.GetErrorCode():
         raise RuntimeError("VTK cannot read %s (error code %d)" % (path, r.GetErrorCode()))
+    if path.endswith(".pvtu"):
+        check_pieces(path, r.GetOutput().GetNumberOfPoints())
     return r.GetOutput()
+
+
+def check_pieces(path, npoints):
+    """A .pvtu's pieces: one per rank, piece r read alone holds rank r's particles only."""
+    sources = [p.get("Source") for p in ET.parse(path).getroot().iter("Piece")]
+    counts, own = [], True
+    for r, src in enumerate(sources):
+        g = read_vtu(os.path.join(os.path.dirname(path), src))
+        counts.append(g.GetNumberOfPoints())
+        own = own and bool((array(g, "rank") == r).all())
+    name = os.path.basename(path)
+    check(len(sources) == RANKS, "%s: %d pieces for %d ranks" % (name, len(sources), RANKS))
+    check(own and sum(counts) == npoints, "%s: piece r holds rank r's particles only (%s, %d in all)" % (name, counts, npoints))
 
 
 def array(grid, name):
@@ -68,7 +102,7 @@ def check_frames(out, pvd, times, files, summary, rel):
 
 
 def static(out, summary):
-    g = read_vtu(os.path.join(out, "particles.vtu"))
+    g = read_vtu(os.path.join(out, "particles." + EXT))
     n = summary["particles"]
     check(g.GetNumberOfPoints() == n and g.GetNumberOfCells() == n, "particles.vtu: %d points, %d cells; summary.json particles %d" % (g.GetNumberOfPoints(), g.GetNumberOfCells(), n))
     u = array(g, "displacement")
@@ -89,8 +123,12 @@ def modal(out, summary):
     f_json = [m["f_hz"] for m in summary["modal"]["modes"]]
     check(all(close(a, b, 1e-9) for a, b in zip(f_csv, f_json)), "modes.csv f_hz equals summary.json modal.modes[].f_hz")
     order = sorted(range(len(f_json)), key=lambda k: f_json[k])[:12]
-    frames = check_frames(out, "modes.pvd", [f_json[k] for k in order], ["mode_%02d.vtu" % (k + 1) for k in order], summary, 1e-11)
-    whole = read_vtu(os.path.join(out, "particles.vtu"))
+    if os.environ.get("DEGENERATE"):
+        f = sorted(f_json[:12])
+        gap = min((b - a) / b for a, b in zip(f, f[1:]))
+        check(gap <= 1e-9, "degenerate modes: the closest frequencies are %.2g apart (relative), at most 1e-9" % gap)
+    frames = check_frames(out, "modes.pvd", [f_json[k] for k in order], ["mode_%02d.%s" % (k + 1, EXT) for k in order], summary, 1e-11)
+    whole = read_vtu(os.path.join(out, "particles." + EXT))
     for _, f in frames:
         k = int(f[5:7])
         u = array(read_vtu(os.path.join(out, f)), "displacement")
@@ -104,25 +142,83 @@ def quasistatic(out, summary):
     every = int(sys.argv[3])
     lam = {int(s["step"]): float(s["load_factor"]) for s in steps}
     last = len(steps)
-    files = ["particles_%04d.vtu" % k for k in range(every, last + 1, every)]
+    files = ["particles_%04d.%s" % (k, EXT) for k in range(every, last + 1, every)]
     times = [lam[k] for k in range(every, last + 1, every)]
     if last % every:
-        files.append("particles.vtu")
+        files.append("particles." + EXT)
         times.append(lam[last])
     check(close(times[-1], summary["quasistatic"]["peak_load_factor"], 1e-9), "the last frame is the last equilibrium: load factor %g, summary.json peak_load_factor %g" % (times[-1], summary["quasistatic"]["peak_load_factor"]))
     # steps.csv has 10 digits; equal load factors are 1e-12 apart in the series
     frames = check_frames(out, "particles.pvd", times, files, summary, 1e-9)
-    final, end = read_vtu(os.path.join(out, frames[-1][1])), read_vtu(os.path.join(out, "particles.vtu"))
+    final, end = read_vtu(os.path.join(out, frames[-1][1])), read_vtu(os.path.join(out, "particles." + EXT))
     check((array(final, "displacement") == array(end, "displacement")).all() and (array(final, "damage") == array(end, "damage")).all(), "the last frame shows particles.vtu's displacement and damage")
     if "ux" in summary.get("max_abs_u", {}):
         check(close(float(abs(array(end, "displacement")[:, 0]).max()), summary["max_abs_u"]["ux"]), "particles.vtu max |ux| equals summary.json max_abs_u.ux")
 
 
+def by_position(g):
+    """The point arrays of g in the order of the points sorted by position (x, then y, then z)."""
+    x = vtk_to_numpy(g.GetPoints().GetData())
+    order = np.lexsort(x.T[::-1])
+    pd = g.GetPointData()
+    arrays = {pd.GetArrayName(k): vtk_to_numpy(pd.GetArray(k))[order] for k in range(pd.GetNumberOfArrays())}
+    return x[order], arrays
+
+
+def mode_group(name, k):
+    """Which mode shape the array k of file name belongs to (its sign is one per mode), or None."""
+    if name.startswith("mode_"):
+        return None if k in ("volume", "neighbors") + NUMBERING else name
+    m = re.match(r"mode_(\d+)", k)
+    return m.group(0) if m else None
+
+
+def compare(out, ref, name, rtol):
+    """Every array of out/name against the one-rank run's ref/name (same name, .vtu), to rtol of
+    the array's largest magnitude; a mode shape up to its sign (one per mode: no solver fixes it)."""
+    xp, ap = by_position(read_vtu(os.path.join(out, name)))
+    xs, as1 = by_position(read_vtu(os.path.join(ref, os.path.splitext(name)[0] + ".vtu")))
+    check(xp.shape == xs.shape and (xp == xs).all(), "%s: the same particle positions on %d ranks as on one" % (name, RANKS))
+    names = sorted(set(ap) | set(as1))
+    check(sorted(ap) == sorted(as1), "%s: the same arrays on %d ranks as on one (%s)" % (name, RANKS, ", ".join(names)))
+    common = [k for k in names if k not in NUMBERING and k in ap and k in as1]
+    sign = {}
+    for k in common:  # a mode's sign: from its largest array (the translations, named first)
+        g = mode_group(name, k)
+        if g and g not in sign:
+            sign[g] = 1.0 if float((ap[k].astype(float) * as1[k]).sum()) >= 0 else -1.0
+    worst = {}
+    for k in common:
+        a, b = ap[k].astype(float) * sign.get(mode_group(name, k), 1.0), as1[k].astype(float)
+        worst[k] = float(abs(a - b).max()) / max(float(abs(b).max()), 1e-300)
+    bad = {k: v for k, v in worst.items() if not v <= rtol}
+    check(not bad, "%s: every array equals the one-rank run's to %g of its largest value (worst %s)" % (name, rtol, max(worst.items(), key=lambda kv: kv[1]) if worst else None))
+    if bad:
+        print("    beyond %g: %s" % (rtol, bad))
+
+
+def compare_run(kind, out, ref, rtol):
+    """The particle file and every frame of the run's series."""
+    names = ["particles." + EXT]
+    pvd = {"modal": "modes.pvd", "quasistatic": "particles.pvd"}.get(kind)
+    if pvd and os.path.exists(os.path.join(out, pvd)):
+        names += [f for _, f in read_pvd(os.path.join(out, pvd)) if f not in names]
+    for n in names:
+        compare(out, ref, n, rtol)
+
+
 def main():
+    global RANKS, EXT
     kind, out = sys.argv[1], sys.argv[2]
+    RANKS = int(sys.argv[4]) if len(sys.argv) > 4 else 1
+    EXT = "pvtu" if RANKS > 1 else "vtu"
     with open(os.path.join(out, "summary.json")) as f:
         summary = json.load(f)
+    other = os.path.join(out, "particles." + ("vtu" if RANKS > 1 else "pvtu"))
+    check(not os.path.exists(other), "%d rank(s): no %s" % (RANKS, os.path.basename(other)))
     {"static": static, "modal": modal, "quasistatic": quasistatic}[kind](out, summary)
+    if len(sys.argv) > 5:
+        compare_run(kind, out, sys.argv[5], RTOL[kind])
     sys.exit(1 if failures else 0)
 
 

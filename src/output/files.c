@@ -125,11 +125,23 @@ static int RemoveTree(const char path[])
   return nftw(path, RemoveEntry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
-/* Whether a file name is one perilin writes into an output directory. */
+/* Whether name is prefix followed by digits only (particles_0012, mode_03). */
+static PetscBool DigitsAfter(const char name[], const char prefix[])
+{
+  size_t a = strlen(prefix), n = strlen(name);
+
+  if (n <= a || strncmp(name, prefix, a)) return PETSC_FALSE;
+  for (size_t k = a; k < n; k++)
+    if (name[k] < '0' || name[k] > '9') return PETSC_FALSE;
+  return PETSC_TRUE;
+}
+
+/* Whether a file name is one perilin writes into an output directory: the files, and the
+ * directories of the pieces of a .pvtu (particles/, particles_NNNN/, mode_NN/, failed_trial/). */
 static PetscBool IsOutputName(const char name[])
 {
-  static const char *const exact[]       = {"summary.json", "particles.vtu", "particles.pvd", "steps.csv", "modes.csv", "modes.pvd", "failed_trial.vtu", "anisotropy.csv", PERI_OUTPUT_MARKER, NULL};
-  static const char *const prefixed[][2] = {{"particles_", ".vtu"}, {"mode_", ".vtu"}};
+  static const char *const exact[]       = {"summary.json", "particles.vtu", "particles.pvtu", "particles.pvd", "steps.csv", "modes.csv", "modes.pvd", "failed_trial.vtu", "failed_trial.pvtu", "anisotropy.csv", PERI_OUTPUT_MARKER, "particles", "failed_trial", NULL};
+  static const char *const prefixed[][2] = {{"particles_", ".vtu"}, {"mode_", ".vtu"}, {"particles_", ".pvtu"}, {"mode_", ".pvtu"}};
   size_t                   n             = strlen(name);
 
   for (PetscInt k = 0; exact[k]; k++)
@@ -138,6 +150,7 @@ static PetscBool IsOutputName(const char name[])
     size_t a = strlen(prefixed[k][0]), b = strlen(prefixed[k][1]);
     if (n > a + b && !strncmp(name, prefixed[k][0], a) && !strcmp(name + n - b, prefixed[k][1])) return PETSC_TRUE;
   }
+  if (DigitsAfter(name, "particles_") || DigitsAfter(name, "mode_")) return PETSC_TRUE;
   return (PetscBool)(n > 4 && !strcmp(name + n - 4, ".tmp"));
 }
 
