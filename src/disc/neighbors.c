@@ -36,15 +36,20 @@ PetscReal PeriSearchRadius(PeriPartialVolume pv, PetscReal delta, PetscReal hmax
 
 typedef struct {
   PetscInt  ncell[3], reach[3];
-  PetscReal size[3], length[3];
+  PetscReal lower[3], size[3], length[3];
   PetscInt *start; /* ncells + 1 */
   PetscInt *item;  /* particles sorted by cell */
 } CellList;
 
+static PetscInt CellOfPoint(const CellList *cl, const PetscReal x[], PetscInt d)
+{
+  PetscInt c = (PetscInt)PetscFloorReal((x[d] - cl->lower[d]) / cl->size[d]);
+  return PetscMin(PetscMax(c, 0), cl->ncell[d] - 1);
+}
+
 static PetscInt CellOf(const CellList *cl, const PeriParticles *p, PetscInt k, PetscInt d)
 {
-  PetscInt c = (PetscInt)PetscFloorReal((p->x[3 * k + d] - p->lower[d]) / cl->size[d]);
-  return PetscMin(PetscMax(c, 0), cl->ncell[d] - 1);
+  return CellOfPoint(cl, &p->x[3 * k], d);
 }
 
 static PetscInt CellIndex(const CellList *cl, const PetscInt c[3])
@@ -52,13 +57,16 @@ static PetscInt CellIndex(const CellList *cl, const PetscInt c[3])
   return (c[2] * cl->ncell[1] + c[1]) * cl->ncell[0] + c[0];
 }
 
-static PetscErrorCode CellListCreate(const PeriParticles *p, PetscReal r, CellList *cl)
+/* Cells of size >= r over the box lower..upper (the body's box; on a periodic axis it must be, so
+ * that a wrap shifts by whole cells). */
+static PetscErrorCode CellListCreate(const PeriParticles *p, const PetscReal lower[], const PetscReal upper[], PetscReal r, CellList *cl)
 {
   PetscInt ncells = 1, *cellof;
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) {
-    cl->length[d] = d < p->dim ? p->upper[d] - p->lower[d] : 0;
+    cl->lower[d]  = lower[d];
+    cl->length[d] = d < p->dim ? upper[d] - lower[d] : 0;
     cl->ncell[d]  = d < p->dim ? PetscMax(1, (PetscInt)PetscFloorReal(cl->length[d] / r)) : 1;
     /* cap the cell count so a huge box with few particles cannot exhaust memory */
     while (d < p->dim && cl->ncell[d] > 1 && (PetscReal)ncells * cl->ncell[d] > 8.0 * p->n + 64) cl->ncell[d] = (cl->ncell[d] + 1) / 2;
@@ -210,7 +218,7 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
   PetscCall(PetscMemzero(b, sizeof(*b)));
   for (PetscInt k = 0; k < p->n; k++) hmax = PetscMax(hmax, p->spacing[k]);
   r = PeriSearchRadius(pv, delta, hmax);
-  PetscCall(CellListCreate(p, r, &cl));
+  PetscCall(CellListCreate(p, p->lower, p->upper, r, &cl));
   {
     /* reserve what a full horizon holds, so the arrays are rarely copied while they grow */
     PetscReal vmean = 0, ball = p->dim == 2 ? PETSC_PI * r * r * p->thickness : 4.0 / 3.0 * PETSC_PI * r * r * r;
@@ -230,6 +238,70 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
   PetscCall(ierr);
   PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
   for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Is any particle of cl (of p) within r of the point y, on the minimum image? */
+static PetscBool PointNear(const PeriParticles *p, const CellList *cl, PetscReal r, const PetscReal y[])
+{
+  PetscInt ci[3], o[3];
+
+  for (PetscInt d = 0; d < 3; d++) ci[d] = d < p->dim ? CellOfPoint(cl, y, d) : 0;
+  for (o[2] = -cl->reach[2]; o[2] <= cl->reach[2]; o[2]++)
+    for (o[1] = -cl->reach[1]; o[1] <= cl->reach[1]; o[1]++)
+      for (o[0] = -cl->reach[0]; o[0] <= cl->reach[0]; o[0]++) {
+        PetscInt  c[3], wrap[3] = {0, 0, 0}, cell;
+        PetscBool skip = PETSC_FALSE;
+        for (PetscInt d = 0; d < 3; d++) {
+          c[d] = ci[d] + o[d];
+          if (c[d] >= 0 && c[d] < cl->ncell[d]) continue;
+          if (!p->periodic[d]) skip = PETSC_TRUE;
+          wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl->ncell[d]);
+          c[d] -= wrap[d] * cl->ncell[d];
+        }
+        if (skip) continue;
+        cell = CellIndex(cl, c);
+        for (PetscInt s = cl->start[cell]; s < cl->start[cell + 1]; s++) {
+          PetscInt  j    = cl->item[s];
+          PetscReal len2 = 0;
+          for (PetscInt d = 0; d < 3; d++) {
+            PetscReal x = p->x[3 * j + d] + wrap[d] * cl->length[d] - y[d];
+            len2 += x * x;
+          }
+          if (len2 <= r * r) return PETSC_TRUE;
+        }
+      }
+  return PETSC_FALSE;
+}
+
+/*@C
+  PeriParticlesNear - near[k] says whether any of the n particles of p lies within r of the point
+  y[3k..3k+2] (minimum image on periodic axes). The cells cover the particles' own bounding box,
+  not the body's, so a rank holding a small part of a large body searches only its part. Not
+  collective.
+@*/
+PetscErrorCode PeriParticlesNear(const PeriParticles *p, PetscReal r, PetscInt m, const PetscReal y[], PetscBool near[])
+{
+  CellList  cl;
+  PetscReal lo[3], hi[3];
+
+  PetscFunctionBeginUser;
+  if (!p->n) {
+    for (PetscInt k = 0; k < m; k++) near[k] = PETSC_FALSE;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  for (PetscInt d = 0; d < 3; d++) {
+    lo[d] = p->periodic[d] ? p->lower[d] : PETSC_MAX_REAL;
+    hi[d] = p->periodic[d] ? p->upper[d] : PETSC_MIN_REAL;
+    for (PetscInt k = 0; k < p->n && !p->periodic[d]; k++) {
+      lo[d] = PetscMin(lo[d], p->x[3 * k + d]);
+      hi[d] = PetscMax(hi[d], p->x[3 * k + d]);
+    }
+    if (hi[d] - lo[d] < r) hi[d] = lo[d] + r; /* one cell along a thin (or flat) extent */
+  }
+  PetscCall(CellListCreate(p, lo, hi, r, &cl));
+  for (PetscInt k = 0; k < m; k++) near[k] = PointNear(p, &cl, r, &y[3 * k]);
+  PetscCall(CellListDestroy(&cl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -4,6 +4,7 @@
 
 #include <perilin/scene.h>
 #include "perilin/private/sys.h"
+#include <petscsf.h>
 
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
@@ -60,6 +61,23 @@ PETSC_EXTERN PetscReal      PeriSearchRadius(PeriPartialVolume, PetscReal, Petsc
 PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm, const PeriParticles *, const PeriBonds *, PetscReal[], PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
+
+PETSC_EXTERN PetscErrorCode PeriParticlesNear(const PeriParticles *, PetscReal, PetscInt, const PetscReal[], PetscBool[]);
+
+/* ------------------------------------------------------------------ ghosts (src/disc/halo.c) */
+/* A rank's particles: the owned ones (global indices rstart..rstart+nowned-1), then nghost ghosts,
+ * copies of other ranks' particles within the halo radius of an owned one. */
+typedef struct {
+  PetscInt  N;      /* particles of the whole body */
+  PetscInt  rstart; /* global index of the first owned particle */
+  PetscInt  nowned, nghost;
+  PetscInt *global; /* nghost: each ghost's global index, ascending */
+  PetscSF   sf;     /* roots: the owned particles; leaves: the ghosts */
+} PeriHalo;
+
+PETSC_EXTERN PetscErrorCode PeriHaloCreate(MPI_Comm, PeriParticles *, PetscReal, PeriHalo *);
+PETSC_EXTERN PetscErrorCode PeriHaloUpdate(const PeriHalo *, MPI_Datatype, const void *, void *);
+PETSC_EXTERN PetscErrorCode PeriHaloDestroy(PeriHalo *);
 
 /* grid, particles and regions.<name>, declared next to the code that reads them. */
 PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
