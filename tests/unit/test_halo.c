@@ -2,13 +2,15 @@
  * periodic axis, for a block partition and a scattered one (every rank's box covers the whole
  * body), each rank's ghosts must be exactly the other ranks' particles within the radius of one of
  * its own (minimum image, all pairs checked), in ascending global index, with their positions,
- * volumes and spacings; PeriHaloUpdate must deliver the owners' values. Any number of ranks. */
+ * volumes and spacings; PeriHaloUpdate must deliver the owners' values. PeriParticlesMigrate from
+ * blocks to the scattered owners must deliver exactly their particles in order. Any number of ranks. */
 #include "testing.h"
 
 typedef struct {
   PetscInt  dim, cells[3];
   PetscBool periodic[3];
   PetscBool scattered; /* owner of cell c: c mod P; else contiguous blocks */
+  PetscBool migrated;  /* scattered: reached by PeriParticlesMigrate from contiguous blocks */
 } Case;
 
 /* The whole grid (every rank, for the brute force): positions; owners and new global numbers. */
@@ -70,6 +72,32 @@ static PetscErrorCode Owned(const Case *c, PetscMPIInt rank, PetscInt N, const P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Blocks migrated to the scattered owners must arrive as Owned() builds them: same particles, same order. */
+static PetscErrorCode Migrated(const Case *c, PetscMPIInt rank, PetscMPIInt size, PetscInt N, const PetscReal x[], const PetscMPIInt owner[], PeriParticles *p)
+{
+  PetscMPIInt  *blocks, *target;
+  PeriParticles q;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(N, &blocks));
+  for (PetscInt k = 0; k < N; k++) blocks[k] = (PetscMPIInt)(k * size / N);
+  PetscCall(Owned(c, rank, N, x, blocks, p));
+  PetscCall(PetscMalloc1(p->n, &target));
+  for (PetscInt i = 0; i < p->n; i++) target[i] = owner[p->source_line[i]];
+  PetscCall(PeriParticlesMigrate(PETSC_COMM_WORLD, p, target));
+  PetscCall(Owned(c, rank, N, x, owner, &q));
+  PetscCheck(q.n == p->n, PETSC_COMM_SELF, PETSC_ERR_PLIB, "migrate: rank %d holds %" PetscInt_FMT " particles, expected %" PetscInt_FMT, rank, p->n, q.n);
+  for (PetscInt i = 0; i < q.n; i++) {
+    PetscBool same = (PetscBool)(q.source_line[i] == p->source_line[i] && q.volume[i] == p->volume[i] && q.spacing[i] == p->spacing[i]);
+    for (PetscInt d = 0; d < 3; d++) same = (PetscBool)(same && q.x[3 * i + d] == p->x[3 * i + d]);
+    PetscCheck(same, PETSC_COMM_SELF, PETSC_ERR_PLIB, "migrate: rank %d, particle %" PetscInt_FMT " is %" PetscInt_FMT ", expected %" PetscInt_FMT, rank, i, p->source_line[i], q.source_line[i]);
+  }
+  PetscCall(PeriParticlesDestroy(&q));
+  PetscCall(PetscFree(target));
+  PetscCall(PetscFree(blocks));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The brute-force ghost list, ascending by new global number. */
 static PetscErrorCode Expected(const Case *c, PetscMPIInt rank, PetscInt N, const PetscReal x[], const PetscMPIInt owner[], const PetscInt number[], PetscReal r, PetscInt *ng, PetscInt **g)
 {
@@ -119,7 +147,10 @@ static PetscErrorCode RunCase(const Case *c, PetscReal r)
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(Grid(c, size, &N, &x, &owner, &number));
-  PetscCall(Owned(c, rank, N, x, owner, &p));
+  if (c->migrated)
+    PetscCall(Migrated(c, rank, size, N, x, owner, &p));
+  else
+    PetscCall(Owned(c, rank, N, x, owner, &p));
   PetscCall(PeriHaloCreate(PETSC_COMM_WORLD, &p, r, &h));
   PetscCheck(h.N == N && p.n == h.nowned + h.nghost, PETSC_COMM_SELF, PETSC_ERR_PLIB, "counts: N %" PetscInt_FMT " (expected %" PetscInt_FMT "), local %" PetscInt_FMT, h.N, N, p.n);
   PetscCheck(h.nowned == 0 || number[p.source_line[0]] == h.rstart, PETSC_COMM_SELF, PETSC_ERR_PLIB, "rstart %" PetscInt_FMT, h.rstart);
@@ -128,7 +159,7 @@ static PetscErrorCode RunCase(const Case *c, PetscReal r)
   for (PetscInt k = 0; k < ng; k++) PetscCheck(g[k] == h.global[k], PETSC_COMM_SELF, PETSC_ERR_PLIB, "rank %d: ghost %" PetscInt_FMT " is %" PetscInt_FMT ", expected %" PetscInt_FMT, rank, k, h.global[k], g[k]);
   PetscCall(CheckGhostData(&p, &h, x, number));
   PetscCallMPI(MPI_Allreduce(&h.nghost, &total, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD));
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %" PetscInt_FMT "D %s%s, %" PetscInt_FMT " particles, radius %g: %" PetscInt_FMT " ghosts on %d ranks, as brute force\n", c->dim, c->scattered ? "scattered" : "blocks", c->periodic[0] ? ", periodic x" : "", N, (double)r, total, size));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %" PetscInt_FMT "D %s%s%s, %" PetscInt_FMT " particles, radius %g: %" PetscInt_FMT " ghosts on %d ranks, as brute force\n", c->dim, c->scattered ? "scattered" : "blocks", c->migrated ? " (migrated from blocks)" : "", c->periodic[0] ? ", periodic x" : "", N, (double)r, total, size));
   PetscCall(PetscFree(g));
   PetscCall(PeriHaloDestroy(&h));
   PetscCall(PeriParticlesDestroy(&p));
@@ -139,11 +170,12 @@ static PetscErrorCode RunCase(const Case *c, PetscReal r)
 int main(int argc, char **argv)
 {
   const Case cases[] = {
-      {2, {24, 17, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE},
-      {2, {24, 17, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE},
-      {2, {13, 11, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE},
-      {3, {9, 8, 7}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE},
-      {3, {6, 5, 7}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE},
+      {2, {24, 17, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE, PETSC_FALSE},
+      {2, {24, 17, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE, PETSC_FALSE},
+      {2, {13, 11, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE, PETSC_FALSE},
+      {2, {13, 11, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE, PETSC_TRUE},
+      {3, {9, 8, 7}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE, PETSC_FALSE},
+      {3, {6, 5, 7}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE, PETSC_TRUE},
   };
 
   PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));

@@ -62,6 +62,7 @@ PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm, const PeriParticle
 PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
 
+PETSC_EXTERN PetscErrorCode PeriParticlesMigrate(MPI_Comm, PeriParticles *, const PetscMPIInt[]);
 PETSC_EXTERN PetscErrorCode PeriParticlesNear(const PeriParticles *, PetscReal, PetscInt, const PetscReal[], PetscBool[]);
 
 /* ------------------------------------------------------------------ ghosts (src/disc/halo.c) */
