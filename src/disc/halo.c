@@ -141,6 +141,10 @@ static PetscErrorCode AppendGhosts(PeriParticles *p, const PeriHalo *h, const Pe
   PetscCall(PeriHaloUpdate(h, MPIU_INT, line, line + h->nowned));
   PetscCall(PetscFree(p->x));
   PetscCall(PetscFree3(p->volume, p->spacing, p->source_line));
+  PetscCall(PetscFree(p->global));
+  PetscCall(PetscMalloc1(n, &p->global));
+  for (PetscInt i = 0; i < h->nowned; i++) p->global[i] = h->rstart + i;
+  PetscCall(PetscArraycpy(p->global + h->nowned, h->global, h->nghost));
   p->x           = x;
   p->volume      = vol;
   p->spacing     = sp;
@@ -180,7 +184,8 @@ static PetscErrorCode BuildSF(MPI_Comm comm, const Exchange *ex, const PetscInt 
 /*@C
   PeriHaloCreate - p holds this rank's particles (owned, numbered globally from the sum of the
   lower ranks' counts); appends as ghosts every other rank's particle within r of one of them
-  (minimum image on periodic axes), in ascending global index, and describes them in h.
+  (minimum image on periodic axes), in ascending global index, sets p->global and describes the
+  ghosts in h.
   Collective: two all-to-all exchanges and an O(P) all-gather; no array of the whole body.
 @*/
 PetscErrorCode PeriHaloCreate(MPI_Comm comm, PeriParticles *p, PetscReal r, PeriHalo *h)

@@ -79,7 +79,7 @@ PetscErrorCode PeriParticlesMigrate(MPI_Comm comm, PeriParticles *p, const Petsc
   PetscInt  *line;
 
   PetscFunctionBeginUser;
-  PetscCheck(!p->image, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "particles with fictitious layers cannot migrate");
+  PetscCheck(!p->image && !p->global, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "only owned particles without fictitious layers migrate");
   PetscCall(PlanCreate(comm, p->n, target, &pl));
   PetscCall(PetscCalloc1(3 * pl.nrecv, &x));
   PetscCall(PetscMalloc3(pl.nrecv, &vol, pl.nrecv, &sp, pl.nrecv, &line));

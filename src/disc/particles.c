@@ -345,9 +345,35 @@ PetscErrorCode PeriParticlesPermute(PeriParticles *p, const PetscInt perm[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriParticlesSlice - q holds copies of particles rstart..rend-1 of p and p's description of the
+  body (box, periodic axes, thickness, mean spacing), no layers and no mesh groups: the owned part
+  of a rank's local view. Not collective.
+@*/
+PetscErrorCode PeriParticlesSlice(const PeriParticles *p, PetscInt rstart, PetscInt rend, PeriParticles *q)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(q, sizeof(*q)));
+  q->dim          = p->dim;
+  q->thickness    = p->thickness;
+  q->mean_spacing = p->mean_spacing;
+  for (PetscInt d = 0; d < 3; d++) {
+    q->lower[d]    = p->lower[d];
+    q->upper[d]    = p->upper[d];
+    q->periodic[d] = p->periodic[d];
+  }
+  PetscCall(ParticlesAllocate(q, rend - rstart));
+  PetscCall(PetscArraycpy(q->x, &p->x[3 * rstart], 3 * (rend - rstart)));
+  PetscCall(PetscArraycpy(q->volume, &p->volume[rstart], rend - rstart));
+  PetscCall(PetscArraycpy(q->spacing, &p->spacing[rstart], rend - rstart));
+  PetscCall(PetscArraycpy(q->source_line, &p->source_line[rstart], rend - rstart));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriParticlesDestroy(PeriParticles *p)
 {
   PetscFunctionBeginUser;
+  PetscCall(PetscFree(p->global));
   PetscCall(PetscFree(p->x));
   PetscCall(PetscFree3(p->volume, p->spacing, p->source_line));
   PetscCall(PetscFree2(p->image, p->crossed));

@@ -8,6 +8,7 @@
 
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriParticlesSlice(const PeriParticles *, PetscInt, PetscInt, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesInputPath(PeriScene, PeriNode, const char[], char[], size_t);
 
@@ -86,7 +87,9 @@ PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
 /* The discretization of one body: every consumer reads particle data through this one owner, so
  * that holding only owned + ghost particles per rank (issue 17) changes src/disc/ alone. */
 typedef struct {
-  PeriParticles         particles;
+  PeriParticles         particles; /* the whole body on every rank: what the consumers not yet moved to local read (docs/distributed.md) */
+  PeriParticles         local;     /* this rank's view: owned particles, then ghosts within the search radius */
+  PeriHalo              halo;
   PetscInt              nregions;
   PeriRegion           *regions;
   PetscReal             delta;
