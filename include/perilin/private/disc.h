@@ -87,9 +87,7 @@ PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
 /* The discretization of one body: every consumer reads particle data through this one owner, so
  * that holding only owned + ghost particles per rank (issue 17) changes src/disc/ alone. */
 typedef struct {
-  PeriParticles         particles; /* the whole body on every rank: what the consumers not yet moved to local read (docs/distributed.md) */
-  PeriParticles         local;     /* this rank's view: owned particles, then ghosts within the search radius */
-  PeriHalo              halo;
+  PeriParticles         particles; /* the whole body on every rank, until its consumers read a rank's local view (docs/distributed.md) */
   PetscInt              nregions;
   PeriRegion           *regions;
   PetscReal             delta;
