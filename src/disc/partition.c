@@ -27,7 +27,7 @@ static const char *const PartitionTypes[] = {"metis", "ptscotch", "geometric"};
 
 /* -peri_partition: read on every run (also on one rank, where nothing is partitioned) so that a
  * misspelt value is an error whatever the rank count */
-static PetscErrorCode ReadType(PartitionType *type)
+static PetscErrorCode ReadType(MPI_Comm comm, PartitionType *type)
 {
   char      name[64] = "ptscotch";
   PetscBool found    = PETSC_FALSE;
@@ -41,7 +41,7 @@ static PetscErrorCode ReadType(PartitionType *type)
       break;
     }
   }
-  PetscCheck(found, PETSC_COMM_WORLD, PETSC_ERR_USER_INPUT, "-peri_partition %s: unknown partitioner; use metis, ptscotch or geometric", name);
+  PetscCheck(found, comm, PETSC_ERR_USER_INPUT, "-peri_partition %s: unknown partitioner; use metis, ptscotch or geometric", name);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -418,7 +418,7 @@ PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal de
   IS            part;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadType(&type));
+  PetscCall(ReadType(comm, &type));
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscMalloc1(p->n, perm));
