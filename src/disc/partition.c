@@ -1,16 +1,19 @@
 /* Partitioning: particles are renumbered so that each rank owns a contiguous range (PETSc's row
  * ownership). Three partitioners (-peri_partition):
- *   ptscotch  (default) PT-Scotch through PETSc's MatPartitioning, in parallel: each rank starts
- *             from a contiguous block of the particles, builds the graph rows of that block
- *             from the block and the particles within the graph radius of it (its halo), and
- *             PT-Scotch moves the vertices between ranks;
- *   geometric a Hilbert space-filling curve through the particles, cut into equal pieces by a
- *             parallel selection of the P - 1 splitting keys (no graph at all);
- *   metis     METIS k-way on rank 0 over the whole graph, broadcast (the former default).
- * The graph is the nearest-neighbour graph (bonds up to 1.5 spacings): a horizon of m spacings
- * only adds edges between particles that graph already links through short paths, so it gives the
- * same parts for a fraction of the graph size and search time (docs/performance.md measures
- * both, and the three partitioners). */
+ *   geometric (default) a Hilbert space-filling curve through the particles, cut into pieces of
+ *             equal count by a parallel selection of the P - 1 splitting keys: no graph, the same
+ *             parts on every run;
+ *   ptscotch  PT-Scotch through PETSc's MatPartitioning, in parallel: each rank starts from a
+ *             contiguous block of the particles, builds the graph rows of that block from the
+ *             block and the particles within the graph radius of it (its halo), and PT-Scotch
+ *             moves the vertices between ranks (its parts vary from run to run);
+ *   metis     METIS k-way on rank 0 over the whole graph, broadcast (the default before issue 17).
+ * docs/performance.md ("Partitioners") measured the three: on grids the curve cuts as few bonds
+ * as the graph partitioners (within a few per cent either way) in a fraction of the time and
+ * memory, on an unstructured mesh with a hole a few per cent more. The graph is the
+ * nearest-neighbour graph (bonds up to 1.5 spacings): a horizon of m spacings only adds edges
+ * between particles that graph already links through short paths, so it gives the same parts for
+ * a fraction of the graph size and search time. */
 #include "perilin/private/disc.h"
 #include <petscmat.h>
 #include <metis.h>
@@ -29,7 +32,7 @@ static const char *const PartitionTypes[] = {"metis", "ptscotch", "geometric"};
  * misspelt value is an error whatever the rank count */
 static PetscErrorCode ReadType(MPI_Comm comm, PartitionType *type)
 {
-  char      name[64] = "ptscotch";
+  char      name[64] = "geometric";
   PetscBool found    = PETSC_FALSE;
 
   PetscFunctionBeginUser;
@@ -231,24 +234,48 @@ static int CurveKeyCompare(const void *a, const void *b)
   return x->g < y->g ? -1 : (x->g > y->g);
 }
 
-/* The keys of the block, sorted: coordinates scaled to the particles' bounding box (all ranks),
- * b bits per axis. */
-static PetscErrorCode CurveKeys(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, CurveKey key[])
+/* The particles' bounding box (all ranks), and its axes longest first: the curve's first cut is
+ * across its first axis, so a bar is cut across its length. */
+static PetscErrorCode CurveBox(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, PetscReal lo[3], PetscReal *length, PetscInt axis[3])
 {
-  PetscReal lo[3], hi[3], nhi[3];
-  PetscInt  n = p->dim, b = 63 / p->dim;
+  PetscReal ext[6], e[3];
 
   PetscFunctionBeginUser;
-  for (PetscInt d = 0; d < 3; d++) lo[d] = PETSC_MAX_REAL, nhi[d] = PETSC_MAX_REAL;
+  for (PetscInt d = 0; d < 6; d++) ext[d] = PETSC_MAX_REAL;
   for (PetscInt i = rstart; i < rend; i++)
-    for (PetscInt d = 0; d < 3; d++) lo[d] = PetscMin(lo[d], p->x[3 * i + d]), nhi[d] = PetscMin(nhi[d], -p->x[3 * i + d]);
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPIU_REAL, MPIU_MIN, comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, nhi, 3, MPIU_REAL, MPIU_MIN, comm));
-  for (PetscInt d = 0; d < 3; d++) hi[d] = -nhi[d];
+    for (PetscInt d = 0; d < 3; d++) ext[d] = PetscMin(ext[d], p->x[3 * i + d]), ext[3 + d] = PetscMin(ext[3 + d], -p->x[3 * i + d]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ext, 6, MPIU_REAL, MPIU_MIN, comm));
+  *length = 0;
+  for (PetscInt d = 0; d < 3; d++) {
+    lo[d]   = ext[d];
+    e[d]    = -ext[3 + d] - ext[d];
+    axis[d] = d;
+    *length = PetscMax(*length, e[d]);
+  }
+  if (*length <= 0) *length = 1;
+  for (PetscInt d = 1; d < p->dim; d++)
+    for (PetscInt k = d; k > 0 && e[axis[k]] > e[axis[k - 1]]; k--) {
+      PetscInt t  = axis[k];
+      axis[k]     = axis[k - 1];
+      axis[k - 1] = t;
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The keys of the block, sorted: the coordinates in the bounding box scaled alike on every axis
+ * (a uniform grid stays uniform on the curve), b bits per axis. */
+static PetscErrorCode CurveKeys(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, CurveKey key[])
+{
+  PetscReal lo[3], length = 1;
+  PetscInt  axis[3], n = p->dim, b = 63 / p->dim;
+  uint64_t  top = ((uint64_t)1 << b) - 1;
+
+  PetscFunctionBeginUser;
+  PetscCall(CurveBox(comm, p, rstart, rend, lo, &length, axis));
   for (PetscInt i = rstart; i < rend; i++) {
-    uint64_t X[3] = {0, 0, 0}, top = ((uint64_t)1 << b) - 1;
+    uint64_t X[3] = {0, 0, 0};
     for (PetscInt d = 0; d < n; d++) {
-      PetscReal s = hi[d] > lo[d] ? (p->x[3 * i + d] - lo[d]) / (hi[d] - lo[d]) : 0;
+      PetscReal s = (p->x[3 * i + axis[d]] - lo[axis[d]]) / length;
       X[d]        = (uint64_t)PetscMin((PetscReal)top, PetscMax(0.0, s * (PetscReal)top));
     }
     key[i - rstart].h = HilbertIndex(X, n, b);
@@ -412,7 +439,7 @@ static PetscErrorCode MetisPartitionAll(MPI_Comm comm, const PeriParticles *p, P
 PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal delta, PetscInt **perm, PetscInt **range)
 {
   PetscMPIInt   rank, size;
-  PartitionType type = PARTITION_PTSCOTCH;
+  PartitionType type = PARTITION_GEOMETRIC;
   PetscReal     hmax = 0, radius;
   PetscInt      rstart, rend;
   IS            part;
