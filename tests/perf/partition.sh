@@ -8,7 +8,8 @@
 # beside it. Prints a Markdown table (docs/performance.md, "Partitioners").
 # Usage: tests/perf/partition.sh build/perilin [case ...] [-- perilin options]
 #   cases: plate_160k (2D plate, 1/401, static), plate_1m (1/1001, set-up only),
-#          block_64k (3D block, 1/40, static), block_216k (1/60, set-up only); default all four
+#          block_64k (3D block, 1/40, static), block_216k (1/60, set-up only), plate_hole (Gmsh
+#          triangles around a hole, examples/mesh/plate_hole.yaml, static); default all five
 set -euo pipefail
 perilin=$(realpath "$1")
 shift
@@ -18,7 +19,7 @@ while [[ $# -gt 0 && $1 != -- ]]; do
   shift
 done
 [[ $# -gt 0 ]] && shift
-[[ ${#cases[@]} -gt 0 ]] || cases=(plate_160k plate_1m block_64k block_216k)
+[[ ${#cases[@]} -gt 0 ]] || cases=(plate_160k plate_1m block_64k block_216k plate_hole)
 ranks=${PARTITION_RANKS:-2 4 8}
 bench=$(cd "$(dirname "$0")/../.." && pwd)/examples/bench
 work=$(mktemp -d)
@@ -32,6 +33,7 @@ scene_of() {
     plate_1m) echo "$bench/plate_2d.yaml -grid_spacing 1/1001 -analysis_type setup" ;;
     block_64k) echo "$bench/block_3d.yaml -grid_spacing 1/40" ;;
     block_216k) echo "$bench/block_3d.yaml -grid_spacing 1/60 -analysis_type setup" ;;
+    plate_hole) echo "$bench/../mesh/plate_hole.yaml" ;;
     *) echo "partition.sh: unknown case $1" >&2; exit 2 ;;
   esac
 }
