@@ -105,12 +105,13 @@ static PetscErrorCode HaloCandidates(const PeriParticles *p, PetscInt rstart, Pe
 {
   PetscReal lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {PETSC_MIN_REAL, PETSC_MIN_REAL, PETSC_MIN_REAL};
   PetscInt  n = rend - rstart;
+  PetscReal r = 1.01 * radius; /* the search takes bonds slightly longer than radius (PeriSearchRadius) */
 
   PetscFunctionBeginUser;
   for (PetscInt i = rstart; i < rend; i++)
     for (PetscInt d = 0; d < 3; d++) {
-      lo[d] = PetscMin(lo[d], p->x[3 * i + d] - radius);
-      hi[d] = PetscMax(hi[d], p->x[3 * i + d] + radius);
+      lo[d] = PetscMin(lo[d], p->x[3 * i + d] - r);
+      hi[d] = PetscMax(hi[d], p->x[3 * i + d] + r);
     }
   for (PetscInt d = 0; d < 3; d++)
     if (p->periodic[d] && (lo[d] < p->lower[d] || hi[d] > p->upper[d])) lo[d] = PETSC_MIN_REAL, hi[d] = PETSC_MAX_REAL;
