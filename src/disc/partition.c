@@ -4,9 +4,9 @@
  *             equal count by a parallel selection of the P - 1 splitting keys: no graph, the same
  *             parts on every run;
  *   ptscotch  PT-Scotch through PETSc's MatPartitioning, in parallel: each rank starts from a
- *             contiguous block of the particles, builds the graph rows of that block from the
- *             block and the particles within the graph radius of it (its halo), and PT-Scotch
- *             moves the vertices between ranks (its parts vary from run to run);
+ *             contiguous block of the particles, builds the graph rows of that block in its local
+ *             view (the block and the particles within the graph radius of it, src/disc/halo.c),
+ *             and PT-Scotch moves the vertices between ranks (its parts vary from run to run);
  *   metis     METIS k-way on rank 0 over the whole graph, broadcast (the default before issue 17).
  * docs/performance.md ("Partitioners") measured the three: on grids the curve cuts as few bonds
  * as the graph partitioners (within a few per cent either way) in a fraction of the time and
@@ -96,91 +96,44 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The particles a rank needs for the graph rows of its block rstart..rend-1: the block itself
- * (first, in order) and every other particle within radius of the block's bounding box (on a
- * periodic axis whose box comes within radius of a face, the whole axis). Today every rank holds
- * all particles and this scans them; once each rank holds only owned + ghost particles, the halo
- * exchange supplies the same set. */
-static PetscErrorCode HaloCandidates(const PeriParticles *p, PetscInt rstart, PetscInt rend, PetscReal radius, PetscInt *ncand, PetscInt **cand)
+/* The graph rows of this rank's block rstart..rend-1: CSR arrays with global column indices, each
+ * neighbour once, allocated with PetscMalloc for MatCreateMPIAdj. The block's local view (the
+ * block and, as ghosts, the particles within radius of it: src/disc/halo.c) is all it reads of
+ * the particles, so it needs no whole body. Collective. */
+static PetscErrorCode BlockGraph(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, PetscReal radius, PetscReal hmax, PetscInt **xadj, PetscInt **adjncy)
 {
-  PetscReal lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {PETSC_MIN_REAL, PETSC_MIN_REAL, PETSC_MIN_REAL};
-  PetscInt  n = rend - rstart;
-  PetscReal r = 1.01 * radius; /* the search takes bonds slightly longer than radius (PeriSearchRadius) */
+  const PetscInt n = rend - rstart;
+  PeriParticles  local;
+  PeriHalo       halo;
+  PeriBonds      g;
 
   PetscFunctionBeginUser;
-  for (PetscInt i = rstart; i < rend; i++)
-    for (PetscInt d = 0; d < 3; d++) {
-      lo[d] = PetscMin(lo[d], p->x[3 * i + d] - r);
-      hi[d] = PetscMax(hi[d], p->x[3 * i + d] + r);
-    }
-  for (PetscInt d = 0; d < 3; d++)
-    if (p->periodic[d] && (lo[d] < p->lower[d] || hi[d] > p->upper[d])) lo[d] = PETSC_MIN_REAL, hi[d] = PETSC_MAX_REAL;
-  for (PetscInt pass = 0; pass < 2; pass++) {
-    PetscInt m = rend - rstart;
-    for (PetscInt i = 0; i < p->n; i++) {
-      PetscBool in = (PetscBool)(i < rstart || i >= rend);
-      for (PetscInt d = 0; d < 3 && in; d++) in = (PetscBool)(p->x[3 * i + d] >= lo[d] && p->x[3 * i + d] <= hi[d]);
-      if (in && pass) (*cand)[m] = i;
-      m += in;
-    }
-    if (!pass) {
-      *ncand = m;
-      PetscCall(PetscMalloc1(m, cand));
-      for (PetscInt i = 0; i < n; i++) (*cand)[i] = rstart + i;
-    }
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The graph rows of the first nown of the candidates cand[0..ncand-1] (global indices), which
- * must hold every neighbour of those rows: CSR arrays with global column indices, each neighbour
- * once, allocated with PetscMalloc for MatCreateMPIAdj. Uses the particles' geometry of cand
- * only. */
-static PetscErrorCode GraphRows(const PeriParticles *p, PetscInt nown, PetscInt ncand, const PetscInt cand[], PetscReal radius, PetscInt **xadj, PetscInt **adjncy)
-{
-  PeriParticles v = *p;
-  PeriBonds     g;
-
-  PetscFunctionBeginUser;
-  /* the candidates as particles of their own: the same box, periodicity and geometry */
-  v.n = ncand;
-  PetscCall(PetscMalloc4(3 * ncand, &v.x, ncand, &v.volume, ncand, &v.spacing, ncand, &v.source_line));
-  for (PetscInt c = 0; c < ncand; c++) {
-    for (PetscInt d = 0; d < 3; d++) v.x[3 * c + d] = p->x[3 * cand[c] + d];
-    v.volume[c]      = p->volume[cand[c]];
-    v.spacing[c]     = p->spacing[cand[c]];
-    v.source_line[c] = p->source_line[cand[c]];
-  }
-  v.image   = NULL;
-  v.crossed = NULL;
-  v.ngroups = 0;
-  v.groups  = NULL;
-  PetscCall(PeriNeighborSearch(&v, radius, PERI_PARTIAL_VOLUME_NONE, 0, nown, PETSC_FALSE, &g));
-  PetscCall(PetscFree4(v.x, v.volume, v.spacing, v.source_line));
-  for (PetscInt k = 0; k < g.nbonds; k++) g.j[k] = cand[g.j[k]];
-  PetscCall(GraphCompact(nown, g.offset, g.j));
-  PetscCall(PetscMalloc1(nown + 1, xadj));
-  PetscCall(PetscMalloc1(g.offset[nown], adjncy));
-  PetscCall(PetscArraycpy(*xadj, g.offset, nown + 1));
-  PetscCall(PetscArraycpy(*adjncy, g.j, g.offset[nown]));
+  PetscCall(PeriParticlesSlice(p, rstart, rend, &local));
+  PetscCall(PeriHaloCreate(comm, &local, PeriSearchRadius(PERI_PARTIAL_VOLUME_NONE, radius, hmax), &halo));
+  PetscCall(PeriNeighborSearch(&local, radius, PERI_PARTIAL_VOLUME_NONE, 0, n, PETSC_FALSE, &g));
+  PetscCall(PeriHaloDestroy(&halo));
+  PetscCall(PeriParticlesDestroy(&local));
+  PetscCall(GraphCompact(n, g.offset, g.j));
+  PetscCall(PetscMalloc1(n + 1, xadj));
+  PetscCall(PetscMalloc1(g.offset[n], adjncy));
+  PetscCall(PetscArraycpy(*xadj, g.offset, n + 1));
+  PetscCall(PetscArraycpy(*adjncy, g.j, g.offset[n]));
   PetscCall(PeriBondsDestroy(&g));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* PT-Scotch over the graph of the blocks: *part holds the target rank of each particle of this
  * rank's block. -mat_partitioning_ptscotch_imbalance and _strategy tune it. */
-static PetscErrorCode PTScotchPartition(MPI_Comm comm, const PeriParticles *p, PetscReal radius, PetscInt rstart, PetscInt rend, IS *part)
+static PetscErrorCode PTScotchPartition(MPI_Comm comm, const PeriParticles *p, PetscReal radius, PetscReal hmax, PetscInt rstart, PetscInt rend, IS *part)
 {
-  PetscInt       *cand, ncand, *xadj, *adjncy;
+  PetscInt       *xadj, *adjncy;
   Mat             adj;
   MatPartitioning mp;
   PetscMPIInt     size;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(HaloCandidates(p, rstart, rend, radius, &ncand, &cand));
-  PetscCall(GraphRows(p, rend - rstart, ncand, cand, radius, &xadj, &adjncy));
-  PetscCall(PetscFree(cand));
+  PetscCall(BlockGraph(comm, p, rstart, rend, radius, hmax, &xadj, &adjncy));
   /* the matrix takes xadj and adjncy over */
   PetscCall(MatCreateMPIAdj(comm, rend - rstart, p->n, xadj, adjncy, NULL, &adj));
   PetscCall(MatPartitioningCreate(comm, &mp));
@@ -468,7 +421,7 @@ PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal de
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   if (type == PARTITION_PTSCOTCH)
-    PetscCall(PTScotchPartition(comm, p, radius, rstart, rend, &part));
+    PetscCall(PTScotchPartition(comm, p, radius, hmax, rstart, rend, &part));
   else
     PetscCall(GeometricPartition(comm, p, rstart, rend, &part));
   PetscCall(PermutationFromParts(comm, p->n, part, *perm, *range));
