@@ -16,7 +16,8 @@
 /* ------------------------------------------------------------------ particles (src/particles.c) */
 typedef struct {
   PetscInt   dim;
-  PetscInt   n;           /* global number of particles; every rank holds all coordinates */
+  PetscInt   n;           /* particles held: the whole body, or a rank's local view (owned, then ghosts) */
+  PetscInt  *global;      /* a local view (src/disc/halo.c): each particle's global index; NULL: the whole body */
   PetscReal *x;           /* 3 per particle (z = 0 in 2D) */
   PetscReal *volume;      /* includes the thickness in 2D */
   PetscReal *spacing;     /* the particle's own grid spacing, for partial volumes */

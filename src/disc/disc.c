@@ -9,6 +9,7 @@ PetscErrorCode PeriDiscDestroy(PeriDisc *disc)
   PetscCall(PeriBondsDestroy(&disc->bonds));
   PetscCall(PeriBondsDestroy(&disc->family));
   PetscCall(PeriParticlesDestroy(&disc->particles));
+
   PetscCall(PetscFree(disc->regions));
   PetscCall(PetscFree2(disc->family_volume, disc->neighbor_count));
   PetscCall(PetscFree(disc->owner));

@@ -36,15 +36,20 @@ PetscReal PeriSearchRadius(PeriPartialVolume pv, PetscReal delta, PetscReal hmax
 
 typedef struct {
   PetscInt  ncell[3], reach[3];
-  PetscReal size[3], length[3];
+  PetscReal lower[3], size[3], length[3];
   PetscInt *start; /* ncells + 1 */
   PetscInt *item;  /* particles sorted by cell */
 } CellList;
 
+static PetscInt CellOfPoint(const CellList *cl, const PetscReal x[], PetscInt d)
+{
+  PetscInt c = (PetscInt)PetscFloorReal((x[d] - cl->lower[d]) / cl->size[d]);
+  return PetscMin(PetscMax(c, 0), cl->ncell[d] - 1);
+}
+
 static PetscInt CellOf(const CellList *cl, const PeriParticles *p, PetscInt k, PetscInt d)
 {
-  PetscInt c = (PetscInt)PetscFloorReal((p->x[3 * k + d] - p->lower[d]) / cl->size[d]);
-  return PetscMin(PetscMax(c, 0), cl->ncell[d] - 1);
+  return CellOfPoint(cl, &p->x[3 * k], d);
 }
 
 static PetscInt CellIndex(const CellList *cl, const PetscInt c[3])
@@ -52,13 +57,16 @@ static PetscInt CellIndex(const CellList *cl, const PetscInt c[3])
   return (c[2] * cl->ncell[1] + c[1]) * cl->ncell[0] + c[0];
 }
 
-static PetscErrorCode CellListCreate(const PeriParticles *p, PetscReal r, CellList *cl)
+/* Cells of size >= r over the box lower..upper (the body's box; on a periodic axis it must be, so
+ * that a wrap shifts by whole cells). */
+static PetscErrorCode CellListCreate(const PeriParticles *p, const PetscReal lower[], const PetscReal upper[], PetscReal r, CellList *cl)
 {
   PetscInt ncells = 1, *cellof;
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) {
-    cl->length[d] = d < p->dim ? p->upper[d] - p->lower[d] : 0;
+    cl->lower[d]  = lower[d];
+    cl->length[d] = d < p->dim ? upper[d] - lower[d] : 0;
     cl->ncell[d]  = d < p->dim ? PetscMax(1, (PetscInt)PetscFloorReal(cl->length[d] / r)) : 1;
     /* cap the cell count so a huge box with few particles cannot exhaust memory */
     while (d < p->dim && cl->ncell[d] > 1 && (PetscReal)ncells * cl->ncell[d] > 8.0 * p->n + 64) cl->ncell[d] = (cl->ncell[d] + 1) / 2;
@@ -139,6 +147,12 @@ static PetscBool ShiftPositive(const PetscInt w[3])
   return PETSC_FALSE;
 }
 
+/* The global index of particle k of p (p may be a rank's local view). */
+static inline PetscInt Global(const PeriParticles *p, PetscInt k)
+{
+  return p->global ? p->global[k] : k;
+}
+
 /* Appends the bonds of particle i (those with j >= i when half) to b. Errors on coincident
  * particles. */
 static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, PetscReal delta, PeriPartialVolume pv, PetscReal r, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
@@ -169,7 +183,8 @@ static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, 
         for (PetscInt s = cl->start[cell]; s < cl->start[cell + 1]; s++) {
           PetscInt  j = cl->item[s], self = (j == i);
           PetscReal x[3], len2            = 0, len, h, alpha;
-          if (half && (j < i || (self && !ShiftPositive(wrap)))) continue;
+          /* the row of the smaller global index holds the pair, whichever rank that is */
+          if (half && (Global(p, j) < Global(p, i) || (self && !ShiftPositive(wrap)))) continue;
           if (self && !wrap[0] && !wrap[1] && !wrap[2]) continue;
           if (!half && self) continue;
           for (PetscInt d = 0; d < 3; d++) {
@@ -183,7 +198,7 @@ static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, 
           alpha = PeriPartialVolumeFactor(pv, len, delta, h);
           if (alpha <= 0) continue;
           PetscCall(BondsReserve(b, b->nbonds + 1, cap));
-          b->j[b->nbonds] = j;
+          b->j[b->nbonds] = Global(p, j);
           for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
           b->length[b->nbonds] = len;
           b->alpha[b->nbonds]  = alpha;
@@ -194,10 +209,14 @@ static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscErrorCode ParticlesBox(const PeriParticles *, PetscReal, PetscReal[], PetscReal[]);
+
 /*@C
-  PeriNeighborSearch - finds the bonds of particles rstart..rend-1 with cell lists. With half,
-  each pair is stored once, in the row of its smaller index; otherwise every neighbour is listed
-  (the graph for partitioning). Not collective. Errors on coincident particles.
+  PeriNeighborSearch - finds the bonds of particles rstart..rend-1 of p with cell lists. With half,
+  each pair is stored once, in the row of its smaller global index; otherwise every neighbour is
+  listed (the graph for partitioning). p may be the whole body or a rank's local view (owned
+  particles rstart..rend-1, then ghosts): the bonds' j and b->rstart, b->rend are global indices
+  either way. Not collective. Errors on coincident particles.
 @*/
 PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
 {
@@ -210,15 +229,20 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
   PetscCall(PetscMemzero(b, sizeof(*b)));
   for (PetscInt k = 0; k < p->n; k++) hmax = PetscMax(hmax, p->spacing[k]);
   r = PeriSearchRadius(pv, delta, hmax);
-  PetscCall(CellListCreate(p, r, &cl));
+  if (p->global) { /* a rank's local view: cells over its particles only */
+    PetscReal lo[3], hi[3];
+    PetscCall(ParticlesBox(p, r, lo, hi));
+    PetscCall(CellListCreate(p, lo, hi, r, &cl));
+  } else
+    PetscCall(CellListCreate(p, p->lower, p->upper, r, &cl));
   {
     /* reserve what a full horizon holds, so the arrays are rarely copied while they grow */
     PetscReal vmean = 0, ball = p->dim == 2 ? PETSC_PI * r * r * p->thickness : 4.0 / 3.0 * PETSC_PI * r * r * r;
     for (PetscInt k = 0; k < p->n; k++) vmean += p->volume[k] / p->n;
     PetscCall(BondsReserve(b, (PetscInt)(1.05 * (rend - rstart) * ball / vmean / (half ? 2 : 1)) + 16, &cap));
   }
-  b->rstart = rstart;
-  b->rend   = rend;
+  b->rstart = rend > rstart ? Global(p, rstart) : 0;
+  b->rend   = b->rstart + rend - rstart; /* a rank's owned particles are numbered contiguously */
   PetscCall(PetscMalloc1(rend - rstart + 1, &b->offset));
   b->offset[0] = 0;
   /* coincident particles are an input error: the cell list is freed before it is passed on */
@@ -230,6 +254,80 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
   PetscCall(ierr);
   PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
   for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The box the cells of a search over p cover: on a periodic axis the body's (a wrap shifts by
+ * whole cells), else the particles' own extent, so that a rank holding a small part of a large
+ * body has cells of its part only. */
+static PetscErrorCode ParticlesBox(const PeriParticles *p, PetscReal r, PetscReal lo[], PetscReal hi[])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) {
+    lo[d] = p->periodic[d] ? p->lower[d] : PETSC_MAX_REAL;
+    hi[d] = p->periodic[d] ? p->upper[d] : PETSC_MIN_REAL;
+    for (PetscInt k = 0; k < p->n && !p->periodic[d]; k++) {
+      lo[d] = PetscMin(lo[d], p->x[3 * k + d]);
+      hi[d] = PetscMax(hi[d], p->x[3 * k + d]);
+    }
+    if (hi[d] - lo[d] < r) hi[d] = lo[d] + r; /* one cell along a thin (or flat) extent */
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Is any particle of cl (of p) within r of the point y, on the minimum image? */
+static PetscBool PointNear(const PeriParticles *p, const CellList *cl, PetscReal r, const PetscReal y[])
+{
+  PetscInt ci[3], o[3];
+
+  for (PetscInt d = 0; d < 3; d++) ci[d] = d < p->dim ? CellOfPoint(cl, y, d) : 0;
+  for (o[2] = -cl->reach[2]; o[2] <= cl->reach[2]; o[2]++)
+    for (o[1] = -cl->reach[1]; o[1] <= cl->reach[1]; o[1]++)
+      for (o[0] = -cl->reach[0]; o[0] <= cl->reach[0]; o[0]++) {
+        PetscInt  c[3], wrap[3] = {0, 0, 0}, cell;
+        PetscBool skip = PETSC_FALSE;
+        for (PetscInt d = 0; d < 3; d++) {
+          c[d] = ci[d] + o[d];
+          if (c[d] >= 0 && c[d] < cl->ncell[d]) continue;
+          if (!p->periodic[d]) skip = PETSC_TRUE;
+          wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl->ncell[d]);
+          c[d] -= wrap[d] * cl->ncell[d];
+        }
+        if (skip) continue;
+        cell = CellIndex(cl, c);
+        for (PetscInt s = cl->start[cell]; s < cl->start[cell + 1]; s++) {
+          PetscInt  j    = cl->item[s];
+          PetscReal len2 = 0;
+          for (PetscInt d = 0; d < 3; d++) {
+            PetscReal x = p->x[3 * j + d] + wrap[d] * cl->length[d] - y[d];
+            len2 += x * x;
+          }
+          if (len2 <= r * r) return PETSC_TRUE;
+        }
+      }
+  return PETSC_FALSE;
+}
+
+/*@C
+  PeriParticlesNear - near[k] says whether any of the n particles of p lies within r of the point
+  y[3k..3k+2] (minimum image on periodic axes). The cells cover the particles' own bounding box,
+  not the body's, so a rank holding a small part of a large body searches only its part. Not
+  collective.
+@*/
+PetscErrorCode PeriParticlesNear(const PeriParticles *p, PetscReal r, PetscInt m, const PetscReal y[], PetscBool near[])
+{
+  CellList  cl;
+  PetscReal lo[3], hi[3];
+
+  PetscFunctionBeginUser;
+  if (!p->n) {
+    for (PetscInt k = 0; k < m; k++) near[k] = PETSC_FALSE;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(ParticlesBox(p, r, lo, hi));
+  PetscCall(CellListCreate(p, lo, hi, r, &cl));
+  for (PetscInt k = 0; k < m; k++) near[k] = PointNear(p, &cl, r, &y[3 * k]);
+  PetscCall(CellListDestroy(&cl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

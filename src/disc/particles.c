@@ -33,48 +33,69 @@ const PeriSchema PeriParticlesSchema[] = {
     {NULL},
 };
 
-static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, PeriParticles *p)
+/* Reads grid.*: the box into p, the cells per axis and the spacing. */
+static PetscErrorCode GridParse(PeriScene scene, PeriNode grid, PetscInt dim, PeriParticles *p, PetscInt cells[3], PetscReal *h)
 {
-  PetscReal lower[3] = {0, 0, 0}, upper[3] = {0, 0, 0}, h, cellvol;
-  PetscInt  nl, nu, cells[3] = {1, 1, 1}, n = 1, k = 0;
+  PetscReal lower[3] = {0, 0, 0}, upper[3] = {0, 0, 0};
+  PetscInt  nl, nu, n = 1;
   PeriNode  per;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckSection(scene, grid, "grid"));
   PetscCall(PeriSceneGetRealArray(scene, grid, "lower", PETSC_TRUE, dim, dim, lower, &nl));
   PetscCall(PeriSceneGetRealArray(scene, grid, "upper", PETSC_TRUE, dim, dim, upper, &nu));
-  PetscCall(PeriSceneGetReal(scene, grid, "spacing", PETSC_TRUE, &h, NULL));
-  PeriInputCheck(h > 0, scene, grid, "spacing", "must be positive, got %g", (double)h);
+  PetscCall(PeriSceneGetReal(scene, grid, "spacing", PETSC_TRUE, h, NULL));
+  PeriInputCheck(*h > 0, scene, grid, "spacing", "must be positive, got %g", (double)*h);
   PetscCall(PeriSceneGetNode(grid, "periodic", &per));
   if (per) {
     PeriInputCheck(per->kind == PERI_NODE_SEQ && per->n == dim, scene, per, NULL, "must be a list of %" PetscInt_FMT " booleans, e.g. [false, true]", dim);
     for (PetscInt d = 0; d < dim; d++) PetscCall(PeriSceneParseBool(scene, per->child[d], &p->periodic[d]));
   }
+  for (PetscInt d = 0; d < 3; d++) cells[d] = 1;
   for (PetscInt d = 0; d < dim; d++) {
     PetscReal L = upper[d] - lower[d], c;
     /* 1e308 - (-1e308) is inf: say so rather than call inf "not a whole number of spacings" */
     PeriInputCheck(!PetscIsInfOrNanReal(L), scene, grid, "upper", "the box is too large for double precision: upper - lower = %g - (%g) overflows along axis %" PetscInt_FMT, (double)upper[d], (double)lower[d], d);
     PeriInputCheck(L > 0, scene, grid, "upper", "must exceed grid.lower in every axis (axis %" PetscInt_FMT ": %g <= %g)", d, (double)upper[d], (double)lower[d]);
-    c        = L / h;
+    c        = L / *h;
     cells[d] = (PetscInt)PetscFloorReal(c + 0.5);
-    PeriInputCheck(cells[d] >= 1 && PetscAbsReal(c - cells[d]) < 1e-6 * PetscMax(c, 1), scene, grid, "spacing", "the box length %g along axis %" PetscInt_FMT " is not a whole number of spacings %g", (double)L, d, (double)h);
+    PeriInputCheck(cells[d] >= 1 && PetscAbsReal(c - cells[d]) < 1e-6 * PetscMax(c, 1), scene, grid, "spacing", "the box length %g along axis %" PetscInt_FMT " is not a whole number of spacings %g", (double)L, d, (double)*h);
     PeriInputCheck(cells[d] <= 100000000 / n, scene, grid, "spacing", "gives too many particles");
     n *= cells[d];
     p->lower[d] = lower[d];
     p->upper[d] = upper[d];
   }
-  PetscCall(ParticlesAllocate(p, n));
-  cellvol = dim == 3 ? h * h * h : h * h * p->thickness;
-  for (PetscInt c2 = 0; c2 < cells[2]; c2++)
-    for (PetscInt c1 = 0; c1 < cells[1]; c1++)
-      for (PetscInt c0 = 0; c0 < cells[0]; c0++, k++) {
-        const PetscInt c[3] = {c0, c1, c2};
-        for (PetscInt d = 0; d < dim; d++) p->x[3 * k + d] = lower[d] + (c[d] + 0.5) * h;
-        p->volume[k]      = cellvol;
-        p->spacing[k]     = h;
-        p->source_line[k] = 0;
-      }
-  p->mean_spacing = h;
+  p->mean_spacing = *h;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The grid's cells kstart..kend-1 (x fastest), one particle at each centre. */
+static PetscErrorCode GridFill(PeriParticles *p, const PetscInt cells[3], PetscReal h, PetscInt kstart, PetscInt kend)
+{
+  const PetscReal cellvol = p->dim == 3 ? h * h * h : h * h * p->thickness;
+
+  PetscFunctionBeginUser;
+  PetscCall(ParticlesAllocate(p, kend - kstart));
+  for (PetscInt k = kstart; k < kend; k++) {
+    const PetscInt c[3] = {k % cells[0], (k / cells[0]) % cells[1], k / (cells[0] * cells[1])}, l = k - kstart;
+    for (PetscInt d = 0; d < p->dim; d++) p->x[3 * l + d] = p->lower[d] + (c[d] + 0.5) * h;
+    p->volume[l]      = cellvol;
+    p->spacing[l]     = h;
+    p->source_line[l] = 0;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The grid's particles: of its cells in x-fastest order, the share rank..rank+1 of size ranks. */
+static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, PetscMPIInt rank, PetscMPIInt size, PeriParticles *p)
+{
+  PetscInt  cells[3], n;
+  PetscReal h;
+
+  PetscFunctionBeginUser;
+  PetscCall(GridParse(scene, grid, dim, p, cells, &h));
+  n = cells[0] * cells[1] * cells[2];
+  PetscCall(GridFill(p, cells, h, (PetscInt)((PetscInt64)n * rank / size), (PetscInt)((PetscInt64)n * (rank + 1) / size)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -275,7 +296,7 @@ PetscErrorCode PeriParticlesCreateFromScene(PeriScene scene, PetscInt dim, Petsc
   PeriInputCheck(grid || csv, scene, scene->root, "grid", "is required (or give particles.file or particles.mesh)");
   PeriInputCheck(!(grid && csv), scene, csv, NULL, "give either grid or particles, not both");
   if (grid) {
-    PetscCall(GridCreate(scene, grid, dim, p));
+    PetscCall(GridCreate(scene, grid, dim, 0, 1, p));
   } else {
     PeriNode file, mesh;
     PetscCall(PeriSceneCheckSection(scene, csv, "particles"));
@@ -324,9 +345,35 @@ PetscErrorCode PeriParticlesPermute(PeriParticles *p, const PetscInt perm[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriParticlesSlice - q holds copies of particles rstart..rend-1 of p and p's description of the
+  body (box, periodic axes, thickness, mean spacing), no layers and no mesh groups: the owned part
+  of a rank's local view. Not collective.
+@*/
+PetscErrorCode PeriParticlesSlice(const PeriParticles *p, PetscInt rstart, PetscInt rend, PeriParticles *q)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(q, sizeof(*q)));
+  q->dim          = p->dim;
+  q->thickness    = p->thickness;
+  q->mean_spacing = p->mean_spacing;
+  for (PetscInt d = 0; d < 3; d++) {
+    q->lower[d]    = p->lower[d];
+    q->upper[d]    = p->upper[d];
+    q->periodic[d] = p->periodic[d];
+  }
+  PetscCall(ParticlesAllocate(q, rend - rstart));
+  PetscCall(PetscArraycpy(q->x, &p->x[3 * rstart], 3 * (rend - rstart)));
+  PetscCall(PetscArraycpy(q->volume, &p->volume[rstart], rend - rstart));
+  PetscCall(PetscArraycpy(q->spacing, &p->spacing[rstart], rend - rstart));
+  PetscCall(PetscArraycpy(q->source_line, &p->source_line[rstart], rend - rstart));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriParticlesDestroy(PeriParticles *p)
 {
   PetscFunctionBeginUser;
+  PetscCall(PetscFree(p->global));
   PetscCall(PetscFree(p->x));
   PetscCall(PetscFree3(p->volume, p->spacing, p->source_line));
   PetscCall(PetscFree2(p->image, p->crossed));

@@ -1,35 +1,91 @@
-/* Partitioning: METIS k-way on rank 0, broadcast; particles are then renumbered so that each rank
- * owns a contiguous range (PETSc's row ownership). METIS sees the nearest-neighbour graph (bonds up
- * to 1.5 spacings): a horizon of m spacings only adds edges between particles that graph already
- * links through short paths, so it gives the same parts for a fraction of the graph size and search
- * time (docs/performance.md measures both). */
+/* Partitioning: particles are renumbered so that each rank owns a contiguous range (PETSc's row
+ * ownership). Three partitioners (-peri_partition):
+ *   geometric (default) a Hilbert space-filling curve through the particles, cut into pieces of
+ *             equal count by a parallel selection of the P - 1 splitting keys: no graph, the same
+ *             parts on every run;
+ *   ptscotch  PT-Scotch through PETSc's MatPartitioning, in parallel: each rank starts from a
+ *             contiguous block of the particles, builds the graph rows of that block in its local
+ *             view (the block and the particles within the graph radius of it, src/disc/halo.c),
+ *             and PT-Scotch moves the vertices between ranks (its parts vary from run to run);
+ *   metis     METIS k-way on rank 0 over the whole graph, broadcast (the default before issue 17).
+ * docs/performance.md ("Partitioners") measured the three: on grids the curve cuts as few bonds
+ * as the graph partitioners (within a few per cent either way) in a fraction of the time and
+ * memory, on an unstructured mesh with a hole a few per cent more. The graph is the
+ * nearest-neighbour graph (bonds up to 1.5 spacings): a horizon of m spacings only adds edges
+ * between particles that graph already links through short paths, so it gives the same parts for
+ * a fraction of the graph size and search time. */
 #include "perilin/private/disc.h"
+#include <petscmat.h>
 #include <metis.h>
+#include <stdint.h>
+#include <stdlib.h>
+
+typedef enum {
+  PARTITION_METIS,
+  PARTITION_PTSCOTCH,
+  PARTITION_GEOMETRIC
+} PartitionType;
+
+static const char *const PartitionTypes[] = {"metis", "ptscotch", "geometric"};
+
+/* -peri_partition: read on every run (also on one rank, where nothing is partitioned) so that a
+ * misspelt value is an error whatever the rank count */
+static PetscErrorCode ReadType(MPI_Comm comm, PartitionType *type)
+{
+  char      name[64] = "geometric";
+  PetscBool found    = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-peri_partition", name, sizeof(name), NULL));
+  for (int t = 0; t < 3; t++) {
+    PetscCall(PetscStrcmp(name, PartitionTypes[t], &found));
+    if (found) {
+      *type = (PartitionType)t;
+      break;
+    }
+  }
+  PetscCheck(found, comm, PETSC_ERR_USER_INPUT, "-peri_partition %s: unknown partitioner; use metis, ptscotch or geometric", name);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Sorts the neighbours of each row and drops repeats (the periodic images of one pair): the
+ * partitioners want each edge once per direction. Compacts adj in place; offsets are rewritten. */
+static PetscErrorCode GraphCompact(PetscInt nrows, PetscInt offset[], PetscInt adj[])
+{
+  PetscInt ne = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < nrows; i++) {
+    PetscInt s = ne, k0 = offset[i], k1 = offset[i + 1];
+    for (PetscInt k = k0; k < k1; k++) adj[ne++] = adj[k];
+    PetscCall(PetscSortInt(ne - s, &adj[s]));
+    {
+      PetscInt m = s;
+      for (PetscInt k = s; k < ne; k++)
+        if (k == s || adj[k] != adj[m - 1]) adj[m++] = adj[k];
+      ne = m;
+    }
+    offset[i + 1] = ne;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, PetscMPIInt nparts, PetscInt part[])
 {
   PeriBonds g;
   idx_t    *xadj, *adjncy, *where, nv = (idx_t)p->n, ncon = 1, np = nparts, objval = 0, options[METIS_NOPTIONS];
-  PetscInt  ne = 0;
+  PetscInt *off;
   int       status;
 
   PetscFunctionBeginUser;
   PetscCall(PeriNeighborSearch(p, radius, PERI_PARTIAL_VOLUME_NONE, 0, p->n, PETSC_FALSE, &g));
-  PetscCall(PetscMalloc3(p->n + 1, &xadj, g.nbonds, &adjncy, p->n, &where));
-  /* METIS wants each edge once per direction: drop repeated periodic images of a pair */
-  xadj[0] = 0;
-  for (PetscInt i = 0; i < p->n; i++) {
-    PetscInt s = ne;
-    for (PetscInt k = g.offset[i]; k < g.offset[i + 1]; k++) adjncy[ne++] = (idx_t)g.j[k];
-    PetscCall(PetscSortInt(ne - s, (PetscInt *)&adjncy[s]));
-    {
-      PetscInt m = s;
-      for (PetscInt k = s; k < ne; k++)
-        if (k == s || adjncy[k] != adjncy[m - 1]) adjncy[m++] = adjncy[k];
-      ne = m;
-    }
-    xadj[i + 1] = (idx_t)ne;
-  }
+  PetscCall(PetscMalloc1(p->n + 1, &off));
+  PetscCall(PetscArraycpy(off, g.offset, p->n + 1));
+  PetscCall(GraphCompact(p->n, off, g.j));
+  PetscCall(PetscMalloc3(p->n + 1, &xadj, off[p->n], &adjncy, p->n, &where));
+  for (PetscInt i = 0; i <= p->n; i++) xadj[i] = (idx_t)off[i];
+  for (PetscInt k = 0; k < off[p->n]; k++) adjncy[k] = (idx_t)g.j[k];
+  PetscCall(PetscFree(off));
   PetscCall(PeriBondsDestroy(&g));
   METIS_SetDefaultOptions(options);
   options[METIS_OPTION_SEED] = 1;
@@ -40,34 +96,335 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriPartition - partitions the particles over the ranks of comm. perm[k] is the old index of new
-  particle k; rank r owns new particles range[r]..range[r+1]-1. Collective.
-@*/
-PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal delta, PetscInt **perm, PetscInt **range)
+/* The graph rows of this rank's block rstart..rend-1: CSR arrays with global column indices, each
+ * neighbour once, allocated with PetscMalloc for MatCreateMPIAdj. The block's local view (the
+ * block and, as ghosts, the particles within radius of it: src/disc/halo.c) is all it reads of
+ * the particles, so it needs no whole body. Collective. */
+static PetscErrorCode BlockGraph(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, PetscReal radius, PetscReal hmax, PetscInt **xadj, PetscInt **adjncy)
+{
+  const PetscInt n = rend - rstart;
+  PeriParticles  local;
+  PeriHalo       halo;
+  PeriBonds      g;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriParticlesSlice(p, rstart, rend, &local));
+  PetscCall(PeriHaloCreate(comm, &local, PeriSearchRadius(PERI_PARTIAL_VOLUME_NONE, radius, hmax), &halo));
+  PetscCall(PeriNeighborSearch(&local, radius, PERI_PARTIAL_VOLUME_NONE, 0, n, PETSC_FALSE, &g));
+  PetscCall(PeriHaloDestroy(&halo));
+  PetscCall(PeriParticlesDestroy(&local));
+  PetscCall(GraphCompact(n, g.offset, g.j));
+  PetscCall(PetscMalloc1(n + 1, xadj));
+  PetscCall(PetscMalloc1(g.offset[n], adjncy));
+  PetscCall(PetscArraycpy(*xadj, g.offset, n + 1));
+  PetscCall(PetscArraycpy(*adjncy, g.j, g.offset[n]));
+  PetscCall(PeriBondsDestroy(&g));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* PT-Scotch over the graph of the blocks: *part holds the target rank of each particle of this
+ * rank's block. -mat_partitioning_ptscotch_imbalance and _strategy tune it. */
+static PetscErrorCode PTScotchPartition(MPI_Comm comm, const PeriParticles *p, PetscReal radius, PetscReal hmax, PetscInt rstart, PetscInt rend, IS *part)
+{
+  PetscInt       *xadj, *adjncy;
+  Mat             adj;
+  MatPartitioning mp;
+  PetscMPIInt     size;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(BlockGraph(comm, p, rstart, rend, radius, hmax, &xadj, &adjncy));
+  /* the matrix takes xadj and adjncy over */
+  PetscCall(MatCreateMPIAdj(comm, rend - rstart, p->n, xadj, adjncy, NULL, &adj));
+  PetscCall(MatPartitioningCreate(comm, &mp));
+  PetscCall(MatPartitioningSetAdjacency(mp, adj));
+  PetscCall(MatPartitioningSetType(mp, MATPARTITIONINGPTSCOTCH));
+  PetscCall(MatPartitioningSetNParts(mp, size));
+  PetscCall(MatPartitioningSetFromOptions(mp));
+  PetscCall(MatPartitioningApply(mp, part));
+  PetscCall(MatPartitioningDestroy(&mp));
+  PetscCall(MatDestroy(&adj));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A particle's place on the curve: its Hilbert index (Skilling's transpose form, AIP Conf. Proc.
+ * 707, 2004) and, to break ties, its global index. */
+typedef struct {
+  uint64_t h;
+  PetscInt g;
+} CurveKey;
+
+/* The Hilbert index of the point with integer coordinates X[0..n-1] of b bits each. */
+static uint64_t HilbertIndex(uint64_t X[3], PetscInt n, PetscInt b)
+{
+  uint64_t M = (uint64_t)1 << (b - 1), t, key = 0;
+
+  /* inverse undo of the rotations and reflections, then Gray encoding */
+  for (uint64_t Q = M; Q > 1; Q >>= 1)
+    for (PetscInt i = 0; i < n; i++) {
+      if (X[i] & Q)
+        X[0] ^= Q - 1;
+      else {
+        t = (X[0] ^ X[i]) & (Q - 1);
+        X[0] ^= t;
+        X[i] ^= t;
+      }
+    }
+  for (PetscInt i = 1; i < n; i++) X[i] ^= X[i - 1];
+  t = 0;
+  for (uint64_t Q = M; Q > 1; Q >>= 1)
+    if (X[n - 1] & Q) t ^= Q - 1;
+  for (PetscInt i = 0; i < n; i++) X[i] ^= t;
+  /* the transpose's bits interleaved, most significant first */
+  for (PetscInt bit = b - 1; bit >= 0; bit--)
+    for (PetscInt i = 0; i < n; i++) key = (key << 1) | ((X[i] >> bit) & 1);
+  return key;
+}
+
+static int CurveKeyCompare(const void *a, const void *b)
+{
+  const CurveKey *x = (const CurveKey *)a, *y = (const CurveKey *)b;
+  if (x->h != y->h) return x->h < y->h ? -1 : 1;
+  return x->g < y->g ? -1 : (x->g > y->g);
+}
+
+/* The particles' bounding box (all ranks), and its axes longest first: the curve's first cut is
+ * across its first axis, so a bar is cut across its length. */
+static PetscErrorCode CurveBox(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, PetscReal lo[3], PetscReal *length, PetscInt axis[3])
+{
+  PetscReal ext[6], e[3];
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 6; d++) ext[d] = PETSC_MAX_REAL;
+  for (PetscInt i = rstart; i < rend; i++)
+    for (PetscInt d = 0; d < 3; d++) ext[d] = PetscMin(ext[d], p->x[3 * i + d]), ext[3 + d] = PetscMin(ext[3 + d], -p->x[3 * i + d]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ext, 6, MPIU_REAL, MPIU_MIN, comm));
+  *length = 0;
+  for (PetscInt d = 0; d < 3; d++) {
+    lo[d]   = ext[d];
+    e[d]    = -ext[3 + d] - ext[d];
+    axis[d] = d;
+    *length = PetscMax(*length, e[d]);
+  }
+  if (*length <= 0) *length = 1;
+  for (PetscInt d = 1; d < p->dim; d++)
+    for (PetscInt k = d; k > 0 && e[axis[k]] > e[axis[k - 1]]; k--) {
+      PetscInt t  = axis[k];
+      axis[k]     = axis[k - 1];
+      axis[k - 1] = t;
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The keys of the block, sorted: the coordinates in the bounding box scaled alike on every axis
+ * (a uniform grid stays uniform on the curve), b bits per axis. */
+static PetscErrorCode CurveKeys(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, CurveKey key[])
+{
+  PetscReal lo[3], length = 1;
+  PetscInt  axis[3], n = p->dim, b = 63 / p->dim;
+  uint64_t  top = ((uint64_t)1 << b) - 1;
+
+  PetscFunctionBeginUser;
+  PetscCall(CurveBox(comm, p, rstart, rend, lo, &length, axis));
+  for (PetscInt i = rstart; i < rend; i++) {
+    uint64_t X[3] = {0, 0, 0};
+    for (PetscInt d = 0; d < n; d++) {
+      PetscReal s = (p->x[3 * i + axis[d]] - lo[axis[d]]) / length;
+      X[d]        = (uint64_t)PetscMin((PetscReal)top, PetscMax(0.0, s * (PetscReal)top));
+    }
+    key[i - rstart].h = HilbertIndex(X, n, b);
+    key[i - rstart].g = i;
+  }
+  qsort(key, (size_t)(rend - rstart), sizeof(CurveKey), CurveKeyCompare);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* How many of the sorted keys are <= k. */
+static PetscInt CountLE(const CurveKey key[], PetscInt n, CurveKey k)
+{
+  PetscInt lo = 0, hi = n;
+  while (lo < hi) {
+    PetscInt mid = lo + (hi - lo) / 2;
+    if (CurveKeyCompare(&key[mid], &k) <= 0)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* split[q] (q = 1..P-1) becomes the key of the particle of global rank floor(q N / P) along the
+ * curve: bisection over the Hilbert index, then over the global index among equal Hilbert
+ * indices, every step one reduction of the P - 1 counts. */
+static PetscErrorCode CurveSplitters(MPI_Comm comm, PetscInt N, PetscMPIInt P, const CurveKey key[], PetscInt n, CurveKey split[])
+{
+  uint64_t *lo, *hi;
+  PetscInt *count;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc3(P, &lo, P, &hi, P, &count));
+  for (PetscInt stage = 0; stage < 2; stage++) {
+    for (PetscMPIInt q = 1; q < P; q++) lo[q] = 0, hi[q] = stage ? (uint64_t)(N - 1) : UINT64_MAX;
+    for (PetscBool busy = PETSC_TRUE; busy;) {
+      busy = PETSC_FALSE;
+      for (PetscMPIInt q = 1; q < P; q++) {
+        split[q].h = stage ? split[q].h : lo[q] + (hi[q] - lo[q]) / 2;
+        split[q].g = stage ? (PetscInt)(lo[q] + (hi[q] - lo[q]) / 2) : PETSC_MAX_INT;
+        count[q]   = CountLE(key, n, split[q]);
+      }
+      PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &count[1], P - 1, MPIU_INT, MPI_SUM, comm));
+      /* the smallest key with more than floor(q N / P) keys at or below it */
+      for (PetscMPIInt q = 1; q < P; q++) {
+        uint64_t mid = stage ? (uint64_t)split[q].g : split[q].h;
+        if (lo[q] == hi[q]) continue;
+        if (count[q] > (PetscInt)((PetscInt64)q * N / P))
+          hi[q] = mid;
+        else
+          lo[q] = mid + 1;
+        busy = (PetscBool)(busy || lo[q] < hi[q]);
+      }
+    }
+    for (PetscMPIInt q = 1; q < P; q++) {
+      if (stage)
+        split[q].g = (PetscInt)lo[q];
+      else
+        split[q].h = lo[q];
+    }
+  }
+  PetscCall(PetscFree3(lo, hi, count));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The Hilbert curve cut into P pieces of floor((q+1) N/P) - floor(q N/P) particles: *part holds
+ * the piece of each particle of the block. */
+static PetscErrorCode GeometricPartition(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, IS *part)
+{
+  PetscMPIInt size;
+  PetscInt    n = rend - rstart, *where;
+  CurveKey   *key, *split;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscMalloc3(n, &key, size, &split, n, &where));
+  PetscCall(CurveKeys(comm, p, rstart, rend, key));
+  PetscCall(CurveSplitters(comm, p->n, size, key, n, split));
+  /* key[k]'s piece: the number of splitters at or below it (splitters are increasing) */
+  for (PetscInt k = 0, q = 0; k < n; k++) {
+    while (q + 1 < size && CurveKeyCompare(&split[q + 1], &key[k]) <= 0) q++;
+    where[key[k].g - rstart] = q;
+  }
+  PetscCall(ISCreateGeneral(comm, n, where, PETSC_COPY_VALUES, part));
+  PetscCall(PetscFree3(key, split, where));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* From the target rank of each particle of this rank's block (*part) to the permutation and
+ * ranges of PeriPartition: ranks keep their particles in the old order. The gather of the new
+ * numbers is the one step of size N, for the interface of every rank holding all particles. */
+static PetscErrorCode PermutationFromParts(MPI_Comm comm, PetscInt N, IS part, PetscInt perm[], PetscInt range[])
+{
+  PetscMPIInt     size;
+  PetscInt       *count, *newof;
+  PetscMPIInt    *recv, *displ;
+  IS              num;
+  const PetscInt *nn;
+  PetscInt        n;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscMalloc1(size, &count));
+  PetscCall(ISPartitioningCount(part, size, count));
+  range[0] = 0;
+  for (PetscMPIInt r = 0; r < size; r++) range[r + 1] = range[r] + count[r];
+  PetscCall(PetscFree(count));
+  PetscCall(ISPartitioningToNumbering(part, &num));
+  PetscCall(ISGetLocalSize(num, &n));
+  PetscCall(ISGetIndices(num, &nn));
+  PetscCall(PetscMalloc3(N, &newof, size, &recv, size, &displ));
+  {
+    PetscMPIInt nm = (PetscMPIInt)n;
+    PetscCallMPI(MPI_Allgather(&nm, 1, MPI_INT, recv, 1, MPI_INT, comm));
+  }
+  displ[0] = 0;
+  for (PetscMPIInt r = 1; r < size; r++) displ[r] = displ[r - 1] + recv[r - 1];
+  PetscCallMPI(MPI_Allgatherv(nn, (PetscMPIInt)n, MPIU_INT, newof, recv, displ, MPIU_INT, comm));
+  PetscCall(ISRestoreIndices(num, &nn));
+  PetscCall(ISDestroy(&num));
+  for (PetscInt i = 0; i < N; i++) perm[newof[i]] = i;
+  PetscCall(PetscFree3(newof, recv, displ));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* METIS's parts (every rank holds all) to the permutation and ranges. */
+static PetscErrorCode PermutationFromAllParts(PetscMPIInt size, PetscInt N, const PetscInt part[], PetscInt perm[], PetscInt range[])
+{
+  PetscInt *fill;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < N; i++) range[part[i] + 1]++;
+  for (PetscMPIInt r = 0; r < size; r++) range[r + 1] += range[r];
+  PetscCall(PetscMalloc1(size, &fill));
+  PetscCall(PetscArraycpy(fill, range, size));
+  for (PetscInt i = 0; i < N; i++) perm[fill[part[i]]++] = i;
+  PetscCall(PetscFree(fill));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode MetisPartitionAll(MPI_Comm comm, const PeriParticles *p, PetscReal radius, PetscInt perm[], PetscInt range[])
 {
   PetscMPIInt rank, size;
-  PetscInt   *part, *fill;
+  PetscInt   *part;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscCalloc1(p->n, &part));
+  if (rank == 0) PetscCall(MetisPartition(p, radius, size, part));
+  PetscCallMPI(MPI_Bcast(part, (PetscMPIInt)p->n, MPIU_INT, 0, comm));
+  PetscCall(PermutationFromAllParts(size, p->n, part, perm, range));
+  PetscCall(PetscFree(part));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriPartition - partitions the particles over the ranks of comm (-peri_partition). perm[k] is the
+  old index of new particle k; rank r owns new particles range[r]..range[r+1]-1. Collective.
+@*/
+PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal delta, PetscInt **perm, PetscInt **range)
+{
+  PetscMPIInt   rank, size;
+  PartitionType type = PARTITION_GEOMETRIC;
+  PetscReal     hmax = 0, radius;
+  PetscInt      rstart, rend;
+  IS            part;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReadType(comm, &type));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscMalloc1(p->n, perm));
   PetscCall(PetscCalloc1(size + 1, range));
-  PetscCall(PetscCalloc1(p->n, &part));
-  if (size > 1) {
-    PetscCheck(p->n >= size, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " particles cannot be shared by %d ranks", p->n, size);
-    PetscReal hmax = 0;
-    for (PetscInt i = 0; i < p->n; i++) hmax = PetscMax(hmax, p->spacing[i]);
-    if (rank == 0) PetscCall(MetisPartition(p, PetscMin(delta, 1.5 * hmax), size, part));
-    PetscCallMPI(MPI_Bcast(part, (PetscMPIInt)p->n, MPIU_INT, 0, comm));
+  if (size == 1) {
+    for (PetscInt i = 0; i < p->n; i++) (*perm)[i] = i;
+    (*range)[1] = p->n;
+    PetscFunctionReturn(PETSC_SUCCESS);
   }
-  for (PetscInt i = 0; i < p->n; i++) (*range)[part[i] + 1]++;
-  for (PetscMPIInt r = 0; r < size; r++) (*range)[r + 1] += (*range)[r];
-  PetscCall(PetscMalloc1(size, &fill));
-  PetscCall(PetscArraycpy(fill, *range, size));
-  for (PetscInt i = 0; i < p->n; i++) (*perm)[fill[part[i]]++] = i;
-  PetscCall(PetscFree(fill));
-  PetscCall(PetscFree(part));
+  PetscCheck(p->n >= size, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " particles cannot be shared by %d ranks", p->n, size);
+  /* the initial blocks: for grid particles (x fastest) slabs along the last axis */
+  rstart = (PetscInt)((PetscInt64)rank * p->n / size);
+  rend   = (PetscInt)((PetscInt64)(rank + 1) * p->n / size);
+  for (PetscInt i = rstart; i < rend; i++) hmax = PetscMax(hmax, p->spacing[i]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPIU_MAX, comm));
+  radius = PetscMin(delta, 1.5 * hmax);
+  if (type == PARTITION_METIS) {
+    PetscCall(MetisPartitionAll(comm, p, radius, *perm, *range));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  if (type == PARTITION_PTSCOTCH)
+    PetscCall(PTScotchPartition(comm, p, radius, hmax, rstart, rend, &part));
+  else
+    PetscCall(GeometricPartition(comm, p, rstart, rend, &part));
+  PetscCall(PermutationFromParts(comm, p->n, part, *perm, *range));
+  PetscCall(ISDestroy(&part));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

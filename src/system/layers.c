@@ -284,6 +284,10 @@ PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
   PetscCall(PetscMalloc1(sys->disc.bonds.rend - sys->disc.bonds.rstart, &rows));
   for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++)
     if (PeriParticleIsFictitious(pt, i)) rows[nf++] = i;
+  /* K T has no (i, i) for a fictitious i (T maps its column to its image's): MatZeroRows reuses a
+   * slot of the row's diagonal block, and must allocate one where that part of the row is empty
+   * (all of i's neighbours owned by other ranks, as a partition may give) */
+  PetscCall(MatSetOption(*A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
   PetscCall(MatZeroRows(*A, nf, rows, diag, NULL, NULL));
   for (PetscInt k = 0; k < nf; k++) PetscCall(VecSetValue(f, rows[k], 0.0, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(f));

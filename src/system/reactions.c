@@ -125,21 +125,65 @@ typedef struct {
   PetscReal scale;                 /* sum over particles of |f_int - lambda f| on held DOFs + |lambda f| */
   PetscReal magnitude;             /* sum of |f_int| + |lambda f| over the DOFs: the round-off's scale */
   PetscReal load2;                 /* ||lambda f||^2 */
+  PetscReal moment[3];             /* per rotation: the moment of the reactions and the loads */
+  PetscReal mscale;                /* sum of |rotation mode| (|reaction| + |load|): the moments' scale */
+  PetscReal mmagnitude;            /* sum of |rotation mode| (|f_int| + |lambda f|): their round-off's scale */
 } Sums;
+
+/* The rotations whose moment balance holds exactly: for a rotation-invariant model the rigid
+ * rotation r is in K's null space, and K is symmetric, so r . K u = 0 and the moments of the
+ * reactions and loads sum to -r . (the free DOFs' residual). Not with periodic axes (a bond across
+ * a face joins minimum images: a rotation stretches it) nor with fictitious layers (their faces'
+ * forces are in mirror relations). *ntrans: the rigid modes before the rotations. */
+static PetscErrorCode MomentModes(PeriSystem sys, const PetscBool trans[], PetscInt *ntrans, PetscInt *nrot)
+{
+  const PeriModelType *desc;
+  PetscReal            X[3] = {0, 0, 0}, vals[PERI_MAX_MODES][PERI_MAX_DOF];
+  PetscInt             nm;
+
+  PetscFunctionBeginUser;
+  *ntrans = *nrot = 0;
+  for (PetscInt c = 0; c < PERI_MAX_DOF; c++) *ntrans += trans[c];
+  PetscCall(PeriModelTypeGet(sys->model->type, &desc));
+  nm = sys->model->ops.rigid_modes(sys->model, X, vals);
+  if (!desc->rotation_invariant || sys->layers.T) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt d = 0; d < 3; d++)
+    if (sys->disc.particles.periodic[d]) PetscFunctionReturn(PETSC_SUCCESS);
+  *nrot = PetscMax(0, nm - *ntrans);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Adds DOF c of particle i (at X from the box centre) to the moment sums: its reaction (held) and load. */
+static void MomentAdd(PeriSystem sys, const PetscReal X[], PetscInt ntrans, PetscInt nrot, PetscInt c, PetscBool held, PetscReal Fi, PetscReal F, Sums *S)
+{
+  PetscReal vals[PERI_MAX_MODES][PERI_MAX_DOF];
+  if (!nrot) return;
+  sys->model->ops.rigid_modes(sys->model, X, vals);
+  for (PetscInt q = 0; q < nrot; q++) {
+    PetscReal w = vals[ntrans + q][c], R = held ? Fi - F : 0;
+    S->moment[q] += w * (R + F);
+    S->mscale += PetscAbsReal(w) * (PetscAbsReal(R) + PetscAbsReal(F));
+    S->mmagnitude += PetscAbsReal(w) * (PetscAbsReal(Fi) + PetscAbsReal(F));
+  }
+}
 
 /* The per-region reactions (R->force, R->applied) and the sums of the check over the owned DOFs. */
 static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const PetscBool trans[], Sums *S)
 {
-  PeriReactions     *R  = &sys->reactions;
-  const PetscInt     bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart, r0 = sys->disc.bonds.rstart * bs;
-  const PetscScalar *fi, *fa;
-  PetscInt           k = 0;
+  PeriReactions       *R  = &sys->reactions;
+  const PeriParticles *pt = &sys->disc.particles;
+  const PetscInt       bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart, r0 = sys->disc.bonds.rstart * bs;
+  const PetscScalar   *fi, *fa;
+  PetscInt             k = 0, ntrans, nrot;
 
   PetscFunctionBeginUser;
+  PetscCall(MomentModes(sys, trans, &ntrans, &nrot));
+  R->nmoments = nrot;
   PetscCall(VecGetArrayRead(fint, &fi));
   PetscCall(VecGetArrayRead(sys->f, &fa));
   for (PetscInt i = 0; i < nloc; i++) {
-    PetscReal p2 = 0, r2 = 0;
+    PetscReal p2 = 0, r2 = 0, X[3];
+    for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * (r0 / bs + i) + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
     for (PetscInt c = 0; c < bs; c++) {
       const PetscInt  row = i * bs + c;
       const PetscReal F = lambda * PetscRealPart(fa[row]), Fi = PetscRealPart(fi[row]);
@@ -152,6 +196,7 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
         region = sys->constrained_region[k];
       }
       if (region >= 0) R->force[region * PERI_MAX_DOF + c] += Fi - F;
+      MomentAdd(sys, X, ntrans, nrot, c, held, Fi, F, S);
       if (!trans[c]) continue;
       R->applied[c] += F;
       S->total[c] += Fi;
@@ -167,6 +212,26 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
   }
   PetscCall(VecRestoreArrayRead(sys->f, &fa));
   PetscCall(VecRestoreArrayRead(fint, &fi));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The moment balance (MomentModes): the free DOFs' residual r gives at most L sum |r_i| <= L sqrt(n)
+ * ||r||, L the largest lever (half the box diagonal; at least 1 for the couples of theta DOFs, whose
+ * weight is 1), so the force bound times L; round-off 1e-9 of the moments' magnitude. */
+static PetscErrorCode CheckMoments(PeriSystem sys, PetscReal force_allowed, const Sums *S)
+{
+  PeriReactions       *R  = &sys->reactions;
+  const PeriParticles *pt = &sys->disc.particles;
+  PetscReal            L2 = 0, m2 = 0, allowed;
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) L2 += PetscSqr(0.5 * (pt->upper[d] - pt->lower[d]));
+  for (PetscInt q = 0; q < 3; q++) R->moment[q] = q < R->nmoments ? S->moment[q] : 0;
+  for (PetscInt q = 0; q < R->nmoments; q++) m2 += PetscSqr(S->moment[q]);
+  allowed                      = PetscMax(PetscSqrtReal(L2), 1) * (force_allowed - 1e-9 * S->magnitude) + 1e-9 * S->mmagnitude;
+  R->relative_moment_imbalance = S->mscale > 0 ? PetscSqrtReal(m2) / S->mscale : 0;
+  R->moment_allowed            = S->mscale > 0 ? allowed / S->mscale : 0;
+  PetscCheck(!R->nmoments || PetscSqrtReal(m2) <= allowed, sys->comm, PETSC_ERR_PLIB, "global equilibrium fails at load factor %g: the moments of the reactions and the applied loads about the body's centre sum to a relative imbalance of %.3g, more than the solve's residual tolerance allows (%.3g); the forces balance, so the internal forces of this rotation-invariant model carry a moment (a bond force not along its bond) or the free DOFs are not in equilibrium", (double)R->load_factor, (double)R->relative_moment_imbalance, (double)R->moment_allowed);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -200,6 +265,7 @@ static PetscErrorCode CheckEquilibrium(PeriSystem sys, PetscReal lambda, const P
   R->evaluated          = PETSC_TRUE;
   /* fictitious layers carry their faces' forces in mirror relations, not in constrained DOFs */
   R->checked = sys->layers.T ? PETSC_FALSE : PETSC_TRUE;
+  PetscCall(CheckMoments(sys, allowed, S));
   if (!R->checked || PetscSqrtReal(imb2) <= allowed) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt c = 0; c < sys->model->dofs; c++)
     if (trans[c]) {
@@ -272,6 +338,15 @@ PetscErrorCode PeriReactionsSummary(PeriSystem sys, PeriJSON j)
   PetscCall(PeriJSONReal(j, "allowed", R->allowed));
   PetscCall(PeriJSONReal(j, "force_scale", R->scale));
   PetscCall(PeriJSONBool(j, "checked", R->checked));
+  PetscCall(PeriJSONBool(j, "moment_checked", R->nmoments > 0 ? PETSC_TRUE : PETSC_FALSE));
+  if (R->nmoments) {
+    static const char *const axes[] = {"x", "y", "z"};
+    PetscCall(PeriJSONBeginObject(j, "moment_imbalance"));
+    for (PetscInt q = 0; q < R->nmoments; q++) PetscCall(PeriJSONReal(j, axes[R->nmoments == 1 ? 2 : q], R->moment[q]));
+    PetscCall(PeriJSONEndObject(j));
+    PetscCall(PeriJSONReal(j, "relative_moment_imbalance", R->relative_moment_imbalance));
+    PetscCall(PeriJSONReal(j, "moment_allowed", R->moment_allowed));
+  }
   PetscCall(PeriJSONReal(j, "load_factor", R->load_factor));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -308,6 +308,29 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The bonds of this rank's particles rstart..rend-1 (and their families for state-based models),
+ * searched in its local view: its particles and, after them, the other ranks' within the search
+ * radius, found without the whole body (src/disc/halo.c). The view is released after the search
+ * until the other consumers read it instead of the whole body (docs/distributed.md). */
+static PetscErrorCode SearchBonds(PeriSystem sys, PetscInt rstart, PetscInt rend)
+{
+  PetscReal     hmax = 0;
+  PeriParticles local;
+  PeriHalo      halo;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = rstart; k < rend; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscCall(PeriParticlesSlice(&sys->disc.particles, rstart, rend, &local));
+  PetscCall(PeriHaloCreate(sys->comm, &local, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax), &halo));
+  PetscCall(PeriNeighborSearch(&local, sys->disc.delta, sys->disc.partial_volume, 0, halo.nowned, PETSC_TRUE, &sys->disc.bonds));
+  /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
+  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&local, sys->disc.delta, sys->disc.partial_volume, 0, halo.nowned, PETSC_FALSE, &sys->disc.family));
+  PetscCall(PeriHaloDestroy(&halo));
+  PetscCall(PeriParticlesDestroy(&local));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Partition, neighbour search (bonds, and families for state-based models), cracks, family
  * volumes and the surface correction; counts of bonds and of bonds between ranks. */
 static PetscErrorCode SetUpBonds(PeriSystem sys)
@@ -326,9 +349,7 @@ static PetscErrorCode SetUpBonds(PeriSystem sys)
     for (PetscInt i = range[r]; i < range[r + 1]; i++) sys->disc.owner[i] = r;
 
   PetscCall(PetscLogEventBegin(PERI_EVENT_Neighbors, 0, 0, 0, 0));
-  PetscCall(PeriNeighborSearch(&sys->disc.particles, sys->disc.delta, sys->disc.partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_TRUE, &sys->disc.bonds));
-  /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
-  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&sys->disc.particles, sys->disc.delta, sys->disc.partial_volume, range[sys->rank], range[sys->rank + 1], PETSC_FALSE, &sys->disc.family));
+  PetscCall(SearchBonds(sys, range[sys->rank], range[sys->rank + 1]));
   PetscCall(PetscMalloc2(sys->disc.particles.n, &sys->disc.family_volume, sys->disc.particles.n, &sys->disc.neighbor_count));
   /* a crack is geometry: the family volumes, the surface correction and the calibration see it */
   PetscCall(PeriCracksApply(sys));

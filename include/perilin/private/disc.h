@@ -4,9 +4,11 @@
 
 #include <perilin/scene.h>
 #include "perilin/private/sys.h"
+#include <petscsf.h>
 
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriParticlesSlice(const PeriParticles *, PetscInt, PetscInt, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesInputPath(PeriScene, PeriNode, const char[], char[], size_t);
 
@@ -61,13 +63,31 @@ PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm, const PeriParticle
 PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
 
+PETSC_EXTERN PetscErrorCode PeriParticlesMigrate(MPI_Comm, PeriParticles *, const PetscMPIInt[]);
+PETSC_EXTERN PetscErrorCode PeriParticlesNear(const PeriParticles *, PetscReal, PetscInt, const PetscReal[], PetscBool[]);
+
+/* ------------------------------------------------------------------ ghosts (src/disc/halo.c) */
+/* A rank's particles: the owned ones (global indices rstart..rstart+nowned-1), then nghost ghosts,
+ * copies of other ranks' particles within the halo radius of an owned one. */
+typedef struct {
+  PetscInt  N;      /* particles of the whole body */
+  PetscInt  rstart; /* global index of the first owned particle */
+  PetscInt  nowned, nghost;
+  PetscInt *global; /* nghost: each ghost's global index, ascending */
+  PetscSF   sf;     /* roots: the owned particles; leaves: the ghosts */
+} PeriHalo;
+
+PETSC_EXTERN PetscErrorCode PeriHaloCreate(MPI_Comm, PeriParticles *, PetscReal, PeriHalo *);
+PETSC_EXTERN PetscErrorCode PeriHaloUpdate(const PeriHalo *, MPI_Datatype, const void *, void *);
+PETSC_EXTERN PetscErrorCode PeriHaloDestroy(PeriHalo *);
+
 /* grid, particles and regions.<name>, declared next to the code that reads them. */
 PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
 
 /* The discretization of one body: every consumer reads particle data through this one owner, so
  * that holding only owned + ghost particles per rank (issue 17) changes src/disc/ alone. */
 typedef struct {
-  PeriParticles         particles;
+  PeriParticles         particles; /* the whole body on every rank, until its consumers read a rank's local view (docs/distributed.md) */
   PetscInt              nregions;
   PeriRegion           *regions;
   PetscReal             delta;

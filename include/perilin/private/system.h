@@ -137,6 +137,12 @@ typedef struct {
   PetscReal  allowed;                 /* the largest relative imbalance the solve's residual tolerance explains */
   PetscReal  load_factor;             /* of the evaluated state */
   PetscBool  evaluated, checked;      /* checked: false with fictitious layers (their faces carry no reaction) */
+  /* the moment balance about the body's box centre (rotation-invariant models without periodic
+     axes or layers: nmoments 1 in 2D, 3 in 3D; else 0 and not checked) */
+  PetscInt  nmoments;
+  PetscReal moment[3];                 /* the moments of the reactions (couples included) + of the loads */
+  PetscReal relative_moment_imbalance; /* |moment| / sum of |lever x force| + |couple| over reactions and loads */
+  PetscReal moment_allowed;            /* the largest relative moment imbalance the solve's residual explains */
 } PeriReactions;
 
 typedef struct _p_PeriSystem *PeriSystem;
