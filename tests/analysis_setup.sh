@@ -19,7 +19,8 @@ for ranks in 1 2; do
 import json, sys
 r = sys.argv[1]
 s, t = (json.load(open(f"{d}{r}/summary.json")) for d in ("setup", "static"))
-vtu = open(f"setup{r}/particles.vtu", "rb").read()
+# one rank writes particles.vtu; several the .pvtu index of one piece per rank (docs/summary.md)
+vtu = open(f"setup{r}/particles.vtu", "rb").read() if r == "1" else open(f"setup{r}/particles.pvtu", "rb").read()
 checks = {
   "analysis is setup": s["analysis"] == "setup",
   "same particles as the static run": s["particles"] == t["particles"],

@@ -12,15 +12,18 @@ when the second run (2 ranks) differs from the first by more than 1e-6 relative.
 """
 import json, sys
 import numpy as np
-from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
+import os
+from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader, vtkXMLUnstructuredGridReader
 from vtkmodules.util.numpy_support import vtk_to_numpy
 
 R, S, HEYWOOD, TOL = 0.05, 1.0e6, 3.03, 0.08
 
 
 def kt(run):
-    r = vtkXMLUnstructuredGridReader()
-    r.SetFileName(run + "/particles.vtu")
+    # one rank writes particles.vtu, several ranks particles.pvtu over one piece per rank
+    parallel = os.path.exists(run + "/particles.pvtu")
+    r = vtkXMLPUnstructuredGridReader() if parallel else vtkXMLUnstructuredGridReader()
+    r.SetFileName(run + ("/particles.pvtu" if parallel else "/particles.vtu"))
     r.Update()
     g = r.GetOutput()
     X = vtk_to_numpy(g.GetPoints().GetData())
