@@ -14,15 +14,8 @@ exe=$1 ex=$2
 shift 2
 mpirun=("$@")
 here=$(cd "$(dirname "$0")" && pwd)
-# python3-vtk9 is Debian's: the first python3 on PATH may be another one (pyenv, a venv)
-py=""
-for p in python3 /usr/bin/python3; do
-  if command -v "$p" > /dev/null && "$p" -c "import vtkmodules.vtkIOXML, vtkmodules.util.numpy_support" 2> /dev/null; then
-    py=$p
-    break
-  fi
-done
-[ -n "$py" ] || { echo "SKIP: VTK's Python readers are not installed (Debian python3-vtk9; bash .ci/install installs it)"; exit 77; }
+# shellcheck source=/dev/null
+source "$here/vtk_python.sh"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 unset PETSC_OPTIONS

@@ -153,6 +153,22 @@ static inline PetscInt Global(const PeriParticles *p, PetscInt k)
   return p->global ? p->global[k] : k;
 }
 
+/* The cell at offset o from cell ci, wrapped across periodic axes (wrap: the images crossed per
+ * axis), or -1 beyond a non-periodic face. */
+static PetscInt NeighborCell(const PeriParticles *p, const CellList *cl, const PetscInt ci[], const PetscInt o[], PetscInt wrap[])
+{
+  PetscInt c[3];
+  for (PetscInt d = 0; d < 3; d++) {
+    c[d]    = ci[d] + o[d];
+    wrap[d] = 0;
+    if (c[d] >= 0 && c[d] < cl->ncell[d]) continue;
+    if (!p->periodic[d]) return -1;
+    wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl->ncell[d]);
+    c[d] -= wrap[d] * cl->ncell[d];
+  }
+  return CellIndex(cl, c);
+}
+
 /* Appends the bonds of particle i (those with j >= i when half) to b. Errors on coincident
  * particles. */
 static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, PetscReal delta, PeriPartialVolume pv, PetscReal r, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
@@ -165,21 +181,8 @@ static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, 
   for (o[2] = -cl->reach[2]; o[2] <= cl->reach[2]; o[2]++)
     for (o[1] = -cl->reach[1]; o[1] <= cl->reach[1]; o[1]++)
       for (o[0] = -cl->reach[0]; o[0] <= cl->reach[0]; o[0]++) {
-        PetscInt  c[3], wrap[3] = {0, 0, 0}, cell;
-        PetscBool skip = PETSC_FALSE;
-        for (PetscInt d = 0; d < 3; d++) {
-          c[d] = ci[d] + o[d];
-          if (c[d] < 0 || c[d] >= cl->ncell[d]) {
-            if (!p->periodic[d])
-              skip = PETSC_TRUE;
-            else {
-              wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl->ncell[d]);
-              c[d] -= wrap[d] * cl->ncell[d];
-            }
-          }
-        }
-        if (skip) continue;
-        cell = CellIndex(cl, c);
+        PetscInt wrap[3], cell = NeighborCell(p, cl, ci, o, wrap);
+        if (cell < 0) continue;
         for (PetscInt s = cl->start[cell]; s < cl->start[cell + 1]; s++) {
           PetscInt  j = cl->item[s], self = (j == i);
           PetscReal x[3], len2            = 0, len, h, alpha;
@@ -284,17 +287,8 @@ static PetscBool PointNear(const PeriParticles *p, const CellList *cl, PetscReal
   for (o[2] = -cl->reach[2]; o[2] <= cl->reach[2]; o[2]++)
     for (o[1] = -cl->reach[1]; o[1] <= cl->reach[1]; o[1]++)
       for (o[0] = -cl->reach[0]; o[0] <= cl->reach[0]; o[0]++) {
-        PetscInt  c[3], wrap[3] = {0, 0, 0}, cell;
-        PetscBool skip = PETSC_FALSE;
-        for (PetscInt d = 0; d < 3; d++) {
-          c[d] = ci[d] + o[d];
-          if (c[d] >= 0 && c[d] < cl->ncell[d]) continue;
-          if (!p->periodic[d]) skip = PETSC_TRUE;
-          wrap[d] = (PetscInt)PetscFloorReal((PetscReal)c[d] / cl->ncell[d]);
-          c[d] -= wrap[d] * cl->ncell[d];
-        }
-        if (skip) continue;
-        cell = CellIndex(cl, c);
+        PetscInt wrap[3], cell = NeighborCell(p, cl, ci, o, wrap);
+        if (cell < 0) continue;
         for (PetscInt s = cl->start[cell]; s < cl->start[cell + 1]; s++) {
           PetscInt  j    = cl->item[s];
           PetscReal len2 = 0;

@@ -7,14 +7,8 @@
 set -u
 exe=$1 ex=$2
 here=$(cd "$(dirname "$0")" && pwd)
-py=""
-for p in python3 /usr/bin/python3; do
-  if command -v "$p" > /dev/null && "$p" -c "import numpy, vtkmodules.vtkIOXML" 2> /dev/null; then
-    py=$p
-    break
-  fi
-done
-[ -n "$py" ] || { echo "SKIP: VTK's Python readers are not installed (Debian python3-vtk9; bash .ci/install installs it)"; exit 77; }
+# shellcheck source=/dev/null
+source "$here/../vtk_python.sh"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
