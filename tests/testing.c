@@ -21,3 +21,65 @@ PetscErrorCode PeriTestSetOption(const char name[], const char value[])
     PetscCall(PetscOptionsClearValue(NULL, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The whole grid on every rank: positions (3 per cell), each cell's owner on size ranks and its
+ * global number (owners in rank order, each owner's cells in grid order); free with PetscFree3. */
+PetscErrorCode PeriTestGridCreate(const PeriTestGrid *c, PetscMPIInt size, PetscInt *N, PetscReal **x, PetscMPIInt **owner, PetscInt **number)
+{
+  PetscInt *fill;
+
+  PetscFunctionBeginUser;
+  *N = c->cells[0] * c->cells[1] * c->cells[2];
+  PetscCall(PetscMalloc3(3 * *N, x, *N, owner, *N, number));
+  PetscCall(PetscCalloc1(size + 1, &fill));
+  for (PetscInt k = 0; k < *N; k++) {
+    PetscInt i[3] = {k % c->cells[0], (k / c->cells[0]) % c->cells[1], k / (c->cells[0] * c->cells[1])};
+    for (PetscInt d = 0; d < 3; d++) (*x)[3 * k + d] = d < c->dim ? (i[d] + 0.5) * 0.1 : 0;
+    (*owner)[k] = (PetscMPIInt)(c->scattered ? k % size : k * size / *N);
+    fill[(*owner)[k] + 1]++;
+  }
+  for (PetscMPIInt r = 0; r < size; r++) fill[r + 1] += fill[r];
+  for (PetscInt k = 0; k < *N; k++) (*number)[k] = fill[(*owner)[k]]++;
+  PetscCall(PetscFree(fill));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Distance between two points of the grid's box, minimum image on its periodic axes. */
+PetscReal PeriTestGridDistance(const PeriTestGrid *c, const PetscReal a[], const PetscReal b[])
+{
+  PetscReal s = 0;
+  for (PetscInt d = 0; d < c->dim; d++) {
+    PetscReal L = 0.1 * c->cells[d], g = PetscAbsReal(a[d] - b[d]);
+    if (c->periodic[d]) g = PetscMin(g, L - g);
+    s += g * g;
+  }
+  return PetscSqrtReal(s);
+}
+
+/* The particles owner[] gives to rank, in the order of their global numbers: volume 1 + cell
+ * index, spacing 0.1, source_line the cell index (how a test finds a particle in the whole grid). */
+PetscErrorCode PeriTestGridOwned(const PeriTestGrid *c, PetscMPIInt rank, PetscInt N, const PetscReal x[], const PetscMPIInt owner[], PeriParticles *p)
+{
+  PetscInt n = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(p, sizeof(*p)));
+  p->dim = c->dim;
+  for (PetscInt d = 0; d < 3; d++) {
+    p->lower[d]    = 0;
+    p->upper[d]    = d < c->dim ? 0.1 * c->cells[d] : 0;
+    p->periodic[d] = c->periodic[d];
+  }
+  for (PetscInt k = 0; k < N; k++) n += owner[k] == rank;
+  PetscCall(PetscMalloc1(3 * n, &p->x));
+  PetscCall(PetscMalloc3(n, &p->volume, n, &p->spacing, n, &p->source_line));
+  for (PetscInt k = 0; k < N; k++)
+    if (owner[k] == rank) {
+      PetscCall(PetscArraycpy(&p->x[3 * p->n], &x[3 * k], 3));
+      p->volume[p->n]      = 1 + k;
+      p->spacing[p->n]     = 0.1;
+      p->source_line[p->n] = k;
+      p->n++;
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

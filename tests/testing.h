@@ -22,3 +22,16 @@ static inline PeriQuasistatic *PeriTestQuasistatic(PeriProblem p)
 {
   return p->analysis && !strcmp(p->analysis->type->name, "quasistatic") ? (PeriQuasistatic *)p->analysis->data : NULL;
 }
+
+/* Local views in unit tests (issue 17): a grid of cells[0] x cells[1] x cells[2] particles spaced
+ * 0.1 apart, owned by contiguous blocks of the x-fastest cell index or scattered (cell k on rank
+ * k mod P), every rank holding the whole grid to check against. */
+typedef struct {
+  PetscInt  dim, cells[3];
+  PetscBool periodic[3];
+  PetscBool scattered;
+} PeriTestGrid;
+
+PetscErrorCode PeriTestGridCreate(const PeriTestGrid *, PetscMPIInt, PetscInt *, PetscReal **, PetscMPIInt **, PetscInt **);
+PetscErrorCode PeriTestGridOwned(const PeriTestGrid *, PetscMPIInt, PetscInt, const PetscReal[], const PetscMPIInt[], PeriParticles *);
+PetscReal      PeriTestGridDistance(const PeriTestGrid *, const PetscReal[], const PetscReal[]);

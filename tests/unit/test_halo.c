@@ -7,72 +7,11 @@
 #include "testing.h"
 
 typedef struct {
-  PetscInt  dim, cells[3];
-  PetscBool periodic[3];
-  PetscBool scattered; /* owner of cell c: c mod P; else contiguous blocks */
-  PetscBool migrated;  /* scattered: reached by PeriParticlesMigrate from contiguous blocks */
+  PeriTestGrid g;        /* the grid and its owners (tests/testing.c) */
+  PetscBool    migrated; /* scattered: reached by PeriParticlesMigrate from contiguous blocks */
 } Case;
 
-/* The whole grid (every rank, for the brute force): positions; owners and new global numbers. */
-static PetscErrorCode Grid(const Case *c, PetscMPIInt size, PetscInt *N, PetscReal **x, PetscMPIInt **owner, PetscInt **number)
-{
-  PetscInt *fill;
-
-  PetscFunctionBeginUser;
-  *N = c->cells[0] * c->cells[1] * c->cells[2];
-  PetscCall(PetscMalloc3(3 * *N, x, *N, owner, *N, number));
-  PetscCall(PetscCalloc1(size + 1, &fill));
-  for (PetscInt k = 0; k < *N; k++) {
-    PetscInt i[3] = {k % c->cells[0], (k / c->cells[0]) % c->cells[1], k / (c->cells[0] * c->cells[1])};
-    for (PetscInt d = 0; d < 3; d++) (*x)[3 * k + d] = d < c->dim ? (i[d] + 0.5) * 0.1 : 0;
-    (*owner)[k] = (PetscMPIInt)(c->scattered ? k % size : k * size / *N);
-    fill[(*owner)[k] + 1]++;
-  }
-  for (PetscMPIInt r = 0; r < size; r++) fill[r + 1] += fill[r];
-  for (PetscInt k = 0; k < *N; k++) (*number)[k] = fill[(*owner)[k]]++;
-  PetscCall(PetscFree(fill));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscReal MinImageDistance(const Case *c, const PetscReal a[], const PetscReal b[])
-{
-  PetscReal s = 0;
-  for (PetscInt d = 0; d < c->dim; d++) {
-    PetscReal L = 0.1 * c->cells[d], g = PetscAbsReal(a[d] - b[d]);
-    if (c->periodic[d]) g = PetscMin(g, L - g);
-    s += g * g;
-  }
-  return PetscSqrtReal(s);
-}
-
-/* This rank's particles, in the order of their new global numbers. */
-static PetscErrorCode Owned(const Case *c, PetscMPIInt rank, PetscInt N, const PetscReal x[], const PetscMPIInt owner[], PeriParticles *p)
-{
-  PetscInt n = 0;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMemzero(p, sizeof(*p)));
-  p->dim = c->dim;
-  for (PetscInt d = 0; d < 3; d++) {
-    p->lower[d]    = 0;
-    p->upper[d]    = d < c->dim ? 0.1 * c->cells[d] : 0;
-    p->periodic[d] = c->periodic[d];
-  }
-  for (PetscInt k = 0; k < N; k++) n += owner[k] == rank;
-  PetscCall(PetscMalloc1(3 * n, &p->x));
-  PetscCall(PetscMalloc3(n, &p->volume, n, &p->spacing, n, &p->source_line));
-  for (PetscInt k = 0; k < N; k++)
-    if (owner[k] == rank) {
-      PetscCall(PetscArraycpy(&p->x[3 * p->n], &x[3 * k], 3));
-      p->volume[p->n]      = 1 + k;
-      p->spacing[p->n]     = 0.1;
-      p->source_line[p->n] = k;
-      p->n++;
-    }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Blocks migrated to the scattered owners must arrive as Owned() builds them: same particles, same order. */
+/* Blocks migrated to the scattered owners must arrive as PeriTestGridOwned() builds them: same particles, same order. */
 static PetscErrorCode Migrated(const Case *c, PetscMPIInt rank, PetscMPIInt size, PetscInt N, const PetscReal x[], const PetscMPIInt owner[], PeriParticles *p)
 {
   PetscMPIInt  *blocks, *target;
@@ -81,11 +20,11 @@ static PetscErrorCode Migrated(const Case *c, PetscMPIInt rank, PetscMPIInt size
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(N, &blocks));
   for (PetscInt k = 0; k < N; k++) blocks[k] = (PetscMPIInt)(k * size / N);
-  PetscCall(Owned(c, rank, N, x, blocks, p));
+  PetscCall(PeriTestGridOwned(&c->g, rank, N, x, blocks, p));
   PetscCall(PetscMalloc1(p->n, &target));
   for (PetscInt i = 0; i < p->n; i++) target[i] = owner[p->source_line[i]];
   PetscCall(PeriParticlesMigrate(PETSC_COMM_WORLD, p, target));
-  PetscCall(Owned(c, rank, N, x, owner, &q));
+  PetscCall(PeriTestGridOwned(&c->g, rank, N, x, owner, &q));
   PetscCheck(q.n == p->n, PETSC_COMM_SELF, PETSC_ERR_PLIB, "migrate: rank %d holds %" PetscInt_FMT " particles, expected %" PetscInt_FMT, rank, p->n, q.n);
   for (PetscInt i = 0; i < q.n; i++) {
     PetscBool same = (PetscBool)(q.source_line[i] == p->source_line[i] && q.volume[i] == p->volume[i] && q.spacing[i] == p->spacing[i]);
@@ -107,7 +46,7 @@ static PetscErrorCode Expected(const Case *c, PetscMPIInt rank, PetscInt N, cons
   for (PetscInt j = 0; j < N; j++) {
     PetscBool near = PETSC_FALSE;
     if (owner[j] == rank) continue;
-    for (PetscInt i = 0; i < N && !near; i++) near = (PetscBool)(owner[i] == rank && MinImageDistance(c, &x[3 * i], &x[3 * j]) <= r);
+    for (PetscInt i = 0; i < N && !near; i++) near = (PetscBool)(owner[i] == rank && PeriTestGridDistance(&c->g, &x[3 * i], &x[3 * j]) <= r);
     if (near) (*g)[(*ng)++] = number[j];
   }
   PetscCall(PetscSortInt(*ng, *g));
@@ -146,11 +85,11 @@ static PetscErrorCode RunCase(const Case *c, PetscReal r)
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
-  PetscCall(Grid(c, size, &N, &x, &owner, &number));
+  PetscCall(PeriTestGridCreate(&c->g, size, &N, &x, &owner, &number));
   if (c->migrated)
     PetscCall(Migrated(c, rank, size, N, x, owner, &p));
   else
-    PetscCall(Owned(c, rank, N, x, owner, &p));
+    PetscCall(PeriTestGridOwned(&c->g, rank, N, x, owner, &p));
   PetscCall(PeriHaloCreate(PETSC_COMM_WORLD, &p, r, &h));
   PetscCheck(h.N == N && p.n == h.nowned + h.nghost, PETSC_COMM_SELF, PETSC_ERR_PLIB, "counts: N %" PetscInt_FMT " (expected %" PetscInt_FMT "), local %" PetscInt_FMT, h.N, N, p.n);
   PetscCheck(h.nowned == 0 || number[p.source_line[0]] == h.rstart, PETSC_COMM_SELF, PETSC_ERR_PLIB, "rstart %" PetscInt_FMT, h.rstart);
@@ -159,7 +98,7 @@ static PetscErrorCode RunCase(const Case *c, PetscReal r)
   for (PetscInt k = 0; k < ng; k++) PetscCheck(g[k] == h.global[k], PETSC_COMM_SELF, PETSC_ERR_PLIB, "rank %d: ghost %" PetscInt_FMT " is %" PetscInt_FMT ", expected %" PetscInt_FMT, rank, k, h.global[k], g[k]);
   PetscCall(CheckGhostData(&p, &h, x, number));
   PetscCallMPI(MPI_Allreduce(&h.nghost, &total, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD));
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %" PetscInt_FMT "D %s%s%s, %" PetscInt_FMT " particles, radius %g: %" PetscInt_FMT " ghosts on %d ranks, as brute force\n", c->dim, c->scattered ? "scattered" : "blocks", c->migrated ? " (migrated from blocks)" : "", c->periodic[0] ? ", periodic x" : "", N, (double)r, total, size));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %" PetscInt_FMT "D %s%s%s, %" PetscInt_FMT " particles, radius %g: %" PetscInt_FMT " ghosts on %d ranks, as brute force\n", c->g.dim, c->g.scattered ? "scattered" : "blocks", c->migrated ? " (migrated from blocks)" : "", c->g.periodic[0] ? ", periodic x" : "", N, (double)r, total, size));
   PetscCall(PetscFree(g));
   PetscCall(PeriHaloDestroy(&h));
   PetscCall(PeriParticlesDestroy(&p));
@@ -170,12 +109,12 @@ static PetscErrorCode RunCase(const Case *c, PetscReal r)
 int main(int argc, char **argv)
 {
   const Case cases[] = {
-      {2, {24, 17, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE, PETSC_FALSE},
-      {2, {24, 17, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE, PETSC_FALSE},
-      {2, {13, 11, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE, PETSC_FALSE},
-      {2, {13, 11, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE, PETSC_TRUE},
-      {3, {9, 8, 7}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE, PETSC_FALSE},
-      {3, {6, 5, 7}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE, PETSC_TRUE},
+      {{2, {24, 17, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE}, PETSC_FALSE},
+      {{2, {24, 17, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE}, PETSC_FALSE},
+      {{2, {13, 11, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE}, PETSC_FALSE},
+      {{2, {13, 11, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE}, PETSC_TRUE},
+      {{3, {9, 8, 7}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE}, PETSC_FALSE},
+      {{3, {6, 5, 7}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_TRUE}, PETSC_TRUE},
   };
 
   PetscCall(PetscInitialize(&argc, &argv, NULL, NULL));

@@ -81,6 +81,12 @@ PETSC_EXTERN PetscErrorCode PeriHaloCreate(MPI_Comm, PeriParticles *, PetscReal,
 PETSC_EXTERN PetscErrorCode PeriHaloUpdate(const PeriHalo *, MPI_Datatype, const void *, void *);
 PETSC_EXTERN PetscErrorCode PeriHaloDestroy(PeriHalo *);
 
+/* ------------------------------------------------------------------ pieces (src/disc/components.c) */
+/* The connected pieces of a local view through its live links (labels: a piece's smallest global
+ * index), and per-piece totals of owned values; no array of the whole body. */
+PETSC_EXTERN PetscErrorCode PeriComponentsLabel(MPI_Comm, const PeriHalo *, const PetscInt[], const PetscInt[], const unsigned char[], PetscInt[], PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriComponentsReduce(MPI_Comm, const PeriHalo *, const PetscInt[], PetscInt, const MPI_Op[], PetscInt[], PetscInt *, PetscInt *);
+
 /* grid, particles and regions.<name>, declared next to the code that reads them. */
 PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
 
