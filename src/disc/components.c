@@ -261,12 +261,8 @@ PetscErrorCode PeriComponentsReduce(MPI_Comm comm, const PeriHalo *h, const Pets
   PetscInt   *leaf, *acc;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscLayoutCreate(comm, &layout));
-  PetscCall(PetscLayoutSetLocalSize(layout, h->nowned));
-  PetscCall(PetscLayoutSetUp(layout));
-  PetscCall(PetscSFCreate(comm, &sf));
-  PetscCall(PetscSFSetGraphLayout(sf, layout, h->nowned, NULL, PETSC_OWN_POINTER, label));
-  PetscCall(PetscSFSetUp(sf));
+  PetscCall(PetscLayoutCreateFromSizes(comm, h->nowned, PETSC_DECIDE, 1, &layout));
+  PetscCall(TargetSF(comm, layout, h->nowned, label, &sf));
   PetscCall(PetscMalloc2(h->nowned, &leaf, h->nowned, &acc));
   for (PetscInt c = 0; c < nv; c++) {
     for (PetscInt i = 0; i < h->nowned; i++) leaf[i] = values[i * nv + c];

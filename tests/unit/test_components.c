@@ -229,6 +229,7 @@ static PetscErrorCode RunCase(const Case *c, const char name[])
 int main(int argc, char **argv)
 {
   const PeriTestGrid plate = {2, {24, 16, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE}, ring = {2, {24, 17, 1}, {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE};
+  const PeriTestGrid row   = {2, {3, 1, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE}; /* 4 ranks: one owns nothing */
   const PeriTestGrid snake = {2, {16, 12, 1}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE}, cube = {3, {9, 8, 7}, {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}, PETSC_FALSE};
   const struct {
     const char *name;
@@ -241,6 +242,8 @@ int main(int argc, char **argv)
       {"cut in four equal quarters", {plate, 0, PETSC_TRUE, PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}},
       {"cut in quarters, isolated particles, 20 % killed", {plate, 0.2, PETSC_TRUE, PETSC_TRUE, PETSC_FALSE, PETSC_TRUE}},
       {"periodic ring, isolated particles, 30 % killed", {ring, 0.3, PETSC_FALSE, PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}},
+      {"three particles, pairs once or twice", {row, 0, PETSC_FALSE, PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}},
+      {"three particles, every link killed", {row, 1, PETSC_FALSE, PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}},
       {"snake through the columns", {snake, 0, PETSC_FALSE, PETSC_FALSE, PETSC_TRUE, PETSC_FALSE}},
       {"cube cut in eighths, 40 % killed", {cube, 0.4, PETSC_TRUE, PETSC_FALSE, PETSC_FALSE, PETSC_FALSE}},
       {"cube, isolated particles, 60 % killed", {cube, 0.6, PETSC_FALSE, PETSC_TRUE, PETSC_FALSE, PETSC_TRUE}},
