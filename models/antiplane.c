@@ -81,7 +81,7 @@ static PetscInt RigidModes(PeriModel m, const PetscReal X[], PetscReal modes[][P
 }
 
 /* eq. 53 for the bond-based form: g = W_CCM / W_PD for u = x and u = y, W_PD = (c mu/4) sum_j alpha x^2/|xi| V_j
- * (eq. 49), summed over both ends of this rank's bonds and then over the ranks. */
+ * (eq. 49), summed over both ends of this rank's bonds and then over the ranks holding the particle. */
 static PetscErrorCode EnergyCorrection(PeriModel m, const PeriCalibrationData *data)
 {
   Antiplane           *ap = (Antiplane *)m->data;
@@ -101,8 +101,8 @@ static PetscErrorCode EnergyCorrection(PeriModel m, const PeriCalibrationData *d
       ap->gx[j] += a * b->xi[3 * k] * b->xi[3 * k] * pt->volume[i];
       ap->gy[j] += a * b->xi[3 * k + 1] * b->xi[3 * k + 1] * pt->volume[i];
     }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ap->gx, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, data->comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ap->gy, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, data->comm));
+  PetscCall(data->combine(data, MPIU_REAL, 1, MPI_SUM, ap->gx));
+  PetscCall(data->combine(data, MPIU_REAL, 1, MPI_SUM, ap->gy));
   for (PetscInt i = 0; i < n; i++) {
     PetscCheck(ap->gx[i] > 0 && ap->gy[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "antiplane: the particle at (%g, %g) has no bond along %s, so the energy surface correction is undefined (a section one particle thin?): use corrections.surface: none or volume", (double)pt->x[3 * i], (double)pt->x[3 * i + 1], ap->gx[i] > 0 ? "y" : "x");
     /* W_CCM / W_PD = (1/2) / ((c/4) S) */

@@ -122,7 +122,7 @@ static PetscReal HorizonIntegral(PeriModel m, PetscReal (*profile)(PeriModel, Pe
 }
 
 /* the degree-2D moments of every particle's family, summed over both ends of this rank's bonds and
- * then over the ranks; mom is n x nmom */
+ * then over the ranks holding the particle; mom is n x nmom */
 static PetscErrorCode FamilyMoments(PeriModel m, const PeriCalibrationData *data, PetscInt D2, PetscReal (*profile)(PeriModel, PetscReal), PetscReal mom[])
 {
   const PeriBonds     *b    = data->bonds;
@@ -145,7 +145,7 @@ static PetscErrorCode FamilyMoments(PeriModel m, const PeriCalibrationData *data
         mom[j * nmom + q] += w * pt->volume[i] * v;
       }
     }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, mom, (PetscMPIInt)(data->n * nmom), MPIU_REAL, MPI_SUM, data->comm));
+  PetscCall(data->combine(data, MPIU_REAL, nmom, MPI_SUM, mom));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -272,14 +272,14 @@ static PetscErrorCode DampLopsided(PeriLattice lat, const PeriCalibrationData *d
       low[i] = PetscMin(low[i], Multiplier(lat, i, pw));
       low[j] = PetscMin(low[j], Multiplier(lat, j, pw));
     }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, low, (PetscMPIInt)lat->n, MPIU_REAL, MPI_MIN, data->comm));
+  PetscCall(data->combine(data, MPIU_REAL, 1, MPI_MIN, low));
   UnitPolynomial(lat, unit);
   for (PetscInt i = 0; i < lat->n; i++)
     if (low[i] < LATTICE_MIN_MU) {
       const PetscReal t = (1 - LATTICE_MIN_MU) / (1 - low[i]);
       PetscReal      *c = lat->coef + i * lat->nbasis;
       for (PetscInt k = 0; k < lat->nbasis; k++) c[k] = unit[k] + t * (c[k] - unit[k]);
-      lat->damped++;
+      if (i < data->nowned) lat->damped++;
     }
   PetscCall(PetscFree(low));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -312,14 +312,16 @@ PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, P
   PetscCall(FamilyMoments(m, data, 2 * degree, profile, mom));
   for (PetscInt i = 0; i < lat->n; i++) {
     PetscReal S;
-    if (!ParticlePolynomial(lat, mom + i * nmom, lat->coef + i * lat->nbasis, &S)) lat->kept++;
+    if (!ParticlePolynomial(lat, mom + i * nmom, lat->coef + i * lat->nbasis, &S) && i < data->nowned) lat->kept++;
     PetscCheck(S > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the particle at (%g, %g) has no bonds, so its lattice calibration is undefined (is the horizon smaller than the spacing?)", m->type, (double)data->particles->x[3 * i], (double)data->particles->x[3 * i + 1]);
     lat->scale[i] = Scont / S;
   }
   PetscCall(PetscFree(mom));
   PetscCall(DampLopsided(lat, data));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lat->kept, 1, MPIU_INT, MPI_SUM, data->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lat->damped, 1, MPIU_INT, MPI_SUM, data->comm));
   if (lat->kept || lat->damped)
-    PetscCall(PetscSNPrintf(m->warning, sizeof(m->warning), "lattice calibration: %" PetscInt_FMT " of %" PetscInt_FMT " particles (at corners and edges) are not made exactly isotropic: %" PetscInt_FMT " have too few bond directions (scale only, as npmb), %" PetscInt_FMT " take part of the correction so that no bond's multiplier falls below %g", lat->kept + lat->damped, lat->n, lat->kept, lat->damped, (double)LATTICE_MIN_MU));
+    PetscCall(PetscSNPrintf(m->warning, sizeof(m->warning), "lattice calibration: %" PetscInt_FMT " of %" PetscInt_FMT " particles (at corners and edges) are not made exactly isotropic: %" PetscInt_FMT " have too few bond directions (scale only, as npmb), %" PetscInt_FMT " take part of the correction so that no bond's multiplier falls below %g", lat->kept + lat->damped, data->N, lat->kept, lat->damped, (double)LATTICE_MIN_MU));
   *lattice = lat;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -7,7 +7,7 @@
 
 typedef struct {
   PetscInt    n;
-  PetscReal  *c;   /* per particle (global index) */
+  PetscReal  *c;   /* per particle of the local view */
   PeriLattice lat; /* model.calibration: lattice (which then holds the normalization), else NULL */
 } NPMB;
 

@@ -290,7 +290,7 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   PeriSystem sys = p->sys;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->disc.particles.n, sys->log.nbonds_total, sys->disc.particles.n * sys->model->dofs, p->size));
+  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->disc.N, sys->log.nbonds_total, sys->disc.N * sys->model->dofs, p->size));
   if (sys->solve.ksp_type[0])
     PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.assembly_s, sys->log.solve_s, sys->solve.ksp_type, sys->solve.pc_type, sys->op ? " matrix-free" : "", sys->solve.iterations, sys->solve.converged_reason, (double)sys->solve.residual_norm, sys->log.memory_mb));
   else

@@ -83,3 +83,24 @@ PetscErrorCode PeriTestGridOwned(const PeriTestGrid *c, PetscMPIInt rank, PetscI
     }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The least-squares slope of v against s over the n points where mask holds (NULL: all) of every
+ * rank of comm: each rank's sums, then theirs. */
+PetscErrorCode PeriTestSlope(MPI_Comm comm, PetscInt n, const PetscReal s[], PetscInt sstride, const PetscReal v[], PetscInt vstride, const PetscBool mask[], PetscReal *slope)
+{
+  PetscReal m[5] = {0, 0, 0, 0, 0}; /* count, sum s, sum v, sum s^2, sum s v */
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < n; k++) {
+    const PetscReal x = s[k * sstride], y = v[k * vstride];
+    if (mask && !mask[k]) continue;
+    m[0] += 1;
+    m[1] += x;
+    m[2] += y;
+    m[3] += x * x;
+    m[4] += x * y;
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, m, 5, MPIU_REAL, MPI_SUM, comm));
+  *slope = (m[0] * m[4] - m[1] * m[2]) / (m[0] * m[3] - m[1] * m[1]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -12,6 +12,7 @@
 
 PetscErrorCode PeriTestRunScene(MPI_Comm, const char[], PeriProblem *);
 PetscErrorCode PeriTestSetOption(const char[], const char[]);
+PetscErrorCode PeriTestSlope(MPI_Comm, PetscInt, const PetscReal[], PetscInt, const PetscReal[], PetscInt, const PetscBool[], PetscReal *);
 
 /* The analysis' results (its data) when the problem ran an analysis of that type, else NULL. */
 static inline PeriModal *PeriTestModal(PeriProblem p)

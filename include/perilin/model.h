@@ -4,16 +4,24 @@
 
 #include <perilin/scene.h>
 
-/* What calibration may use besides the material: the discrete family volumes sum_j alpha_ij V_j. */
-typedef struct {
-  PetscInt              n;
+/* What calibration may use besides the material: the discrete family volumes sum_j alpha_ij V_j.
+ * The arrays cover the rank's local view: particles 0..nowned-1 are its own, the rest (to n) copies
+ * of other ranks' particles within a horizon of them (ghosts). */
+typedef struct PeriCalibrationData_s PeriCalibrationData;
+struct PeriCalibrationData_s {
+  PetscInt              n, nowned, N; /* local view, owned, whole body */
   const PetscReal      *family_volume;
   const PetscReal      *mu; /* shear modulus per particle (material.mu_by_region), or NULL: uniform */
   MPI_Comm              comm;
   const PeriParticles  *particles;
-  const PeriBonds      *bonds; /* this rank's bonds, for corrections computed from the family */
+  const PeriBonds      *bonds; /* this rank's bonds (rows: owned particles; j: local indices) */
   PeriSurfaceCorrection surface;
-} PeriCalibrationData;
+  /* Combines, with op, the values (count of type base per local particle) that the ranks holding a
+     particle accumulated for it, and leaves the result on every copy: what a sum over the ends of
+     this rank's bonds needs to become the particle's own. Collective. */
+  PetscErrorCode (*combine)(const PeriCalibrationData *, MPI_Datatype base, PetscInt count, MPI_Op op, void *values);
+  const void *ctx;
+};
 
 typedef struct _p_PeriModel *PeriModel;
 

@@ -118,7 +118,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, PetscInt *nev, PetscReal *ta
 /* The owned DOFs that are not prescribed. */
 static PetscErrorCode FreeDOFs(PeriAnalysis an, IS *is)
 {
-  const PetscInt bs = an->sys->model->dofs, nloc = (an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart) * bs, r0 = an->sys->disc.bonds.rstart * bs;
+  const PetscInt bs = an->sys->model->dofs, nloc = (an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart) * bs, r0 = an->sys->disc.rstart * bs; /* r0: the first owned global row */
   PetscInt      *idx, n = 0, c = 0;
 
   PetscFunctionBeginUser;

@@ -154,21 +154,16 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
  * softened by more than 1 %. */
 static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *nbroken)
 {
-  PeriBonds         *b  = &an->sys->disc.bonds;
-  PeriModel          m  = an->sys->model;
-  const PetscInt     bs = m->dofs;
-  VecScatter         scatter;
-  Vec                all;
-  const PetscScalar *u;
-  PeriFailureCause  *cause;
-  PetscReal         *index, *soft, worst = 0, threshold = 1;
-  PetscInt           mine = 0;
+  PeriBonds        *b  = &an->sys->disc.bonds;
+  PeriModel         m  = an->sys->model;
+  const PetscInt    bs = m->dofs;
+  PetscScalar      *u;
+  PeriFailureCause *cause;
+  PetscReal        *index, *soft, worst = 0, threshold = 1;
+  PetscInt          mine = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecScatterCreateToAll(an->sys->u, &scatter, &all));
-  PetscCall(VecScatterBegin(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecGetArrayRead(all, &u));
+  PetscCall(PeriSystemLocalDOFs(an->sys, an->sys->u, &u));
   PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
@@ -186,9 +181,7 @@ static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *
       soft[k]  = b->intact ? PeriBondSoftening(an->sys, meas) : 1;
       worst    = PetscMax(worst, index[k]);
     }
-  PetscCall(VecRestoreArrayRead(all, &u));
-  PetscCall(VecDestroy(&all));
-  PetscCall(VecScatterDestroy(&scatter));
+  PetscCall(PetscFree(u));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, an->comm));
   /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
   if (!st->all && worst > 1) threshold = worst - st->fraction * (worst - 1);
@@ -251,9 +244,9 @@ static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscInt c
   PetscFunctionBeginUser;
   *v = 0;
   if (!probe) PetscFunctionReturn(PETSC_SUCCESS);
-  row = probe->particle * an->sys->model->dofs + component;
-  if (an->sys->disc.owner[probe->particle] == an->rank) {
+  if (probe->rank == an->rank) {
     PetscScalar x;
+    row = (an->sys->disc.rstart + probe->particle) * an->sys->model->dofs + component;
     PetscCall(VecGetValues(an->sys->u, 1, &row, &x));
     *v = PetscRealPart(x);
   }
@@ -568,19 +561,14 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
  * Collective. */
 static PetscErrorCode NextEvent(PeriAnalysis an, PetscReal lam, PetscReal *next)
 {
-  PeriBonds         *b  = &an->sys->disc.bonds;
-  PeriModel          m  = an->sys->model;
-  const PetscInt     bs = m->dofs;
-  VecScatter         scatter;
-  Vec                all;
-  const PetscScalar *u;
+  PeriBonds     *b  = &an->sys->disc.bonds;
+  PeriModel      m  = an->sys->model;
+  const PetscInt bs = m->dofs;
+  PetscScalar   *u;
 
   PetscFunctionBeginUser;
   *next = PETSC_INFINITY;
-  PetscCall(VecScatterCreateToAll(an->sys->u, &scatter, &all));
-  PetscCall(VecScatterBegin(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(scatter, an->sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecGetArrayRead(all, &u));
+  PetscCall(PeriSystemLocalDOFs(an->sys, an->sys->u, &u));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PeriBondGeometry g;
@@ -594,9 +582,7 @@ static PetscErrorCode NextEvent(PeriAnalysis an, PetscReal lam, PetscReal *next)
       m->ops.bond_measures(m, &g, ui, uj, meas);
       *next = PetscMin(*next, PeriBondCriticalLoad(an->sys, &g, meas, m->nmeasures));
     }
-  PetscCall(VecRestoreArrayRead(all, &u));
-  PetscCall(VecDestroy(&all));
-  PetscCall(VecScatterDestroy(&scatter));
+  PetscCall(PetscFree(u));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, next, 1, MPIU_REAL, MPI_MIN, an->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

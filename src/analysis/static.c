@@ -16,7 +16,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Allreduce(&an->sys->nconstrained, &nc, 1, MPIU_INT, MPI_SUM, an->comm));
-  if (nc == an->sys->disc.particles.n * an->sys->model->dofs) {
+  if (nc == an->sys->disc.N * an->sys->model->dofs) {
     /* every DOF prescribed: the solution is known, K is not needed */
     PetscCall(VecDestroy(&an->sys->u));
     PetscCall(PeriSystemCreateVec(an->sys, &an->sys->u));

@@ -6,10 +6,14 @@ const char *const PeriSurfaceCorrections[] = {"none", "volume", "energy", NULL};
 
 /*@C
   PeriNeighborhoodVolumes - family volume sum_j alpha_ij V_j (the particle itself excluded) and
-  neighbour count of every particle, summed over the ranks' bonds. Collective.
+  neighbour count of every particle of the local view: each rank sums its bonds into both ends,
+  the ghosts' sums reach their owners, and the owners' totals return to the ghosts. Collective.
 @*/
-PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm comm, const PeriParticles *p, const PeriBonds *b, PetscReal family[], PetscInt count[])
+PetscErrorCode PeriNeighborhoodVolumes(const PeriDisc *d, PetscReal family[], PetscInt count[])
 {
+  const PeriParticles *p = &d->particles;
+  const PeriBonds     *b = &d->bonds;
+
   PetscFunctionBeginUser;
   PetscCall(PetscArrayzero(family, p->n));
   PetscCall(PetscArrayzero(count, p->n));
@@ -23,8 +27,10 @@ PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm comm, const PeriParticles *p, co
       count[i]++;
       count[j]++;
     }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, family, (PetscMPIInt)p->n, MPIU_REAL, MPI_SUM, comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, count, (PetscMPIInt)p->n, MPIU_INT, MPI_SUM, comm));
+  PetscCall(PeriDiscGhostsToOwners(d, MPIU_REAL, 1, MPI_SUM, family));
+  PetscCall(PeriDiscGhostsToOwners(d, MPIU_INT, 1, MPI_SUM, count));
+  PetscCall(PeriDiscOwnersToGhosts(d, MPIU_REAL, 1, family));
+  PetscCall(PeriDiscOwnersToGhosts(d, MPIU_INT, 1, count));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -120,6 +120,25 @@ static PetscErrorCode ExchangeDestroy(Exchange *ex)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Fictitious layer particles (src/system/layers.c): the ghosts' mirror images (global indices)
+ * and crossed faces, from their owners. */
+static PetscErrorCode AppendLayerImages(PeriParticles *p, const PeriHalo *h)
+{
+  PetscInt      *image;
+  unsigned char *crossed;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc2(h->nowned + h->nghost, &image, h->nowned + h->nghost, &crossed));
+  PetscCall(PetscArraycpy(image, p->image, h->nowned));
+  PetscCall(PetscArraycpy(crossed, p->crossed, h->nowned));
+  PetscCall(PeriHaloUpdate(h, MPIU_INT, image, image + h->nowned));
+  PetscCall(PeriHaloUpdate(h, MPI_UNSIGNED_CHAR, crossed, crossed + h->nowned));
+  PetscCall(PetscFree2(p->image, p->crossed));
+  p->image   = image;
+  p->crossed = crossed;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Appends the kept candidates to p as ghosts (positions as received, the rest through the SF). */
 static PetscErrorCode AppendGhosts(PeriParticles *p, const PeriHalo *h, const PetscReal y[], const PetscInt kept[])
 {
@@ -141,6 +160,7 @@ static PetscErrorCode AppendGhosts(PeriParticles *p, const PeriHalo *h, const Pe
   PetscCall(PeriHaloUpdate(h, MPIU_INT, line, line + h->nowned));
   PetscCall(PetscFree(p->x));
   PetscCall(PetscFree3(p->volume, p->spacing, p->source_line));
+  if (p->image) PetscCall(AppendLayerImages(p, h));
   PetscCall(PetscFree(p->global));
   PetscCall(PetscMalloc1(n, &p->global));
   for (PetscInt i = 0; i < h->nowned; i++) p->global[i] = h->rstart + i;

@@ -467,6 +467,31 @@ PetscErrorCode PeriMeshRead(PeriScene scene, PeriNode node, PetscInt dim, PetscR
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriMeshGroupsRestrict - keeps of each group of p the positions of p's own particles: once p is a
+  rank's local view, the rest of the body's group is never asked for (a group may be the whole
+  body). The positions stay sorted. Not collective.
+@*/
+PetscErrorCode PeriMeshGroupsRestrict(PeriParticles *p)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt g = 0; g < p->ngroups; g++) {
+    PeriMeshGroup *grp = &p->groups[g];
+    PetscBool     *keep;
+    PetscInt       m = 0;
+    PetscCall(PetscCalloc1(grp->count, &keep));
+    for (PetscInt i = 0; i < p->n; i++) {
+      const PetscReal *hit = (const PetscReal *)bsearch(&p->x[3 * i], grp->x, (size_t)grp->count, 3 * sizeof(PetscReal), ComparePositions);
+      if (hit) keep[(hit - grp->x) / 3] = PETSC_TRUE;
+    }
+    for (PetscInt k = 0; k < grp->count; k++)
+      if (keep[k]) PetscCall(PetscArraymove(&grp->x[3 * m++], &grp->x[3 * k], 3));
+    grp->count = m;
+    PetscCall(PetscFree(keep));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriMeshGroupsDestroy(PetscInt *ngroups, PeriMeshGroup **groups)
 {
   PetscFunctionBeginUser;

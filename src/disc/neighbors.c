@@ -201,7 +201,7 @@ static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, 
           alpha = PeriPartialVolumeFactor(pv, len, delta, h);
           if (alpha <= 0) continue;
           PetscCall(BondsReserve(b, b->nbonds + 1, cap));
-          b->j[b->nbonds] = Global(p, j);
+          b->j[b->nbonds] = j;
           for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
           b->length[b->nbonds] = len;
           b->alpha[b->nbonds]  = alpha;
@@ -218,8 +218,8 @@ static PetscErrorCode ParticlesBox(const PeriParticles *, PetscReal, PetscReal[]
   PeriNeighborSearch - finds the bonds of particles rstart..rend-1 of p with cell lists. With half,
   each pair is stored once, in the row of its smaller global index; otherwise every neighbour is
   listed (the graph for partitioning). p may be the whole body or a rank's local view (owned
-  particles rstart..rend-1, then ghosts): the bonds' j and b->rstart, b->rend are global indices
-  either way. Not collective. Errors on coincident particles.
+  particles, then ghosts): the bonds' rows and j are indices into p (p->global maps them to global
+  indices). Not collective. Errors on coincident particles.
 @*/
 PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
 {
@@ -244,8 +244,8 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
     for (PetscInt k = 0; k < p->n; k++) vmean += p->volume[k] / p->n;
     PetscCall(BondsReserve(b, (PetscInt)(1.05 * (rend - rstart) * ball / vmean / (half ? 2 : 1)) + 16, &cap));
   }
-  b->rstart = rend > rstart ? Global(p, rstart) : 0;
-  b->rend   = b->rstart + rend - rstart; /* a rank's owned particles are numbered contiguously */
+  b->rstart = rstart;
+  b->rend   = rend;
   PetscCall(PetscMalloc1(rend - rstart + 1, &b->offset));
   b->offset[0] = 0;
   /* coincident particles are an input error: the cell list is freed before it is passed on */

@@ -347,8 +347,8 @@ PetscErrorCode PeriParticlesPermute(PeriParticles *p, const PetscInt perm[])
 
 /*@C
   PeriParticlesSlice - q holds copies of particles rstart..rend-1 of p and p's description of the
-  body (box, periodic axes, thickness, mean spacing), no layers and no mesh groups: the owned part
-  of a rank's local view. Not collective.
+  body (box, periodic axes, thickness, mean spacing), with their layer images (global indices) but
+  no mesh groups: the owned part of a rank's local view. Not collective.
 @*/
 PetscErrorCode PeriParticlesSlice(const PeriParticles *p, PetscInt rstart, PetscInt rend, PeriParticles *q)
 {
@@ -367,6 +367,12 @@ PetscErrorCode PeriParticlesSlice(const PeriParticles *p, PetscInt rstart, Petsc
   PetscCall(PetscArraycpy(q->volume, &p->volume[rstart], rend - rstart));
   PetscCall(PetscArraycpy(q->spacing, &p->spacing[rstart], rend - rstart));
   PetscCall(PetscArraycpy(q->source_line, &p->source_line[rstart], rend - rstart));
+  if (p->image) { /* the images stay global indices */
+    PetscCall(PetscMalloc2(rend - rstart, &q->image, rend - rstart, &q->crossed));
+    PetscCall(PetscArraycpy(q->image, &p->image[rstart], rend - rstart));
+    PetscCall(PetscArraycpy(q->crossed, &p->crossed[rstart], rend - rstart));
+    q->nfictitious = p->nfictitious;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

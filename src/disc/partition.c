@@ -111,6 +111,7 @@ static PetscErrorCode BlockGraph(MPI_Comm comm, const PeriParticles *p, PetscInt
   PetscCall(PeriParticlesSlice(p, rstart, rend, &local));
   PetscCall(PeriHaloCreate(comm, &local, PeriSearchRadius(PERI_PARTIAL_VOLUME_NONE, radius, hmax), &halo));
   PetscCall(PeriNeighborSearch(&local, radius, PERI_PARTIAL_VOLUME_NONE, 0, n, PETSC_FALSE, &g));
+  for (PetscInt k = 0; k < g.nbonds; k++) g.j[k] = local.global[g.j[k]]; /* MatCreateMPIAdj's columns are global */
   PetscCall(PeriHaloDestroy(&halo));
   PetscCall(PeriParticlesDestroy(&local));
   PetscCall(GraphCompact(n, g.offset, g.j));

@@ -131,12 +131,6 @@ static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const Peri
     for (PetscInt d = 0; d < dim; d++)
       if (d != r->axis) r->face_area *= p->upper[d] - p->lower[d];
   }
-  for (PetscInt k = 0; k < p->n; k++)
-    if (PeriRegionContains(r, &p->x[3 * k])) {
-      r->count++;
-      r->volume += p->volume[k];
-    }
-  PeriInputCheck(r->count > 0, scene, node, NULL, "the region holds no particle");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -150,19 +144,39 @@ static PetscErrorCode RegionsFromGroups(PeriScene scene, const PeriParticles *p,
     PetscCall(PetscStrncpy(rg->name, p->groups[g].name, sizeof(rg->name)));
     rg->node = scene->root;
     RegionFromGroup(&p->groups[g], PeriRegionTolerance(p), rg);
-    for (PetscInt k = 0; k < p->n; k++)
-      if (PeriRegionContains(rg, &p->x[3 * k])) {
-        rg->count++;
-        rg->volume += p->volume[k];
-      }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The particles and volume of every region: the owned particles 0..nowned-1 of p, summed over the
+ * ranks ("all": the body's, not the fictitious layers'). A region of the scene must hold one. */
+static PetscErrorCode RegionsCount(MPI_Comm comm, PeriScene scene, const PeriParticles *p, PetscInt nowned, PetscInt n, PeriRegion r[], PetscInt first)
+{
+  PetscReal *sums;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(2 * n, &sums));
+  for (PetscInt k = 0; k < nowned; k++)
+    for (PetscInt g = 0; g < n; g++)
+      if (g ? PeriRegionContains(&r[g], &p->x[3 * k]) : !PeriParticleIsFictitious(p, k)) {
+        sums[2 * g] += 1;
+        sums[2 * g + 1] += p->volume[k];
+      }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sums, (PetscMPIInt)(2 * n), MPIU_REAL, MPI_SUM, comm));
+  for (PetscInt g = 0; g < n; g++) {
+    r[g].count  = (PetscInt)sums[2 * g];
+    r[g].volume = sums[2 * g + 1];
+    PeriInputCheck(g < first || r[g].count > 0, scene, r[g].node, NULL, "the region holds no particle");
+  }
+  PetscCall(PetscFree(sums));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriRegionsCreateFromScene - reads the regions map; region "all" always exists. Not collective.
+  PeriRegionsCreateFromScene - reads the regions map; region "all" always exists. p is a rank's
+  local view, whose owned particles 0..nowned-1 the counts sum. Collective.
 @*/
-PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *p, PetscReal delta, PetscInt *nregions, PeriRegion **regions)
+PetscErrorCode PeriRegionsCreateFromScene(MPI_Comm comm, PeriScene scene, const PeriParticles *p, PetscInt nowned, PetscReal delta, PetscInt *nregions, PeriRegion **regions)
 {
   PeriNode    map;
   PetscInt    n;
@@ -178,11 +192,6 @@ PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *
     r[0].lower[d] = p->lower[d] - PeriRegionTolerance(p);
     r[0].upper[d] = p->upper[d] + PeriRegionTolerance(p);
   }
-  for (PetscInt k = 0; k < p->n; k++)
-    if (!PeriParticleIsFictitious(p, k)) {
-      r[0].count++;
-      r[0].volume += p->volume[k];
-    }
   PetscCall(RegionsFromGroups(scene, p, r));
   for (PetscInt k = 1 + p->ngroups; k < n; k++) {
     PeriNode node = map->child[k - 1 - p->ngroups];
@@ -190,6 +199,7 @@ PetscErrorCode PeriRegionsCreateFromScene(PeriScene scene, const PeriParticles *
     for (PetscInt g = 0; g < p->ngroups; g++) PeriInputCheck(strcmp(node->key, p->groups[g].name), scene, node, NULL, "'%s' is a physical group of particles.mesh already, and so a region: name this one otherwise", node->key);
     PetscCall(RegionFromScene(scene, node, p, delta, &r[k]));
   }
+  PetscCall(RegionsCount(comm, scene, p, nowned, n, r, 1 + p->ngroups));
   *nregions = n;
   *regions  = r;
   PetscFunctionReturn(PETSC_SUCCESS);

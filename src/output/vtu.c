@@ -129,6 +129,17 @@ PetscErrorCode PeriFieldListAddInt(PeriFieldList fl, const char name[], const Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* An integer field of one value at every particle (Int32). */
+PetscErrorCode PeriFieldListAddIntConstant(PeriFieldList fl, const char name[], PetscInt value)
+{
+  VTUArray *a = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(FieldListPush(fl, VTU_POINT_DATA, name, VTU_INT32, 1, &a));
+  a->first = value;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriFieldListAddSolution - the DOFs u (dofs per particle, named components[]) as fields: ux, uy,
   uz as one vector "displacement" (none when the model has no translation: a zero vector would
@@ -173,10 +184,11 @@ static PetscErrorCode VTUFill(const VTUArray *a, PetscInt n, void *buf)
       case VTU_FLOAT64:
         ((double *)buf)[k] = a->map[c] < 0 ? 0.0 : (double)a->real[i * a->stride + a->map[c]];
         break;
-      case VTU_INT32:
-        PetscCheck(a->ints[i] >= INT32_MIN && a->ints[i] <= INT32_MAX, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "VTU array %s: value %" PetscInt_FMT " of particle %" PetscInt_FMT " does not fit in Int32", a->name, a->ints[i], i);
-        ((int32_t *)buf)[k] = (int32_t)a->ints[i];
-        break;
+      case VTU_INT32: {
+        const PetscInt v = a->ints ? a->ints[i] : (PetscInt)a->first; /* no array: the constant first */
+        PetscCheck(v >= INT32_MIN && v <= INT32_MAX, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "VTU array %s: value %" PetscInt_FMT " of particle %" PetscInt_FMT " does not fit in Int32", a->name, v, i);
+        ((int32_t *)buf)[k] = (int32_t)v;
+      } break;
       case VTU_INT64:
         ((int64_t *)buf)[k] = a->first + (int64_t)i;
         break;

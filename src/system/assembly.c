@@ -29,16 +29,16 @@ static PetscInt RowPartners(const PeriBonds *b, const BondFilter *f, PetscInt i,
 
 /* Block counts per owned row: diagonal/off-diagonal part, and their upper-triangular share for
  * SBAIJ. Row i sees its stored partners (j > i, upper) and the particles that store a bond to i
- * (lower), which may live on other ranks: counts for those are summed with MPI_Reduce_scatter. */
+ * (lower): those on other ranks count i as a ghost, and their counts reach i's owner through the
+ * halo. */
 static PetscErrorCode Preallocation(PeriSystem sys, const BondFilter *f, PetscInt **dnz, PetscInt **onz, PetscInt **dnzu, PetscInt **onzu)
 {
   const PeriBonds *b = &sys->disc.bonds;
   const PetscInt   n = sys->disc.particles.n, nloc = b->rend - b->rstart;
   PetscInt        *cnt, *buf, maxrow = 0;
-  PetscMPIInt     *recv;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc1(2 * n, &cnt)); /* [diag | offdiag] counts of every global row */
+  PetscCall(PetscCalloc1(2 * n, &cnt)); /* (diag, offdiag) counts of every local particle's row */
   PetscCall(PetscMalloc4(nloc, dnz, nloc, onz, nloc, dnzu, nloc, onzu));
   for (PetscInt i = b->rstart; i < b->rend; i++) maxrow = PetscMax(maxrow, b->offset[i - b->rstart + 1] - b->offset[i - b->rstart]);
   PetscCall(PetscMalloc1(maxrow + 1, &buf));
@@ -46,37 +46,24 @@ static PetscErrorCode Preallocation(PeriSystem sys, const BondFilter *f, PetscIn
     PetscInt m = RowPartners(b, f, i, buf), du = 1, ou = 0;
     for (PetscInt k = 0; k < m; k++) {
       PetscInt  j    = buf[k];
-      PetscBool same = (PetscBool)(sys->disc.owner[j] == sys->rank);
+      PetscBool same = (PetscBool)(j < sys->disc.nowned);
       if (same)
         du++;
       else
         ou++;
-      cnt[(same ? 0 : n) + j]++; /* row j, column i */
+      cnt[2 * j + (same ? 0 : 1)]++; /* row j, column i */
     }
     (*dnzu)[i - b->rstart] = du;
     (*onzu)[i - b->rstart] = ou;
-    cnt[i] += du;
-    cnt[n + i] += ou;
+    cnt[2 * i] += du;
+    cnt[2 * i + 1] += ou;
   }
   PetscCall(PetscFree(buf));
-  /* owners hold contiguous ranges, so the rows in global order are already grouped by rank */
-  PetscCall(PetscCalloc1(sys->size, &recv));
-  for (PetscInt i = 0; i < n; i++) recv[sys->disc.owner[i]] += 2;
-  {
-    PetscInt *mine, *sendbuf;
-    PetscCall(PetscMalloc2(2 * nloc, &mine, 2 * n, &sendbuf));
-    for (PetscInt i = 0; i < n; i++) {
-      sendbuf[2 * i]     = cnt[i];
-      sendbuf[2 * i + 1] = cnt[n + i];
-    }
-    PetscCallMPI(MPI_Reduce_scatter(sendbuf, mine, recv, MPIU_INT, MPI_SUM, sys->comm));
-    for (PetscInt i = 0; i < nloc; i++) {
-      (*dnz)[i] = mine[2 * i];
-      (*onz)[i] = mine[2 * i + 1];
-    }
-    PetscCall(PetscFree2(mine, sendbuf));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_INT, 2, MPI_SUM, cnt));
+  for (PetscInt i = 0; i < nloc; i++) {
+    (*dnz)[i] = cnt[2 * i];
+    (*onz)[i] = cnt[2 * i + 1];
   }
-  PetscCall(PetscFree(recv));
   PetscCall(PetscFree(cnt));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -102,12 +89,13 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
   const PetscInt    bs = m->dofs, nmax = PeriSystemMaxFamily(sys);
   PeriBondGeometry *fam;
   PetscReal        *Ke, *work;
-  PetscInt         *idx;
+  PetscInt         *idx, *gidx;
   PeriElement       el;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc4(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, 2 * (nmax + 1) * bs, &work, nmax + 1, &idx));
+  PetscCall(PetscMalloc5(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, 2 * (nmax + 1) * bs, &work, nmax + 1, &idx, nmax + 1, &gidx));
   el.idx    = idx;
+  el.gidx   = gidx;
   el.nshare = 1;
   el.K      = Ke;
   el.g      = fam;
@@ -118,10 +106,11 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
     PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
     idx[0] = i;
     for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
+    for (PetscInt t = 0; t <= n; t++) gidx[t] = sys->disc.particles.global[idx[t]];
     el.n = n + 1;
     PetscCall((*fn)(sys, &el, ctx));
   }
-  PetscCall(PetscFree4(fam, Ke, work, idx));
+  PetscCall(PetscFree5(fam, Ke, work, idx, gidx));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -132,9 +121,9 @@ static PetscErrorCode BondsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
   const PeriBonds *b = &sys->disc.bonds;
   PeriModel        m = sys->model;
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], work[4 * PERI_MAX_DOF];
-  PetscInt         idx[2];
+  PetscInt         idx[2], gidx[2];
   PeriBondGeometry g;
-  PeriElement      el = {2, idx, 2, Ke, &g, work};
+  PeriElement      el = {2, idx, gidx, 2, Ke, &g, work};
 
   PetscFunctionBeginUser;
   for (PetscInt i = b->rstart; i < b->rend; i++)
@@ -142,14 +131,16 @@ static PetscErrorCode BondsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
       if (!b->live[k] || b->j[k] == i) continue;
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
-      idx[0] = i;
-      idx[1] = g.j;
+      idx[0]  = i;
+      idx[1]  = g.j;
+      gidx[0] = sys->disc.particles.global[i];
+      gidx[1] = sys->disc.particles.global[g.j];
       PetscCall((*fn)(sys, &el, ctx));
     }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The element's DOFs u_e (all particles' DOFs u, global numbering) into el->work[0, N) and its
+/* The element's DOFs u_e (u: the DOFs of the local view, PeriSystemLocalDOFs) into el->work[0, N) and its
  * forces f = K_e u_e into el->work[N, 2N), N = el->n dofs: what the stress and the reactions of an
  * element share. */
 void PeriElementForces(PeriSystem sys, const PeriElement *el, const PetscScalar u[])
@@ -184,7 +175,7 @@ static PetscErrorCode InsertElement(PeriSystem sys, const PeriElement *el, void 
 {
   PetscFunctionBeginUser;
   (void)sys;
-  PetscCall(MatSetValuesBlocked((Mat)ctx, el->n, el->idx, el->n, el->idx, el->K, ADD_VALUES));
+  PetscCall(MatSetValuesBlocked((Mat)ctx, el->n, el->gidx, el->n, el->gidx, el->K, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -206,7 +197,7 @@ static PetscErrorCode CreateBlockMatrix(PeriSystem sys, MatType type, Mat *K)
 
   PetscFunctionBeginUser;
   PetscCall(MatCreate(sys->comm, K));
-  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->disc.particles.n * bs, sys->disc.particles.n * bs));
+  PetscCall(MatSetSizes(*K, nloc * bs, nloc * bs, sys->disc.N * bs, sys->disc.N * bs));
   PetscCall(MatSetBlockSize(*K, bs));
   PetscCall(MatSetType(*K, type));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -319,7 +310,7 @@ static PetscErrorCode GatherBondRow(PeriSystem sys, const BondFilter *f, const I
 {
   const PeriBonds *b  = &sys->disc.bonds;
   PeriModel        m  = sys->model;
-  const PetscInt   bs = m->dofs, nb = 2 * bs, rstart = b->rstart;
+  const PetscInt   bs = m->dofs, nb = 2 * bs, rstart = b->rstart, *G = sys->disc.particles.global;
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
   PeriBondGeometry g;
 
@@ -335,9 +326,9 @@ static PetscErrorCode GatherBondRow(PeriSystem sys, const BondFilter *f, const I
     PetscCall(BondBlock(sys, f, i, k, &g, Ke));
     RowAdd(bs, i, &Ke[0], nb, w->slot, w->col, w->blocks, &w->ncol);
     RowAdd(bs, j, &Ke[bs], nb, w->slot, w->col, w->blocks, &w->ncol);
-    if (sys->disc.owner[j] != sys->rank) {
-      PetscInt idx[2] = {i, j};
-      PetscCall(MatSetValuesBlocked(K, 1, &j, 2, idx, &Ke[bs * nb], ADD_VALUES));
+    if (j >= sys->disc.nowned) { /* row j is another rank's */
+      PetscInt idx[2] = {G[i], G[j]};
+      PetscCall(MatSetValuesBlocked(K, 1, &idx[1], 2, idx, &Ke[bs * nb], ADD_VALUES));
     }
   }
   for (PetscInt t = in->ptr[i - rstart]; t < in->ptr[i - rstart + 1]; t++) {
@@ -348,21 +339,24 @@ static PetscErrorCode GatherBondRow(PeriSystem sys, const BondFilter *f, const I
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Inserts the gathered row i with one call, its columns sorted (the insertion is then a merge),
- * and clears the slots for the next row. */
-static PetscErrorCode InsertRow(PetscInt bs, PetscInt i, RowBuffer *w, Mat K)
+/* Inserts the gathered row i with one call, its columns in global numbering and sorted (the
+ * insertion is then a merge), and clears the slots for the next row. */
+static PetscErrorCode InsertRow(PetscInt bs, const PetscInt G[], PetscInt i, RowBuffer *w, Mat K)
 {
   const PetscInt ncol = w->ncol;
 
   PetscFunctionBeginUser;
-  for (PetscInt c = 0; c < ncol; c++) w->perm[c] = c;
-  PetscCall(PetscSortIntWithArray(ncol, w->col, w->perm));
   for (PetscInt c = 0; c < ncol; c++) {
     w->slot[w->col[c]] = -1;
+    w->col[c]          = G[w->col[c]];
+    w->perm[c]         = c;
+  }
+  PetscCall(PetscSortIntWithArray(ncol, w->col, w->perm));
+  for (PetscInt c = 0; c < ncol; c++) {
     for (PetscInt a = 0; a < bs; a++)
       for (PetscInt e = 0; e < bs; e++) w->row[a * ncol * bs + c * bs + e] = w->blocks[w->perm[c] * bs * bs + a * bs + e];
   }
-  PetscCall(MatSetValuesBlocked(K, 1, &i, ncol, w->col, w->row, ADD_VALUES));
+  PetscCall(MatSetValuesBlocked(K, 1, &G[i], ncol, w->col, w->row, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -383,7 +377,7 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, const BondFilter *f, Mat *K)
   PetscCall(PetscMalloc4(maxcol, &w.col, maxcol, &w.perm, maxcol * bs * bs, &w.blocks, maxcol * bs * bs, &w.row));
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     PetscCall(GatherBondRow(sys, f, &in, i, &w, *K));
-    PetscCall(InsertRow(bs, i, &w, *K));
+    PetscCall(InsertRow(bs, sys->disc.particles.global, i, &w, *K));
   }
   PetscCall(PetscFree4(w.col, w.perm, w.blocks, w.row));
   PetscCall(PetscFree(w.slot));
@@ -438,8 +432,8 @@ PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pe
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(BondBlock(sys, &change, i, k, &g, Ke)); /* the change of the bond's block */
-  idx[0] = i;
-  idx[1] = g.j;
+  idx[0] = sys->disc.particles.global[i];
+  idx[1] = sys->disc.particles.global[g.j];
   PetscCall(MatSetValuesBlocked(sys->K, 2, idx, 2, idx, Ke, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

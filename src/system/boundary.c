@@ -189,7 +189,7 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   n = 0;
   for (PetscInt k = 0; k < nloc; k++)
     if (set[k]) {
-      sys->constrained[n]        = sys->disc.bonds.rstart * bs + k;
+      sys->constrained[n]        = sys->disc.rstart * bs + k;
       sys->constrained_value[n]  = value[k];
       sys->constrained_region[n] = region[k];
       n++;
@@ -266,9 +266,9 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
     /* Finite but huge values (1e308) overflow the solver's inner products, which then stops with
        a NaN residual that blames the operator; say here that the load is at fault. */
     PetscCallMPI(MPIU_Allreduce(MPI_IN_PLACE, &largest, 1, MPIU_REAL, MPIU_MAX, sys->comm));
-    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(sys->disc.particles.n * bs)), s, item, field ? "traction_field" : force  ? "force"
-                                                                                                                                      : traction ? "traction"
-                                                                                                                                                 : "body_force",
+    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(sys->disc.N * bs)), s, item, field ? "traction_field" : force  ? "force"
+                                                                                                                            : traction ? "traction"
+                                                                                                                                       : "body_force",
                    "the load is too large for double precision: a particle force of %g overflows the solver's inner products (keep particle forces below about 1e150)", (double)largest);
   }
   PetscCall(VecRestoreArray(f, &a));
@@ -347,9 +347,10 @@ static PetscErrorCode RigidGramLayers(PeriSystem sys, PetscInt nm, const PetscRe
     const PetscScalar *vals;
     PetscReal          sign;
     if (mi < 0) continue;
-    PetscCall(MatGetRow(sys->layers.T, i, &ncols, &cols, &vals));
+    mi = PeriDiscLocal(&sys->disc, mi); /* the image is a ghost at worst (SetLocalView) */
+    PetscCall(MatGetRow(sys->layers.T, pt->global[i], &ncols, &cols, &vals));
     sign = PetscRealPart(vals[0]);
-    PetscCall(MatRestoreRow(sys->layers.T, i, &ncols, &cols, &vals));
+    PetscCall(MatRestoreRow(sys->layers.T, pt->global[i], &ncols, &cols, &vals));
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
     m->ops.rigid_modes(m, X, vf);
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * mi + d] - centre[d];
@@ -442,7 +443,7 @@ PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[],
   *nfree = 0;
   if (what) what[0] = 0;
   for (PetscInt k = 0; k < nm; k++) {
-    if (w[k] > 1e-12 / sys->disc.particles.n) continue;
+    if (w[k] > 1e-12 / sys->disc.N) continue;
     if (free) PetscCall(RigidFreeVector(nm, modes, V, k, *nfree, free));
     if ((*nfree)++ || !what) continue;
     PetscCall(RigidMotionName(sys, nm, norm, V, k, what, len));

@@ -263,8 +263,8 @@ PetscReal PeriBondSoftening(PeriSystem sys, const PetscReal meas[])
 /*@C
   PeriDamage - phi_i = 1 - (sum of live alpha V_j) / (sum over every bond found, the pre-cracked
   included) (Oterkus & Madenci eq. 79), softened bonds weighed by their remaining share; and per
-  criterion (Diana & Casolo eqs. 47, 48, 51) the share of the family lost to it. Every rank gets
-  (all particles until issue 17 item 3; each writes its own particles' piece) PERI_NCAUSES + 1 values per particle: the total, then one per PeriFailureCause. Collective.
+  criterion (Diana & Casolo eqs. 47, 48, 51) the share of the family lost to it: PERI_NCAUSES + 1
+  values per owned particle, the total, then one per PeriFailureCause. Collective.
 @*/
 PetscErrorCode PeriDamage(PeriSystem sys, PetscReal **damage)
 {
@@ -286,11 +286,11 @@ PetscErrorCode PeriDamage(PeriSystem sys, PetscReal **damage)
         a[2 + (b->cause ? b->cause[k] : 0)] += (1 - left) * V;
       }
     }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, acc, (PetscMPIInt)(w * pt->n), MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, w, MPI_SUM, acc));
   PetscCall(PetscFree(*damage));
   {
-    PetscCall(PetscMalloc1((PERI_NCAUSES + 1) * pt->n, damage));
-    for (PetscInt i = 0; i < pt->n; i++) {
+    PetscCall(PetscMalloc1((PERI_NCAUSES + 1) * sys->disc.nowned, damage));
+    for (PetscInt i = 0; i < sys->disc.nowned; i++) {
       const PetscReal *a                = &acc[w * i];
       (*damage)[(PERI_NCAUSES + 1) * i] = a[0] > 0 ? 1 - a[1] / a[0] : 1;
       for (PetscInt c = 0; c < PERI_NCAUSES; c++) (*damage)[(PERI_NCAUSES + 1) * i + 1 + c] = a[0] > 0 ? a[2 + c] / a[0] : 0;
@@ -310,13 +310,15 @@ static int ComparePair(const void *a, const void *b)
 /*@C
   PeriFamilySync - state-based models keep each particle's whole family (sys->disc.family, both
   directions); this marks dead every family entry whose bond is dead in sys->disc.bonds (stored once, at
-  the smaller index, possibly on another rank): the dead pairs are gathered on every rank.
+  the smaller global index, possibly on another rank): the dead pairs (global indices) are gathered
+  on every rank.
   Collective.
 @*/
 PetscErrorCode PeriFamilySync(PeriSystem sys)
 {
   const PeriBonds *b = &sys->disc.bonds;
   PeriBonds       *F = &sys->disc.family;
+  const PetscInt  *G = sys->disc.particles.global;
   PetscInt        *mine, *all, nmine = 0, nall;
   PetscMPIInt      n2, *counts, *displs;
 
@@ -328,8 +330,8 @@ PetscErrorCode PeriFamilySync(PeriSystem sys)
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
       if (!b->live[k]) {
-        mine[2 * nmine]       = i;
-        mine[2 * nmine++ + 1] = b->j[k];
+        mine[2 * nmine]       = G[i];
+        mine[2 * nmine++ + 1] = G[b->j[k]];
       }
   PetscCall(PetscMalloc2(sys->size, &counts, sys->size, &displs));
   PetscCall(PetscMPIIntCast(2 * nmine, &n2));
@@ -342,7 +344,7 @@ PetscErrorCode PeriFamilySync(PeriSystem sys)
   qsort(all, (size_t)nall, 2 * sizeof(PetscInt), ComparePair);
   for (PetscInt i = F->rstart; i < F->rend; i++)
     for (PetscInt k = F->offset[i - F->rstart]; k < F->offset[i - F->rstart + 1]; k++) {
-      PetscInt key[2] = {PetscMin(i, F->j[k]), PetscMax(i, F->j[k])};
+      PetscInt key[2] = {PetscMin(G[i], G[F->j[k]]), PetscMax(G[i], G[F->j[k]])};
       F->live[k]      = bsearch(key, all, (size_t)nall, 2 * sizeof(PetscInt), ComparePair) ? 0 : 1;
     }
   PetscCall(PetscFree(mine));
@@ -351,50 +353,27 @@ PetscErrorCode PeriFamilySync(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscInt Find(PetscInt parent[], PetscInt i)
+/* Per owned particle: whether its piece is anchored (a prescribed DOF, or a fictitious particle of
+ * a displacement layer) and loaded; ones for the pieces' sizes. */
+static PetscErrorCode PieceFlags(PeriSystem sys, PetscInt flags[])
 {
-  while (parent[i] != i) {
-    parent[i] = parent[parent[i]];
-    i         = parent[i];
-  }
-  return i;
-}
-
-static void Union(PetscInt parent[], PetscInt a, PetscInt b)
-{
-  a = Find(parent, a);
-  b = Find(parent, b);
-  if (a != b) parent[PetscMax(a, b)] = PetscMin(a, b);
-}
-
-/*@C
-  PeriComponents - the connected pieces of the body through its live bonds: label[i] = the
-  smallest particle index of i's piece, on every rank. Each rank joins its bonds (union-find),
-  rank 0 merges the ranks' forests. Collective.
-@*/
-PetscErrorCode PeriComponents(PeriSystem sys, PetscInt label[])
-{
-  const PeriBonds *b   = &sys->disc.bonds;
-  const PetscInt   n   = sys->disc.particles.n;
-  PetscInt        *all = NULL;
+  const PeriParticles *pt = &sys->disc.particles;
+  const PetscInt       bs = sys->model->dofs;
+  const PetscScalar   *f;
 
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < n; i++) label[i] = i;
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-      if (b->live[k]) Union(label, i, b->j[k]);
-  for (PetscInt i = 0; i < n; i++) label[i] = Find(label, i);
-  if (sys->size > 1) {
-    if (sys->rank == 0) PetscCall(PetscMalloc1(n * sys->size, &all));
-    PetscCallMPI(MPI_Gather(label, (PetscMPIInt)n, MPIU_INT, all, (PetscMPIInt)n, MPIU_INT, 0, sys->comm));
-    if (sys->rank == 0) {
-      for (PetscMPIInt r = 1; r < sys->size; r++)
-        for (PetscInt i = 0; i < n; i++) Union(label, i, all[r * n + i]);
-      for (PetscInt i = 0; i < n; i++) label[i] = Find(label, i);
+  for (PetscInt i = 0; i < sys->disc.nowned; i++) flags[2 * i] = flags[2 * i + 1] = 0;
+  for (PetscInt k = 0; k < sys->nconstrained; k++) flags[2 * (sys->constrained[k] / bs - sys->disc.rstart)] = 1;
+  PetscCall(VecGetArrayRead(sys->f, &f));
+  for (PetscInt i = 0; i < sys->disc.nowned; i++) {
+    if (PeriParticleIsFictitious(pt, i)) {
+      for (PetscInt face = 0; face < 4; face++)
+        if ((pt->crossed[i] & (1 << face)) && sys->layers.kind[face] == PERI_LAYER_DISPLACEMENT) flags[2 * i] = 1;
     }
-    PetscCall(PetscFree(all));
-    PetscCallMPI(MPI_Bcast(label, (PetscMPIInt)n, MPIU_INT, 0, sys->comm));
+    for (PetscInt c = 0; c < bs; c++)
+      if (f[i * bs + c] != 0) flags[2 * i + 1] = 1;
   }
+  PetscCall(VecRestoreArrayRead(sys->f, &f));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -402,64 +381,41 @@ PetscErrorCode PeriComponents(PeriSystem sys, PetscInt label[])
   PeriPieces - the pieces of the body: a piece is anchored when it holds a prescribed DOF or a fictitious
  * particle of a displacement layer. With none anchored, the largest piece is the body (its rigid
  * motions are handled by the solve). Every other piece is held where it is (hold/held: owned DOFs
- * and their current values, freed by the caller with PetscFree2); *lost when a held piece carries
- * load. Collective.
+ * (global rows) and their current values, freed by the caller with PetscFree2); *lost when a held
+ * piece carries load. The pieces come from PeriComponentsLabel over the live bonds, their flags
+ * from PeriComponentsReduce: no array of the whole body. Collective.
 @*/
 PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, PetscReal **held, PetscInt *npieces, PetscBool *lost)
 {
-  const PeriParticles *pt = &sys->disc.particles;
-  const PetscInt       n = pt->n, bs = sys->model->dofs, rstart = sys->disc.bonds.rstart, rend = sys->disc.bonds.rend;
-  PetscInt            *label, *anchored, *size, *loaded, main = -1, big = 0, lostl = 0;
-  const PetscScalar   *f, *u = NULL;
+  const PeriBonds   *b  = &sys->disc.bonds;
+  const PetscInt     bs = sys->model->dofs, no = sys->disc.nowned, r0 = sys->disc.rstart;
+  const MPI_Op       ops[2] = {MPI_MAX, MPI_MAX};
+  PetscInt          *label, *flags, main = -1, anchored = 0, lostl = 0;
+  const PetscScalar *u = NULL;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(n, &label));
-  PetscCall(PetscCalloc3(n, &anchored, n, &size, n, &loaded));
-  PetscCall(PeriComponents(sys, label));
-  for (PetscInt k = 0; k < sys->nconstrained; k++) anchored[label[sys->constrained[k] / bs]] = 1;
-  PetscCall(VecGetArrayRead(sys->f, &f));
-  for (PetscInt i = rstart; i < rend; i++) {
-    if (PeriParticleIsFictitious(pt, i)) {
-      for (PetscInt face = 0; face < 4; face++)
-        if ((pt->crossed[i] & (1 << face)) && sys->layers.kind[face] == PERI_LAYER_DISPLACEMENT) anchored[label[i]] = 1;
-    }
-    for (PetscInt c = 0; c < bs; c++)
-      if (f[(i - rstart) * bs + c] != 0) loaded[label[i]] = 1;
-  }
-  PetscCall(VecRestoreArrayRead(sys->f, &f));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, anchored, (PetscMPIInt)n, MPIU_INT, MPI_MAX, sys->comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, loaded, (PetscMPIInt)n, MPIU_INT, MPI_MAX, sys->comm));
-  *npieces = 0;
-  for (PetscInt i = 0; i < n; i++) {
-    if (!size[label[i]]++) (*npieces)++;
-  }
-  {
-    PetscBool any = PETSC_FALSE;
-    for (PetscInt i = 0; i < n; i++) any = (PetscBool)(any || anchored[i]);
-    if (!any)
-      for (PetscInt i = 0; i < n; i++)
-        if (size[i] > big) {
-          big  = size[i];
-          main = i;
-        }
-  }
-  PetscCall(PetscMalloc2((rend - rstart) * bs, hold, (rend - rstart) * bs, held));
+  PetscCall(PetscMalloc2(sys->disc.particles.n, &label, 2 * no, &flags));
+  PetscCall(PeriComponentsLabel(sys->comm, &sys->disc.halo, b->offset, b->j, b->live, label, NULL));
+  PetscCall(PieceFlags(sys, flags));
+  PetscCall(PeriComponentsReduce(sys->comm, &sys->disc.halo, label, 2, ops, flags, npieces, &main));
+  for (PetscInt i = 0; i < no; i++) anchored = PetscMax(anchored, flags[2 * i]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &anchored, 1, MPIU_INT, MPI_MAX, sys->comm));
+  if (anchored) main = -1;
+  PetscCall(PetscMalloc2(no * bs, hold, no * bs, held));
   *nhold = 0;
   if (sys->u) PetscCall(VecGetArrayRead(sys->u, &u));
-  for (PetscInt i = rstart; i < rend; i++) {
-    PetscInt l = label[i];
-    if (anchored[l] || l == main) continue;
-    if (loaded[l]) lostl = 1;
+  for (PetscInt i = 0; i < no; i++) {
+    if (flags[2 * i] || label[i] == main) continue;
+    if (flags[2 * i + 1]) lostl = 1;
     for (PetscInt c = 0; c < bs; c++) {
-      (*hold)[*nhold]     = i * bs + c;
-      (*held)[(*nhold)++] = u ? PetscRealPart(u[(i - rstart) * bs + c]) : 0;
+      (*hold)[*nhold]     = (r0 + i) * bs + c;
+      (*held)[(*nhold)++] = u ? PetscRealPart(u[i * bs + c]) : 0;
     }
   }
   if (sys->u) PetscCall(VecRestoreArrayRead(sys->u, &u));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lostl, 1, MPIU_INT, MPI_MAX, sys->comm));
   *lost = lostl ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PetscFree(label));
-  PetscCall(PetscFree3(anchored, size, loaded));
+  PetscCall(PetscFree2(label, flags));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -473,13 +429,13 @@ PetscErrorCode PeriFailureAddFields(PeriSystem sys, PeriFieldList fl)
 
   PetscFunctionBeginUser;
   if (!sys->damage) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage + (PERI_NCAUSES + 1) * sys->disc.bonds.rstart, PERI_NCAUSES + 1, &map0));
+  PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage, PERI_NCAUSES + 1, &map0));
   for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
     char           name[32];
     const PetscInt map = 1 + c;
     if (!used[c]) continue;
     PetscCall(PetscSNPrintf(name, sizeof(name), "damage_%s", PeriFailureCauses[c]));
-    PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage + (PERI_NCAUSES + 1) * sys->disc.bonds.rstart, PERI_NCAUSES + 1, &map));
+    PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage, PERI_NCAUSES + 1, &map));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -15,11 +15,57 @@ static const PeriKey probe_keys[] = {
 };
 const PeriSchema PeriProbesSchema[] = {{"probes", probe_keys}, {NULL}};
 
+/* The nearest owned particle of the body to the point y: its local index (-1: none) and squared
+ * distance; ties go to the lexicographically smallest position, whatever the numbering (ranks). */
+static PetscInt NearestOwned(PeriSystem sys, const PetscReal y[], PetscReal *best)
+{
+  const PeriParticles *pt = &sys->disc.particles;
+  PetscInt             p  = -1;
+
+  *best = PETSC_MAX_REAL;
+  for (PetscInt i = 0; i < sys->disc.nowned; i++) {
+    PetscReal d2 = 0;
+    if (PeriParticleIsFictitious(pt, i)) continue;
+    for (PetscInt d = 0; d < pt->dim; d++) d2 += PetscSqr(pt->x[3 * i + d] - y[d]);
+    if (d2 < *best || (d2 == *best && LexLess(&pt->x[3 * i], &pt->x[3 * p]))) {
+      *best = d2;
+      p     = i;
+    }
+  }
+  return p;
+}
+
+/* The probe's nearest particle over all ranks: each rank offers its nearest owned one (squared
+ * distance, position, spacing), the best offer wins. Collective. */
+static PetscErrorCode ProbeLocate(PeriSystem sys, PeriProbe *pr, PetscReal *dist, PetscReal *spacing)
+{
+  const PeriParticles *pt = &sys->disc.particles;
+  PetscReal            mine[5], *all;
+  PetscInt             p = NearestOwned(sys, pr->x, &mine[0]);
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) mine[1 + d] = p >= 0 ? pt->x[3 * p + d] : 0;
+  mine[4] = p >= 0 ? pt->spacing[p] : 0;
+  PetscCall(PetscMalloc1(5 * sys->size, &all));
+  PetscCallMPI(MPI_Allgather(mine, 5, MPIU_REAL, all, 5, MPIU_REAL, sys->comm));
+  pr->rank = 0;
+  for (PetscMPIInt r = 1; r < sys->size; r++) {
+    const PetscReal *o = &all[5 * r], *b = &all[5 * pr->rank];
+    if (o[0] < b[0] || (o[0] == b[0] && o[0] < PETSC_MAX_REAL && LexLess(&o[1], &b[1]))) pr->rank = r;
+  }
+  pr->particle = pr->rank == sys->rank ? p : -1;
+  for (PetscInt d = 0; d < 3; d++) pr->particle_x[d] = all[5 * pr->rank + 1 + d];
+  *dist    = PetscSqrtReal(all[5 * pr->rank]);
+  *spacing = all[5 * pr->rank + 4];
+  PetscCall(PetscFree(all));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriReadProbes(PeriSystem sys)
 {
-  PeriScene            s = sys->scene;
-  PeriNode             map;
-  const PeriParticles *pt = &sys->disc.particles;
+  PeriScene s = sys->scene;
+  PeriNode  map;
+  PetscInt  dim = sys->disc.particles.dim;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "probes", PETSC_FALSE, &map));
@@ -28,22 +74,37 @@ PetscErrorCode PeriReadProbes(PeriSystem sys)
   PetscCall(PetscCalloc1(map->n, &sys->probes));
   for (PetscInt k = 0; k < map->n; k++) {
     PeriProbe *pr   = &sys->probes[k];
-    PetscReal  best = PETSC_MAX_REAL;
+    PetscReal  dist = 0, h = 0;
     PetscInt   n;
     PetscCall(PetscStrncpy(pr->name, map->child[k]->key, sizeof(pr->name)));
-    PetscCall(PeriSceneGetRealArray(s, map, map->child[k]->key, PETSC_TRUE, pt->dim, pt->dim, pr->x, &n));
-    for (PetscInt i = 0; i < pt->n; i++) {
-      PetscReal d2 = 0;
-      if (PeriParticleIsFictitious(pt, i)) continue;
-      for (PetscInt d = 0; d < pt->dim; d++) d2 += PetscSqr(pt->x[3 * i + d] - pr->x[d]);
-      /* ties go to the lexicographically smallest position, whatever the numbering (ranks) */
-      if (d2 < best || (d2 == best && LexLess(&pt->x[3 * i], &pt->x[3 * pr->particle]))) {
-        best         = d2;
-        pr->particle = i;
+    PetscCall(PeriSceneGetRealArray(s, map, map->child[k]->key, PETSC_TRUE, dim, dim, pr->x, &n));
+    PetscCall(ProbeLocate(sys, pr, &dist, &h));
+    /* inside the body: within the nearest particle's cell (its circumscribed ball) */
+    PeriInputCheck(dist <= 0.5 * PetscSqrtReal((PetscReal)dim) * h * (1 + 1e-9), s, map, map->child[k]->key, "the point lies outside the body (nearest particle at distance %g)", (double)dist);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The probes' values from their owners' particles, on every rank. Collective. */
+static PetscErrorCode ProbesEvaluate(PeriSystem sys, const PetscScalar u[])
+{
+  const PetscInt bs = sys->model->dofs;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < sys->nprobes; k++) {
+    PeriProbe     *pr = &sys->probes[k];
+    const PetscInt p  = pr->particle;
+    if (p >= 0) {
+      for (PetscInt c = 0; c < bs; c++) pr->u[c] = PetscRealPart(u[p * bs + c]);
+      pr->W = sys->W[p];
+      if (sys->stress) {
+        PetscCall(PetscArraycpy(pr->sigma, &sys->stress[9 * p], 9));
+        PetscCall(PetscArraycpy(pr->epsilon, &sys->strain[9 * p], 9));
+        PetscCall(PetscArraycpy(pr->sigma_elastic, &sys->elastic_stress[9 * p], 9));
       }
     }
-    /* inside the body: within the nearest particle's cell (its circumscribed ball) */
-    PeriInputCheck(PetscSqrtReal(best) <= 0.5 * PetscSqrtReal((PetscReal)pt->dim) * pt->spacing[pr->particle] * (1 + 1e-9), s, map, map->child[k]->key, "the point lies outside the body (nearest particle at distance %g)", (double)PetscSqrtReal(best));
+    /* u, W and the three tensors are contiguous: PERI_MAX_DOF + 28 reals */
+    PetscCallMPI(MPI_Bcast(pr->u, PERI_MAX_DOF + 28, MPIU_REAL, pr->rank, sys->comm));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -79,10 +140,8 @@ static PetscErrorCode ElementEnergy(PeriSystem sys, const PeriElement *el, void 
 
 /* Antiplane models: the corrected shear angles grad uz = M^-1 R with M = sum w alpha xi xi^T V_j
  * and R = sum w alpha (u_j - u_i) xi V_j (w = 1/|xi|^2), exact for every linear field (eq. 53 with
- * the full 2x2 moment, so also at corners), and tau = mu (grad uz + twist terms). Every rank gets
- * tau_xz, tau_yz and |tau| of every particle: rank 0 for the torsion results, each rank its own
- * particles' for its piece of the output (the whole array until the per-rank data of issue 17
- * item 3 replaces it). */
+ * the full 2x2 moment, so also at corners), and tau = mu (grad uz + twist terms): tau_xz, tau_yz
+ * and |tau| of the owned particles (u: the local view's DOFs). */
 static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
 {
   const PeriBonds     *b  = &sys->disc.bonds;
@@ -107,11 +166,11 @@ static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
         A[4] += w * e * xi[1] * V;
       }
     }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, acc, (PetscMPIInt)(5 * n), MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 5, MPI_SUM, acc));
   PetscCall(PetscFree(sys->tau));
   {
-    PetscCall(PetscMalloc1(3 * n, &sys->tau));
-    for (PetscInt i = 0; i < n; i++) {
+    PetscCall(PetscMalloc1(3 * sys->disc.nowned, &sys->tau));
+    for (PetscInt i = 0; i < sys->disc.nowned; i++) {
       const PetscReal *A   = &acc[5 * i];
       PetscReal        det = A[0] * A[2] - A[1] * A[1], gx = 0, gy = 0, mu = sys->mu ? sys->mu[i] : sys->model->material.G;
       if (det > 1e-12 * PetscSqr(A[0] + A[2])) {
@@ -153,58 +212,66 @@ static PetscErrorCode KeepOwnedSolution(PeriSystem sys)
 }
 
 /*@C
+  PeriSystemLocalDOFs - the DOFs of the local view from the distributed u: the owned particles'
+  from u, the ghosts' from their owners. *ul (particles.n x dofs) is freed with PetscFree.
+  Collective.
+@*/
+PetscErrorCode PeriSystemLocalDOFs(PeriSystem sys, Vec u, PetscScalar **ul)
+{
+  const PetscInt     bs = sys->model->dofs;
+  const PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(sys->disc.particles.n * bs, ul));
+  PetscCall(VecGetArrayRead(u, &a));
+  PetscCall(PetscArraycpy(*ul, a, sys->disc.nowned * bs));
+  PetscCall(VecRestoreArrayRead(u, &a));
+  PetscCall(PeriDiscOwnersToGhosts(&sys->disc, MPIU_SCALAR, bs, *ul));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The largest |u| per component over the body's particles (fictitious ones excluded). */
+static PetscErrorCode MaxDisplacement(PeriSystem sys, const PetscScalar u[])
+{
+  const PetscInt bs                 = sys->model->dofs;
+  PetscReal      umax[PERI_MAX_DOF] = {0, 0, 0};
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->disc.nowned; i++)
+    for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(&sys->disc.particles, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
+  PetscCallMPI(MPI_Allreduce(umax, sys->max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
   PeriSystemEvaluateEnergy - from the solution sys->u: the strain energy of the body, the energy
-  density W_i = (1/2) sum_j (pair energy) / V_i of every particle (every rank, all particles: the
-  accumulation spans them until issue 17 item 3), the displacements of all particles (rank 0,
-  u_all) and of the owned ones (every rank, u_owned), the probes, the largest displacement per component, and for antiplane
-  models the shear stresses and the torsion results. Collective.
+  density W_i = (1/2) sum_j (pair energy) / V_i of the owned particles (the ghosts' shares reach
+  their owners), the owned particles' DOFs (u_owned), the probes, the largest displacement per
+  component, and for antiplane models the shear stresses and the torsion results. Collective.
 @*/
 PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
 {
-  VecScatter           scatter;
-  Vec                  all;
-  const PetscScalar   *u;
-  PeriModel            m  = sys->model;
-  const PeriParticles *pt = &sys->disc.particles;
-  const PetscInt       n = pt->n, bs = m->dofs;
-  PetscReal            umax[PERI_MAX_DOF] = {0, 0, 0}, *W;
-  EnergyCtx            E;
+  PetscScalar *u;
+  EnergyCtx    E;
 
   PetscFunctionBeginUser;
-  PetscCall(VecScatterCreateToAll(sys->u, &scatter, &all));
-  PetscCall(VecScatterBegin(scatter, sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(scatter, sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecGetArrayRead(all, &u));
-  PetscCall(PetscCalloc1(n, &W));
+  PetscCall(PeriSystemLocalDOFs(sys, sys->u, &u));
+  PetscCall(PetscFree(sys->W));
+  PetscCall(PetscCalloc1(sys->disc.particles.n, &sys->W));
   E.u      = u;
-  E.W      = W;
+  E.W      = sys->W;
   E.energy = 0;
   PetscCall(PeriElementsForEach(sys, ElementEnergy, &E));
-  for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++)
-    for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(pt, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
-  PetscCallMPI(MPI_Allreduce(umax, sys->max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 1, MPI_SUM, sys->W));
+  PetscCall(MaxDisplacement(sys, u));
   PetscCallMPI(MPI_Allreduce(&E.energy, &sys->strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, W, (PetscMPIInt)n, MPIU_REAL, MPI_SUM, sys->comm));
-  if (m->antiplane) PetscCall(ShearStresses(sys, u));
+  if (sys->model->antiplane) PetscCall(ShearStresses(sys, u));
   PetscCall(PeriSystemEvaluateStress(sys, u));
-  PetscCall(PetscFree(sys->W));
-  PetscCall(PetscFree(sys->u_all));
   PetscCall(KeepOwnedSolution(sys));
-  sys->W = W;
-  if (sys->rank == 0) {
-    PetscCall(PetscMalloc1(n * bs, &sys->u_all));
-    for (PetscInt k = 0; k < n * bs; k++) sys->u_all[k] = PetscRealPart(u[k]);
-    for (PetscInt k = 0; k < sys->nprobes; k++) {
-      PeriProbe *pr = &sys->probes[k];
-      for (PetscInt c = 0; c < bs; c++) pr->u[c] = sys->u_all[pr->particle * bs + c];
-      pr->W = W[pr->particle];
-    }
-    PetscCall(PeriTorsionEvaluate(sys));
-  }
-  if (sys->torsion.active) PetscCallMPI(MPI_Bcast(&sys->torsion.torque, 6, MPIU_REAL, 0, sys->comm));
-  PetscCall(VecRestoreArrayRead(all, &u));
-  PetscCall(VecDestroy(&all));
-  PetscCall(VecScatterDestroy(&scatter));
+  PetscCall(ProbesEvaluate(sys, u));
+  PetscCall(PeriTorsionEvaluate(sys));
+  sys->has_solution = PETSC_TRUE;
+  PetscCall(PetscFree(u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -222,27 +289,24 @@ PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe 
   PeriSystemAddFields - the system's per-particle fields besides the solution, over this rank's
   particles (a list of PeriSystemFieldListCreate): volume, neighbours, rank, and where they exist
   strain energy density and antiplane shear stresses; then the features' own (damage:
-  PeriFailureAddFields; mirror images: PeriLayersAddFields). Every rank: the arrays hold all
-  particles today (issue 17 item 1), each rank's piece is its owned range of them.
+  PeriFailureAddFields; mirror images: PeriLayersAddFields). Each rank's piece: its owned particles, local 0..nowned-1.
 @*/
 PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
 {
-  const PetscInt r0 = sys->disc.bonds.rstart;
-
   PetscFunctionBeginUser;
-  PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->disc.particles.volume + r0, 1, NULL));
-  PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count + r0));
-  PetscCall(PeriFieldListAddInt(fl, "rank", sys->disc.owner + r0));
-  if (sys->W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->W + r0, 1, NULL));
+  PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->disc.particles.volume, 1, NULL));
+  PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count));
+  PetscCall(PeriFieldListAddIntConstant(fl, "rank", sys->rank));
+  if (sys->W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->W, 1, NULL));
   if (sys->tau) {
     const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
-    PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau + 3 * r0, 3, tmap)); /* tau_xz, tau_yz, 0 */
-    PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau + 3 * r0, 3, &nmap));
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau, 3, &nmap));
   }
   if (sys->stress) {
-    PetscCall(PeriFieldListAddReal(fl, "stress", 9, sys->stress + 9 * r0, 9, NULL));
-    PetscCall(PeriFieldListAddReal(fl, "strain", 9, sys->strain + 9 * r0, 9, NULL));
-    PetscCall(PeriFieldListAddReal(fl, "elastic_stress", 9, sys->elastic_stress + 9 * r0, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "stress", 9, sys->stress, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "strain", 9, sys->strain, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "elastic_stress", 9, sys->elastic_stress, 9, NULL));
   }
   PetscCall(PeriFailureAddFields(sys, fl));
   PetscCall(PeriLayersAddFields(sys, fl));
@@ -255,8 +319,7 @@ PetscErrorCode PeriSystemFieldListCreate(PeriSystem sys, PeriFieldList *fl)
   const PeriBonds *b = &sys->disc.bonds;
 
   PetscFunctionBeginUser;
-  /* the coordinates of all particles are on every rank today (issue 17 item 1): the owned range */
-  PetscCall(PeriFieldListCreate(b->rend - b->rstart, sys->disc.particles.x + 3 * b->rstart, fl));
+  PetscCall(PeriFieldListCreate(b->rend - b->rstart, sys->disc.particles.x, fl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -297,18 +360,18 @@ PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
 {
   PetscFunctionBeginUser;
   PetscCall(PeriJSONBeginObject(j, "probes"));
-  for (PetscInt k = 0; sys->u_all && k < sys->nprobes; k++) {
+  for (PetscInt k = 0; sys->has_solution && k < sys->nprobes; k++) {
     const PeriProbe *pr = &sys->probes[k];
     PetscCall(PeriJSONBeginObject(j, pr->name));
     PetscCall(PeriJSONRealArray(j, "x", sys->disc.particles.dim, pr->x));
-    PetscCall(PeriJSONRealArray(j, "particle_x", sys->disc.particles.dim, &sys->disc.particles.x[3 * pr->particle]));
+    PetscCall(PeriJSONRealArray(j, "particle_x", sys->disc.particles.dim, pr->particle_x));
     PetscCall(PeriJSONString(j, "sampling", "nearest particle"));
     PetscCall(PeriJSONRealArray(j, "u", sys->model->dofs, pr->u));
     PetscCall(PeriJSONReal(j, "W", pr->W));
     if (sys->stress) {
-      PetscCall(ProbeTensor(j, "sigma", sys->disc.particles.dim, &sys->stress[9 * pr->particle]));
-      PetscCall(ProbeTensor(j, "epsilon", sys->disc.particles.dim, &sys->strain[9 * pr->particle]));
-      PetscCall(ProbeTensor(j, "sigma_elastic", sys->disc.particles.dim, &sys->elastic_stress[9 * pr->particle]));
+      PetscCall(ProbeTensor(j, "sigma", sys->disc.particles.dim, pr->sigma));
+      PetscCall(ProbeTensor(j, "epsilon", sys->disc.particles.dim, pr->epsilon));
+      PetscCall(ProbeTensor(j, "sigma_elastic", sys->disc.particles.dim, pr->sigma_elastic));
     }
     PetscCall(PeriJSONEndObject(j));
   }

@@ -210,16 +210,18 @@ PetscErrorCode PeriLayersSetUp(PeriSystem sys)
 
   PetscFunctionBeginUser;
   if (!L->nfaces) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(MatCreateAIJ(sys->comm, rend - rstart, rend - rstart, pt->n, pt->n, 1, NULL, 1, NULL, &L->T));
+  PetscCall(MatCreateAIJ(sys->comm, rend - rstart, rend - rstart, sys->disc.N, sys->disc.N, 1, NULL, 1, NULL, &L->T));
   PetscCall(PeriSystemCreateVec(sys, &L->g));
   for (PetscInt i = rstart; i < rend; i++) {
-    PetscInt    m = pt->image[i], faces[2], nf = 0;
+    PetscInt    gi = pt->global[i], gm = pt->image[i], m, faces[2], nf = 0;
     PetscReal   sign = 1, offset = 0, mu;
     PetscScalar v;
-    if (m < 0) {
-      PetscCall(MatSetValue(L->T, i, i, 1.0, INSERT_VALUES));
+    if (gm < 0) {
+      PetscCall(MatSetValue(L->T, gi, gi, 1.0, INSERT_VALUES));
       continue;
     }
+    m = PeriDiscLocal(&sys->disc, gm); /* the halo reaches every image (SetLocalView) */
+    PetscCheck(m >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the mirror image %" PetscInt_FMT " of fictitious particle %" PetscInt_FMT " is not in the local view", gm, gi);
     mu = sys->mu ? sys->mu[m] : sys->model->material.G;
     for (PetscInt f = 0; f < 4; f++)
       if (pt->crossed[i] & (1 << f)) faces[nf++] = f;
@@ -240,8 +242,8 @@ PetscErrorCode PeriLayersSetUp(PeriSystem sys)
       }
     }
     v = sign;
-    PetscCall(MatSetValue(L->T, i, m, v, INSERT_VALUES));
-    PetscCall(VecSetValue(L->g, i, offset, INSERT_VALUES));
+    PetscCall(MatSetValue(L->T, gi, gm, v, INSERT_VALUES));
+    PetscCall(VecSetValue(L->g, gi, offset, INSERT_VALUES));
   }
   PetscCall(MatAssemblyBegin(L->T, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(L->T, MAT_FINAL_ASSEMBLY));
@@ -283,7 +285,7 @@ PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
   PetscCall(MatDestroy(&Kaij));
   PetscCall(PetscMalloc1(sys->disc.bonds.rend - sys->disc.bonds.rstart, &rows));
   for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++)
-    if (PeriParticleIsFictitious(pt, i)) rows[nf++] = i;
+    if (PeriParticleIsFictitious(pt, i)) rows[nf++] = pt->global[i];
   /* K T has no (i, i) for a fictitious i (T maps its column to its image's): MatZeroRows reuses a
    * slot of the row's diagonal block, and must allocate one where that part of the row is empty
    * (all of i's neighbours owned by other ranks, as a partition may give) */
@@ -340,7 +342,7 @@ static PetscErrorCode TorsionElementLoad(PeriSystem sys, const PeriElement *el, 
     fe[a] = 0;
     for (PetscInt b = 0; b < n; b++) fe[a] -= el->K[a * n + b] * e[b];
   }
-  PetscCall(VecSetValues((Vec)ctx, n, el->idx, fe, ADD_VALUES));
+  PetscCall(VecSetValues((Vec)ctx, n, el->gidx, fe, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -369,10 +371,37 @@ static PetscReal RectangleTorsionConstant(PetscReal A, PetscReal B)
   return 16.0 / 3.0 * a * a * a * b * (1 - 192 / PetscPowReal(PETSC_PI, 5) * a / b * sum);
 }
 
+/* The largest |tau| of the owned body particles and where (the first in global order on ties),
+ * then over the ranks (the lowest rank on ties, so the first in global order). Collective. */
+static PetscErrorCode TorsionMaxStress(PeriSystem sys, PeriTorsion *t)
+{
+  const PeriParticles *pt      = &sys->disc.particles;
+  PetscReal            mine[3] = {0, 0, 0}, *all;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->disc.nowned; i++)
+    if (!PeriParticleIsFictitious(pt, i) && sys->tau[3 * i + 2] > mine[0]) {
+      mine[0] = sys->tau[3 * i + 2];
+      mine[1] = pt->x[3 * i];
+      mine[2] = pt->x[3 * i + 1];
+    }
+  PetscCall(PetscMalloc1(3 * sys->size, &all));
+  PetscCallMPI(MPI_Allgather(mine, 3, MPIU_REAL, all, 3, MPIU_REAL, sys->comm));
+  t->max_stress = 0;
+  for (PetscMPIInt r = 0; r < sys->size; r++)
+    if (all[3 * r] > t->max_stress) {
+      t->max_stress = all[3 * r];
+      t->max_at[0]  = all[3 * r + 1];
+      t->max_at[1]  = all[3 * r + 2];
+    }
+  PetscCall(PetscFree(all));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriTorsionEvaluate - from the shear stresses sys->tau (rank 0): the torque per unit length
-  T = sum (x tau_yz - y tau_xz) A over the body's particles (A = V / l), the torsion constant
-  J = T / (mu psi), the largest stress |tau| and where. Not collective (rank 0 has the fields).
+  PeriTorsionEvaluate - from the shear stresses sys->tau of the owned particles: the torque per
+  unit length T = sum (x tau_yz - y tau_xz) A over the body's particles (A = V / l), the torsion
+  constant J = T / (mu psi), the largest stress |tau| and where. Collective.
 @*/
 PetscErrorCode PeriTorsionEvaluate(PeriSystem sys)
 {
@@ -380,19 +409,14 @@ PetscErrorCode PeriTorsionEvaluate(PeriSystem sys)
   PeriTorsion         *t  = &sys->torsion;
 
   PetscFunctionBeginUser;
-  if (!t->active || !sys->tau) PetscFunctionReturn(PETSC_SUCCESS);
-  t->torque = t->max_stress = 0;
-  for (PetscInt i = 0; i < pt->n; i++) {
-    PetscReal x = pt->x[3 * i] - t->center[0], y = pt->x[3 * i + 1] - t->center[1], tau;
-    if (PeriParticleIsFictitious(pt, i)) continue;
-    t->torque += (x * sys->tau[3 * i + 1] - y * sys->tau[3 * i]) * pt->volume[i] / pt->thickness;
-    tau = sys->tau[3 * i + 2];
-    if (tau > t->max_stress) {
-      t->max_stress = tau;
-      t->max_at[0]  = pt->x[3 * i];
-      t->max_at[1]  = pt->x[3 * i + 1];
-    }
+  if (!t->active) PetscFunctionReturn(PETSC_SUCCESS); /* the antiplane models' tau exists on every rank */
+  t->torque = 0;
+  for (PetscInt i = 0; i < sys->disc.nowned; i++) {
+    PetscReal x = pt->x[3 * i] - t->center[0], y = pt->x[3 * i + 1] - t->center[1];
+    if (!PeriParticleIsFictitious(pt, i)) t->torque += (x * sys->tau[3 * i + 1] - y * sys->tau[3 * i]) * pt->volume[i] / pt->thickness;
   }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &t->torque, 1, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCall(TorsionMaxStress(sys, t));
   t->J           = t->torque / (sys->model->material.G * t->twist);
   t->J_rectangle = RectangleTorsionConstant(pt->upper[0] - pt->lower[0], pt->upper[1] - pt->lower[1]);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -437,6 +461,6 @@ PetscErrorCode PeriLayersSummary(PeriSystem sys, PeriJSON j)
 PetscErrorCode PeriLayersAddFields(PeriSystem sys, PeriFieldList fl)
 {
   PetscFunctionBeginUser;
-  if (sys->disc.particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->disc.particles.image + sys->disc.bonds.rstart)); /* the owned range: the piece */
+  if (sys->disc.particles.image) PetscCall(PeriFieldListAddInt(fl, "mirror_of", sys->disc.particles.image)); /* the owned particles: the piece */
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -287,11 +287,11 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
       PetscCall(SpringConstant(m, &g, Ke, &kb));
       for (PetscInt d = 0; d < op->bs; d++) op->w[nb * op->bs + d] = PetscSqrtReal(kb) * g.xi[d] / g.length;
       op->len[nb] = g.length;
-      if (g.j >= b->rstart && g.j < b->rend)
-        op->jl[nb] = g.j - b->rstart;
-      else { /* for now -1 - j: numbered below */
-        op->jl[nb]              = -1 - g.j;
-        op->ghost[op->nghost++] = g.j;
+      if (g.j < sys->disc.nowned)
+        op->jl[nb] = g.j;
+      else { /* for now -1 - its global index: numbered below, as the ghosted vectors number them */
+        op->jl[nb]              = -1 - sys->disc.particles.global[g.j];
+        op->ghost[op->nghost++] = sys->disc.particles.global[g.j];
       }
       nb++;
     }
@@ -439,7 +439,7 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
 {
   PeriOperator   op = sys->op;
   const PetscInt t = op->slot ? op->slot[k] : -1, n = 2 * op->bs;
-  PetscInt       idx[2] = {i, sys->disc.bonds.j[k]};
+  PetscInt       idx[2] = {sys->disc.particles.global[i], sys->disc.particles.global[sys->disc.bonds.j[k]]};
   PetscReal      dP[4 * PERI_MAX_DOF * PERI_MAX_DOF];
 
   PetscFunctionBeginUser;

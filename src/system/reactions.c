@@ -72,7 +72,7 @@ PetscErrorCode PeriReactionsFindRegion(PeriSystem sys, const char name[], PetscI
 }
 
 typedef struct {
-  const PetscScalar *u; /* all particles' DOFs */
+  const PetscScalar *u; /* the local view's DOFs */
   Vec                fint;
   PetscInt          *rows;
 } ForceCtx;
@@ -87,7 +87,7 @@ static PetscErrorCode ElementForce(PeriSystem sys, const PeriElement *el, void *
   PetscFunctionBeginUser;
   PeriElementForces(sys, el, F->u);
   for (PetscInt t = 0; t < el->n; t++)
-    for (PetscInt c = 0; c < bs; c++) F->rows[t * bs + c] = el->idx[t] * bs + c;
+    for (PetscInt c = 0; c < bs; c++) F->rows[t * bs + c] = el->gidx[t] * bs + c;
   PetscCall(VecSetValues(F->fint, N, F->rows, f, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -95,16 +95,13 @@ static PetscErrorCode ElementForce(PeriSystem sys, const PeriElement *el, void *
 /* fint = K u with the unconstrained stiffness, from the model's element blocks. Collective. */
 static PetscErrorCode InternalForce(PeriSystem sys, Vec fint)
 {
-  VecScatter scatter;
-  Vec        all;
-  ForceCtx   F;
-  PetscInt   nmax = PetscMax(1, PeriSystemMaxFamily(sys));
+  ForceCtx     F;
+  PetscInt     nmax = PetscMax(1, PeriSystemMaxFamily(sys));
+  PetscScalar *u;
 
   PetscFunctionBeginUser;
-  PetscCall(VecScatterCreateToAll(sys->u, &scatter, &all));
-  PetscCall(VecScatterBegin(scatter, sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(scatter, sys->u, all, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecGetArrayRead(all, &F.u));
+  PetscCall(PeriSystemLocalDOFs(sys, sys->u, &u));
+  F.u = u;
   PetscCall(PetscMalloc1((nmax + 1) * sys->model->dofs, &F.rows));
   F.fint = fint;
   PetscCall(VecZeroEntries(fint));
@@ -112,9 +109,7 @@ static PetscErrorCode InternalForce(PeriSystem sys, Vec fint)
   PetscCall(VecAssemblyBegin(fint));
   PetscCall(VecAssemblyEnd(fint));
   PetscCall(PetscFree(F.rows));
-  PetscCall(VecRestoreArrayRead(all, &F.u));
-  PetscCall(VecDestroy(&all));
-  PetscCall(VecScatterDestroy(&scatter));
+  PetscCall(PetscFree(u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -172,7 +167,7 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
 {
   PeriReactions       *R  = &sys->reactions;
   const PeriParticles *pt = &sys->disc.particles;
-  const PetscInt       bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart, r0 = sys->disc.bonds.rstart * bs;
+  const PetscInt       bs = sys->model->dofs, nloc = sys->disc.nowned, r0 = sys->disc.rstart * bs; /* r0: the first owned global row */
   const PetscScalar   *fi, *fa;
   PetscInt             k = 0, ntrans, nrot;
 
@@ -183,7 +178,7 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
   PetscCall(VecGetArrayRead(sys->f, &fa));
   for (PetscInt i = 0; i < nloc; i++) {
     PetscReal p2 = 0, r2 = 0, X[3];
-    for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * (r0 / bs + i) + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
+    for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
     for (PetscInt c = 0; c < bs; c++) {
       const PetscInt  row = i * bs + c;
       const PetscReal F = lambda * PetscRealPart(fa[row]), Fi = PetscRealPart(fi[row]);
@@ -244,7 +239,7 @@ static PetscErrorCode CheckMoments(PeriSystem sys, PetscReal force_allowed, cons
 static PetscErrorCode CheckEquilibrium(PeriSystem sys, PetscReal lambda, const PetscBool trans[], const Sums *S)
 {
   PeriReactions  *R    = &sys->reactions;
-  const PetscReal sqn  = PetscSqrtReal((PetscReal)sys->disc.particles.n);
+  const PetscReal sqn  = PetscSqrtReal((PetscReal)sys->disc.N);
   PetscReal       imb2 = 0, allowed, factor = 0;
   char            what[256] = "";
 
@@ -322,7 +317,7 @@ PetscErrorCode PeriReactionsSummary(PeriSystem sys, PeriJSON j)
   PetscBool            trans[PERI_MAX_DOF];
 
   PetscFunctionBeginUser;
-  if (!R->evaluated || !sys->u_all) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!R->evaluated || !sys->has_solution) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(Translations(sys->model, trans));
   PetscCall(ComponentObject(sys, j, "applied_load", R->applied, trans));
   PetscCall(PeriJSONBeginObject(j, "reactions"));

@@ -41,7 +41,8 @@ PetscErrorCode PeriReferenceSetUp(PeriSystem sys)
   r->type = (PeriReferenceType)type;
   PetscCall(PeriSceneGetReal(s, node, "stress", PETSC_TRUE, &r->stress, NULL));
   PeriInputCheck(r->stress != 0, s, node, "stress", "must not be 0: the reference field would vanish and there is nothing to compare with");
-  for (PetscInt i = 0; i < sys->disc.particles.n; i++) ninterior += Interior(sys, i);
+  for (PetscInt i = 0; i < sys->disc.nowned; i++) ninterior += Interior(sys, i);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &ninterior, 1, MPIU_INT, MPI_SUM, sys->comm));
   PeriInputCheck(ninterior >= 3, s, node, NULL, "only %" PetscInt_FMT " particles lie farther than 2 delta = %g from the edges: too few to measure the interior strain (enlarge the body or reduce the horizon)", ninterior, (double)(2 * sys->disc.delta));
   r->axis = 0;
   PetscCall(PeriSceneGetChoice(s, node, "axis", axes, &r->axis, NULL));
@@ -135,83 +136,114 @@ static PetscBool Interior(PeriSystem sys, PetscInt i)
   return PETSC_TRUE;
 }
 
-/*@C
-  PeriReferenceEvaluate - on rank 0, from sys->u_all: the interior strain (least-squares displacement
-  gradient over the particles farther than 2 delta from every edge), the effective moduli it
-  implies for the reference's stress state, and the interior displacement error against the
-  reference after removing the best-fit rigid motion. Not collective.
-@*/
-PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
+/* The least-squares sums over the owned interior particles, then over the ranks: u = a + H x' for
+ * each component (A, bx, by) and the rigid fit of the error (R, br). Collective. */
+typedef struct {
+  PetscReal A[3][3], bx[3], by[3], R[3][3], br[3], n;
+} FitSums;
+
+static PetscErrorCode InteriorFit(PeriSystem sys, PetscInt ux, PetscInt uy, FitSums *F)
 {
-  const PetscInt   bs      = sys->model->dofs;
-  const PetscReal *c       = sys->reference.center;
-  PetscReal        A[3][3] = {{0}}, bx[3] = {0, 0, 0}, by[3] = {0, 0, 0}, R[3][3] = {{0}}, br[3] = {0, 0, 0};
-  PetscReal        num = 0, den = 0, dmax = 0, umax = 0;
-  PetscInt         n = 0, ux, uy;
+  const PetscInt   bs = sys->model->dofs;
+  const PetscReal *c  = sys->reference.center;
 
   PetscFunctionBeginUser;
-  sys->reference.evaluated = PETSC_FALSE;
-  if (sys->rank || sys->reference.type == PERI_REFERENCE_NONE) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
-  PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
-  PetscCheck(ux >= 0 && uy >= 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "reference fields need the in-plane displacements ux, uy; model %s has none", sys->model->type);
-  /* least squares u = a + H x' for each component, and the rigid fit of the error */
-  for (PetscInt i = 0; i < sys->disc.particles.n; i++) {
-    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_all[i * bs];
+  PetscCall(PetscMemzero(F, sizeof(*F)));
+  for (PetscInt i = 0; i < sys->disc.nowned; i++) {
+    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_owned[i * bs];
     PetscReal        phi[3] = {1, X[0] - c[0], X[1] - c[1]}, ref[2], d[2], rig[3][2];
     if (!Interior(sys, i)) continue;
-    n++;
+    F->n++;
     PeriReferenceDisplacement(sys, X, ref);
     d[0] = u[ux] - ref[0];
     d[1] = u[uy] - ref[1];
     /* rigid motion basis: (1,0), (0,1), (-y', x') */
     rig[0][0] = 1, rig[0][1] = 0, rig[1][0] = 0, rig[1][1] = 1, rig[2][0] = -phi[2], rig[2][1] = phi[1];
     for (PetscInt a = 0; a < 3; a++) {
-      bx[a] += phi[a] * u[ux];
-      by[a] += phi[a] * u[uy];
-      br[a] += rig[a][0] * d[0] + rig[a][1] * d[1];
+      F->bx[a] += phi[a] * u[ux];
+      F->by[a] += phi[a] * u[uy];
+      F->br[a] += rig[a][0] * d[0] + rig[a][1] * d[1];
       for (PetscInt b = 0; b < 3; b++) {
-        A[a][b] += phi[a] * phi[b];
-        R[a][b] += rig[a][0] * rig[b][0] + rig[a][1] * rig[b][1];
+        F->A[a][b] += phi[a] * phi[b];
+        F->R[a][b] += rig[a][0] * rig[b][0] + rig[a][1] * rig[b][1];
       }
     }
   }
-  PetscCheck(n >= 3, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: only %" PetscInt_FMT " particles lie farther than 2 delta from the edges: too few to measure the interior strain", sys->scene->file, n);
-  {
-    PetscReal A2[3][3];
-    PetscCall(PetscArraycpy(&A2[0][0], &A[0][0], 9));
-    PetscCall(SmallSolve(3, A, bx));
-    PetscCall(SmallSolve(3, A2, by));
-    PetscCall(SmallSolve(3, R, br));
-  }
-  sys->reference.interior_particles = n;
-  sys->reference.interior_strain[0] = bx[1];
-  sys->reference.interior_strain[1] = by[2];
-  sys->reference.interior_strain[2] = bx[2] + by[1];
-  for (PetscInt i = 0; i < sys->disc.particles.n; i++) {
-    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_all[i * bs];
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, F, (PetscMPIInt)(sizeof(*F) / sizeof(PetscReal)), MPIU_REAL, MPI_SUM, sys->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The interior displacement error after the rigid fit br: sums of |e|^2 and |ref|^2 and the largest
+ * |e| and |ref|, over the ranks. Collective. */
+static PetscErrorCode InteriorError(PeriSystem sys, PetscInt ux, PetscInt uy, const PetscReal br[], PetscReal err[4])
+{
+  const PetscInt   bs = sys->model->dofs;
+  const PetscReal *c  = sys->reference.center;
+
+  PetscFunctionBeginUser;
+  err[0] = err[1] = err[2] = err[3] = 0;
+  for (PetscInt i = 0; i < sys->disc.nowned; i++) {
+    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_owned[i * bs];
     PetscReal        ref[2], e[2];
     if (!Interior(sys, i)) continue;
     PeriReferenceDisplacement(sys, X, ref);
     e[0] = u[ux] - ref[0] - (br[0] - br[2] * (X[1] - c[1]));
     e[1] = u[uy] - ref[1] - (br[1] + br[2] * (X[0] - c[0]));
-    num += e[0] * e[0] + e[1] * e[1];
-    den += ref[0] * ref[0] + ref[1] * ref[1];
-    dmax = PetscMax(dmax, PetscSqrtReal(e[0] * e[0] + e[1] * e[1]));
-    umax = PetscMax(umax, PetscSqrtReal(ref[0] * ref[0] + ref[1] * ref[1]));
+    err[0] += e[0] * e[0] + e[1] * e[1];
+    err[1] += ref[0] * ref[0] + ref[1] * ref[1];
+    err[2] = PetscMax(err[2], PetscSqrtReal(e[0] * e[0] + e[1] * e[1]));
+    err[3] = PetscMax(err[3], PetscSqrtReal(ref[0] * ref[0] + ref[1] * ref[1]));
   }
-  PetscCheck(den > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the reference field vanishes on the interior particles (reference.stress = 0?)", sys->scene->file);
-  sys->reference.error_l2_rel  = PetscSqrtReal(num / den);
-  sys->reference.error_max_rel = dmax / umax;
-  sys->reference.effective_E = sys->reference.effective_nu = sys->reference.effective_G = 0;
-  if (sys->reference.type == PERI_REFERENCE_UNIAXIAL) {
-    PetscInt  a  = sys->reference.axis;
-    PetscReal ea = sys->reference.interior_strain[a], eb = sys->reference.interior_strain[1 - a];
-    sys->reference.effective_E  = sys->reference.stress / ea;
-    sys->reference.effective_nu = -eb / ea;
-  } else if (sys->reference.type == PERI_REFERENCE_SHEAR)
-    sys->reference.effective_G = sys->reference.stress / sys->reference.interior_strain[2];
-  sys->reference.evaluated = PETSC_TRUE;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, err, 2, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, err + 2, 2, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriReferenceEvaluate - from the owned particles' DOFs (u_owned) of every rank: the interior
+  strain (least-squares displacement gradient over the particles farther than 2 delta from every
+  edge), the effective moduli it implies for the reference's stress state, and the interior
+  displacement error against the reference after removing the best-fit rigid motion. Collective.
+@*/
+PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
+{
+  PeriReference *r = &sys->reference;
+  FitSums        F;
+  PetscReal      err[4];
+  PetscInt       ux, uy;
+
+  PetscFunctionBeginUser;
+  r->evaluated = PETSC_FALSE;
+  if (r->type == PERI_REFERENCE_NONE) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
+  PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
+  PetscCheck(ux >= 0 && uy >= 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "reference fields need the in-plane displacements ux, uy; model %s has none", sys->model->type);
+  PetscCall(InteriorFit(sys, ux, uy, &F));
+  PetscCheck(F.n >= 3, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: only %" PetscInt_FMT " particles lie farther than 2 delta from the edges: too few to measure the interior strain", sys->scene->file, (PetscInt)F.n);
+  {
+    PetscReal A2[3][3];
+    PetscCall(PetscArraycpy(&A2[0][0], &F.A[0][0], 9));
+    PetscCall(SmallSolve(3, F.A, F.bx));
+    PetscCall(SmallSolve(3, A2, F.by));
+    PetscCall(SmallSolve(3, F.R, F.br));
+  }
+  r->interior_particles = (PetscInt)F.n;
+  r->interior_strain[0] = F.bx[1];
+  r->interior_strain[1] = F.by[2];
+  r->interior_strain[2] = F.bx[2] + F.by[1];
+  PetscCall(InteriorError(sys, ux, uy, F.br, err));
+  PetscCheck(err[1] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: the reference field vanishes on the interior particles (reference.stress = 0?)", sys->scene->file);
+  r->error_l2_rel  = PetscSqrtReal(err[0] / err[1]);
+  r->error_max_rel = err[2] / err[3];
+  r->effective_E = r->effective_nu = r->effective_G = 0;
+  if (r->type == PERI_REFERENCE_UNIAXIAL) {
+    PetscInt  a  = r->axis;
+    PetscReal ea = r->interior_strain[a], eb = r->interior_strain[1 - a];
+    r->effective_E  = r->stress / ea;
+    r->effective_nu = -eb / ea;
+  } else if (r->type == PERI_REFERENCE_SHEAR)
+    r->effective_G = r->stress / r->interior_strain[2];
+  r->evaluated = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

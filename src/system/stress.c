@@ -119,8 +119,9 @@ static void ElasticStress(PeriModel m, PetscInt dim, const PetscReal eps[9], Pet
 }
 
 /*@C
-  PeriSystemEvaluateStress - sys->stress, sys->strain and sys->elastic_stress (every rank, all
-  particles until issue 17 item 3; each rank writes its own particles' piece; 9 per particle, row-major 3 x 3, symmetric) from all particles' DOFs u (every rank), when output.stress
+  PeriSystemEvaluateStress - sys->stress, sys->strain and sys->elastic_stress of the owned
+  particles (9 per particle, row-major 3 x 3, symmetric; the ghosts' shares reach their owners)
+  from the local view's DOFs u (PeriSystemLocalDOFs), when output.stress
   asks for them. Nothing for the antiplane models. Collective.
 @*/
 PetscErrorCode PeriSystemEvaluateStress(PeriSystem sys, const PetscScalar u[])
@@ -137,11 +138,12 @@ PetscErrorCode PeriSystemEvaluateStress(PeriSystem sys, const PetscScalar u[])
   sc.S = S;
   PetscCall(PeriElementsForEach(sys, ElementStress, &sc));
   PetscCall(GradientMoments(sys, u, acc));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, S, (PetscMPIInt)(9 * n), MPIU_REAL, MPI_SUM, sys->comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, acc, (PetscMPIInt)(18 * n), MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 9, MPI_SUM, S));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 18, MPI_SUM, acc));
   {
-    PetscCall(PetscMalloc3(9 * n, &sys->stress, 9 * n, &sys->strain, 9 * n, &sys->elastic_stress));
-    for (PetscInt i = 0; i < n; i++) {
+    const PetscInt no = sys->disc.nowned;
+    PetscCall(PetscMalloc3(9 * no, &sys->stress, 9 * no, &sys->strain, 9 * no, &sys->elastic_stress));
+    for (PetscInt i = 0; i < no; i++) {
       for (PetscInt a = 0; a < 3; a++)
         for (PetscInt b = 0; b < 3; b++) sys->stress[9 * i + 3 * a + b] = 0.5 * (S[9 * i + 3 * a + b] + S[9 * i + 3 * b + a]);
       StrainFromMoments(&acc[18 * i], &acc[18 * i + 9], sys->disc.particles.dim, &sys->strain[9 * i]);

@@ -22,9 +22,9 @@ PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
   const PeriModel m = sys->model;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriJSONInt(j, "particles", sys->disc.particles.n));
+  PetscCall(PeriJSONInt(j, "particles", sys->disc.N));
   PetscCall(PeriJSONInt(j, "bonds", sys->log.nbonds_total));
-  PetscCall(PeriJSONInt(j, "dofs", sys->disc.particles.n * m->dofs));
+  PetscCall(PeriJSONInt(j, "dofs", sys->disc.N * m->dofs));
   PetscCall(PeriJSONInt(j, "ranks", sys->size));
   PetscCall(PeriJSONInt(j, "edge_cut", sys->log.edge_cut));
   PetscCall(PeriJSONReal(j, "horizon", sys->disc.delta));
@@ -78,7 +78,7 @@ PetscErrorCode PeriSystemSummarySolver(PeriSystem sys, PeriJSON j)
   PetscCall(PeriJSONReal(j, "residual_norm", sys->solve.residual_norm));
   if (sys->solve.residual_tol > 0) PetscCall(PeriJSONReal(j, "residual_tol", sys->solve.residual_tol));
   /* written results passed every check; an interrupted solve did not finish */
-  PetscCall(PeriJSONBool(j, "converged", sys->interrupted && !sys->u_all ? PETSC_FALSE : PETSC_TRUE));
+  PetscCall(PeriJSONBool(j, "converged", sys->interrupted && !sys->has_solution ? PETSC_FALSE : PETSC_TRUE));
   PetscCall(PeriJSONString(j, "operator", sys->solve.symmetric ? "symmetric" : "unsymmetric"));
   PetscCall(PeriJSONString(j, "stiffness", sys->op ? "matrix_free" : "assembled"));
   if (sys->solve.free_modes) {
@@ -94,7 +94,7 @@ PetscErrorCode PeriSystemSummaryFields(PeriSystem sys, PeriJSON j)
 {
 
   PetscFunctionBeginUser;
-  if (!sys->u_all) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->has_solution) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONReal(j, "strain_energy", sys->strain_energy));
   PetscCall(PeriJSONBeginObject(j, "max_abs_u"));
   for (PetscInt c = 0; c < sys->model->dofs; c++) PetscCall(PeriJSONReal(j, sys->model->components[c], sys->max_abs_u[c]));

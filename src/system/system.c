@@ -308,61 +308,93 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The bonds of this rank's particles rstart..rend-1 (and their families for state-based models),
- * searched in its local view: its particles and, after them, the other ranks' within the search
- * radius, found without the whole body (src/disc/halo.c). The view is released after the search
- * until the other consumers read it instead of the whole body (docs/distributed.md). */
-static PetscErrorCode SearchBonds(PeriSystem sys, PetscInt rstart, PetscInt rend)
+/* This rank's local view: its share rstart..rend-1 of the partitioned body, then the ghosts within
+ * the bonds' search radius (src/disc/halo.c), or within reach of the mirror image of every owned
+ * fictitious layer particle (its relation reads the image's position and shear modulus); the mesh
+ * groups move over with them. The whole body is freed. */
+static PetscErrorCode SetLocalView(PeriSystem sys, PetscInt rstart, PetscInt rend)
 {
-  PetscReal     hmax = 0;
-  PeriParticles local;
-  PeriHalo      halo;
+  PeriParticles *body = &sys->disc.particles, local;
+  PetscReal      hmax = 0, reach = 0, radius;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = rstart; k < rend; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
+  for (PetscInt k = rstart; k < rend; k++) {
+    hmax = PetscMax(hmax, body->spacing[k]);
+    if (PeriParticleIsFictitious(body, k)) {
+      PetscReal d2 = 0;
+      for (PetscInt d = 0; d < 3; d++) d2 += PetscSqr(body->x[3 * k + d] - body->x[3 * body->image[k] + d]);
+      reach = PetscMax(reach, PetscSqrtReal(d2) * (1 + 1e-9));
+    }
+  }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
-  PetscCall(PeriParticlesSlice(&sys->disc.particles, rstart, rend, &local));
-  PetscCall(PeriHaloCreate(sys->comm, &local, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax), &halo));
-  PetscCall(PeriNeighborSearch(&local, sys->disc.delta, sys->disc.partial_volume, 0, halo.nowned, PETSC_TRUE, &sys->disc.bonds));
-  /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
-  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&local, sys->disc.delta, sys->disc.partial_volume, 0, halo.nowned, PETSC_FALSE, &sys->disc.family));
-  PetscCall(PeriHaloDestroy(&halo));
-  PetscCall(PeriParticlesDestroy(&local));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &reach, 1, MPIU_REAL, MPI_MAX, sys->comm));
+  radius = PetscMax(PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax), reach);
+  PetscCall(PeriParticlesSlice(body, rstart, rend, &local));
+  local.ngroups = body->ngroups;
+  local.groups  = body->groups;
+  body->ngroups = 0;
+  body->groups  = NULL;
+  PetscCall(PeriParticlesDestroy(body));
+  PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &local, radius));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Partition, neighbour search (bonds, and families for state-based models), cracks, family
- * volumes and the surface correction; counts of bonds and of bonds between ranks. */
+/* The bonds of the owned particles (and their families for state-based models), searched in the
+ * local view. */
+static PetscErrorCode SearchBonds(PeriSystem sys)
+{
+  PeriDisc *d = &sys->disc;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->partial_volume, 0, d->nowned, PETSC_TRUE, &d->bonds));
+  /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
+  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->partial_volume, 0, d->nowned, PETSC_FALSE, &d->family));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Partition, local view, neighbour search (bonds, and families for state-based models), cracks,
+ * family volumes and the surface correction; counts of bonds and of bonds between ranks. */
 static PetscErrorCode SetUpBonds(PeriSystem sys)
 {
+  PeriDisc      *d = &sys->disc;
   PetscInt      *perm, *range, cut = 0;
   PetscLogDouble t0, t1;
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Partition, 0, 0, 0, 0));
-  PetscCall(PeriPartition(sys->comm, &sys->disc.particles, sys->disc.delta, &perm, &range));
-  if (sys->size > 1) PetscCall(PeriParticlesPermute(&sys->disc.particles, perm));
+  PetscCall(PeriPartition(sys->comm, &d->particles, d->delta, &perm, &range));
+  if (sys->size > 1) PetscCall(PeriParticlesPermute(&d->particles, perm));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Partition, 0, 0, 0, 0));
-  PetscCall(PetscMalloc1(sys->disc.particles.n, &sys->disc.owner));
-  for (PetscMPIInt r = 0; r < sys->size; r++)
-    for (PetscInt i = range[r]; i < range[r + 1]; i++) sys->disc.owner[i] = r;
 
   PetscCall(PetscLogEventBegin(PERI_EVENT_Neighbors, 0, 0, 0, 0));
-  PetscCall(SearchBonds(sys, range[sys->rank], range[sys->rank + 1]));
-  PetscCall(PetscMalloc2(sys->disc.particles.n, &sys->disc.family_volume, sys->disc.particles.n, &sys->disc.neighbor_count));
+  PetscCall(SetLocalView(sys, range[sys->rank], range[sys->rank + 1]));
+  PetscCall(PetscFree(perm));
+  PetscCall(PetscFree(range));
+  PetscCall(SearchBonds(sys));
+  PetscCall(PetscMalloc2(d->particles.n, &d->family_volume, d->particles.n, &d->neighbor_count));
   /* a crack is geometry: the family volumes, the surface correction and the calibration see it */
   PetscCall(PeriCracksApply(sys));
-  PetscCall(PeriNeighborhoodVolumes(sys->comm, &sys->disc.particles, &sys->disc.bonds, sys->disc.family_volume, sys->disc.neighbor_count));
-  PetscCall(PeriSurfaceCorrectionApply(sys->disc.surface, &sys->disc.particles, sys->disc.delta, sys->disc.family_volume, &sys->disc.bonds));
+  PetscCall(PeriNeighborhoodVolumes(d, d->family_volume, d->neighbor_count));
+  PetscCall(PeriSurfaceCorrectionApply(d->surface, &d->particles, d->delta, d->family_volume, &d->bonds));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Neighbors, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
   sys->log.neighbors_s = t1 - t0;
-  PetscCallMPI(MPI_Allreduce(&sys->disc.bonds.nbonds, &sys->log.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
-  for (PetscInt k = 0; k < sys->disc.bonds.nbonds; k++) cut += sys->disc.owner[sys->disc.bonds.j[k]] != sys->rank;
+  PetscCallMPI(MPI_Allreduce(&d->bonds.nbonds, &sys->log.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
+  for (PetscInt k = 0; k < d->bonds.nbonds; k++) cut += d->bonds.j[k] >= d->nowned;
   PetscCallMPI(MPI_Allreduce(&cut, &sys->log.edge_cut, 1, MPIU_INT, MPI_SUM, sys->comm));
-  PetscCall(PetscFree(perm));
-  PetscCall(PetscFree(range));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The calibration's combine (PeriCalibrationData): every copy of a particle gets the op of all
+ * copies' values. */
+static PetscErrorCode CombineCopies(const PeriCalibrationData *data, MPI_Datatype base, PetscInt count, MPI_Op op, void *values)
+{
+  const PeriDisc *d = (const PeriDisc *)data->ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriDiscGhostsToOwners(d, base, count, op, values));
+  PetscCall(PeriDiscOwnersToGhosts(d, base, count, values));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -373,12 +405,16 @@ static PetscErrorCode Calibrate(PeriSystem sys)
 
   PetscFunctionBeginUser;
   cal.n             = sys->disc.particles.n;
+  cal.nowned        = sys->disc.nowned;
+  cal.N             = sys->disc.N;
   cal.family_volume = sys->disc.family_volume;
   cal.mu            = sys->mu;
   cal.comm          = sys->comm;
   cal.particles     = &sys->disc.particles;
   cal.bonds         = &sys->disc.bonds;
   cal.surface       = sys->disc.surface;
+  cal.combine       = CombineCopies;
+  cal.ctx           = &sys->disc;
   PetscCall(sys->model->ops.calibrate(sys->model, &cal));
   if (sys->model->warning[0]) PetscCall(PetscPrintf(sys->comm, "perilin: warning: %s\n", sys->model->warning));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -400,9 +436,9 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(ReadCorrections(sys));
   PetscCall(PeriLayersAddParticles(sys));
   PetscCall(SetUpBonds(sys));
-  for (PetscInt i = 0; i < pt->n; i++)
-    PetscCheck(sys->disc.neighbor_count[i] > 0, sys->comm, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->disc.delta, (double)pt->spacing[i]);
-  PetscCall(PeriRegionsCreateFromScene(s, &sys->disc.particles, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
+  for (PetscInt i = 0; i < sys->disc.nowned; i++)
+    PetscCheck(sys->disc.neighbor_count[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->disc.delta, (double)pt->spacing[i]);
+  PetscCall(PeriRegionsCreateFromScene(sys->comm, s, &sys->disc.particles, sys->disc.nowned, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
   PetscCall(ReadShearModuli(sys));
   PetscCall(Calibrate(sys));
   PetscCall(PeriReadProbes(sys));
@@ -441,7 +477,6 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PetscFree(sys->constrained_region));
   PetscCall(PeriReactionsDestroy(&sys->reactions));
   PetscCall(PetscFree(sys->W));
-  PetscCall(PetscFree(sys->u_all));
   PetscCall(PetscFree(sys->u_owned));
   PetscCall(PeriProgressDestroy(&sys->progress));
   PetscCall(PetscFree(sys));
@@ -534,7 +569,7 @@ static void DefaultPC(PeriSystem sys)
   PetscReal            extent = 0;
 
   for (PetscInt d = 0; d < pt->dim; d++) extent = PetscMax(extent, pt->upper[d] - pt->lower[d]);
-  if (sys->op && pt->dim == 3 && pt->n <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
+  if (sys->op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
     PetscStrncpy(sys->pc_default, PCJACOBI, sizeof(sys->pc_default));
   else
     PetscStrncpy(sys->pc_default, PCGAMG, sizeof(sys->pc_default));

@@ -53,8 +53,9 @@ static PetscErrorCode TestRead(const char scene[], const char mesh[], PetscReal 
   PetscCall(CountElements(mesh, strstr(mesh, "tet") ? 3 : 2, &n, &left));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, scene, &p));
   pt = &p->sys->disc.particles;
-  PeriTestClose("particles = elements", (PetscReal)pt->n, (PetscReal)n, 0);
-  for (PetscInt k = 0; k < pt->n; k++) sum += pt->volume[k];
+  PeriTestClose("particles = elements", (PetscReal)p->sys->disc.N, (PetscReal)n, 0);
+  for (PetscInt k = 0; k < p->sys->disc.nowned; k++) sum += pt->volume[k];
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPIU_REAL, MPI_SUM, PETSC_COMM_WORLD));
   PeriTestClose("total volume", sum, volume, 1e-12 * volume);
   for (PetscInt k = 0; k < p->sys->disc.nregions; k++)
     if (!strcmp(p->sys->disc.regions[k].name, "left")) r = &p->sys->disc.regions[k];
@@ -65,44 +66,31 @@ static PetscErrorCode TestRead(const char scene[], const char mesh[], PetscReal 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Least-squares slope of v against the coordinate s over the particles of mask. */
-static PetscReal Slope(PetscInt n, const PetscReal s[], PetscInt sstride, const PetscReal v[], PetscInt vstride, const PetscBool mask[])
-{
-  PetscReal m = 0, ms = 0, mv = 0, sss = 0, ssv = 0;
-  for (PetscInt k = 0; k < n; k++)
-    if (mask[k]) m++, ms += s[k * sstride], mv += v[k * vstride];
-  ms /= m, mv /= m;
-  for (PetscInt k = 0; k < n; k++)
-    if (mask[k]) sss += PetscSqr(s[k * sstride] - ms), ssv += (s[k * sstride] - ms) * (v[k * vstride] - mv);
-  return ssv / sss;
-}
-
 static PetscErrorCode TestUniform(const char scene[], PetscReal tol)
 {
   PeriProblem    p;
   PeriParticles *pt;
   PetscBool     *in;
-  PetscReal      delta, eps = 1e6 / 1e9;
-  PetscInt       bs;
-  PetscMPIInt    rank;
+  PetscReal      delta, eps = 1e6 / 1e9, sx, sy;
+  PetscInt       bs, no;
 
   PetscFunctionBeginUser;
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, scene, &p));
-  PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
-  if (!rank) {
-    pt    = &p->sys->disc.particles;
-    delta = p->sys->disc.delta;
-    bs    = p->sys->model->dofs;
-    PetscCall(PetscMalloc1(pt->n, &in));
-    for (PetscInt k = 0; k < pt->n; k++) {
-      in[k] = PETSC_TRUE;
-      for (PetscInt d = 0; d < pt->dim; d++)
-        if (pt->x[3 * k + d] < pt->lower[d] + delta || pt->x[3 * k + d] > pt->upper[d] - delta) in[k] = PETSC_FALSE;
-    }
-    PeriTestClose("interior strain xx (ux slope along x)", Slope(pt->n, &pt->x[0], 3, &p->sys->u_all[0], bs, in), eps, tol * eps);
-    PeriTestClose("interior strain yy (uy slope along y)", Slope(pt->n, &pt->x[1], 3, &p->sys->u_all[1], bs, in), -eps / 3, tol * eps / 3);
-    PetscCall(PetscFree(in));
+  pt    = &p->sys->disc.particles;
+  delta = p->sys->disc.delta;
+  bs    = p->sys->model->dofs;
+  no    = p->sys->disc.nowned;
+  PetscCall(PetscMalloc1(no, &in));
+  for (PetscInt k = 0; k < no; k++) {
+    in[k] = PETSC_TRUE;
+    for (PetscInt d = 0; d < pt->dim; d++)
+      if (pt->x[3 * k + d] < pt->lower[d] + delta || pt->x[3 * k + d] > pt->upper[d] - delta) in[k] = PETSC_FALSE;
   }
+  PetscCall(PeriTestSlope(PETSC_COMM_WORLD, no, &pt->x[0], 3, &p->sys->u_owned[0], bs, in, &sx));
+  PetscCall(PeriTestSlope(PETSC_COMM_WORLD, no, &pt->x[1], 3, &p->sys->u_owned[1], bs, in, &sy));
+  PeriTestClose("interior strain xx (ux slope along x)", sx, eps, tol * eps);
+  PeriTestClose("interior strain yy (uy slope along y)", sy, -eps / 3, tol * eps / 3);
+  PetscCall(PetscFree(in));
   PetscCall(PeriProblemDestroy(&p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

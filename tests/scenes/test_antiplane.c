@@ -64,23 +64,22 @@ static PetscReal TorsionWarping(const PetscReal X[])
   return w;
 }
 
-/* Relative l2 error of u_z over the body's particles with y <= ymax (rank 0 holds the fields; broadcast). */
+/* Relative l2 error of u_z over the body's particles with y <= ymax (each rank's own, then summed). */
 static PetscErrorCode FieldErrorBelow(PeriProblem p, PetscReal (*exact)(const PetscReal[]), PetscReal ymax, PetscReal *err)
 {
-  const PeriParticles *pt  = &p->sys->disc.particles;
-  PetscReal            num = 0, den = 0;
+  const PeriParticles *pt    = &p->sys->disc.particles;
+  PetscReal            nd[2] = {0, 0};
 
   PetscFunctionBeginUser;
-  if (p->rank == 0)
-    for (PetscInt i = 0; i < pt->n; i++) {
-      PetscReal ue;
-      if (PeriParticleIsFictitious(pt, i) || pt->x[3 * i + 1] > ymax) continue;
-      ue = exact(&pt->x[3 * i]);
-      num += PetscSqr(p->sys->u_all[i] - ue) * pt->volume[i];
-      den += ue * ue * pt->volume[i];
-    }
-  *err = PetscSqrtReal(num / den);
-  PetscCallMPI(MPI_Bcast(err, 1, MPIU_REAL, 0, p->comm));
+  for (PetscInt i = 0; i < p->sys->disc.nowned; i++) {
+    PetscReal ue;
+    if (PeriParticleIsFictitious(pt, i) || pt->x[3 * i + 1] > ymax) continue;
+    ue = exact(&pt->x[3 * i]);
+    nd[0] += PetscSqr(p->sys->u_owned[i] - ue) * pt->volume[i];
+    nd[1] += ue * ue * pt->volume[i];
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, nd, 2, MPIU_REAL, MPI_SUM, p->comm));
+  *err = PetscSqrtReal(nd[0] / nd[1]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -93,20 +92,19 @@ static PetscErrorCode FieldError(PeriProblem p, PetscReal (*exact)(const PetscRe
 
 static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
 {
-  const PeriParticles *pt  = &p->sys->disc.particles;
-  PetscReal            num = 0, den = 0;
+  const PeriParticles *pt    = &p->sys->disc.particles;
+  PetscReal            nd[2] = {0, 0};
 
   PetscFunctionBeginUser;
-  if (p->rank == 0)
-    for (PetscInt i = 0; i < pt->n; i++) {
-      PetscReal w, txz, tyz;
-      if (PeriParticleIsFictitious(pt, i)) continue;
-      Torsion(&pt->x[3 * i], &w, &txz, &tyz);
-      num += (PetscSqr(p->sys->tau[3 * i] - txz) + PetscSqr(p->sys->tau[3 * i + 1] - tyz)) * pt->volume[i];
-      den += (txz * txz + tyz * tyz) * pt->volume[i];
-    }
-  *err = PetscSqrtReal(num / den);
-  PetscCallMPI(MPI_Bcast(err, 1, MPIU_REAL, 0, p->comm));
+  for (PetscInt i = 0; i < p->sys->disc.nowned; i++) {
+    PetscReal w, txz, tyz;
+    if (PeriParticleIsFictitious(pt, i)) continue;
+    Torsion(&pt->x[3 * i], &w, &txz, &tyz);
+    nd[0] += (PetscSqr(p->sys->tau[3 * i] - txz) + PetscSqr(p->sys->tau[3 * i + 1] - tyz)) * pt->volume[i];
+    nd[1] += (txz * txz + tyz * tyz) * pt->volume[i];
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, nd, 2, MPIU_REAL, MPI_SUM, p->comm));
+  *err = PetscSqrtReal(nd[0] / nd[1]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -114,21 +112,15 @@ static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
 static PetscErrorCode InteriorSlope(PeriProblem p, PetscReal *slope)
 {
   const PeriParticles *pt = &p->sys->disc.particles;
-  PetscReal            n = 0, sy = 0, su = 0, syy = 0, syu = 0;
+  const PetscInt       no = p->sys->disc.nowned;
+  PetscBool           *in;
 
   PetscFunctionBeginUser;
-  if (p->rank == 0)
-    for (PetscInt i = 0; i < pt->n; i++) {
-      PetscReal y = pt->x[3 * i + 1], u = p->sys->u_all[i];
-      if (PetscAbsReal(y) > 0.25) continue;
-      n += 1;
-      sy += y;
-      su += u;
-      syy += y * y;
-      syu += y * u;
-    }
-  *slope = p->rank ? 0 : (n * syu - sy * su) / (n * syy - sy * sy) * MU / S;
-  PetscCallMPI(MPI_Bcast(slope, 1, MPIU_REAL, 0, p->comm));
+  PetscCall(PetscMalloc1(no, &in));
+  for (PetscInt i = 0; i < no; i++) in[i] = PetscAbsReal(pt->x[3 * i + 1]) <= 0.25 ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PeriTestSlope(p->comm, no, &pt->x[1], 3, p->sys->u_owned, 1, in, slope));
+  *slope *= MU / S;
+  PetscCall(PetscFree(in));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

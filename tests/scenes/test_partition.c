@@ -9,7 +9,7 @@
 
 static PetscErrorCode CheckShares(PeriProblem p, const char *type, PetscReal imbalance)
 {
-  const PetscInt N = p->sys->disc.particles.n;
+  const PetscInt N = p->sys->disc.N;
   PetscMPIInt    size;
   PetscInt      *count;
   char           what[160];
@@ -17,7 +17,7 @@ static PetscErrorCode CheckShares(PeriProblem p, const char *type, PetscReal imb
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(PetscCalloc1(size, &count));
-  for (PetscInt i = 0; i < N; i++) count[p->sys->disc.owner[i]]++;
+  PetscCallMPI(MPI_Allgather(&p->sys->disc.nowned, 1, MPIU_INT, count, 1, MPIU_INT, PETSC_COMM_WORLD));
   for (PetscMPIInt r = 0; r < size; r++) {
     PetscReal upper = imbalance > 0 ? (1 + imbalance) * N / size + 1 : PetscCeilReal((PetscReal)N / size);
     PetscReal lower = imbalance > 0 ? 1 : PetscFloorReal((PetscReal)N / size);

@@ -12,30 +12,34 @@
 /* the strain at every particle and, where the energy is exact, the stress in the interior */
 static PetscErrorCode CheckFields(PeriProblem p, Vec u, const PetscReal A[3][3], PetscReal reach)
 {
-  const PeriParticles *pt   = &p->sys->disc.particles;
-  const PetscInt       dim  = pt->dim;
-  PetscReal            eerr = 0, serr = 0, snorm = 0, anorm = 0;
+  const PeriParticles *pt     = &p->sys->disc.particles;
+  const PetscInt       dim    = pt->dim;
+  PetscReal            err[3] = {0, 0, 0}, anorm = 0; /* strain error, stress error, stress norm */
+  PetscInt             have;
 
   PetscFunctionBeginUser;
   if (!p->sys->u) PetscCall(VecDuplicate(u, &p->sys->u));
   PetscCall(VecCopy(u, p->sys->u));
   PetscCall(PeriSystemEvaluateEnergy(p->sys));
-  if (p->rank || !p->sys->strain) PetscFunctionReturn(PETSC_SUCCESS);
+  have = p->sys->strain ? 1 : 0;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &have, 1, MPIU_INT, MPI_MAX, p->comm));
+  if (!have) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt a = 0; a < dim; a++)
     for (PetscInt b = 0; b < dim; b++) anorm = PetscMax(anorm, PetscAbsReal(A[a][b]));
-  for (PetscInt i = 0; i < pt->n; i++) {
+  for (PetscInt i = 0; i < p->sys->disc.nowned; i++) {
     PetscBool inner = PETSC_TRUE;
     for (PetscInt d = 0; d < dim; d++) inner = (PetscBool)(inner && (pt->periodic[d] || (pt->x[3 * i + d] - pt->lower[d] >= reach && pt->upper[d] - pt->x[3 * i + d] >= reach)));
     for (PetscInt a = 0; a < dim; a++)
       for (PetscInt b = 0; b < dim; b++) {
-        eerr = PetscMax(eerr, PetscAbsReal(p->sys->strain[9 * i + 3 * a + b] - 0.5 * (A[a][b] + A[b][a])));
+        err[0] = PetscMax(err[0], PetscAbsReal(p->sys->strain[9 * i + 3 * a + b] - 0.5 * (A[a][b] + A[b][a])));
         if (!inner) continue;
-        serr  = PetscMax(serr, PetscAbsReal(p->sys->stress[9 * i + 3 * a + b] - p->sys->elastic_stress[9 * i + 3 * a + b]));
-        snorm = PetscMax(snorm, PetscAbsReal(p->sys->elastic_stress[9 * i + 3 * a + b]));
+        err[1] = PetscMax(err[1], PetscAbsReal(p->sys->stress[9 * i + 3 * a + b] - p->sys->elastic_stress[9 * i + 3 * a + b]));
+        err[2] = PetscMax(err[2], PetscAbsReal(p->sys->elastic_stress[9 * i + 3 * a + b]));
       }
   }
-  PeriTestClose("least-squares strain of an affine field, every particle (relative to |A|)", eerr / anorm, 0.0, 1e-10);
-  if (p->sys->model->calibration == PERI_CALIBRATION_LATTICE) PeriTestClose("bond-force stress against C : eps, interior (lattice calibration, relative)", serr / snorm, 0.0, 1e-10);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, err, 3, MPIU_REAL, MPI_MAX, p->comm));
+  PeriTestClose("least-squares strain of an affine field, every particle (relative to |A|)", err[0] / anorm, 0.0, 1e-10);
+  if (p->sys->model->calibration == PERI_CALIBRATION_LATTICE) PeriTestClose("bond-force stress against C : eps, interior (lattice calibration, relative)", err[1] / err[2], 0.0, 1e-10);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

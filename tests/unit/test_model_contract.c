@@ -261,18 +261,18 @@ static PetscErrorCode EnergyError(PeriProblem p, PetscReal norm2, const PetscRea
   *err   = 0;
   *count = 0;
   *total = 0;
-  for (PetscInt i = 0; i < pt->n; i++) *total += PeriParticleIsFictitious(pt, i) ? 0 : W * pt->volume[i];
+  for (PetscInt i = 0; i < p->sys->disc.nowned; i++) *total += PeriParticleIsFictitious(pt, i) ? 0 : W * pt->volume[i];
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, total, 1, MPIU_REAL, MPI_SUM, p->comm));
   *total = PetscAbsReal(p->sys->strain_energy - *total) / *total;
-  if (p->rank == 0)
-    for (PetscInt i = 0; i < pt->n; i++) {
-      PetscBool inner = (PetscBool)!PeriParticleIsFictitious(pt, i);
-      for (PetscInt b = 0; b < pt->dim; b++) inner = (PetscBool)(inner && pt->x[3 * i + b] - pt->lower[b] >= reach && pt->upper[b] - pt->x[3 * i + b] >= reach);
-      if (!inner) continue;
-      *err = PetscMax(*err, PetscAbsReal(p->sys->W[i] - W) / W);
-      (*count)++;
-    }
-  PetscCallMPI(MPI_Bcast(err, 1, MPIU_REAL, 0, p->comm));
-  PetscCallMPI(MPI_Bcast(count, 1, MPIU_INT, 0, p->comm));
+  for (PetscInt i = 0; i < p->sys->disc.nowned; i++) {
+    PetscBool inner = (PetscBool)!PeriParticleIsFictitious(pt, i);
+    for (PetscInt b = 0; b < pt->dim; b++) inner = (PetscBool)(inner && pt->x[3 * i + b] - pt->lower[b] >= reach && pt->upper[b] - pt->x[3 * i + b] >= reach);
+    if (!inner) continue;
+    *err = PetscMax(*err, PetscAbsReal(p->sys->W[i] - W) / W);
+    (*count)++;
+  }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, err, 1, MPIU_REAL, MPI_MAX, p->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, count, 1, MPIU_INT, MPI_SUM, p->comm));
   PetscCheck(*count > 0, p->comm, PETSC_ERR_PLIB, "no particle two search radii inside the body: enlarge the patch");
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -5,6 +5,7 @@
 #include <perilin/scene.h>
 #include "perilin/private/sys.h"
 #include <petscsf.h>
+#include <petscis.h>
 
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
@@ -25,6 +26,7 @@ typedef struct _n_PeriMeshGroup {
 
 PETSC_EXTERN PetscErrorCode PeriMeshRead(PeriScene, PeriNode, PetscInt, PetscReal, PetscInt *, PetscReal **, PetscReal **, PetscInt *, PeriMeshGroup **);
 PETSC_EXTERN PetscErrorCode PeriMeshGroupsDestroy(PetscInt *, PeriMeshGroup **);
+PETSC_EXTERN PetscErrorCode PeriMeshGroupsRestrict(PeriParticles *);
 
 /* ------------------------------------------------------------------ regions (src/regions.c) */
 typedef enum {
@@ -48,7 +50,7 @@ typedef struct {
   PeriNode       node;
 } PeriRegion;
 
-PETSC_EXTERN PetscErrorCode PeriRegionsCreateFromScene(PeriScene, const PeriParticles *, PetscReal, PetscInt *, PeriRegion **);
+PETSC_EXTERN PetscErrorCode PeriRegionsCreateFromScene(MPI_Comm, PeriScene, const PeriParticles *, PetscInt, PetscReal, PetscInt *, PeriRegion **);
 PETSC_EXTERN PetscErrorCode PeriRegionFind(PeriScene, PeriNode, const char[], PetscInt, PeriRegion *, PeriRegion **);
 PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscReal[]);
 PETSC_EXTERN PetscReal      PeriRegionTolerance(const PeriParticles *);
@@ -59,7 +61,6 @@ PETSC_EXTERN PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *, Peri
 PETSC_EXTERN PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *, PetscReal, PeriPartialVolume, PeriBonds *);
 PETSC_EXTERN PetscReal      PeriPartialVolumeFactor(PeriPartialVolume, PetscReal, PetscReal, PetscReal);
 PETSC_EXTERN PetscReal      PeriSearchRadius(PeriPartialVolume, PetscReal, PetscReal);
-PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(MPI_Comm, const PeriParticles *, const PeriBonds *, PetscReal[], PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
 
@@ -90,20 +91,33 @@ PETSC_EXTERN PetscErrorCode PeriComponentsReduce(MPI_Comm, const PeriHalo *, con
 /* grid, particles and regions.<name>, declared next to the code that reads them. */
 PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
 
-/* The discretization of one body: every consumer reads particle data through this one owner, so
- * that holding only owned + ghost particles per rank (issue 17) changes src/disc/ alone. */
+/* The discretization of one body: every consumer reads particle data through this one owner.
+ * Each rank holds its local view (docs/distributed.md): its owned particles, local indices
+ * 0..nowned-1 (global rstart..rstart+nowned-1), then its ghosts (particles.global gives every
+ * local particle's global index). Every per-particle array is sized to the local view; the bonds'
+ * rows are the owned particles and their j are local indices. */
 typedef struct {
-  PeriParticles         particles; /* the whole body on every rank, until its consumers read a rank's local view (docs/distributed.md) */
+  PeriParticles         particles; /* the local view: owned, then ghosts */
+  PetscInt              N;         /* particles of the whole body */
+  PetscInt              nowned;    /* this rank's own particles */
+  PetscInt              rstart;    /* the global index of local particle 0 */
+  PetscInt             *range;     /* size + 1: rank r owns global indices range[r]..range[r+1]-1 */
+  PeriHalo              halo;      /* the ghosts and the SF that refreshes them */
   PetscInt              nregions;
   PeriRegion           *regions;
   PetscReal             delta;
   PeriPartialVolume     partial_volume;
   PeriSurfaceCorrection surface;
-  PeriBonds             bonds;          /* once per pair, in the row of the smaller index (owned rows) */
+  PeriBonds             bonds;          /* once per pair, in the row of the smaller global index (owned rows, local j) */
   PeriBonds             family;         /* state-based models: every bond of each owned particle (both directions) */
-  PetscReal            *family_volume;  /* sum_j alpha_ij V_j over the family, per particle (all ranks) */
-  PetscInt             *neighbor_count; /* per particle (all ranks) */
-  PetscInt             *owner;          /* rank owning each particle (all ranks) */
+  PetscReal            *family_volume;  /* sum_j alpha_ij V_j over the family, per local particle (ghosts' from their owners) */
+  PetscInt             *neighbor_count; /* per local particle (ghosts' from their owners) */
 } PeriDisc;
 
 PETSC_EXTERN PetscErrorCode PeriDiscDestroy(PeriDisc *);
+PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(const PeriDisc *, PetscReal[], PetscInt[]);
+PETSC_EXTERN PetscErrorCode PeriDiscSetLocalView(MPI_Comm, PeriDisc *, PeriParticles *, PetscReal);
+PETSC_EXTERN PetscMPIInt    PeriDiscOwner(const PeriDisc *, PetscInt);
+PETSC_EXTERN PetscInt       PeriDiscLocal(const PeriDisc *, PetscInt);
+PETSC_EXTERN PetscErrorCode PeriDiscGhostsToOwners(const PeriDisc *, MPI_Datatype, PetscInt, MPI_Op, void *);
+PETSC_EXTERN PetscErrorCode PeriDiscOwnersToGhosts(const PeriDisc *, MPI_Datatype, PetscInt, void *);

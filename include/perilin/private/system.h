@@ -10,11 +10,15 @@
 #include "perilin/private/sys.h"
 
 typedef struct {
-  char      name[PERI_NAME_LEN];
-  PetscReal x[3];
-  PetscInt  particle; /* nearest particle (global index) */
+  char        name[PERI_NAME_LEN];
+  PetscReal   x[3];
+  PetscMPIInt rank;          /* the rank owning the nearest particle */
+  PetscInt    particle;      /* its local index on that rank (-1 on the others) */
+  PetscReal   particle_x[3]; /* its position */
+  /* after a solve, on every rank: */
   PetscReal u[PERI_MAX_DOF];
   PetscReal W;
+  PetscReal sigma[9], epsilon[9], sigma_elastic[9]; /* output.stress */
 } PeriProbe;
 
 /* The last linear solve: what solved it, how well, and the rigid motions it left free. */
@@ -156,13 +160,13 @@ struct _p_PeriSystem {
   PetscReal       *bond_mu;   /* per local bond: the shear modulus across materials (eq. 60), or NULL */
   PeriLayers       layers;
   PeriTorsion      torsion;
-  PetscReal       *tau;            /* antiplane models, every rank (all particles): tau_xz, tau_yz, |tau| per particle after the solve */
-  PetscReal       *stress;         /* vector models, every rank (all particles): the bond-force stress per particle, 3 x 3 row-major (stress.c) */
-  PetscReal       *strain;         /* vector models, every rank (all particles): the least-squares strain per particle, 3 x 3 row-major */
-  PetscReal       *elastic_stress; /* vector models, every rank (all particles): C : strain of the target elasticity */
+  PetscReal       *tau;            /* antiplane models, per owned particle: tau_xz, tau_yz, |tau| after the solve */
+  PetscReal       *stress;         /* vector models, per owned particle: the bond-force stress, 3 x 3 row-major (stress.c) */
+  PetscReal       *strain;         /* vector models, per owned particle: the least-squares strain, 3 x 3 row-major */
+  PetscReal       *elastic_stress; /* vector models, per owned particle: C : strain of the target elasticity */
   PetscBool        stress_output;  /* output.stress: evaluate the three above after each solve */
   PeriFailure      failure;
-  PetscReal       *damage; /* every rank (all particles), scenes with failure: per particle phi, then phi per PeriFailureCause */
+  PetscReal       *damage; /* scenes with failure, per owned particle: phi, then phi per PeriFailureCause */
   PeriModel        model;
   Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
   Mat              Kpc;                     /* with op: the assembled short-range stiffness that preconditions K */
@@ -180,9 +184,9 @@ struct _p_PeriSystem {
   PeriReactions    reactions;
   PetscInt         nprobes;
   PeriProbe       *probes;
-  PetscReal       *W;       /* strain energy density per particle (every rank, all particles, after the solve) */
-  PetscReal       *u_all;   /* displacements of all particles (rank 0, after the solve) */
-  PetscReal       *u_owned; /* the same state's DOFs of this rank's particles (every rank): its piece of the output */
+  PetscReal       *W;            /* strain energy density per owned particle, after the solve */
+  PetscReal       *u_owned;      /* the same state's DOFs of the owned particles: this rank's piece of the output */
+  PetscBool        has_solution; /* the fields above describe a solution */
   PeriSolveInfo    solve;
   PeriRunLog       log;
   PetscReal        strain_energy;           /* after the last solve */
@@ -203,6 +207,7 @@ PETSC_EXTERN PetscErrorCode PeriSystemBondGeometry(PeriSystem, PetscInt, PetscIn
 PETSC_EXTERN PetscErrorCode PeriSystemFamilyGeometry(PeriSystem, PetscInt, PetscInt *, PeriBondGeometry[]);
 PETSC_EXTERN PetscInt       PeriSystemMaxFamily(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemLocalDOFs(PeriSystem, Vec, PetscScalar **);
 PETSC_EXTERN PetscErrorCode PeriSystemFindProbe(PeriSystem, const char[], PeriProbe **);
 PETSC_EXTERN PetscReal      PeriResidualTolerance(PeriSystem, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriReadProbes(PeriSystem);
@@ -216,7 +221,8 @@ PETSC_EXTERN PetscErrorCode PeriSystemWriteParticles(PeriSystem, const PetscReal
  * or the family of an owned particle of a state-based model. */
 typedef struct {
   PetscInt                n;      /* particles: 2 for a bond, the family's size + 1 */
-  const PetscInt         *idx;    /* their global indices, the bond's or family's particle i first */
+  const PetscInt         *idx;    /* their local indices (the local view), the bond's or family's particle i first */
+  const PetscInt         *gidx;   /* their global indices (matrix and vector rows) */
   PetscInt                nshare; /* idx[0..nshare-1] share its energy equally: a bond's 2 ends, a family's i */
   const PetscReal        *K;      /* the ((n dofs)^2) stiffness block, row-major, DOFs in the order of idx */
   const PeriBondGeometry *g;      /* the bond's geometry, or the family's n - 1 bonds */
@@ -271,7 +277,6 @@ PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeome
 PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriSystem, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriDamage(PeriSystem, PetscReal **);
-PETSC_EXTERN PetscErrorCode PeriComponents(PeriSystem, PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriFamilySync(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriPieces(PeriSystem, PetscInt *, PetscInt **, PetscReal **, PetscInt *, PetscBool *);
 /* fictitious boundary layers and torsion (src/system/layers.c) */
