@@ -5,7 +5,8 @@
  *   grid            each rank generates its block of cells (x fastest);
  *   particles.file  rank 0 reads the file twice: once to check every line and count the
  *                   particles (with the messages of the whole-body read), then to deal them out
- *                   in chunks of at most CHUNK particles to the ranks in turn;
+ *                   in chunks of at most -peri_read_chunk particles (default 65536: 2.6 MB of
+ *                   positions, volumes and lines) to the ranks in turn;
  *   particles.mesh  Gmsh runs on rank 0 (it is serial), which holds the mesh and its particles
  *                   while reading, then deals them out as for a file; the mesh groups (positions:
  *                   O(group size)) are broadcast.
@@ -15,8 +16,6 @@
  * order: rank r's particles, numbered from range[r] in arrival order, are exactly those the
  * whole-body path (PeriPartition, PeriParticlesPermute) gives it, in its order. */
 #include "perilin/private/disc.h"
-
-#define CHUNK 65536 /* particles per message from rank 0: 2.6 MB of positions, volumes and lines */
 
 static PetscInt BlockStart(PetscInt N, PetscMPIInt size, PetscMPIInt r)
 {
@@ -61,29 +60,30 @@ static PetscErrorCode OnRoot(MPI_Comm comm, PetscErrorCode (*fn)(void *), void *
 }
 
 /* Rank 0 deals the body's particles, in order, to the ranks' blocks: its own block straight into
- * p, the others' in chunks of at most CHUNK particles (a chunk never spans two blocks). */
+ * p, the others' in chunks of at most chunk particles (a chunk never spans two blocks). */
 typedef struct {
   MPI_Comm       comm;
   PetscMPIInt    tag, size, dest; /* dest: the rank whose block particle k is in */
   PetscInt       N, k, end;       /* particles in all, dealt so far; the first past dest's block */
-  PetscInt       nbuf;            /* particles waiting in the buffers */
+  PetscInt       chunk, nbuf;     /* the most particles per message; those waiting in the buffers */
   PetscReal     *rbuf;            /* 4 per particle: x, y, z, volume */
   PetscInt      *ibuf;            /* source lines */
   PeriParticles *p;               /* rank 0's block */
   PeriExtent     extent;          /* of all particles dealt */
 } Dealer;
 
-static PetscErrorCode DealerCreate(MPI_Comm comm, PetscMPIInt tag, PetscInt N, PeriParticles *p, Dealer *d)
+static PetscErrorCode DealerCreate(MPI_Comm comm, PetscMPIInt tag, PetscInt chunk, PetscInt N, PeriParticles *p, Dealer *d)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(d, sizeof(*d)));
-  d->comm = comm;
-  d->tag  = tag;
-  d->N    = N;
-  d->p    = p;
+  d->comm  = comm;
+  d->tag   = tag;
+  d->chunk = chunk;
+  d->N     = N;
+  d->p     = p;
   PetscCallMPI(MPI_Comm_size(comm, &d->size));
   d->end = BlockStart(N, d->size, 1);
-  PetscCall(PetscMalloc2(4 * CHUNK, &d->rbuf, CHUNK, &d->ibuf));
+  PetscCall(PetscMalloc2(4 * chunk, &d->rbuf, chunk, &d->ibuf));
   PeriExtentInit(&d->extent);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -116,7 +116,7 @@ static PetscErrorCode DealerPut(Dealer *d, const PetscReal x[], PetscReal vol, P
     for (PetscInt c = 0; c < 3; c++) d->rbuf[4 * d->nbuf + c] = x[c];
     d->rbuf[4 * d->nbuf + 3] = vol;
     d->ibuf[d->nbuf++]       = line;
-    if (d->nbuf == CHUNK || d->k + 1 == d->end) {
+    if (d->nbuf == d->chunk || d->k + 1 == d->end) {
       PetscCallMPI(MPI_Send(d->rbuf, (PetscMPIInt)(4 * d->nbuf), MPIU_REAL, d->dest, d->tag, d->comm));
       PetscCallMPI(MPI_Send(d->ibuf, (PetscMPIInt)d->nbuf, MPIU_INT, d->dest, d->tag, d->comm));
       d->nbuf = 0;
@@ -127,15 +127,15 @@ static PetscErrorCode DealerPut(Dealer *d, const PetscReal x[], PetscReal vol, P
 }
 
 /* A rank other than 0: its block of p->n particles from rank 0, in the chunks DealerPut sends. */
-static PetscErrorCode ReceiveBlock(MPI_Comm comm, PetscMPIInt tag, PeriParticles *p)
+static PetscErrorCode ReceiveBlock(MPI_Comm comm, PetscMPIInt tag, PetscInt chunk, PeriParticles *p)
 {
   PetscReal *rbuf;
   PetscInt  *ibuf;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc2(4 * CHUNK, &rbuf, CHUNK, &ibuf));
-  for (PetscInt off = 0; off < p->n; off += CHUNK) {
-    PetscInt m = PetscMin(CHUNK, p->n - off);
+  PetscCall(PetscMalloc2(4 * chunk, &rbuf, chunk, &ibuf));
+  for (PetscInt off = 0; off < p->n; off += chunk) {
+    PetscInt m = PetscMin(chunk, p->n - off);
     PetscCallMPI(MPI_Recv(rbuf, (PetscMPIInt)(4 * m), MPIU_REAL, 0, tag, comm, MPI_STATUS_IGNORE));
     PetscCallMPI(MPI_Recv(ibuf, (PetscMPIInt)m, MPIU_INT, 0, tag, comm, MPI_STATUS_IGNORE));
     for (PetscInt l = 0; l < m; l++) {
@@ -242,17 +242,20 @@ static PetscErrorCode ReadBlock(MPI_Comm comm, PeriSource source, RootRead *r)
   PetscMPIInt rank, size, tag;
   MPI_Comm    inner;
   PetscReal   ext[7];
+  PetscInt    chunk = 65536;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_read_chunk", &chunk, NULL));
+  PetscCheck(chunk > 0, comm, PETSC_ERR_USER_INPUT, "-peri_read_chunk %" PetscInt_FMT ": must be positive", chunk);
   PetscCall(OnRoot(comm, source == PERI_SOURCE_MESH ? MeshReadRoot : CSVCount, r));
   PetscCallMPI(MPI_Bcast(&r->N, 1, MPIU_INT, 0, comm));
   PetscCall(PeriParticlesAllocate(r->p, BlockStart(r->N, size, rank + 1) - BlockStart(r->N, size, rank)));
   PetscCall(PetscCommDuplicate(comm, &inner, &tag));
   if (rank == 0) {
     Dealer d;
-    PetscCall(DealerCreate(inner, tag, r->N, r->p, &d));
+    PetscCall(DealerCreate(inner, tag, chunk, r->N, r->p, &d));
     if (source == PERI_SOURCE_MESH)
       for (PetscInt k = 0; k < r->N; k++) PetscCall(DealerPut(&d, &r->x[3 * k], r->vol[k], 0));
     else
@@ -260,7 +263,7 @@ static PetscErrorCode ReadBlock(MPI_Comm comm, PeriSource source, RootRead *r)
     PetscCall(DealerDestroy(&d));
     if (source == PERI_SOURCE_MESH) PetscCall(PetscFree2(r->x, r->vol));
   } else
-    PetscCall(ReceiveBlock(inner, tag, r->p));
+    PetscCall(ReceiveBlock(inner, tag, chunk, r->p));
   PetscCall(PetscCommDestroy(&inner));
   if (source == PERI_SOURCE_MESH) PetscCall(GroupsBcast(comm, r->p));
   for (PetscInt d = 0; d < 3; d++) ext[d] = r->p->lower[d], ext[3 + d] = r->p->upper[d];

@@ -24,6 +24,9 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+/* from scotch.h, which needs Scotch's integer width to be included: the random generator reset */
+void SCOTCH_randomReset(void);
+
 typedef enum {
   PARTITION_METIS,
   PARTITION_PTSCOTCH,
@@ -147,6 +150,11 @@ static PetscErrorCode PTScotchPartition(MPI_Comm comm, const PeriParticles *b, P
   PetscCall(MatPartitioningSetType(mp, MATPARTITIONINGPTSCOTCH));
   PetscCall(MatPartitioningSetNParts(mp, size));
   PetscCall(MatPartitioningSetFromOptions(mp));
+  /* one graph, one partition: Scotch's threads (its own, beside the ranks) split the work in an
+   * order that varies from run to run, and its random generator would go on from the last
+   * partition. An explicit SCOTCH_PTHREAD_NUMBER wins. */
+  if (setenv("SCOTCH_PTHREAD_NUMBER", "1", 0)) SETERRQ(PETSC_COMM_SELF, PETSC_ERR_SYS, "setenv failed");
+  SCOTCH_randomReset();
   PetscCall(MatPartitioningApply(mp, &part));
   PetscCall(MatPartitioningDestroy(&mp));
   PetscCall(MatDestroy(&adj));
