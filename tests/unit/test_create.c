@@ -190,13 +190,14 @@ static PetscErrorCode CheckBad(const char file[], PeriScene scene, PetscInt dim,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* -peak old|new: one path, then every rank's peak resident set (kB) and the time. */
+/* -peak old|new: one path, then every rank's peak resident set and the time. The partition graph's
+ * radius is 1.5 spacings (delta unbounded). */
 static PetscErrorCode Peak(const char file[], const char mode[])
 {
   PetscMPIInt    rank, size;
   PeriScene      scene;
   PetscInt       dim, N, *range;
-  PetscReal      thickness, delta;
+  PetscReal      thickness;
   PeriParticles  whole, owned;
   PetscLogDouble t0, t1;
   struct rusage  ru;
@@ -208,11 +209,11 @@ static PetscErrorCode Peak(const char file[], const char mode[])
   PetscCall(LoadScene(file, &scene, &dim, &thickness));
   PetscCall(PetscTime(&t0));
   if (!strcmp(mode, "old")) {
-    PetscCall(Reference(scene, dim, thickness, 0.01, &whole, &owned, &range));
+    PetscCall(Reference(scene, dim, thickness, PETSC_MAX_REAL, &whole, &owned, &range));
     N = whole.n;
     PetscCall(PeriParticlesDestroy(&whole));
   } else
-    PetscCall(PeriParticlesCreateOwned(PETSC_COMM_WORLD, scene, dim, thickness, 0.01, &owned, &N, &range));
+    PetscCall(PeriParticlesCreateOwned(PETSC_COMM_WORLD, scene, dim, thickness, PETSC_MAX_REAL, &owned, &N, &range));
   PetscCall(PetscTime(&t1));
   PetscCheck(!getrusage(RUSAGE_SELF, &ru), PETSC_COMM_SELF, PETSC_ERR_SYS, "getrusage failed");
   mine = ru.ru_maxrss;
