@@ -190,6 +190,27 @@ static PetscErrorCode CheckBad(const char file[], PeriScene scene, PetscInt dim,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A scene with fictitious layers: refused by PeriParticlesCreateOwned on every rank. */
+static PetscErrorCode CheckRefused(const char file[], PeriScene scene, PetscInt dim, PetscReal thickness)
+{
+  char           msg[1024] = "", what[PETSC_MAX_PATH_LEN + 64];
+  PeriParticles  p;
+  PetscInt       N, *range = NULL;
+  PetscErrorCode e;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&p, sizeof(p)));
+  PetscCall(PetscPushErrorHandler(CaptureFirst, msg));
+  e = PeriParticlesCreateOwned(PETSC_COMM_WORLD, scene, dim, thickness, 1, &p, &N, &range);
+  PetscCall(PetscPopErrorHandler());
+  PetscCall(PeriParticlesDestroy(&p));
+  PetscCall(PetscFree(range));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "%s (fictitious layers)", file));
+  PetscCall(Agree(what, e == PETSC_ERR_SUP && strstr(msg, "fictitious layers") ? "" : "not refused, or another error"));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s: refused on every rank: %s\n", file, msg));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* -peak old|new: one path, then every rank's peak resident set and the time. The partition graph's
  * radius is 1.5 spacings (delta unbounded). */
 static PetscErrorCode Peak(const char file[], const char mode[])
@@ -259,14 +280,18 @@ int main(int argc, char **argv)
     PetscInt  dim;
     PetscReal thickness;
     PetscBool bad;
+    PeriNode  layers;
 
     PetscCall(IsBad(argv[a], &bad));
     PetscCall(LoadScene(argv[a], &scene, &dim, &thickness));
+    PetscCall(PeriSceneGetNode(scene->root, "boundary_layers", &layers));
     if (bad)
       PetscCall(CheckBad(argv[a], scene, dim, thickness));
+    else if (layers)
+      PetscCall(CheckRefused(argv[a], scene, dim, thickness));
     else
       PetscCall(CheckBlocks(argv[a], scene, dim, thickness));
-    for (int t = 0; t < 3 && !bad; t++) PetscCall(CheckOwned(argv[a], types[t], scene, dim, thickness));
+    for (int t = 0; t < 3 && !bad && !layers; t++) PetscCall(CheckOwned(argv[a], types[t], scene, dim, thickness));
     PetscCall(PeriSceneDestroy(&scene));
   }
   PetscCall(PeriFinalize());
