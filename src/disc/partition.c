@@ -6,7 +6,8 @@
  *   ptscotch  PT-Scotch through PETSc's MatPartitioning, in parallel: each rank starts from a
  *             contiguous block of the particles, builds the graph rows of that block in its local
  *             view (the block and the particles within the graph radius of it, src/disc/halo.c),
- *             and PT-Scotch moves the vertices between ranks (its parts vary from run to run);
+ *             and PT-Scotch moves the vertices between ranks (one Scotch thread, its generator
+ *             reset: the same parts for the same graph);
  *   metis     METIS k-way on rank 0 over the whole graph (the default before issue 17): the blocks'
  *             particles are gathered to rank 0 for it, so it is for small runs only.
  * Each partitioner reads the body as blocks, rank r holding a contiguous range of the particles
