@@ -3,7 +3,8 @@
 #include "perilin/private/disc.h"
 #include <errno.h>
 
-static PetscErrorCode ParticlesAllocate(PeriParticles *p, PetscInt n)
+/* Room for n particles: positions (zeroed: z = 0 in 2D), volumes, spacings, source lines. */
+PetscErrorCode PeriParticlesAllocate(PeriParticles *p, PetscInt n)
 {
   PetscFunctionBeginUser;
   p->n = n;
@@ -75,7 +76,7 @@ static PetscErrorCode GridFill(PeriParticles *p, const PetscInt cells[3], PetscR
   const PetscReal cellvol = p->dim == 3 ? h * h * h : h * h * p->thickness;
 
   PetscFunctionBeginUser;
-  PetscCall(ParticlesAllocate(p, kend - kstart));
+  PetscCall(PeriParticlesAllocate(p, kend - kstart));
   for (PetscInt k = kstart; k < kend; k++) {
     const PetscInt c[3] = {k % cells[0], (k / cells[0]) % cells[1], k / (cells[0] * cells[1])}, l = k - kstart;
     for (PetscInt d = 0; d < p->dim; d++) p->x[3 * l + d] = p->lower[d] + (c[d] + 0.5) * h;
@@ -86,20 +87,23 @@ static PetscErrorCode GridFill(PeriParticles *p, const PetscInt cells[3], PetscR
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The grid's particles: of its cells in x-fastest order, the share rank..rank+1 of size ranks. */
-static PetscErrorCode GridCreate(PeriScene scene, PeriNode grid, PetscInt dim, PetscMPIInt rank, PetscMPIInt size, PeriParticles *p)
+/*@C
+  PeriGridCreate - the grid's particles (grid.*): of its *N cells in x-fastest order, the share
+  floor(rank N / size) .. floor((rank + 1) N / size) - 1; p's box, periodic axes and spacing are
+  the whole grid's. Not collective.
+@*/
+PetscErrorCode PeriGridCreate(PeriScene scene, PeriNode grid, PetscInt dim, PetscMPIInt rank, PetscMPIInt size, PeriParticles *p, PetscInt *N)
 {
-  PetscInt  cells[3], n;
+  PetscInt  cells[3];
   PetscReal h;
 
   PetscFunctionBeginUser;
   PetscCall(GridParse(scene, grid, dim, p, cells, &h));
-  n = cells[0] * cells[1] * cells[2];
-  PetscCall(GridFill(p, cells, h, (PetscInt)((PetscInt64)n * rank / size), (PetscInt)((PetscInt64)n * (rank + 1) / size)));
+  *N = cells[0] * cells[1] * cells[2];
+  PetscCall(GridFill(p, cells, h, (PetscInt)((PetscInt64)*N * rank / size), (PetscInt)((PetscInt64)*N * (rank + 1) / size)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The particles file's path from the section's one key: absolute as given, else relative to the scene file's folder. */
 /* The file named by node.key (required), relative to the scene file's directory unless absolute:
  * particles.file and particles.mesh. */
 PetscErrorCode PeriParticlesInputPath(PeriScene scene, PeriNode node, const char key[], char path[], size_t size)
@@ -175,90 +179,185 @@ static PetscErrorCode CSVGrow(PetscInt *cap, PetscReal **x, PetscReal **vol, Pet
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Reads the file's n particles into x, vol, src (allocated here, freed by the caller); stops at the first bad line. */
-static PetscErrorCode CSVRead(PeriScene scene, PeriNode node, const char path[], PetscInt dim, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt **src)
+/*@C
+  PeriCSVOpen - opens particles.file (section node) for reading particle by particle with
+  PeriCSVNext. Not collective.
+@*/
+PetscErrorCode PeriCSVOpen(PeriScene scene, PeriNode node, PetscInt dim, PeriCSV *csv)
 {
-  char      line[1024];
-  FILE     *fp;
-  PetscInt  cap = 1024, lineno = 0;
-  PetscBool header = PETSC_FALSE;
-
   PetscFunctionBeginUser;
-  *n = 0;
-  fp = fopen(path, "r");
-  PeriInputCheck(fp, scene, node, "file", "cannot open %s: %s", path, strerror(errno));
-  PetscCall(PetscMalloc3(3 * cap, x, cap, vol, cap, src));
-  while (fgets(line, sizeof(line), fp)) {
-    double      v[5];
-    int         nf;
-    PetscBool   skip, rest;
-    const char *problem;
-
-    lineno++;
-    PetscCall(CSVLineSplit(line, v, &nf, &skip, &rest));
-    if (skip) continue;
-    if (nf == 0 && *n == 0 && !header) { /* a header line before the first particle */
-      header = PETSC_TRUE;
-      continue;
-    }
-    PetscCall(CSVLineProblem(dim, v, nf, rest, &problem));
-    if (problem) {
-      fclose(fp);
-      PetscCall(PetscFree3(*x, *vol, *src));
-      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%" PetscInt_FMT ": %s (particles.file, referenced from %s)", path, lineno, problem, scene->file);
-    }
-    if (*n == cap) PetscCall(CSVGrow(&cap, x, vol, src));
-    for (PetscInt d = 0; d < 3; d++) (*x)[3 * *n + d] = d < dim ? v[d] : 0;
-    (*vol)[*n] = v[dim];
-    (*src)[*n] = lineno;
-    (*n)++;
-  }
-  fclose(fp);
+  PetscCall(PetscMemzero(csv, sizeof(*csv)));
+  csv->scene = scene;
+  csv->node  = node;
+  csv->dim   = dim;
+  PetscCall(PeriParticlesInputPath(scene, node, "file", csv->path, sizeof(csv->path)));
+  csv->fp = fopen(csv->path, "r");
+  PeriInputCheck(csv->fp, scene, node, "file", "cannot open %s: %s", csv->path, strerror(errno));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Fills p with the n particles read: each one's spacing from its volume, the bounding box from those spacings. */
-static PetscErrorCode CSVFill(PeriParticles *p, PetscInt dim, PetscInt n, const PetscReal x[], const PetscReal vol[], const PetscInt src[])
+/*@C
+  PeriCSVNext - the file's next particle: position (z = 0 in 2D), volume and line number; *done
+  at the end of the file. *problem (else NULL) says what is wrong with the line just read: the
+  caller frees what it holds, then raises the error with PeriCSVFail. Not collective.
+@*/
+PetscErrorCode PeriCSVNext(PeriCSV *csv, PetscReal x[], PetscReal *vol, PetscInt *line, PetscBool *done, const char **problem)
 {
-  PetscReal sum = 0;
+  char line_text[1024];
 
   PetscFunctionBeginUser;
-  PetscCall(ParticlesAllocate(p, n));
-  for (PetscInt d = 0; d < 3; d++) {
-    p->lower[d] = PETSC_MAX_REAL;
-    p->upper[d] = PETSC_MIN_REAL;
-  }
-  for (PetscInt k = 0; k < n; k++) {
-    PetscReal h = dim == 3 ? PetscCbrtReal(vol[k]) : PetscSqrtReal(vol[k] / p->thickness);
-    for (PetscInt d = 0; d < 3; d++) p->x[3 * k + d] = x[3 * k + d];
-    for (PetscInt d = 0; d < dim; d++) {
-      p->lower[d] = PetscMin(p->lower[d], x[3 * k + d] - h / 2);
-      p->upper[d] = PetscMax(p->upper[d], x[3 * k + d] + h / 2);
+  *done    = PETSC_TRUE;
+  *problem = NULL;
+  while (fgets(line_text, sizeof(line_text), csv->fp)) {
+    double    v[5];
+    int       nf;
+    PetscBool skip, rest;
+
+    csv->lineno++;
+    PetscCall(CSVLineSplit(line_text, v, &nf, &skip, &rest));
+    if (skip) continue;
+    if (nf == 0 && csv->n == 0 && !csv->header) { /* a header line before the first particle */
+      csv->header = PETSC_TRUE;
+      continue;
     }
+    PetscCall(CSVLineProblem(csv->dim, v, nf, rest, problem));
+    if (*problem) break;
+    for (PetscInt d = 0; d < 3; d++) x[d] = d < csv->dim ? v[d] : 0;
+    *vol  = v[csv->dim];
+    *line = csv->lineno;
+    *done = PETSC_FALSE;
+    csv->n++;
+    break;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriCSVFail - closes the file and raises the error of its last line read (file:line: problem).
+@*/
+PetscErrorCode PeriCSVFail(PeriCSV *csv, const char problem[])
+{
+  PetscFunctionBeginUser;
+  fclose(csv->fp);
+  csv->fp = NULL;
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%" PetscInt_FMT ": %s (particles.file, referenced from %s)", csv->path, csv->lineno, problem, csv->scene->file);
+}
+
+/*@C
+  PeriCSVClose - closes the file; a file without particles is an error. Not collective.
+@*/
+PetscErrorCode PeriCSVClose(PeriCSV *csv)
+{
+  PetscFunctionBeginUser;
+  fclose(csv->fp);
+  csv->fp = NULL;
+  PeriInputCheck(csv->n > 0, csv->scene, csv->node, "file", "%s holds no particles", csv->path);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Reads the file's n particles into x, vol, src (allocated here, freed by the caller); stops at the first bad line. */
+static PetscErrorCode CSVRead(PeriScene scene, PeriNode node, PetscInt dim, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt **src)
+{
+  PeriCSV     csv;
+  PetscInt    cap = 1024;
+  PetscBool   done;
+  const char *problem;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  PetscCall(PeriCSVOpen(scene, node, dim, &csv));
+  PetscCall(PetscMalloc3(3 * cap, x, cap, vol, cap, src));
+  for (;;) {
+    PetscReal xk[3], vk;
+    PetscInt  lk;
+
+    PetscCall(PeriCSVNext(&csv, xk, &vk, &lk, &done, &problem));
+    if (problem || (done && !*n)) PetscCall(PetscFree3(*x, *vol, *src));
+    if (problem) PetscCall(PeriCSVFail(&csv, problem));
+    if (done) break;
+    if (*n == cap) PetscCall(CSVGrow(&cap, x, vol, src));
+    for (PetscInt d = 0; d < 3; d++) (*x)[3 * *n + d] = xk[d];
+    (*vol)[*n] = vk;
+    (*src)[*n] = lk;
+    (*n)++;
+  }
+  PetscCall(PeriCSVClose(&csv));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriParticleSpacing - a read particle's spacing from its volume: cbrt(V) in 3D, sqrt(V /
+  thickness) in 2D.
+@*/
+PetscReal PeriParticleSpacing(const PeriParticles *p, PetscReal vol)
+{
+  return p->dim == 3 ? PetscCbrtReal(vol) : PetscSqrtReal(vol / p->thickness);
+}
+
+/*@C
+  PeriExtentInit, PeriExtentAdd, PeriExtentSet - the box of read particles (each one's cell of its
+  own spacing) and their mean spacing, accumulated particle by particle in the body's order:
+  every creation path sums the spacings in that order, so the mean rounds alike on all of them.
+@*/
+void PeriExtentInit(PeriExtent *e)
+{
+  for (PetscInt d = 0; d < 3; d++) {
+    e->lower[d] = PETSC_MAX_REAL;
+    e->upper[d] = PETSC_MIN_REAL;
+  }
+  e->sum = 0;
+  e->n   = 0;
+}
+
+void PeriExtentAdd(PeriExtent *e, PetscInt dim, const PetscReal x[], PetscReal h)
+{
+  for (PetscInt d = 0; d < dim; d++) {
+    e->lower[d] = PetscMin(e->lower[d], x[d] - h / 2);
+    e->upper[d] = PetscMax(e->upper[d], x[d] + h / 2);
+  }
+  e->sum += h;
+  e->n++;
+}
+
+void PeriExtentSet(const PeriExtent *e, PeriParticles *p)
+{
+  for (PetscInt d = 0; d < 3; d++) {
+    p->lower[d] = d < p->dim ? e->lower[d] : 0;
+    p->upper[d] = d < p->dim ? e->upper[d] : 0;
+  }
+  p->mean_spacing = e->sum / e->n;
+}
+
+/* Fills p with the n particles read: each one's spacing from its volume, the bounding box from those spacings. */
+static PetscErrorCode CSVFill(PeriParticles *p, PetscInt n, const PetscReal x[], const PetscReal vol[], const PetscInt src[])
+{
+  PeriExtent e;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriParticlesAllocate(p, n));
+  PeriExtentInit(&e);
+  for (PetscInt k = 0; k < n; k++) {
+    PetscReal h = PeriParticleSpacing(p, vol[k]);
+    for (PetscInt d = 0; d < 3; d++) p->x[3 * k + d] = x[3 * k + d];
+    PeriExtentAdd(&e, p->dim, &x[3 * k], h);
     p->volume[k]      = vol[k];
     p->spacing[k]     = h;
     p->source_line[k] = src[k];
-    sum += h;
   }
-  for (PetscInt d = dim; d < 3; d++) p->lower[d] = p->upper[d] = 0;
-  p->mean_spacing = sum / n;
+  PeriExtentSet(&e, p);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* x, y[, z], volume[, material]: one particle per line; '#' comments and a header line allowed. */
 static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, PeriParticles *p)
 {
-  char       path[PETSC_MAX_PATH_LEN];
   PetscInt   n;
   PetscReal *x, *vol;
   PetscInt  *src;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesInputPath(scene, node, "file", path, sizeof(path)));
-  PetscCall(CSVRead(scene, node, path, dim, &n, &x, &vol, &src));
-  if (!n) PetscCall(PetscFree3(x, vol, src));
-  PeriInputCheck(n > 0, scene, node, "file", "%s holds no particles", path);
-  PetscCall(CSVFill(p, dim, n, x, vol, src));
+  PetscCall(CSVRead(scene, node, dim, &n, &x, &vol, &src));
+  PetscCall(CSVFill(p, n, x, vol, src));
   PetscCall(PetscFree3(x, vol, src));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -273,19 +372,20 @@ static PetscErrorCode MeshCreate(PeriScene scene, PeriNode node, PetscInt dim, P
   PetscFunctionBeginUser;
   PetscCall(PeriMeshRead(scene, node, dim, p->thickness, &n, &x, &vol, &p->ngroups, &p->groups));
   PetscCall(PetscCalloc1(n, &src));
-  PetscCall(CSVFill(p, dim, n, x, vol, src));
+  PetscCall(CSVFill(p, n, x, vol, src));
   PetscCall(PetscFree2(x, vol));
   PetscCall(PetscFree(src));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
-  PeriParticlesCreateFromScene - generates the particles from the scene's grid or particles
-  section. Not collective: every rank builds the same set.
+  PeriParticlesSource - starts p (no particles; its dimension and thickness) and finds where the
+  scene's body comes from: grid, particles.file or particles.mesh, exactly one of them. *node is
+  the grid or the particles section. Not collective.
 @*/
-PetscErrorCode PeriParticlesCreateFromScene(PeriScene scene, PetscInt dim, PetscReal thickness, PeriParticles *p)
+PetscErrorCode PeriParticlesSource(PeriScene scene, PetscInt dim, PetscReal thickness, PeriParticles *p, PeriSource *source, PeriNode *node)
 {
-  PeriNode grid, csv;
+  PeriNode grid, csv, file, mesh;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(p, sizeof(*p)));
@@ -295,20 +395,37 @@ PetscErrorCode PeriParticlesCreateFromScene(PeriScene scene, PetscInt dim, Petsc
   PetscCall(PeriSceneGetMap(scene, scene->root, "particles", PETSC_FALSE, &csv));
   PeriInputCheck(grid || csv, scene, scene->root, "grid", "is required (or give particles.file or particles.mesh)");
   PeriInputCheck(!(grid && csv), scene, csv, NULL, "give either grid or particles, not both");
-  if (grid) {
-    PetscCall(GridCreate(scene, grid, dim, 0, 1, p));
-  } else {
-    PeriNode file, mesh;
-    PetscCall(PeriSceneCheckSection(scene, csv, "particles"));
-    PetscCall(PeriSceneGetNode(csv, "file", &file));
-    PetscCall(PeriSceneGetNode(csv, "mesh", &mesh));
-    PeriInputCheck(file || mesh, scene, csv, "file", "is required (or give particles.mesh)");
-    PeriInputCheck(!(file && mesh), scene, csv, "mesh", "give either particles.file or particles.mesh, not both");
-    if (mesh)
-      PetscCall(MeshCreate(scene, csv, dim, p));
-    else
-      PetscCall(CSVCreate(scene, csv, dim, p));
-  }
+  *node   = grid ? grid : csv;
+  *source = PERI_SOURCE_GRID;
+  if (grid) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneCheckSection(scene, csv, "particles"));
+  PetscCall(PeriSceneGetNode(csv, "file", &file));
+  PetscCall(PeriSceneGetNode(csv, "mesh", &mesh));
+  PeriInputCheck(file || mesh, scene, csv, "file", "is required (or give particles.mesh)");
+  PeriInputCheck(!(file && mesh), scene, csv, "mesh", "give either particles.file or particles.mesh, not both");
+  *source = mesh ? PERI_SOURCE_MESH : PERI_SOURCE_FILE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriParticlesCreateFromScene - generates the particles from the scene's grid or particles
+  section. Not collective: every rank builds the same set, the whole body (PeriParticlesCreateOwned
+  builds only a rank's share).
+@*/
+PetscErrorCode PeriParticlesCreateFromScene(PeriScene scene, PetscInt dim, PetscReal thickness, PeriParticles *p)
+{
+  PeriSource source;
+  PeriNode   node;
+  PetscInt   N;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriParticlesSource(scene, dim, thickness, p, &source, &node));
+  if (source == PERI_SOURCE_GRID)
+    PetscCall(PeriGridCreate(scene, node, dim, 0, 1, p, &N));
+  else if (source == PERI_SOURCE_MESH)
+    PetscCall(MeshCreate(scene, node, dim, p));
+  else
+    PetscCall(CSVCreate(scene, node, dim, p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -318,7 +435,7 @@ PetscErrorCode PeriParticlesPermute(PeriParticles *p, const PetscInt perm[])
   PeriParticles q = *p;
 
   PetscFunctionBeginUser;
-  PetscCall(ParticlesAllocate(&q, p->n));
+  PetscCall(PeriParticlesAllocate(&q, p->n));
   for (PetscInt k = 0; k < p->n; k++) {
     PetscInt o = perm[k];
     for (PetscInt d = 0; d < 3; d++) q.x[3 * k + d] = p->x[3 * o + d];
@@ -362,7 +479,7 @@ PetscErrorCode PeriParticlesSlice(const PeriParticles *p, PetscInt rstart, Petsc
     q->upper[d]    = p->upper[d];
     q->periodic[d] = p->periodic[d];
   }
-  PetscCall(ParticlesAllocate(q, rend - rstart));
+  PetscCall(PeriParticlesAllocate(q, rend - rstart));
   PetscCall(PetscArraycpy(q->x, &p->x[3 * rstart], 3 * (rend - rstart)));
   PetscCall(PetscArraycpy(q->volume, &p->volume[rstart], rend - rstart));
   PetscCall(PetscArraycpy(q->spacing, &p->spacing[rstart], rend - rstart));

@@ -6,8 +6,13 @@
  *   ptscotch  PT-Scotch through PETSc's MatPartitioning, in parallel: each rank starts from a
  *             contiguous block of the particles, builds the graph rows of that block in its local
  *             view (the block and the particles within the graph radius of it, src/disc/halo.c),
- *             and PT-Scotch moves the vertices between ranks (its parts vary from run to run);
- *   metis     METIS k-way on rank 0 over the whole graph, broadcast (the default before issue 17).
+ *             and PT-Scotch moves the vertices between ranks (one Scotch thread, its generator
+ *             reset: the same parts for the same graph);
+ *   metis     METIS k-way on rank 0 over the whole graph (the default before issue 17): the blocks'
+ *             particles are gathered to rank 0 for it, so it is for small runs only.
+ * Each partitioner reads the body as blocks, rank r holding a contiguous range of the particles
+ * (PeriPartitionBlocks), and names each particle's target rank; PeriParticlesMigrate then moves
+ * them, or PeriPartition turns the targets into the permutation of the whole body.
  * docs/performance.md ("Partitioners") measured the three: on grids the curve cuts as few bonds
  * as the graph partitioners (within a few per cent either way) in a fraction of the time and
  * memory, on an unstructured mesh with a hole a few per cent more. The graph is the
@@ -19,6 +24,9 @@
 #include <metis.h>
 #include <stdint.h>
 #include <stdlib.h>
+
+/* from scotch.h, which needs Scotch's integer width to be included: the random generator reset */
+void SCOTCH_randomReset(void);
 
 typedef enum {
   PARTITION_METIS,
@@ -96,19 +104,19 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The graph rows of this rank's block rstart..rend-1: CSR arrays with global column indices, each
- * neighbour once, allocated with PetscMalloc for MatCreateMPIAdj. The block's local view (the
- * block and, as ghosts, the particles within radius of it: src/disc/halo.c) is all it reads of
- * the particles, so it needs no whole body. Collective. */
-static PetscErrorCode BlockGraph(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, PetscReal radius, PetscReal hmax, PetscInt **xadj, PetscInt **adjncy)
+/* The graph rows of this rank's block: CSR arrays with global column indices, each neighbour once,
+ * allocated with PetscMalloc for MatCreateMPIAdj. The block's local view (the block and, as
+ * ghosts, the particles within radius of it: src/disc/halo.c) is all it reads of the particles.
+ * Collective. */
+static PetscErrorCode BlockGraph(MPI_Comm comm, const PeriParticles *b, PetscReal radius, PetscReal hmax, PetscInt **xadj, PetscInt **adjncy)
 {
-  const PetscInt n = rend - rstart;
+  const PetscInt n = b->n;
   PeriParticles  local;
   PeriHalo       halo;
   PeriBonds      g;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesSlice(p, rstart, rend, &local));
+  PetscCall(PeriParticlesSlice(b, 0, n, &local));
   PetscCall(PeriHaloCreate(comm, &local, PeriSearchRadius(PERI_PARTIAL_VOLUME_NONE, radius, hmax), &halo));
   PetscCall(PeriNeighborSearch(&local, radius, PERI_PARTIAL_VOLUME_NONE, 0, n, PETSC_FALSE, &g));
   for (PetscInt k = 0; k < g.nbonds; k++) g.j[k] = local.global[g.j[k]]; /* MatCreateMPIAdj's columns are global */
@@ -123,28 +131,39 @@ static PetscErrorCode BlockGraph(MPI_Comm comm, const PeriParticles *p, PetscInt
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* PT-Scotch over the graph of the blocks: *part holds the target rank of each particle of this
- * rank's block. -mat_partitioning_ptscotch_imbalance and _strategy tune it. */
-static PetscErrorCode PTScotchPartition(MPI_Comm comm, const PeriParticles *p, PetscReal radius, PetscReal hmax, PetscInt rstart, PetscInt rend, IS *part)
+/* PT-Scotch over the graph of the blocks: target[] the rank of each particle of this rank's block
+ * b (N particles in all). -mat_partitioning_ptscotch_imbalance and _strategy tune it. */
+static PetscErrorCode PTScotchPartition(MPI_Comm comm, const PeriParticles *b, PetscInt N, PetscReal radius, PetscReal hmax, PetscMPIInt target[])
 {
   PetscInt       *xadj, *adjncy;
   Mat             adj;
   MatPartitioning mp;
   PetscMPIInt     size;
+  IS              part;
+  const PetscInt *t;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(BlockGraph(comm, p, rstart, rend, radius, hmax, &xadj, &adjncy));
+  PetscCall(BlockGraph(comm, b, radius, hmax, &xadj, &adjncy));
   /* the matrix takes xadj and adjncy over */
-  PetscCall(MatCreateMPIAdj(comm, rend - rstart, p->n, xadj, adjncy, NULL, &adj));
+  PetscCall(MatCreateMPIAdj(comm, b->n, N, xadj, adjncy, NULL, &adj));
   PetscCall(MatPartitioningCreate(comm, &mp));
   PetscCall(MatPartitioningSetAdjacency(mp, adj));
   PetscCall(MatPartitioningSetType(mp, MATPARTITIONINGPTSCOTCH));
   PetscCall(MatPartitioningSetNParts(mp, size));
   PetscCall(MatPartitioningSetFromOptions(mp));
-  PetscCall(MatPartitioningApply(mp, part));
+  /* one graph, one partition: Scotch's threads (its own, beside the ranks) split the work in an
+   * order that varies from run to run, and its random generator would go on from the last
+   * partition. An explicit SCOTCH_PTHREAD_NUMBER wins. */
+  if (setenv("SCOTCH_PTHREAD_NUMBER", "1", 0)) SETERRQ(PETSC_COMM_SELF, PETSC_ERR_SYS, "setenv failed");
+  SCOTCH_randomReset();
+  PetscCall(MatPartitioningApply(mp, &part));
   PetscCall(MatPartitioningDestroy(&mp));
   PetscCall(MatDestroy(&adj));
+  PetscCall(ISGetIndices(part, &t));
+  for (PetscInt i = 0; i < b->n; i++) target[i] = (PetscMPIInt)t[i];
+  PetscCall(ISRestoreIndices(part, &t));
+  PetscCall(ISDestroy(&part));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -191,13 +210,13 @@ static int CurveKeyCompare(const void *a, const void *b)
 
 /* The particles' bounding box (all ranks), and its axes longest first: the curve's first cut is
  * across its first axis, so a bar is cut across its length. */
-static PetscErrorCode CurveBox(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, PetscReal lo[3], PetscReal *length, PetscInt axis[3])
+static PetscErrorCode CurveBox(MPI_Comm comm, const PeriParticles *p, PetscReal lo[3], PetscReal *length, PetscInt axis[3])
 {
   PetscReal ext[6], e[3];
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 6; d++) ext[d] = PETSC_MAX_REAL;
-  for (PetscInt i = rstart; i < rend; i++)
+  for (PetscInt i = 0; i < p->n; i++)
     for (PetscInt d = 0; d < 3; d++) ext[d] = PetscMin(ext[d], p->x[3 * i + d]), ext[3 + d] = PetscMin(ext[3 + d], -p->x[3 * i + d]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, ext, 6, MPIU_REAL, MPIU_MIN, comm));
   *length = 0;
@@ -217,26 +236,26 @@ static PetscErrorCode CurveBox(MPI_Comm comm, const PeriParticles *p, PetscInt r
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The keys of the block, sorted: the coordinates in the bounding box scaled alike on every axis
- * (a uniform grid stays uniform on the curve), b bits per axis. */
-static PetscErrorCode CurveKeys(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, CurveKey key[])
+/* The keys of the block p (global indices from rstart), sorted: the coordinates in the bounding
+ * box scaled alike on every axis (a uniform grid stays uniform on the curve), b bits per axis. */
+static PetscErrorCode CurveKeys(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, CurveKey key[])
 {
   PetscReal lo[3], length = 1;
   PetscInt  axis[3], n = p->dim, b = 63 / p->dim;
   uint64_t  top = ((uint64_t)1 << b) - 1;
 
   PetscFunctionBeginUser;
-  PetscCall(CurveBox(comm, p, rstart, rend, lo, &length, axis));
-  for (PetscInt i = rstart; i < rend; i++) {
+  PetscCall(CurveBox(comm, p, lo, &length, axis));
+  for (PetscInt i = 0; i < p->n; i++) {
     uint64_t X[3] = {0, 0, 0};
     for (PetscInt d = 0; d < n; d++) {
       PetscReal s = (p->x[3 * i + axis[d]] - lo[axis[d]]) / length;
       X[d]        = (uint64_t)PetscMin((PetscReal)top, PetscMax(0.0, s * (PetscReal)top));
     }
-    key[i - rstart].h = HilbertIndex(X, n, b);
-    key[i - rstart].g = i;
+    key[i].h = HilbertIndex(X, n, b);
+    key[i].g = rstart + i;
   }
-  qsort(key, (size_t)(rend - rstart), sizeof(CurveKey), CurveKeyCompare);
+  qsort(key, (size_t)p->n, sizeof(CurveKey), CurveKeyCompare);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -296,136 +315,159 @@ static PetscErrorCode CurveSplitters(MPI_Comm comm, PetscInt N, PetscMPIInt P, c
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The Hilbert curve cut into P pieces of floor((q+1) N/P) - floor(q N/P) particles: *part holds
- * the piece of each particle of the block. */
-static PetscErrorCode GeometricPartition(MPI_Comm comm, const PeriParticles *p, PetscInt rstart, PetscInt rend, IS *part)
+/* The Hilbert curve cut into P pieces of floor((q+1) N/P) - floor(q N/P) particles: target[] the
+ * piece of each particle of the block b, whose first has global index rstart. */
+static PetscErrorCode GeometricPartition(MPI_Comm comm, const PeriParticles *b, PetscInt N, PetscInt rstart, PetscMPIInt target[])
 {
   PetscMPIInt size;
-  PetscInt    n = rend - rstart, *where;
   CurveKey   *key, *split;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(PetscMalloc3(n, &key, size, &split, n, &where));
-  PetscCall(CurveKeys(comm, p, rstart, rend, key));
-  PetscCall(CurveSplitters(comm, p->n, size, key, n, split));
+  PetscCall(PetscMalloc2(b->n, &key, size, &split));
+  PetscCall(CurveKeys(comm, b, rstart, key));
+  PetscCall(CurveSplitters(comm, N, size, key, b->n, split));
   /* key[k]'s piece: the number of splitters at or below it (splitters are increasing) */
-  for (PetscInt k = 0, q = 0; k < n; k++) {
+  for (PetscInt k = 0, q = 0; k < b->n; k++) {
     while (q + 1 < size && CurveKeyCompare(&split[q + 1], &key[k]) <= 0) q++;
-    where[key[k].g - rstart] = q;
+    target[key[k].g - rstart] = (PetscMPIInt)q;
   }
-  PetscCall(ISCreateGeneral(comm, n, where, PETSC_COPY_VALUES, part));
-  PetscCall(PetscFree3(key, split, where));
+  PetscCall(PetscFree2(key, split));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* From the target rank of each particle of this rank's block (*part) to the permutation and
- * ranges of PeriPartition: ranks keep their particles in the old order. The gather of the new
- * numbers is the one step of size N, for the interface of every rank holding all particles. */
-static PetscErrorCode PermutationFromParts(MPI_Comm comm, PetscInt N, IS part, PetscInt perm[], PetscInt range[])
+/* METIS on rank 0: the blocks are gathered there (the whole body on one rank: small runs only),
+ * and each rank gets back the parts of its block. */
+static PetscErrorCode MetisPartitionGathered(MPI_Comm comm, const PeriParticles *b, PetscReal radius, PetscMPIInt target[])
 {
-  PetscMPIInt     size;
-  PetscInt       *count, *newof;
-  PetscMPIInt    *recv, *displ;
-  IS              num;
-  const PetscInt *nn;
-  PetscInt        n;
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(PetscMalloc1(size, &count));
-  PetscCall(ISPartitioningCount(part, size, count));
-  range[0] = 0;
-  for (PetscMPIInt r = 0; r < size; r++) range[r + 1] = range[r] + count[r];
-  PetscCall(PetscFree(count));
-  PetscCall(ISPartitioningToNumbering(part, &num));
-  PetscCall(ISGetLocalSize(num, &n));
-  PetscCall(ISGetIndices(num, &nn));
-  PetscCall(PetscMalloc3(N, &newof, size, &recv, size, &displ));
-  {
-    PetscMPIInt nm = (PetscMPIInt)n;
-    PetscCallMPI(MPI_Allgather(&nm, 1, MPI_INT, recv, 1, MPI_INT, comm));
-  }
-  displ[0] = 0;
-  for (PetscMPIInt r = 1; r < size; r++) displ[r] = displ[r - 1] + recv[r - 1];
-  PetscCallMPI(MPI_Allgatherv(nn, (PetscMPIInt)n, MPIU_INT, newof, recv, displ, MPIU_INT, comm));
-  PetscCall(ISRestoreIndices(num, &nn));
-  PetscCall(ISDestroy(&num));
-  for (PetscInt i = 0; i < N; i++) perm[newof[i]] = i;
-  PetscCall(PetscFree3(newof, recv, displ));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* METIS's parts (every rank holds all) to the permutation and ranges. */
-static PetscErrorCode PermutationFromAllParts(PetscMPIInt size, PetscInt N, const PetscInt part[], PetscInt perm[], PetscInt range[])
-{
-  PetscInt *fill;
-
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < N; i++) range[part[i] + 1]++;
-  for (PetscMPIInt r = 0; r < size; r++) range[r + 1] += range[r];
-  PetscCall(PetscMalloc1(size, &fill));
-  PetscCall(PetscArraycpy(fill, range, size));
-  for (PetscInt i = 0; i < N; i++) perm[fill[part[i]]++] = i;
-  PetscCall(PetscFree(fill));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode MetisPartitionAll(MPI_Comm comm, const PeriParticles *p, PetscReal radius, PetscInt perm[], PetscInt range[])
-{
-  PetscMPIInt rank, size;
-  PetscInt   *part;
+  PeriParticles whole;
+  PetscMPIInt   rank, size, n = (PetscMPIInt)b->n, *count = NULL, *displ = NULL, *part = NULL;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(PetscCalloc1(p->n, &part));
-  if (rank == 0) PetscCall(MetisPartition(p, radius, size, part));
-  PetscCallMPI(MPI_Bcast(part, (PetscMPIInt)p->n, MPIU_INT, 0, comm));
-  PetscCall(PermutationFromAllParts(size, p->n, part, perm, range));
-  PetscCall(PetscFree(part));
+  PetscCall(PeriParticlesGather(comm, b, &whole));
+  if (rank == 0) {
+    PetscInt *where;
+    PetscCall(PetscMalloc3(size, &count, size + 1, &displ, whole.n, &part));
+    PetscCall(PetscMalloc1(whole.n, &where));
+    PetscCall(MetisPartition(&whole, radius, size, where));
+    for (PetscInt i = 0; i < whole.n; i++) part[i] = (PetscMPIInt)where[i];
+    PetscCall(PetscFree(where));
+  }
+  PetscCallMPI(MPI_Gather(&n, 1, MPI_INT, count, 1, MPI_INT, 0, comm));
+  if (rank == 0) {
+    displ[0] = 0;
+    for (PetscMPIInt r = 0; r < size; r++) displ[r + 1] = displ[r] + count[r];
+  }
+  PetscCallMPI(MPI_Scatterv(part, count, displ, MPI_INT, target, n, MPI_INT, 0, comm));
+  if (rank == 0) PetscCall(PetscFree3(count, displ, part));
+  PetscCall(PeriParticlesDestroy(&whole));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
-  PeriPartition - partitions the particles over the ranks of comm (-peri_partition). perm[k] is the
-  old index of new particle k; rank r owns new particles range[r]..range[r+1]-1. Collective.
+  PeriPartitionBlocks - partitions the body over the ranks of comm (-peri_partition) when each rank
+  holds a block of it: b holds particles rstart..rstart+b->n-1 of the body, the blocks in rank
+  order making it up (b's box, periodic axes and spacing are the body's). *target (allocated here)
+  holds the rank each particle of b goes to; the new global order is by target rank, then by old
+  index (PeriParticlesMigrate delivers them so). Collective.
 @*/
-PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal delta, PetscInt **perm, PetscInt **range)
+PetscErrorCode PeriPartitionBlocks(MPI_Comm comm, const PeriParticles *b, PetscReal delta, PetscMPIInt **target)
 {
   PetscMPIInt   rank, size;
   PartitionType type = PARTITION_GEOMETRIC;
   PetscReal     hmax = 0, radius;
-  PetscInt      rstart, rend;
-  IS            part;
+  PetscInt      N, rstart = 0;
 
   PetscFunctionBeginUser;
   PetscCall(ReadType(comm, &type));
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(PetscMalloc1(p->n, perm));
-  PetscCall(PetscCalloc1(size + 1, range));
-  if (size == 1) {
-    for (PetscInt i = 0; i < p->n; i++) (*perm)[i] = i;
-    (*range)[1] = p->n;
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCheck(p->n >= size, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " particles cannot be shared by %d ranks", p->n, size);
-  /* the initial blocks: for grid particles (x fastest) slabs along the last axis */
-  rstart = (PetscInt)((PetscInt64)rank * p->n / size);
-  rend   = (PetscInt)((PetscInt64)(rank + 1) * p->n / size);
-  for (PetscInt i = rstart; i < rend; i++) hmax = PetscMax(hmax, p->spacing[i]);
+  PetscCall(PetscCalloc1(b->n, target));
+  if (size == 1) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCallMPI(MPI_Allreduce(&b->n, &N, 1, MPIU_INT, MPI_SUM, comm));
+  PetscCallMPI(MPI_Exscan(&b->n, &rstart, 1, MPIU_INT, MPI_SUM, comm));
+  if (rank == 0) rstart = 0; /* MPI leaves rank 0's result undefined */
+  PetscCheck(N >= size, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " particles cannot be shared by %d ranks", N, size);
+  for (PetscInt i = 0; i < b->n; i++) hmax = PetscMax(hmax, b->spacing[i]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPIU_MAX, comm));
   radius = PetscMin(delta, 1.5 * hmax);
-  if (type == PARTITION_METIS) {
-    PetscCall(MetisPartitionAll(comm, p, radius, *perm, *range));
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  if (type == PARTITION_PTSCOTCH)
-    PetscCall(PTScotchPartition(comm, p, radius, hmax, rstart, rend, &part));
+  if (type == PARTITION_METIS)
+    PetscCall(MetisPartitionGathered(comm, b, radius, *target));
+  else if (type == PARTITION_PTSCOTCH)
+    PetscCall(PTScotchPartition(comm, b, N, radius, hmax, *target));
   else
-    PetscCall(GeometricPartition(comm, p, rstart, rend, &part));
-  PetscCall(PermutationFromParts(comm, p->n, part, *perm, *range));
-  PetscCall(ISDestroy(&part));
+    PetscCall(GeometricPartition(comm, b, N, rstart, *target));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* From the target rank of each particle of this rank's block (which starts at global index
+ * rstart) to the permutation and ranges of PeriPartition: ranks keep their particles in the old
+ * order. The gather of the new numbers is the one step of size N, for the interface of every
+ * rank holding all particles. */
+static PetscErrorCode PermutationFromTargets(MPI_Comm comm, PetscInt N, PetscInt n, const PetscMPIInt target[], PetscInt perm[], PetscInt range[])
+{
+  PetscMPIInt rank, size, nm = (PetscMPIInt)n, *recv, *displ;
+  PetscInt   *count, *before, *newof, *mine;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscCalloc2(size, &count, size, &before));
+  for (PetscInt i = 0; i < n; i++) count[target[i]]++;
+  /* before[t]: the particles of lower ranks going to t; range from the totals */
+  PetscCallMPI(MPI_Exscan(count, before, (PetscMPIInt)size, MPIU_INT, MPI_SUM, comm));
+  if (rank == 0) PetscCall(PetscArrayzero(before, size));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, count, (PetscMPIInt)size, MPIU_INT, MPI_SUM, comm));
+  range[0] = 0;
+  for (PetscMPIInt r = 0; r < size; r++) range[r + 1] = range[r] + count[r];
+  PetscCall(PetscMalloc4(n, &mine, N, &newof, size, &recv, size, &displ));
+  for (PetscInt i = 0; i < n; i++) mine[i] = range[target[i]] + before[target[i]]++;
+  PetscCallMPI(MPI_Allgather(&nm, 1, MPI_INT, recv, 1, MPI_INT, comm));
+  displ[0] = 0;
+  for (PetscMPIInt r = 1; r < size; r++) displ[r] = displ[r - 1] + recv[r - 1];
+  PetscCallMPI(MPI_Allgatherv(mine, nm, MPIU_INT, newof, recv, displ, MPIU_INT, comm));
+  for (PetscInt i = 0; i < N; i++) perm[newof[i]] = i;
+  PetscCall(PetscFree4(mine, newof, recv, displ));
+  PetscCall(PetscFree2(count, before));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriPartition - partitions the particles over the ranks of comm (-peri_partition) when every rank
+  holds the whole body p. perm[k] is the old index of new particle k; rank r owns new particles
+  range[r]..range[r+1]-1. Collective.
+@*/
+PetscErrorCode PeriPartition(MPI_Comm comm, const PeriParticles *p, PetscReal delta, PetscInt **perm, PetscInt **range)
+{
+  PetscMPIInt   rank, size;
+  PetscInt      rstart, rend;
+  PeriParticles b;
+  PetscMPIInt  *target;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscMalloc1(p->n, perm));
+  PetscCall(PetscCalloc1(size + 1, range));
+  /* this rank's block of p (for grid particles, x fastest: a slab along the last axis), as a view
+   * into p's arrays: nothing is copied, nothing freed */
+  rstart = (PetscInt)((PetscInt64)rank * p->n / size);
+  rend   = (PetscInt)((PetscInt64)(rank + 1) * p->n / size);
+  b      = *p;
+  b.n    = rend - rstart;
+  b.x += 3 * rstart;
+  b.volume += rstart;
+  b.spacing += rstart;
+  b.source_line += rstart;
+  b.global  = NULL;
+  b.image   = NULL;
+  b.crossed = NULL;
+  b.groups  = NULL;
+  b.ngroups = 0;
+  PetscCall(PeriPartitionBlocks(comm, &b, delta, &target));
+  PetscCall(PermutationFromTargets(comm, p->n, b.n, target, *perm, *range));
+  PetscCall(PetscFree(target));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -8,10 +8,48 @@
 #include <petscis.h>
 
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, PetscReal, PeriParticles *);
+PETSC_EXTERN PetscErrorCode PeriParticlesCreateBlock(MPI_Comm, PeriScene, PetscInt, PetscReal, PeriParticles *, PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriParticlesCreateOwned(MPI_Comm, PeriScene, PetscInt, PetscReal, PetscReal, PeriParticles *, PetscInt *, PetscInt **);
+PETSC_EXTERN PetscErrorCode PeriParticlesAllocate(PeriParticles *, PetscInt);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriParticlesSlice(const PeriParticles *, PetscInt, PetscInt, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesInputPath(PeriScene, PeriNode, const char[], char[], size_t);
+
+/* ------------------------------------------------------------------ creation (particles.c, create.c) */
+/* Where the body comes from: exactly one of grid, particles.file, particles.mesh. */
+typedef enum {
+  PERI_SOURCE_GRID,
+  PERI_SOURCE_FILE,
+  PERI_SOURCE_MESH
+} PeriSource;
+PETSC_EXTERN PetscErrorCode PeriParticlesSource(PeriScene, PetscInt, PetscReal, PeriParticles *, PeriSource *, PeriNode *);
+PETSC_EXTERN PetscErrorCode PeriGridCreate(PeriScene, PeriNode, PetscInt, PetscMPIInt, PetscMPIInt, PeriParticles *, PetscInt *);
+
+/* particles.file read particle by particle: by every rank (the whole body) or by rank 0, which
+ * deals the particles out in chunks (src/disc/create.c). */
+typedef struct {
+  PeriScene scene;
+  PeriNode  node;
+  char      path[PETSC_MAX_PATH_LEN];
+  FILE     *fp;
+  PetscInt  dim, lineno, n; /* lines read, particles read */
+  PetscBool header;
+} PeriCSV;
+PETSC_EXTERN PetscErrorCode PeriCSVOpen(PeriScene, PeriNode, PetscInt, PeriCSV *);
+PETSC_EXTERN PetscErrorCode PeriCSVNext(PeriCSV *, PetscReal[], PetscReal *, PetscInt *, PetscBool *, const char **);
+PETSC_EXTERN PetscErrorCode PeriCSVFail(PeriCSV *, const char[]);
+PETSC_EXTERN PetscErrorCode PeriCSVClose(PeriCSV *);
+
+/* The box and mean spacing of read particles (CSV, mesh), summed in the body's order. */
+typedef struct {
+  PetscReal lower[3], upper[3], sum;
+  PetscInt  n;
+} PeriExtent;
+PETSC_EXTERN PetscReal PeriParticleSpacing(const PeriParticles *, PetscReal);
+PETSC_EXTERN void      PeriExtentInit(PeriExtent *);
+PETSC_EXTERN void      PeriExtentAdd(PeriExtent *, PetscInt, const PetscReal[], PetscReal);
+PETSC_EXTERN void      PeriExtentSet(const PeriExtent *, PeriParticles *);
 
 /* ------------------------------------------------------------------ Gmsh meshes (src/mesh.c) */
 /* A named physical group: the positions of its particles, sorted lexicographically (positions,
@@ -63,8 +101,10 @@ PETSC_EXTERN PetscReal      PeriPartialVolumeFactor(PeriPartialVolume, PetscReal
 PETSC_EXTERN PetscReal      PeriSearchRadius(PeriPartialVolume, PetscReal, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
+PETSC_EXTERN PetscErrorCode PeriPartitionBlocks(MPI_Comm, const PeriParticles *, PetscReal, PetscMPIInt **);
 
 PETSC_EXTERN PetscErrorCode PeriParticlesMigrate(MPI_Comm, PeriParticles *, const PetscMPIInt[]);
+PETSC_EXTERN PetscErrorCode PeriParticlesGather(MPI_Comm, const PeriParticles *, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesNear(const PeriParticles *, PetscReal, PetscInt, const PetscReal[], PetscBool[]);
 
 /* ------------------------------------------------------------------ ghosts (src/disc/halo.c) */
