@@ -6,8 +6,8 @@
 /* What a run holds at its peak, from the scene alone (docs/performance.md, "Memory"). */
 typedef struct {
   PetscReal n, nbonds;  /* particles, bonds (each pair once) */
-  PetscReal per_rank;   /* bytes every rank holds: the runtime and the replicated particle arrays */
-  PetscReal shared;     /* bytes the ranks share: bonds, stiffness matrix, solver, vectors */
+  PetscReal per_rank;   /* bytes every rank holds: the runtime */
+  PetscReal shared;     /* bytes the ranks share: particles, bonds, stiffness matrix, solver, vectors */
   PetscReal need, have; /* bytes on the node that needs the most, and what it has available */
 } MemoryEstimate;
 
@@ -155,9 +155,11 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
      nested-dissection fill grew as 0.45 log2(n) matrices (2D lamina, 3,600 to 230,400 particles) */
   if (!strcmp(analysis, "quasistatic")) e->shared += matrix;
   if (!strcmp(analysis, "modal")) e->shared += matrix * 0.45 * PetscLog2Real(n);
-  /* coordinates, volume, spacing, line, owner, family volume, neighbour count, the cell list, and
-     the gathered displacements and energy densities */
-  e->per_rank = PERI_MEMORY_RUNTIME + n * (8 * sizeof(PetscReal) + 6 * sizeof(PetscInt) + (2 * dofs + 1) * sizeof(PetscReal));
+  /* coordinates, volume, spacing, line, family volume, neighbour count, the cell list, the local
+     view's displacements and energy densities: each rank holds its own particles' (and a thin
+     layer of ghosts), so they share out like the rest (docs/distributed.md) */
+  e->shared += n * (8 * sizeof(PetscReal) + 6 * sizeof(PetscInt) + (2 * dofs + 1) * sizeof(PetscReal));
+  e->per_rank = PERI_MEMORY_RUNTIME;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -214,7 +216,7 @@ static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
 
 /*@C
   PeriParticlesCheckMemory - estimates, from the scene's grid, horizon and the model, the memory the
-  run will need (bonds, matrix, solver, replicated particle arrays) and refuses with an input error
+  run will need (bonds, matrix, solver, particle arrays) and refuses with an input error
   naming grid.spacing when it exceeds what the nodes have available (MemAvailable shared by the
   node's ranks). Called before any particle is allocated; errors in the grid or horizon are left
   to the readers that report them. Skipped with -peri_memory_check false, and for particles.file.

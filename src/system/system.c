@@ -63,6 +63,7 @@ static PetscErrorCode ReadHorizon(PeriSystem sys)
     PeriInputCheck(sys->disc.delta <= PetscSqrtReal(diag2), s, h, hasm ? "m" : "delta", "the horizon %g exceeds the body's size (its diagonal %g): every particle would bond with every other; a horizon is a few spacings (m = 3 is usual)", (double)sys->disc.delta, (double)PetscSqrtReal(diag2));
   }
   for (PetscInt k = 0; k < sys->disc.particles.n; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm)); /* the ranks' blocks */
   PeriInputCheck(sys->disc.delta >= hmax * (1 - 1e-10), s, h, hasm ? "m" : "delta", "the horizon %g is smaller than the particle spacing %g: particles would have no bonds", (double)sys->disc.delta, (double)hmax);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -308,34 +309,69 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* This rank's local view: its share rstart..rend-1 of the partitioned body, then the ghosts within
- * the bonds' search radius (src/disc/halo.c), or within reach of the mirror image of every owned
- * fictitious layer particle (its relation reads the image's position and shear modulus); the mesh
- * groups move over with them. The whole body is freed. */
-static PetscErrorCode SetLocalView(PeriSystem sys, PetscInt rstart, PetscInt rend)
+/* The farthest mirror image of a fictitious layer particle of the whole body (0 without layers):
+ * the halo must reach every owned fictitious particle's image. Collective. */
+static PetscErrorCode LayerReach(PeriSystem sys, PetscReal *reach)
 {
-  PeriParticles *body = &sys->disc.particles, local;
-  PetscReal      hmax = 0, reach = 0, radius;
+  const PeriParticles *body = &sys->disc.particles;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = rstart; k < rend; k++) {
-    hmax = PetscMax(hmax, body->spacing[k]);
+  *reach = 0;
+  for (PetscInt k = 0; k < body->n; k++)
     if (PeriParticleIsFictitious(body, k)) {
       PetscReal d2 = 0;
       for (PetscInt d = 0; d < 3; d++) d2 += PetscSqr(body->x[3 * k + d] - body->x[3 * body->image[k] + d]);
-      reach = PetscMax(reach, PetscSqrtReal(d2) * (1 + 1e-9));
+      *reach = PetscMax(*reach, PetscSqrtReal(d2) * (1 + 1e-9));
     }
-  }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &reach, 1, MPIU_REAL, MPI_MAX, sys->comm));
-  radius = PetscMax(PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax), reach);
-  PetscCall(PeriParticlesSlice(body, rstart, rend, &local));
-  local.ngroups = body->ngroups;
-  local.groups  = body->groups;
-  body->ngroups = 0;
-  body->groups  = NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The whole body (scenes with fictitious layers, whose mirror images are indices of the whole
+ * grid) partitioned: this rank's share in owned, the mesh groups with it; the body is freed. */
+static PetscErrorCode PartitionWhole(PeriSystem sys, PeriParticles *owned, PetscReal *reach)
+{
+  PeriParticles *body = &sys->disc.particles;
+  PetscInt      *perm, *range;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriPartition(sys->comm, body, sys->disc.delta, &perm, &range));
+  if (sys->size > 1) PetscCall(PeriParticlesPermute(body, perm));
+  PetscCall(LayerReach(sys, reach));
+  PetscCall(PeriParticlesSlice(body, range[sys->rank], range[sys->rank + 1], owned));
+  owned->ngroups = body->ngroups;
+  owned->groups  = body->groups;
+  body->ngroups  = 0;
+  body->groups   = NULL;
   PetscCall(PeriParticlesDestroy(body));
-  PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &local, radius));
+  PetscCall(PetscFree(perm));
+  PetscCall(PetscFree(range));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* This rank's local view: its owned particles, partitioned (-peri_partition) from the blocks each
+ * rank created (PeriParticlesCreateBlock, PeriPartitionBlocks, PeriParticlesMigrate) or from the
+ * whole body, then the ghosts within the bonds' search radius, or within reach of every owned
+ * fictitious particle's mirror image (its relation reads the image's position and shear
+ * modulus). */
+static PetscErrorCode SetLocalView(PeriSystem sys)
+{
+  PeriParticles owned;
+  PetscReal     hmax = 0, reach = 0;
+
+  PetscFunctionBeginUser;
+  if (sys->whole_body)
+    PetscCall(PartitionWhole(sys, &owned, &reach));
+  else {
+    PetscMPIInt *target;
+    PetscCall(PeriPartitionBlocks(sys->comm, &sys->disc.particles, sys->disc.delta, &target));
+    if (sys->size > 1) PetscCall(PeriParticlesMigrate(sys->comm, &sys->disc.particles, target));
+    PetscCall(PetscFree(target));
+    owned = sys->disc.particles;
+    PetscCall(PetscMemzero(&sys->disc.particles, sizeof(sys->disc.particles)));
+  }
+  for (PetscInt k = 0; k < owned.n; k++) hmax = PetscMax(hmax, owned.spacing[k]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PetscMax(PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax), reach)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -356,21 +392,17 @@ static PetscErrorCode SearchBonds(PeriSystem sys)
  * family volumes and the surface correction; counts of bonds and of bonds between ranks. */
 static PetscErrorCode SetUpBonds(PeriSystem sys)
 {
-  PeriDisc      *d = &sys->disc;
-  PetscInt      *perm, *range, cut = 0;
+  PeriDisc      *d   = &sys->disc;
+  PetscInt       cut = 0;
   PetscLogDouble t0, t1;
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Partition, 0, 0, 0, 0));
-  PetscCall(PeriPartition(sys->comm, &d->particles, d->delta, &perm, &range));
-  if (sys->size > 1) PetscCall(PeriParticlesPermute(&d->particles, perm));
+  PetscCall(SetLocalView(sys));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Partition, 0, 0, 0, 0));
 
   PetscCall(PetscLogEventBegin(PERI_EVENT_Neighbors, 0, 0, 0, 0));
-  PetscCall(SetLocalView(sys, range[sys->rank], range[sys->rank + 1]));
-  PetscCall(PetscFree(perm));
-  PetscCall(PetscFree(range));
   PetscCall(SearchBonds(sys));
   PetscCall(PetscMalloc2(d->particles.n, &d->family_volume, d->particles.n, &d->neighbor_count));
   /* a crack is geometry: the family volumes, the surface correction and the calibration see it */
@@ -429,8 +461,16 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PeriScene            s  = sys->scene;
   const PeriParticles *pt = &sys->disc.particles;
 
+  PeriNode layers;
+
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesCreateFromScene(s, sys->model->dim, sys->thickness, &sys->disc.particles));
+  /* fictitious layers mirror the whole grid (global indices): those scenes create the whole body */
+  PetscCall(PeriSceneGetNode(s->root, "boundary_layers", &layers));
+  sys->whole_body = layers ? PETSC_TRUE : PETSC_FALSE;
+  if (sys->whole_body)
+    PetscCall(PeriParticlesCreateFromScene(s, sys->model->dim, sys->thickness, &sys->disc.particles));
+  else
+    PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->thickness, &sys->disc.particles, &sys->disc.N));
   PetscCall(ReadHorizon(sys));
   PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
   PetscCall(ReadCorrections(sys));
