@@ -32,6 +32,7 @@ d = json.load(open("out/summary.json"))
 mem = [int(open(f).read().split()[-1]) / 1024 for f in sorted(glob.glob("mem.*"))]
 t = d["timing"]
 wall = float(open("wall.txt").read().split()[-1])
-print(f"| {P} | {d['particles']} | {max(mem):.0f} | {min(mem):.0f} | {sum(mem):.0f} | {d['edge_cut']} | {t['neighbors_s']:.2f} | {t['assembly_s']:.2f} | {t['solve_s']:.2f} | {t['total_s']:.2f} | {wall:.1f} |")
+ph = d["memory_phases_mb"]  # the largest rank's peak at the end of each phase
+print(f"| {P} | {d['particles']} | {max(mem):.0f} | {min(mem):.0f} | {sum(mem):.0f} | {ph['setup']:.0f} | {ph['assembly']:.0f} | {ph['run']:.0f} | {d['edge_cut']} | {t['neighbors_s']:.2f} | {t['assembly_s']:.2f} | {t['solve_s']:.2f} | {t['total_s']:.2f} | {wall:.1f} |")
 PY
 done
