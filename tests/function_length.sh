@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# No function in src/ or models/ runs past 80 lines (docs/design.md, "Conventions"): a long
+# No function in src/ or models/ runs past 80 lines (docs/build.md, the test table): a long
 # function is split into named steps. A function is counted from its opening brace in column 0
 # to its closing brace in column 0, as clang-format lays them out.
 # Usage: function_length.sh REPO [LIMIT]

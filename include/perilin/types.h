@@ -54,9 +54,9 @@ PETSC_EXTERN const char *const PeriSurfaceCorrections[];
 
 /* Bonds are stored once per pair, in the row of the smaller global index (CSR over owned particles). */
 typedef struct {
-  PetscInt       rstart, rend; /* owned particles */
+  PetscInt       rstart, rend; /* the rows: indices of the particles searched (a local view: its owned particles 0 .. nowned - 1) */
   PetscInt      *offset;       /* rend - rstart + 1 */
-  PetscInt      *j;            /* the other particle (global index, j >= i; j == i only for periodic self-images) */
+  PetscInt      *j;            /* the other particle, a local index of the particles searched (the pair's row is its smaller global index; j == i only for periodic self-images) */
   PetscReal     *xi;           /* 3 per bond: X_j - X_i, minimum image on periodic axes */
   PetscReal     *length;
   PetscReal     *alpha;  /* partial-volume factor */

@@ -312,8 +312,8 @@ PetscErrorCode PeriParticlesCreateBlock(MPI_Comm comm, PeriScene scene, PetscInt
   numbers range[r] .. range[r + 1] - 1 (range: P + 1 entries, allocated here), in the order and
   with the numbering of the whole-body path (PeriParticlesCreateFromScene, PeriPartition,
   PeriParticlesPermute, then the slice range[r] .. range[r + 1]); *N is the body's count. Scenes
-  with fictitious layers (boundary_layers) are refused: the layers are appended to the whole body.
-  Collective.
+  with fictitious layers (boundary_layers) are refused: the system adds the layers to each rank's
+  particles after the partition (PeriLayersAddParticles). Collective.
 @*/
 PetscErrorCode PeriParticlesCreateOwned(MPI_Comm comm, PeriScene scene, PetscInt dim, PetscReal thickness, PetscReal delta, PeriParticles *p, PetscInt *N, PetscInt **range)
 {
@@ -323,7 +323,7 @@ PetscErrorCode PeriParticlesCreateOwned(MPI_Comm comm, PeriScene scene, PetscInt
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(scene->root, "boundary_layers", &layers));
-  PetscCheck(!layers, comm, PETSC_ERR_SUP, "%s: fictitious layers (boundary_layers) extend the whole body: create it with PeriParticlesCreateFromScene", scene->file);
+  PetscCheck(!layers, comm, PETSC_ERR_SUP, "%s: fictitious layers (boundary_layers) are added after the partition by the system (PeriLayersAddParticles)", scene->file);
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PeriParticlesCreateBlock(comm, scene, dim, thickness, p, N));
   PetscCall(PeriPartitionBlocks(comm, p, delta, &target));

@@ -91,19 +91,61 @@ static PetscErrorCode LayerRead(PeriSystem sys, PeriNode item, const PetscInt ce
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Appends the fictitious cells lo/hi deep beyond the faces of the cells[0] x cells[1] body, each with
- * its mirror image in the body and the faces it crossed. */
+/* The fictitious cells whose mirror image is the body cell m (cells[0] x cells[1] body, layers
+ * lo/hi deep): per axis the cell itself or its mirror through each face within reach (both faces
+ * on a body fewer than lo + hi cells across), every combination but m itself; c[] and mask[] get
+ * them (at most 8), *n their number. */
+static void MirrorCells(const PetscInt cells[], const PetscInt lo[], const PetscInt hi[], const PetscInt m[], PetscInt c[][2], unsigned char mask[], PetscInt *n)
+{
+  PetscInt      opt[2][3], nopt[2];
+  unsigned char bit[2][3];
+
+  for (PetscInt d = 0; d < 2; d++) {
+    opt[d][0] = m[d];
+    bit[d][0] = 0;
+    nopt[d]   = 1;
+    if (m[d] < lo[d]) {
+      opt[d][nopt[d]]   = -1 - m[d];
+      bit[d][nopt[d]++] = (unsigned char)(1 << (2 * d));
+    }
+    if (m[d] >= cells[d] - hi[d]) {
+      opt[d][nopt[d]]   = 2 * cells[d] - 1 - m[d];
+      bit[d][nopt[d]++] = (unsigned char)(1 << (2 * d + 1));
+    }
+  }
+  *n = 0;
+  for (PetscInt b = 0; b < nopt[1]; b++)
+    for (PetscInt a = 0; a < nopt[0]; a++) {
+      if (!a && !b) continue;
+      c[*n][0]     = opt[0][a];
+      c[*n][1]     = opt[1][b];
+      mask[(*n)++] = (unsigned char)(bit[0][a] | bit[1][b]);
+    }
+}
+
+/* Appends to this rank's particles (its owned body particles, partitioned) the fictitious cells
+ * lo/hi deep beyond the faces of the cells[0] x cells[1] body whose mirror images they are, with
+ * the faces they crossed: each fictitious particle lives on the rank of its image, which is then
+ * never a ghost. The images are the body particles' global indices in the numbering of the
+ * extended ranks (body particles first on each rank, then its fictitious ones). Collective. */
 static PetscErrorCode LayersAppendParticles(PeriSystem sys, const PetscInt cells[], const PetscInt lo[], const PetscInt hi[])
 {
-  PeriParticles *pt = &sys->disc.particles;
-  PetscReal      h  = pt->mean_spacing;
-  PetscInt       n  = (cells[0] + lo[0] + hi[0]) * (cells[1] + lo[1] + hi[1]) - cells[0] * cells[1];
-  PetscInt       nb = pt->n, N = pt->n + n, k;
-  PetscReal     *x, *vol, *sp;
-  PetscInt      *src;
-  unsigned char *crossed;
+  PeriParticles  *pt = &sys->disc.particles;
+  const PetscReal h  = pt->mean_spacing;
+  PetscInt        nb = pt->n, n = 0, N, rstart = 0, k;
+  PetscReal      *x, *vol, *sp;
+  PetscInt       *src, c[8][2], m[2], nc;
+  unsigned char  *crossed, mask[8];
 
   PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < nb; i++) {
+    for (PetscInt d = 0; d < 2; d++) m[d] = (PetscInt)PetscFloorReal((pt->x[3 * i + d] - pt->lower[d]) / h);
+    MirrorCells(cells, lo, hi, m, c, mask, &nc);
+    n += nc;
+  }
+  N = nb + n;
+  PetscCallMPI(MPI_Exscan(&N, &rstart, 1, MPIU_INT, MPI_SUM, sys->comm));
+  if (!sys->rank) rstart = 0; /* MPI_Exscan leaves rank 0's result undefined */
   PetscCall(PetscCalloc1(3 * N, &x));
   PetscCall(PetscMalloc3(N, &vol, N, &sp, N, &src));
   PetscCall(PetscMalloc2(N, &pt->image, N, &crossed));
@@ -115,29 +157,18 @@ static PetscErrorCode LayersAppendParticles(PeriSystem sys, const PetscInt cells
     pt->image[k] = -1;
     crossed[k]   = 0;
   }
-  for (PetscInt c1 = -lo[1]; c1 < cells[1] + hi[1]; c1++)
-    for (PetscInt c0 = -lo[0]; c0 < cells[0] + hi[0]; c0++) {
-      const PetscInt c[2] = {c0, c1};
-      PetscInt       m[2] = {c0, c1};
-      unsigned char  mask = 0;
-      for (PetscInt d = 0; d < 2; d++) {
-        if (c[d] < 0) {
-          mask |= (unsigned char)(1 << (2 * d));
-          m[d] = -1 - c[d];
-        } else if (c[d] >= cells[d]) {
-          mask |= (unsigned char)(1 << (2 * d + 1));
-          m[d] = 2 * cells[d] - 1 - c[d];
-        }
-      }
-      if (!mask) continue;
-      for (PetscInt d = 0; d < 2; d++) x[3 * k + d] = pt->lower[d] + (c[d] + 0.5) * h;
-      vol[k]       = pt->volume[0];
+  for (PetscInt i = 0; i < nb; i++) {
+    for (PetscInt d = 0; d < 2; d++) m[d] = (PetscInt)PetscFloorReal((pt->x[3 * i + d] - pt->lower[d]) / h);
+    MirrorCells(cells, lo, hi, m, c, mask, &nc);
+    for (PetscInt t = 0; t < nc; t++, k++) {
+      for (PetscInt d = 0; d < 2; d++) x[3 * k + d] = pt->lower[d] + (c[t][d] + 0.5) * h;
+      vol[k]       = pt->volume[i];
       sp[k]        = h;
       src[k]       = 0;
-      pt->image[k] = m[1] * cells[0] + m[0];
-      crossed[k]   = mask;
-      k++;
+      pt->image[k] = rstart + i;
+      crossed[k]   = mask[t];
     }
+  }
   PetscCall(PetscFree(pt->x));
   PetscCall(PetscFree3(pt->volume, pt->spacing, pt->source_line));
   pt->x           = x;
@@ -146,14 +177,14 @@ static PetscErrorCode LayersAppendParticles(PeriSystem sys, const PetscInt cells
   pt->source_line = src;
   pt->crossed     = crossed;
   pt->n           = N;
-  pt->nfictitious = n;
+  PetscCallMPI(MPI_Allreduce(&n, &pt->nfictitious, 1, MPIU_INT, MPI_SUM, sys->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
-  PeriLayersAddParticles - reads boundary_layers and torsion and appends the fictitious particles
-  (with their mirror images) to the grid's particles. Call after the horizon and the corrections
-  are known, before partitioning. Not collective.
+  PeriLayersAddParticles - reads boundary_layers and torsion and appends to each rank's particles
+  (its body particles, partitioned) the fictitious particles whose mirror images they are. Call
+  after the horizon, the corrections and the partition, before the ghosts. Collective.
 @*/
 PetscErrorCode PeriLayersAddParticles(PeriSystem sys)
 {

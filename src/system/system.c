@@ -309,69 +309,25 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The farthest mirror image of a fictitious layer particle of the whole body (0 without layers):
- * the halo must reach every owned fictitious particle's image. Collective. */
-static PetscErrorCode LayerReach(PeriSystem sys, PetscReal *reach)
-{
-  const PeriParticles *body = &sys->disc.particles;
-
-  PetscFunctionBeginUser;
-  *reach = 0;
-  for (PetscInt k = 0; k < body->n; k++)
-    if (PeriParticleIsFictitious(body, k)) {
-      PetscReal d2 = 0;
-      for (PetscInt d = 0; d < 3; d++) d2 += PetscSqr(body->x[3 * k + d] - body->x[3 * body->image[k] + d]);
-      *reach = PetscMax(*reach, PetscSqrtReal(d2) * (1 + 1e-9));
-    }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The whole body (scenes with fictitious layers, whose mirror images are indices of the whole
- * grid) partitioned: this rank's share in owned, the mesh groups with it; the body is freed. */
-static PetscErrorCode PartitionWhole(PeriSystem sys, PeriParticles *owned, PetscReal *reach)
-{
-  PeriParticles *body = &sys->disc.particles;
-  PetscInt      *perm, *range;
-
-  PetscFunctionBeginUser;
-  PetscCall(PeriPartition(sys->comm, body, sys->disc.delta, &perm, &range));
-  if (sys->size > 1) PetscCall(PeriParticlesPermute(body, perm));
-  PetscCall(LayerReach(sys, reach));
-  PetscCall(PeriParticlesSlice(body, range[sys->rank], range[sys->rank + 1], owned));
-  owned->ngroups = body->ngroups;
-  owned->groups  = body->groups;
-  body->ngroups  = 0;
-  body->groups   = NULL;
-  PetscCall(PeriParticlesDestroy(body));
-  PetscCall(PetscFree(perm));
-  PetscCall(PetscFree(range));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* This rank's local view: its owned particles, partitioned (-peri_partition) from the blocks each
- * rank created (PeriParticlesCreateBlock, PeriPartitionBlocks, PeriParticlesMigrate) or from the
- * whole body, then the ghosts within the bonds' search radius, or within reach of every owned
- * fictitious particle's mirror image (its relation reads the image's position and shear
- * modulus). */
+ * rank created (PeriParticlesCreateBlock, PeriPartitionBlocks, PeriParticlesMigrate), with the
+ * fictitious layer particles that mirror them, then the ghosts within the bonds' search radius. */
 static PetscErrorCode SetLocalView(PeriSystem sys)
 {
   PeriParticles owned;
-  PetscReal     hmax = 0, reach = 0;
+  PetscMPIInt  *target;
+  PetscReal     hmax = 0;
 
   PetscFunctionBeginUser;
-  if (sys->whole_body)
-    PetscCall(PartitionWhole(sys, &owned, &reach));
-  else {
-    PetscMPIInt *target;
-    PetscCall(PeriPartitionBlocks(sys->comm, &sys->disc.particles, sys->disc.delta, &target));
-    if (sys->size > 1) PetscCall(PeriParticlesMigrate(sys->comm, &sys->disc.particles, target));
-    PetscCall(PetscFree(target));
-    owned = sys->disc.particles;
-    PetscCall(PetscMemzero(&sys->disc.particles, sizeof(sys->disc.particles)));
-  }
+  PetscCall(PeriPartitionBlocks(sys->comm, &sys->disc.particles, sys->disc.delta, &target));
+  if (sys->size > 1) PetscCall(PeriParticlesMigrate(sys->comm, &sys->disc.particles, target));
+  PetscCall(PetscFree(target));
+  PetscCall(PeriLayersAddParticles(sys));
+  owned = sys->disc.particles;
+  PetscCall(PetscMemzero(&sys->disc.particles, sizeof(sys->disc.particles)));
   for (PetscInt k = 0; k < owned.n; k++) hmax = PetscMax(hmax, owned.spacing[k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
-  PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PetscMax(PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax), reach)));
+  PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -461,20 +417,11 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PeriScene            s  = sys->scene;
   const PeriParticles *pt = &sys->disc.particles;
 
-  PeriNode layers;
-
   PetscFunctionBeginUser;
-  /* fictitious layers mirror the whole grid (global indices): those scenes create the whole body */
-  PetscCall(PeriSceneGetNode(s->root, "boundary_layers", &layers));
-  sys->whole_body = layers ? PETSC_TRUE : PETSC_FALSE;
-  if (sys->whole_body)
-    PetscCall(PeriParticlesCreateFromScene(s, sys->model->dim, sys->thickness, &sys->disc.particles));
-  else
-    PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->thickness, &sys->disc.particles, &sys->disc.N));
+  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->thickness, &sys->disc.particles, &sys->disc.N));
   PetscCall(ReadHorizon(sys));
   PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
   PetscCall(ReadCorrections(sys));
-  PetscCall(PeriLayersAddParticles(sys));
   PetscCall(SetUpBonds(sys));
   for (PetscInt i = 0; i < sys->disc.nowned; i++)
     PetscCheck(sys->disc.neighbor_count[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->disc.delta, (double)pt->spacing[i]);

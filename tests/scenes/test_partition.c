@@ -4,20 +4,23 @@
  * of every component; both independent of the particles' order). The shares: the Hilbert curve
  * is cut into pieces of floor or ceil(N/P) particles; PT-Scotch is asked (PETSc's default) for
  * loads within 1 % of N/P and METIS (its default ufactor 30) within 3 %; one particle more is
- * allowed for the rounding of N/P. */
+ * allowed for the rounding of N/P. N counts the body's particles: the fictitious layer particles,
+ * added after the partition, live on the rank of their mirror image. */
 #include "testing.h"
 
 static PetscErrorCode CheckShares(PeriProblem p, const char *type, PetscReal imbalance)
 {
-  const PetscInt N = p->sys->disc.N;
-  PetscMPIInt    size;
-  PetscInt      *count;
-  char           what[160];
+  const PeriParticles *pt = &p->sys->disc.particles;
+  const PetscInt       N  = p->sys->disc.N - pt->nfictitious; /* the partition shares the body; a fictitious layer particle joins its mirror image's rank */
+  PetscMPIInt          size;
+  PetscInt            *count, mine = 0;
+  char                 what[160];
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
   PetscCall(PetscCalloc1(size, &count));
-  PetscCallMPI(MPI_Allgather(&p->sys->disc.nowned, 1, MPIU_INT, count, 1, MPIU_INT, PETSC_COMM_WORLD));
+  for (PetscInt i = 0; i < p->sys->disc.nowned; i++) mine += !PeriParticleIsFictitious(pt, i);
+  PetscCallMPI(MPI_Allgather(&mine, 1, MPIU_INT, count, 1, MPIU_INT, PETSC_COMM_WORLD));
   for (PetscMPIInt r = 0; r < size; r++) {
     PetscReal upper = imbalance > 0 ? (1 + imbalance) * N / size + 1 : PetscCeilReal((PetscReal)N / size);
     PetscReal lower = imbalance > 0 ? 1 : PetscFloorReal((PetscReal)N / size);

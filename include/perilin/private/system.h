@@ -153,12 +153,11 @@ typedef struct _p_PeriSystem *PeriSystem;
 struct _p_PeriSystem {
   MPI_Comm         comm;
   PetscMPIInt      rank, size;
-  PeriScene        scene;      /* borrowed from the problem: for reading sections and locating errors */
-  PetscReal        thickness;  /* material.thickness (2D) */
-  PeriDisc         disc;       /* the particles, regions, bonds and volumes: their one owner */
-  PetscBool        whole_body; /* set-up: every rank creates the whole body (fictitious layers), not its block */
-  PetscReal       *mu;         /* shear modulus per particle when material.mu_by_region is given, else NULL */
-  PetscReal       *bond_mu;    /* per local bond: the shear modulus across materials (eq. 60), or NULL */
+  PeriScene        scene;     /* borrowed from the problem: for reading sections and locating errors */
+  PetscReal        thickness; /* material.thickness (2D) */
+  PeriDisc         disc;      /* the particles, regions, bonds and volumes: their one owner */
+  PetscReal       *mu;        /* shear modulus per particle when material.mu_by_region is given, else NULL */
+  PetscReal       *bond_mu;   /* per local bond: the shear modulus across materials (eq. 60), or NULL */
   PeriLayers       layers;
   PeriTorsion      torsion;
   PetscReal       *tau;            /* antiplane models, per owned particle: tau_xz, tau_yz, |tau| after the solve */
