@@ -10,12 +10,9 @@
 set -euo pipefail
 exe=$(realpath "$1")
 shift
-ranks=()
-while [[ $# -gt 0 && $1 != -- ]]; do
-  ranks+=("$1")
-  shift
-done
-[[ $# -gt 0 ]] && shift
+source "$(dirname "$0")/args.sh"
+perf_args ranks "$@"
+set -- "${PERF_REST[@]}"
 [[ ${#ranks[@]} -gt 0 ]] || ranks=(1 2 4)
 h=${CREATE_SPACING:-1/1001}
 scene=$(cd "$(dirname "$0")/../.." && pwd)/examples/bench/plate_2d.yaml

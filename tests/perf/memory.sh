@@ -9,12 +9,9 @@
 set -euo pipefail
 perilin=$(realpath "$1")
 shift
-spacings=()
-while [[ $# -gt 0 && $1 != -- ]]; do
-  spacings+=("$1")
-  shift
-done
-[[ $# -gt 0 ]] && shift
+source "$(dirname "$0")/args.sh"
+perf_args spacings "$@"
+set -- "${PERF_REST[@]}"
 [[ ${#spacings[@]} -gt 0 ]] || spacings=(1/401)
 scene=$(cd "$(dirname "$0")/../.." && pwd)/examples/bench/plate_2d.yaml
 work=$(mktemp -d)

@@ -14,12 +14,9 @@
 set -euo pipefail
 perilin=$(realpath "$1")
 shift
-cases=()
-while [[ $# -gt 0 && $1 != -- ]]; do
-  cases+=("$1")
-  shift
-done
-[[ $# -gt 0 ]] && shift
+source "$(dirname "$0")/args.sh"
+perf_args cases "$@"
+set -- "${PERF_REST[@]}"
 [[ ${#cases[@]} -gt 0 ]] || cases=(plate_160k plate_1m block_64k block_216k plate_hole)
 ranks=${PARTITION_RANKS:-2 4 8}
 bench=$(cd "$(dirname "$0")/../.." && pwd)/examples/bench

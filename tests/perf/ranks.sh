@@ -9,12 +9,9 @@ perilin=$(realpath "$1")
 shift
 h=${1:-1/1001}
 [[ $# -gt 0 ]] && shift
-ranks=()
-while [[ $# -gt 0 && $1 != -- ]]; do
-  ranks+=("$1")
-  shift
-done
-[[ $# -gt 0 ]] && shift
+source "$(dirname "$0")/args.sh"
+perf_args ranks "$@"
+set -- "${PERF_REST[@]}"
 [[ ${#ranks[@]} -gt 0 ]] || ranks=(1 2 4 8)
 scene=$(cd "$(dirname "$0")/../.." && pwd)/examples/bench/plate_2d.yaml
 work=$(mktemp -d)
