@@ -307,49 +307,74 @@ static int ComparePair(const void *a, const void *b)
   return x[1] < y[1] ? -1 : x[1] > y[1];
 }
 
+/* The dead pairs (global indices, the smaller first) this rank's families need: those of its own
+ * bonds, and those other ranks store towards a particle it owns (each rank sends a dead bond to
+ * the owner of its other end when that end is a ghost there). *pairs is freed with PetscFree. */
+static PetscErrorCode DeadPairs(PeriSystem sys, PetscInt *npairs, PetscInt **pairs)
+{
+  const PeriBonds *b = &sys->disc.bonds;
+  const PetscInt  *G = sys->disc.particles.global;
+  PetscMPIInt     *sc, *rc, *sd, *rd;
+  PetscInt        *send, nself = 0, nrecv = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc4(sys->size, &sc, sys->size, &rc, sys->size + 1, &sd, sys->size + 1, &rd));
+  for (PetscInt k = 0; k < b->nbonds; k++)
+    if (!b->live[k]) {
+      nself++;
+      if (b->j[k] >= sys->disc.nowned) sc[PeriDiscOwner(&sys->disc, G[b->j[k]])] += 2;
+    }
+  for (PetscMPIInt r = 0; r < sys->size; r++) sd[r + 1] = sd[r] + sc[r];
+  PetscCall(PetscMalloc1(sd[sys->size] + 1, &send));
+  PetscCall(PetscMalloc1(2 * nself + 1, pairs));
+  *npairs = 0;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      const PetscInt j = b->j[k];
+      if (b->live[k]) continue;
+      (*pairs)[2 * *npairs]         = G[i];
+      (*pairs)[2 * (*npairs)++ + 1] = G[j];
+      if (j >= sys->disc.nowned) {
+        const PetscMPIInt r = PeriDiscOwner(&sys->disc, G[j]);
+        send[sd[r]++]       = G[i];
+        send[sd[r]++]       = G[j];
+      }
+    }
+  for (PetscMPIInt r = sys->size; r > 0; r--) sd[r] = sd[r - 1]; /* the fill moved each start to the next */
+  sd[0] = 0;
+  PetscCallMPI(MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, sys->comm));
+  for (PetscMPIInt r = 0; r < sys->size; r++) rd[r + 1] = rd[r] + rc[r];
+  nrecv = rd[sys->size] / 2;
+  PetscCall(PetscRealloc(sizeof(PetscInt) * (2 * (nself + nrecv) + 1), pairs));
+  PetscCallMPI(MPI_Alltoallv(send, sc, sd, MPIU_INT, *pairs + 2 * nself, rc, rd, MPIU_INT, sys->comm));
+  *npairs = nself + nrecv;
+  PetscCall(PetscFree(send));
+  PetscCall(PetscFree4(sc, rc, sd, rd));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriFamilySync - state-based models keep each particle's whole family (sys->disc.family, both
-  directions); this marks dead every family entry whose bond is dead in sys->disc.bonds (stored once, at
-  the smaller global index, possibly on another rank): the dead pairs (global indices) are gathered
-  on every rank.
-  Collective.
+  directions); this marks dead every family entry whose bond is dead in sys->disc.bonds (stored
+  once, in the row of the smaller global index, possibly on another rank): each rank gets the dead
+  pairs that touch its own particles (DeadPairs), no more. Collective.
 @*/
 PetscErrorCode PeriFamilySync(PeriSystem sys)
 {
-  const PeriBonds *b = &sys->disc.bonds;
-  PeriBonds       *F = &sys->disc.family;
-  const PetscInt  *G = sys->disc.particles.global;
-  PetscInt        *mine, *all, nmine = 0, nall;
-  PetscMPIInt      n2, *counts, *displs;
+  PeriBonds      *F = &sys->disc.family;
+  const PetscInt *G = sys->disc.particles.global;
+  PetscInt       *pairs, n;
 
   PetscFunctionBeginUser;
   if (!F->offset) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt k = 0; k < b->nbonds; k++) nmine += !b->live[k];
-  PetscCall(PetscMalloc1(2 * nmine + 1, &mine));
-  nmine = 0;
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-      if (!b->live[k]) {
-        mine[2 * nmine]       = G[i];
-        mine[2 * nmine++ + 1] = G[b->j[k]];
-      }
-  PetscCall(PetscMalloc2(sys->size, &counts, sys->size, &displs));
-  PetscCall(PetscMPIIntCast(2 * nmine, &n2));
-  PetscCallMPI(MPI_Allgather(&n2, 1, MPI_INT, counts, 1, MPI_INT, sys->comm));
-  displs[0] = 0;
-  for (PetscMPIInt r = 1; r < sys->size; r++) displs[r] = displs[r - 1] + counts[r - 1];
-  nall = (displs[sys->size - 1] + counts[sys->size - 1]) / 2;
-  PetscCall(PetscMalloc1(2 * nall + 1, &all));
-  PetscCallMPI(MPI_Allgatherv(mine, n2, MPIU_INT, all, counts, displs, MPIU_INT, sys->comm));
-  qsort(all, (size_t)nall, 2 * sizeof(PetscInt), ComparePair);
+  PetscCall(DeadPairs(sys, &n, &pairs));
+  qsort(pairs, (size_t)n, 2 * sizeof(PetscInt), ComparePair);
   for (PetscInt i = F->rstart; i < F->rend; i++)
     for (PetscInt k = F->offset[i - F->rstart]; k < F->offset[i - F->rstart + 1]; k++) {
       PetscInt key[2] = {PetscMin(G[i], G[F->j[k]]), PetscMax(G[i], G[F->j[k]])};
-      F->live[k]      = bsearch(key, all, (size_t)nall, 2 * sizeof(PetscInt), ComparePair) ? 0 : 1;
+      F->live[k]      = bsearch(key, pairs, (size_t)n, 2 * sizeof(PetscInt), ComparePair) ? 0 : 1;
     }
-  PetscCall(PetscFree(mine));
-  PetscCall(PetscFree(all));
-  PetscCall(PetscFree2(counts, displs));
+  PetscCall(PetscFree(pairs));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
