@@ -37,23 +37,24 @@ PetscErrorCode PeriDiscSetLocalView(MPI_Comm comm, PeriDisc *disc, PeriParticles
   disc->N      = disc->halo.N;
   disc->nowned = disc->halo.nowned;
   disc->rstart = disc->halo.rstart;
+  disc->size   = size;
   PetscCall(PetscMalloc1(size + 1, &disc->range));
   PetscCallMPI(MPI_Allgather(&disc->rstart, 1, MPIU_INT, disc->range, 1, MPIU_INT, comm));
   disc->range[size] = disc->N;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The rank owning global particle g. */
+/* The rank owning global particle g: the last r with range[r] <= g < range[r + 1] (a rank that owns
+ * nothing has range[r] == range[r + 1]), by bisection: O(log P) per call. */
 PetscMPIInt PeriDiscOwner(const PeriDisc *disc, PetscInt g)
 {
-  PetscMPIInt lo = 0, hi = 0;
-  while (disc->range[hi + 1] < disc->N) hi++; /* the last rank with particles */
-  while (lo < hi) {
-    PetscMPIInt mid = (lo + hi + 1) / 2;
+  PetscMPIInt lo = 0, hi = disc->size; /* range has size + 1 entries */
+  while (hi - lo > 1) {
+    PetscMPIInt mid = (lo + hi) / 2;
     if (disc->range[mid] <= g)
       lo = mid;
     else
-      hi = mid - 1;
+      hi = mid;
   }
   return lo;
 }

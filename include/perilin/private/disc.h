@@ -141,6 +141,7 @@ typedef struct {
   PetscInt              N;         /* particles of the whole body */
   PetscInt              nowned;    /* this rank's own particles */
   PetscInt              rstart;    /* the global index of local particle 0 */
+  PetscMPIInt           size;      /* ranks */
   PetscInt             *range;     /* size + 1: rank r owns global indices range[r]..range[r+1]-1 */
   PeriHalo              halo;      /* the ghosts and the SF that refreshes them */
   PetscInt              nregions;
