@@ -11,65 +11,6 @@ static inline PeriModal *Modal(PeriAnalysis an)
   return (PeriModal *)an->data;
 }
 
-/* The density of each owned particle: material.rho, or material.rho_by_region {region: rho}
- * (later regions win where they overlap). */
-static PetscErrorCode Densities(PeriAnalysis an, PetscReal **rho)
-{
-  PeriScene      s    = an->sys->scene;
-  const PetscInt nloc = an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart;
-  PeriNode       mat, map;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(nloc, rho));
-  for (PetscInt i = 0; i < nloc; i++) (*rho)[i] = an->sys->model->material.rho;
-  PetscCall(PeriSceneGetNode(s->root, "material", &mat));
-  PetscCall(PeriSceneGetMap(s, mat, "rho_by_region", PETSC_FALSE, &map));
-  for (PetscInt k = 0; map && k < map->n; k++) {
-    PeriRegion *r;
-    PetscReal   v;
-    PetscCall(PeriRegionFind(s, map->child[k], NULL, an->sys->disc.nregions, an->sys->disc.regions, &r));
-    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &v, NULL));
-    PeriInputCheck(v > 0, s, map, map->child[k]->key, "must be positive");
-    for (PetscInt i = 0; i < nloc; i++)
-      if (PeriRegionContains(r, &an->sys->disc.particles.x[3 * (an->sys->disc.bonds.rstart + i)])) (*rho)[i] = v;
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriAssembleMass - the lumped mass matrix, diagonal, in the layout of K. Collective.
-@*/
-static PetscErrorCode PeriAssembleMass(PeriAnalysis an, Mat *M)
-{
-  const PetscInt bs = an->sys->model->dofs, nloc = an->sys->disc.bonds.rend - an->sys->disc.bonds.rstart;
-  PetscReal     *rho;
-  Vec            d;
-  PetscScalar   *a;
-
-  PetscFunctionBeginUser;
-  PetscCall(MatCreate(an->comm, M));
-  PetscCall(MatSetSizes(*M, nloc * bs, nloc * bs, PETSC_DETERMINE, PETSC_DETERMINE));
-  PetscCall(MatSetBlockSize(*M, bs));
-  PetscCall(MatSetType(*M, MATAIJ));
-  PetscCall(MatXAIJSetPreallocation(*M, 1, NULL, NULL, NULL, NULL));
-  PetscCall(MatSeqAIJSetPreallocation(*M, 1, NULL));
-  PetscCall(MatMPIAIJSetPreallocation(*M, 1, NULL, 0, NULL));
-  PetscCall(PeriSystemCreateVec(an->sys, &d));
-  PetscCall(Densities(an, &rho));
-  PetscCall(VecGetArray(d, &a));
-  for (PetscInt i = 0; i < nloc; i++) {
-    PetscReal V = an->sys->disc.particles.volume[an->sys->disc.bonds.rstart + i], h = an->sys->disc.particles.spacing[an->sys->disc.bonds.rstart + i];
-    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = an->sys->model->rotational[c] ? rho[i] * V * (h * h + h * h) / 12 : rho[i] * V;
-  }
-  PetscCall(VecRestoreArray(d, &a));
-  PetscCall(PetscFree(rho));
-  PetscCall(MatDiagonalSet(*M, d, INSERT_VALUES));
-  PetscCall(MatAssemblyBegin(*M, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(*M, MAT_FINAL_ASSEMBLY));
-  PetscCall(VecDestroy(&d));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The structure's main axis: away from its constraints (a cantilever's length), or, for a free
  * body, its longest extent. Components held at 0 because they are inactive do not count. */
 static PetscErrorCode MainAxis(PeriAnalysis an, PetscInt *axis)
@@ -451,19 +392,14 @@ static PetscErrorCode CheckModes(PeriAnalysis an, PetscReal eps_tol)
 static PetscErrorCode SetUpModal(PeriAnalysis an, PetscReal target_hz, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff)
 {
   PeriModal *md;
-  PetscReal *rho;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriAssembleMass(an, M));
-  PetscCall(MatCreateVecs(*M, mdiag, NULL));
-  PetscCall(MatGetDiagonal(*M, *mdiag));
+  /* the system's mass service (src/system/mass.c): borrowed */
+  PetscCall(PeriMassGetMatrix(an->sys, M));
+  PetscCall(PeriMassGetDiagonal(an->sys, mdiag));
   PetscCall(PetscNew(&md));
   an->data = md;
-  /* rotations carry inertia, not mass: the total mass is that of the particles */
-  PetscCall(Densities(an, &rho));
-  for (PetscInt i = an->sys->disc.bonds.rstart; i < an->sys->disc.bonds.rend; i++) md->total_mass += rho[i - an->sys->disc.bonds.rstart] * an->sys->disc.particles.volume[i];
-  PetscCall(PetscFree(rho));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &md->total_mass, 1, MPIU_REAL, MPI_SUM, an->comm));
+  PetscCall(PeriMassGetTotal(an->sys, &md->total_mass));
   md->target_hz = target_hz;
   PetscCall(MainAxis(an, &md->axis));
   PetscCall(FreeDOFs(an, isfree));
@@ -546,9 +482,9 @@ static PetscErrorCode RecordSolver(PeriAnalysis an, EPS eps, PetscInt nev, const
 
 /* What one modal solve holds: freed whether it succeeds or a check stops it inside SLEPc. */
 typedef struct {
-  Mat        M, Kff, Mff;
+  Mat        M, Kff, Mff; /* M: borrowed from the mass service */
   IS         isfree;
-  Vec        mdiag;
+  Vec        mdiag; /* borrowed from the mass service */
   EPS        eps;
   InnerCheck inner;
   Pair      *pairs;
@@ -559,11 +495,9 @@ static PetscErrorCode ModalWorkDestroy(ModalWork *w)
   PetscFunctionBeginUser;
   PetscCall(PetscFree(w->pairs));
   PetscCall(VecDestroy(&w->inner.r));
-  PetscCall(VecDestroy(&w->mdiag));
   PetscCall(EPSDestroy(&w->eps));
   PetscCall(MatDestroy(&w->Kff));
   PetscCall(MatDestroy(&w->Mff));
-  PetscCall(MatDestroy(&w->M));
   PetscCall(ISDestroy(&w->isfree));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

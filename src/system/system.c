@@ -448,6 +448,7 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(MatDestroy(&sys->K));
   PetscCall(MatDestroy(&sys->Kpc));
   PetscCall(PeriOperatorDestroy(&sys->op));
+  PetscCall(PeriMassDestroy(&sys->mass));
   PetscCall(VecDestroy(&sys->u));
   PetscCall(VecDestroy(&sys->f));
   PetscCall(PeriModelDestroy(&sys->model));

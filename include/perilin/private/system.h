@@ -8,6 +8,7 @@
 #include "perilin/private/model.h"
 #include "perilin/private/output.h"
 #include "perilin/private/sys.h"
+#include "perilin/private/mass.h"
 
 typedef struct {
   char        name[PERI_NAME_LEN];
@@ -168,6 +169,7 @@ struct _p_PeriSystem {
   PeriFailure      failure;
   PetscReal       *damage; /* scenes with failure, per owned particle: phi, then phi per PeriFailureCause */
   PeriModel        model;
+  PeriMass         mass;                    /* densities and lumped mass, on request (mass.h) */
   Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
   Mat              Kpc;                     /* with op: the assembled short-range stiffness that preconditions K */
   PeriOperator     op;                      /* solver.operator: matrix_free, else NULL */
