@@ -110,7 +110,7 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneCheckSection(s, o, "output"));
   PetscCall(PeriSceneGetString(s, o, "dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
   PetscCall(PeriSceneGetBool(s, o, "vtk", &p->vtk, NULL));
-  PetscCall(PeriSceneGetBool(s, o, "stress", &p->sys->stress_output, NULL));
+  PetscCall(PeriSceneGetBool(s, o, "stress", &p->sys->fields.stress_output, NULL));
   PetscCall(PeriSceneGetInt(s, o, "every", PETSC_FALSE, &p->output_every, NULL));
   PeriInputCheck(p->output_every >= 0, s, o, "every", "must not be negative (0: only the end), got %" PetscInt_FMT, p->output_every);
   PetscCall(ReadAnalysis(p));
@@ -128,12 +128,12 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
   PetscCall(PeriSceneCheckSection(p->scene, p->scene->root, ""));
   PetscCall(PeriSystemCreate(p->comm, p->scene, &p->sys));
-  PetscCall(PeriProgressUpdate(p->sys->progress, PERI_PROGRESS_PHASE, "setup"));
+  PetscCall(PeriProgressUpdate(p->sys->run.progress, PERI_PROGRESS_PHASE, "setup"));
   PetscCall(PeriSystemSetFromScene(p->sys));
   PetscCall(ReadOutput(p, p->scene->file));
   if (p->write_output) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   PetscCall(PeriSystemSetUp(p->sys));
-  p->sys->log.memory_phase_mb[0] = PeriPeakMemoryMB();
+  p->sys->run.log.memory_phase_mb[0] = PeriPeakMemoryMB();
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -147,7 +147,7 @@ static PetscErrorCode WriteSnapshot(void *ctx, const char base[])
 
   PetscFunctionBeginUser;
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
-  PetscCall(PeriSystemWriteParticles(p->sys, p->sys->u_owned, p->staging_dir, base));
+  PetscCall(PeriSystemWriteParticles(p->sys, p->sys->fields.u_owned, p->staging_dir, base));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -176,17 +176,17 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   p->analysis->snapshot    = WriteSnapshot;
   p->analysis->snapshotctx = p;
   /* a signal during the set-up: no analysis, only the summary saying so */
-  PetscCall(PeriSignalReceived(p->comm, &p->sys->interrupted));
+  PetscCall(PeriSignalReceived(p->comm, &p->sys->run.interrupted));
   PetscCall(PetscLogStagePush(PERI_STAGE_Solve));
-  if (!p->sys->interrupted) PetscCall(type->ops.run(p->analysis));
+  if (!p->sys->run.interrupted) PetscCall(type->ops.run(p->analysis));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscTime(&t));
-  p->sys->log.total_s            = t - p->t_start;
-  mb                             = PeriPeakMemoryMB();
-  p->sys->log.memory_phase_mb[2] = mb;
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, p->sys->log.memory_phase_mb, 3, MPIU_REAL, MPI_MAX, p->comm));
-  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->log.memory_mb, 1, MPIU_REAL, MPI_SUM, p->comm));
-  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->log.memory_mb_max_rank, 1, MPIU_REAL, MPI_MAX, p->comm));
+  p->sys->run.log.total_s            = t - p->t_start;
+  mb                                 = PeriPeakMemoryMB();
+  p->sys->run.log.memory_phase_mb[2] = mb;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, p->sys->run.log.memory_phase_mb, 3, MPIU_REAL, MPI_MAX, p->comm));
+  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->run.log.memory_mb, 1, MPIU_REAL, MPI_SUM, p->comm));
+  PetscCallMPI(MPI_Allreduce(&mb, &p->sys->run.log.memory_mb_max_rank, 1, MPIU_REAL, MPI_MAX, p->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -199,7 +199,7 @@ static PetscErrorCode WriteParticles(PeriProblem p)
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemFieldListCreate(sys, &fl));
-  if (sys->u_owned) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->u_owned));
+  if (sys->fields.u_owned) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->fields.u_owned));
   if (p->analysis && p->analysis->type->ops.fields) PetscCall(p->analysis->type->ops.fields(p->analysis, fl));
   PetscCall(PeriSystemAddFields(sys, fl));
   PetscCall(PeriWriteParticles(p->comm, fl, p->staging_dir, "particles"));
@@ -218,11 +218,11 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Output));
-  PetscCall(PeriProgressUpdate(p->sys->progress, PERI_PROGRESS_ANALYSIS, NULL));
-  PetscCall(PeriProgressUpdate(p->sys->progress, PERI_PROGRESS_PHASE, "output"));
+  PetscCall(PeriProgressUpdate(p->sys->run.progress, PERI_PROGRESS_ANALYSIS, NULL));
+  PetscCall(PeriProgressUpdate(p->sys->run.progress, PERI_PROGRESS_PHASE, "output"));
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   /* an analysis stopped before it had a state writes no fields: only the summary saying so */
-  if (p->vtk && (!p->sys->interrupted || p->sys->u_owned)) {
+  if (p->vtk && (!p->sys->run.interrupted || p->sys->fields.u_owned)) {
     PetscCall(WriteParticles(p));
   }
   if (p->analysis && p->analysis->type->ops.files) PetscCall(p->analysis->type->ops.files(p->analysis, p->staging_dir));
@@ -265,14 +265,14 @@ PetscErrorCode PeriProblemCheckOptions(PeriProblem p)
 
 PetscErrorCode PeriProblemCheckUnusedOptions(PeriProblem p)
 {
-  PeriRunSolvers run = {p->comm, p->scene, p->sys->mat_type, p->sys->solve.ksp_type, p->sys->solve.pc_type, p->analysis ? p->analysis->type->eigensolver : PETSC_FALSE};
+  PeriRunSolvers run = {p->comm, p->scene, p->sys->stiffness.mat_type, p->sys->fields.solve.ksp_type, p->sys->fields.solve.pc_type, p->analysis ? p->analysis->type->eigensolver : PETSC_FALSE};
 
   PetscFunctionBeginUser;
   /* -mat_type sets the type of the assembled matrix: K, or with a matrix-free K its preconditioner */
-  if (p->sys->Kpc)
-    PetscCall(MatGetType(p->sys->Kpc, &run.mat_type));
-  else if (p->sys->K)
-    PetscCall(MatGetType(p->sys->K, &run.mat_type));
+  if (p->sys->stiffness.Kpc)
+    PetscCall(MatGetType(p->sys->stiffness.Kpc, &run.mat_type));
+  else if (p->sys->stiffness.K)
+    PetscCall(MatGetType(p->sys->stiffness.K, &run.mat_type));
   PetscCall(PeriOptionsCheckUnused(&run));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -280,7 +280,7 @@ PetscErrorCode PeriProblemCheckUnusedOptions(PeriProblem p)
 PetscErrorCode PeriProblemInterrupted(PeriProblem p, int *signal)
 {
   PetscFunctionBeginUser;
-  *signal = p->sys ? p->sys->interrupted : 0;
+  *signal = p->sys ? p->sys->run.interrupted : 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -290,19 +290,19 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   PeriSystem sys = p->sys;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->disc.N, sys->log.nbonds_total, sys->disc.N * sys->model->dofs, p->size));
-  if (sys->solve.ksp_type[0])
-    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.assembly_s, sys->log.solve_s, sys->solve.ksp_type, sys->solve.pc_type, sys->op ? " matrix-free" : "", sys->solve.iterations, sys->solve.converged_reason, (double)sys->solve.residual_norm, sys->log.memory_mb));
+  PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->disc.N, sys->run.log.nbonds_total, sys->disc.N * sys->model->dofs, p->size));
+  if (sys->fields.solve.ksp_type[0])
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", sys->run.log.neighbors_s, sys->run.log.assembly_s, sys->run.log.solve_s, sys->fields.solve.ksp_type, sys->fields.solve.pc_type, sys->stiffness.op ? " matrix-free" : "", sys->fields.solve.iterations, sys->fields.solve.converged_reason, (double)sys->fields.solve.residual_norm, sys->run.log.memory_mb));
   else
-    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", sys->log.neighbors_s, sys->log.memory_mb));
-  if (sys->interrupted) {
-    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->u_owned ? "the last complete state was written" : "no result was reached", p->output_dir));
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", sys->run.log.neighbors_s, sys->run.log.memory_mb));
+  if (sys->run.interrupted) {
+    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->run.interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->fields.u_owned ? "the last complete state was written" : "no result was reached", p->output_dir));
   } else if (p->analysis && p->analysis->type->ops.report) {
     PetscCall(p->analysis->type->ops.report(p->analysis));
   } else {
-    const PeriTorsion *t = &sys->torsion;
+    const PeriTorsion *t = &sys->conditions.torsion;
     if (t->active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)t->torque, (double)t->J, (double)t->J_rectangle, 100 * (double)(t->J / t->J_rectangle - 1), (double)t->max_stress, (double)t->max_at[0], (double)t->max_at[1]));
-    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", sys->strain_energy, p->output_dir));
+    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", sys->fields.strain_energy, p->output_dir));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -13,8 +13,8 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriJSONString(j, "analysis", p->analysis_type));
   /* false only for a run stopped by a signal: then the fields below describe the last complete
      state (quasistatic), or there are none */
-  PetscCall(PeriJSONBool(j, "complete", sys->interrupted ? PETSC_FALSE : PETSC_TRUE));
-  if (sys->interrupted) PetscCall(PeriJSONString(j, "interrupted_by", sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  PetscCall(PeriJSONBool(j, "complete", sys->run.interrupted ? PETSC_FALSE : PETSC_TRUE));
+  if (sys->run.interrupted) PetscCall(PeriJSONString(j, "interrupted_by", sys->run.interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
   PetscCall(PeriSystemSummaryDiscretization(sys, j));
   PetscCall(PeriLayersSummary(sys, j));
   PetscCall(PeriSystemSummaryCost(sys, j));

@@ -17,7 +17,7 @@ declare -A allow=(
   [src/main]="perilin.h perilin/private/output.h"
   [src]="perilin.h perilin/private/problem.h perilin/private/analysis.h perilin/private/system.h perilin/private/scene.h perilin/private/model.h perilin/private/sys.h"
   [src/analysis]="perilin/private/analysis.h perilin/private/system.h list.h"
-  [src/system]="perilin/private/system.h perilin/private/mass.h perilin/private/disc.h perilin/private/model.h perilin/private/output.h perilin/private/scene.h perilin/private/sys.h"
+  [src/system]="perilin/private/system.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/disc.h perilin/private/model.h perilin/private/output.h perilin/private/scene.h perilin/private/sys.h"
   [src/disc]="perilin/private/disc.h perilin/private/sys.h"
   [src/model]="perilin/private/model.h perilin/private/sys.h ../../models/list.h"
   [models]="perilin/model.h"
@@ -25,10 +25,10 @@ declare -A allow=(
   [src/output]="perilin/private/output.h perilin/private/sys.h"
   [src/sys]="perilin/private/sys.h"
   [include/perilin]="perilin/types.h perilin/scene.h"
-  [include/perilin/private]="perilin/types.h perilin/scene.h perilin/model.h perilin.h perilin/private/sys.h perilin/private/scene.h perilin/private/output.h perilin/private/disc.h perilin/private/model.h perilin/private/mass.h perilin/private/system.h perilin/private/analysis.h"
+  [include/perilin/private]="perilin/types.h perilin/scene.h perilin/model.h perilin.h perilin/private/sys.h perilin/private/scene.h perilin/private/output.h perilin/private/disc.h perilin/private/model.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/system.h perilin/private/analysis.h"
 )
 # Within include/perilin/private, a header may include only those listed before it here.
-hdr_order=(sys scene output disc model mass system analysis problem)
+hdr_order=(sys scene output disc model mass fields conditions stiffness bondstate system analysis problem)
 
 folder_of() { # a source path relative to the repo -> its folder key
   case $1 in

@@ -51,7 +51,7 @@ static void FailureLoads(PeriSystem sys, PetscReal m, const PetscReal H[], Petsc
 }
 
 /* e_max (%) of one path (in units of s0t, scaled by unit) and m under the criterion now in
- * sys->failure. */
+ * sys->bond_state.failure. */
 static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal unit, PetscReal m)
 {
   const PetscInt  n     = AN(an)->norient;
@@ -70,12 +70,12 @@ static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal uni
   return 100 * worst;
 }
 
-/* sys->failure with only criterion c of the scene's (0 stretch: tension and compression, 1
+/* sys->bond_state.failure with only criterion c of the scene's (0 stretch: tension and compression, 1
  * sliding, 2 frictional sliding with the stretch limits as its cut-offs, as Diana & Casolo pair
  * them: without them a bond in compression never fails), the other limits cleared. */
 static PetscErrorCode OnlyCriterion(PeriAnalysis an, const PeriFailure *all, PetscInt c)
 {
-  PeriFailure *F = &an->sys->failure;
+  PeriFailure *F = &an->sys->bond_state.failure;
   PeriNode     node;
 
   PetscFunctionBeginUser;
@@ -137,7 +137,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Anisotropy *A)
 static PetscErrorCode Run_Anisotropy(PeriAnalysis an)
 {
   Anisotropy       *A;
-  const PeriFailure all  = an->sys->failure;
+  const PeriFailure all  = an->sys->bond_state.failure;
   const PetscReal   unit = all.stretch > 0 ? all.stretch : 1;
 
   PetscFunctionBeginUser;
@@ -151,7 +151,7 @@ static PetscErrorCode Run_Anisotropy(PeriAnalysis an)
     for (PetscInt p = 0; p < A->npaths; p++)
       for (PetscInt k = 0; k < A->nm; k++) A->emax[(c * A->npaths + p) * A->nm + k] = MaxError(an, &A->paths[2 * p], unit, A->m[k]);
   }
-  an->sys->failure = all;
+  an->sys->bond_state.failure = all;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

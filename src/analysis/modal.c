@@ -19,9 +19,9 @@ static PetscErrorCode MainAxis(PeriAnalysis an, PetscInt *axis)
   PetscReal            s[4] = {0, 0, 0, 0}, best = -1;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < an->sys->nconstrained; k++) {
-    PetscInt i = an->sys->constrained[k] / an->sys->model->dofs;
-    if (an->sys->model->inactive[an->sys->constrained[k] % an->sys->model->dofs]) continue;
+  for (PetscInt k = 0; k < an->sys->conditions.nconstrained; k++) {
+    PetscInt i = an->sys->conditions.constrained[k] / an->sys->model->dofs;
+    if (an->sys->model->inactive[an->sys->conditions.constrained[k] % an->sys->model->dofs]) continue;
     for (PetscInt d = 0; d < pt->dim; d++) s[d] += pt->x[3 * i + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
     s[3] += 1;
   }
@@ -52,7 +52,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, PetscInt *nev, PetscReal *ta
   PeriInputCheck(*target_hz >= 0, s, a, "target_hz", "must not be negative");
   PetscCall(PeriSceneGetNode(s->root, "material", &mat));
   PeriInputCheck(an->sys->model->material.rho > 0, s, mat, "rho", "a modal analysis needs the density (material.rho > 0)");
-  PeriInputCheck(!an->sys->layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
+  PeriInputCheck(!an->sys->conditions.layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -64,9 +64,9 @@ static PetscErrorCode FreeDOFs(PeriAnalysis an, IS *is)
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(nloc, &idx));
-  /* an->sys->constrained is sorted: built by a loop over the owned DOFs */
+  /* an->sys->conditions.constrained is sorted: built by a loop over the owned DOFs */
   for (PetscInt k = 0; k < nloc; k++) {
-    if (c < an->sys->nconstrained && an->sys->constrained[c] == r0 + k) {
+    if (c < an->sys->conditions.nconstrained && an->sys->conditions.constrained[c] == r0 + k) {
       c++;
       continue;
     }
@@ -244,7 +244,7 @@ static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sig
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
 #endif
   PetscCall(EPSSetFromOptions(*eps));
-  if (PeriProgressActive(an->sys->progress)) PetscCall(EPSMonitorSet(*eps, ProgressMonitor, an->sys->progress, NULL));
+  if (PeriProgressActive(an->sys->run.progress)) PetscCall(EPSMonitorSet(*eps, ProgressMonitor, an->sys->run.progress, NULL));
   /* STPRECOND (Davidson methods) solves only approximately by design: there only the modes
    * themselves are checked */
   PetscCall(PetscObjectTypeCompare((PetscObject)st, STPRECOND, &precond));
@@ -405,7 +405,7 @@ static PetscErrorCode SetUpModal(PeriAnalysis an, PetscReal target_hz, Mat *M, V
   PetscCall(FreeDOFs(an, isfree));
   PetscCall(ISGetSize(*isfree, &md->nfree_dofs));
   PetscCheck(md->nfree_dofs > 0, an->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", an->sys->scene->file);
-  PetscCall(MatCreateSubMatrix(an->sys->K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
+  PetscCall(MatCreateSubMatrix(an->sys->stiffness.K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
   /* for an inner solve by algebraic multigrid (-st_pc_type gamg): the rigid modes on the free DOFs */
   PetscCall(PeriSetNearNullSpace(an->sys, *Kff, *isfree));
   PetscCall(MatCreateSubMatrix(*M, *isfree, *isfree, MAT_INITIAL_MATRIX, Mff));
@@ -469,14 +469,14 @@ static PetscErrorCode RecordSolver(PeriAnalysis an, EPS eps, PetscInt nev, const
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pt));
-  PetscCall(PetscStrncpy(an->sys->solve.ksp_type, kt, sizeof(an->sys->solve.ksp_type)));
-  PetscCall(PetscStrncpy(an->sys->solve.pc_type, pt, sizeof(an->sys->solve.pc_type)));
+  PetscCall(PetscStrncpy(an->sys->fields.solve.ksp_type, kt, sizeof(an->sys->fields.solve.ksp_type)));
+  PetscCall(PetscStrncpy(an->sys->fields.solve.pc_type, pt, sizeof(an->sys->fields.solve.pc_type)));
   PetscCall(EPSGetDimensions(eps, &asked, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &nconv));
   partial = (PetscBool)(nconv < asked || Modal(an)->nmodes < PetscMin(nev, Modal(an)->nfree_dofs - Modal(an)->nrigid));
-  PetscCall(PetscStrncpy(an->sys->solve.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(an->sys->solve.converged_reason)));
-  PetscCall(EPSGetIterationNumber(eps, &an->sys->solve.iterations));
-  an->sys->solve.residual_norm = inner->worst;
+  PetscCall(PetscStrncpy(an->sys->fields.solve.converged_reason, partial ? "EPS_PARTIAL" : "EPS_CONVERGED", sizeof(an->sys->fields.solve.converged_reason)));
+  PetscCall(EPSGetIterationNumber(eps, &an->sys->fields.solve.iterations));
+  an->sys->fields.solve.residual_norm = inner->worst;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -528,16 +528,16 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   PetscCall(CreateEPS(an, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
   /* the factorization (MUMPS) and its solves run with the BLAS threads (src/sys/threads.c) */
   PetscCall(PeriBLASThreads(PETSC_TRUE));
-  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_PHASE, "factorization"));
+  PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_PHASE, "factorization"));
   PetscCall(EPSSetUp(w->eps));
   PetscCall(PetscTime(&t1));
-  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_PHASE, "eigensolve"));
+  PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_PHASE, "eigensolve"));
   PetscCall(SolveModes(an, w->eps, nev, target_hz, sigma, nfree, scale, &npairs, &w->pairs));
   PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(PetscTime(&t2));
-  md->factor_s         = t1 - t0;
-  md->solve_s          = t2 - t1;
-  an->sys->log.solve_s = t2 - t0;
+  md->factor_s             = t1 - t0;
+  md->solve_s              = t2 - t1;
+  an->sys->run.log.solve_s = t2 - t0;
   PetscCheck(npairs + md->nrigid > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", an->sys->scene->file);
   PetscCall(CollectModes(an, w->eps, w->Kff, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
   PetscCall(EPSGetTolerances(w->eps, &eps_tol, NULL));
@@ -576,8 +576,8 @@ static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
 
   PetscFunctionBeginUser;
   PetscCall(ReadSettings(an, &nev, &target_hz));
-  PetscCall(PetscStrncpy(an->sys->mat_type, MATAIJ, sizeof(an->sys->mat_type)));
-  if (!an->sys->K) PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(PetscStrncpy(an->sys->stiffness.mat_type, MATAIJ, sizeof(an->sys->stiffness.mat_type)));
+  if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   /* a failed check may return from deep inside SLEPc: free everything, then pass the error on */

@@ -39,10 +39,10 @@ static PetscErrorCode CheckSomethingLoaded(PeriAnalysis an, PeriNode a)
   PetscReal fnorm, v = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecNorm(an->sys->f, NORM_INFINITY, &fnorm));
-  for (PetscInt k = 0; k < an->sys->nconstrained; k++) v = PetscMax(v, PetscAbsReal(an->sys->constrained_value[k]));
-  for (PetscInt f = 0; f < 6; f++) v = PetscMax(v, an->sys->layers.kind[f] ? PetscAbsReal(an->sys->layers.value[f]) : 0);
-  if (an->sys->torsion.active) v = PetscMax(v, PetscAbsReal(an->sys->torsion.twist));
+  PetscCall(VecNorm(an->sys->fields.f, NORM_INFINITY, &fnorm));
+  for (PetscInt k = 0; k < an->sys->conditions.nconstrained; k++) v = PetscMax(v, PetscAbsReal(an->sys->conditions.constrained_value[k]));
+  for (PetscInt f = 0; f < 6; f++) v = PetscMax(v, an->sys->conditions.layers.kind[f] ? PetscAbsReal(an->sys->conditions.layers.value[f]) : 0);
+  if (an->sys->conditions.torsion.active) v = PetscMax(v, PetscAbsReal(an->sys->conditions.torsion.twist));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &v, 1, MPIU_REAL, MPI_MAX, an->comm));
   PeriInputCheck(fnorm > 0 || v > 0, an->sys->scene, a, "type", "a quasistatic analysis scales the loads and prescribed values, and this scene has none (no loads, every bc value 0): give loads or a bc value");
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -53,7 +53,7 @@ static PetscErrorCode CheckSomethingLoaded(PeriAnalysis an, PeriNode a)
  * that holds that component, else none (-1). */
 static PetscInt DefaultReactionRegion(PeriSystem sys, PetscInt c)
 {
-  const PeriReactions *R = &sys->reactions;
+  const PeriReactions *R = &sys->conditions.reactions;
   for (PetscInt r = 0; r < R->nregions; r++)
     if (R->holds[r * PERI_MAX_DOF + c] && R->moves[r]) return r;
   for (PetscInt r = 0; r < R->nregions; r++)
@@ -81,13 +81,13 @@ static PetscErrorCode ReadLoadDisplacement(PeriAnalysis an, PeriNode a, Settings
   if (!has) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriReactionsFindRegion(an->sys, name, &st->reaction));
   list[0] = 0;
-  for (PetscInt r = 0; r < an->sys->reactions.nregions; r++) {
+  for (PetscInt r = 0; r < an->sys->conditions.reactions.nregions; r++) {
     PetscInt k;
     PetscCall(PeriReactionsFindRegion(an->sys, an->sys->disc.regions[r].name, &k));
     if (k == r) PeriListAppend(list, sizeof(list), an->sys->disc.regions[r].name);
   }
   PeriInputCheck(st->reaction >= 0, s, a, "reaction_region", "no bc item holds a region named '%s', so it has no reaction; the regions with one are: %s", name, list[0] ? list : "none (the scene has no bc)");
-  PeriInputCheck(an->sys->reactions.holds[st->reaction * PERI_MAX_DOF + st->component], s, a, "reaction_region", "the bc items on region '%s' do not hold %s (the control component), so its reaction has no %s force: hold it there or choose another region or control_component", name, m->components[st->component], m->components[st->component]);
+  PeriInputCheck(an->sys->conditions.reactions.holds[st->reaction * PERI_MAX_DOF + st->component], s, a, "reaction_region", "the bc items on region '%s' do not hold %s (the control component), so its reaction has no %s force: hold it there or choose another region or control_component", name, m->components[st->component], m->components[st->component]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -102,7 +102,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
-  PeriInputCheck(an->sys->failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
+  PeriInputCheck(an->sys->bond_state.failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
   PetscCall(PeriSceneGetChoice(s, a, "stepping", qs_steppings, &stepping, NULL));
   st->events = stepping == 1 ? PETSC_TRUE : PETSC_FALSE;
   PeriInputCheck(!st->events || !an->sys->disc.bonds.intact, s, a, "stepping", "events needs brittle bonds: with softening (failure.ultimate_stretch) the bonds weaken gradually; use stepping: increments");
@@ -133,12 +133,12 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
   PeriInputCheck(st->max_iterations >= 1, s, a, "max_iterations", "must be at least 1");
   st->reuse = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));
-  st->control = an->sys->nprobes ? &an->sys->probes[0] : NULL;
+  st->control = an->sys->fields.nprobes ? &an->sys->fields.probes[0] : NULL;
   PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, name, sizeof(name), &has));
   if (has) {
     st->control = NULL;
-    for (PetscInt k = 0; k < an->sys->nprobes; k++)
-      if (!strcmp(an->sys->probes[k].name, name)) st->control = &an->sys->probes[k];
+    for (PetscInt k = 0; k < an->sys->fields.nprobes; k++)
+      if (!strcmp(an->sys->fields.probes[k].name, name)) st->control = &an->sys->fields.probes[k];
     PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", name);
   }
   PetscCall(ReadLoadDisplacement(an, a, st));
@@ -148,73 +148,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Evaluates every live bond of this rank against the criterion and breaks those past it (all, or
- * those within the top fraction of the worst index), subtracting their blocks from K; softening
- * bonds lose stiffness by eqs. 45-46 (irreversibly). Returns the global number of bonds broken or
- * softened by more than 1 %. */
-static PetscErrorCode BreakBonds(PeriAnalysis an, const Settings *st, PetscInt *nbroken)
-{
-  PeriBonds        *b  = &an->sys->disc.bonds;
-  PeriModel         m  = an->sys->model;
-  const PetscInt    bs = m->dofs;
-  PetscScalar      *u;
-  PeriFailureCause *cause;
-  PetscReal        *index, *soft, worst = 0, threshold = 1;
-  PetscInt          mine = 0;
-
-  PetscFunctionBeginUser;
-  PetscCall(PeriSystemLocalDOFs(an->sys, an->sys->u, &u));
-  PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PeriBondGeometry g;
-      PetscReal        ui[PERI_MAX_DOF], uj[PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
-      index[k] = 0;
-      if (!b->live[k] || b->j[k] == i) continue;
-      PetscCall(PeriSystemBondGeometry(an->sys, i, k, &g));
-      for (PetscInt c = 0; c < bs; c++) {
-        ui[c] = PetscRealPart(u[i * bs + c]);
-        uj[c] = PetscRealPart(u[g.j * bs + c]);
-      }
-      m->ops.bond_measures(m, &g, ui, uj, meas);
-      index[k] = PeriBondFailureIndex(an->sys, &g, meas, &cause[k]);
-      soft[k]  = b->intact ? PeriBondSoftening(an->sys, meas) : 1;
-      worst    = PetscMax(worst, index[k]);
-    }
-  PetscCall(PetscFree(u));
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, an->comm));
-  /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
-  if (!st->all && worst > 1) threshold = worst - st->fraction * (worst - 1);
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscBool breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
-      if (!b->live[k] || b->j[k] == i) continue;
-      if (!breaks && !(b->intact && soft[k] < b->intact[k])) continue;
-      /* the bond's stiffness becomes new share / old share of itself (state-based models: K is
-         reassembled from the synchronized families below) */
-      if (m->ops.bond_stiffness) PetscCall(PeriStiffnessScaleBond(an->sys, i, k, breaks ? 0 : soft[k] / b->intact[k]));
-      if (breaks || soft[k] <= 0) {
-        b->live[k]  = 0;
-        b->cause[k] = (unsigned char)cause[k];
-        mine++;
-      } else {
-        /* softening: iterate until no bond loses more than 1 % of its stiffness */
-        if (b->intact[k] - soft[k] > 1e-2) mine++;
-        b->intact[k] = soft[k];
-        b->cause[k]  = (unsigned char)cause[k];
-      }
-    }
-  PetscCall(PetscFree3(index, soft, cause));
-  PetscCall(PeriStiffnessScaled(an->sys));
-  PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, an->comm));
-  if (*nbroken && !m->ops.bond_stiffness) {
-    PetscCall(PeriFamilySync(an->sys));
-    PetscCall(PeriSystemAssemble(an->sys));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Appends the step and every region's reaction at it (sys->reactions, just evaluated). */
+/* Appends the step and every region's reaction at it (sys->conditions.reactions, just evaluated). */
 static PetscErrorCode RecordStep(PeriQuasistatic *q, const PeriStep *s, const PeriReactions *R)
 {
   const PetscInt w = R->nregions * PERI_MAX_DOF;
@@ -247,7 +181,7 @@ static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscInt c
   if (probe->rank == an->rank) {
     PetscScalar x;
     row = (an->sys->disc.rstart + probe->particle) * an->sys->model->dofs + component;
-    PetscCall(VecGetValues(an->sys->u, 1, &row, &x));
+    PetscCall(VecGetValues(an->sys->fields.u, 1, &row, &x));
     *v = PetscRealPart(x);
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, v, 1, MPIU_REAL, MPI_SUM, an->comm));
@@ -259,7 +193,7 @@ static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriSt
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   /* the bar where the status line would be drawn: a terminal of the user's (src/sys/progress.c) */
-  if (PeriProgressActive(an->sys->progress)) {
+  if (PeriProgressActive(an->sys->run.progress)) {
     char     bar[41];
     PetscInt fill = (PetscInt)(40 * s->lambda / st->max);
     for (PetscInt k = 0; k < 40; k++) bar[k] = k < fill ? '#' : '.';
@@ -270,69 +204,6 @@ static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriSt
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The state of the last equilibrium: what the outputs describe when a later step fails or the
- * run is interrupted, so that every file of the set shows one state. */
-typedef struct {
-  Vec            u;
-  unsigned char *live;
-  PetscReal     *intact;
-  PeriSolveInfo  solve; /* the solve that reached it */
-} Equilibrium;
-
-static PetscErrorCode EquilibriumCreate(PeriAnalysis an, Equilibrium *e)
-{
-  PetscFunctionBeginUser;
-  PetscCall(MatCreateVecs(an->sys->K, &e->u, NULL)); /* lambda = 0: no displacement */
-  PetscCall(PetscMalloc1(an->sys->disc.bonds.nbonds, &e->live));
-  PetscCall(PetscArraycpy(e->live, an->sys->disc.bonds.live, an->sys->disc.bonds.nbonds));
-  e->intact = NULL;
-  if (an->sys->disc.bonds.intact) {
-    PetscCall(PetscMalloc1(an->sys->disc.bonds.nbonds, &e->intact));
-    PetscCall(PetscArraycpy(e->intact, an->sys->disc.bonds.intact, an->sys->disc.bonds.nbonds));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode EquilibriumSave(PeriAnalysis an, Equilibrium *e)
-{
-  PetscFunctionBeginUser;
-  PetscCall(VecCopy(an->sys->u, e->u));
-  e->solve = an->sys->solve;
-  PetscCall(PetscArraycpy(e->live, an->sys->disc.bonds.live, an->sys->disc.bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(e->intact, an->sys->disc.bonds.intact, an->sys->disc.bonds.nbonds));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Back to the last equilibrium: bonds (and the families and K built from them when the loop goes
- * on), and, with restore_u, the displacements. */
-static PetscErrorCode EquilibriumRestore(PeriAnalysis an, Equilibrium *e, PetscBool reassemble, PetscBool restore_u)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscArraycpy(an->sys->disc.bonds.live, e->live, an->sys->disc.bonds.nbonds));
-  if (e->intact) PetscCall(PetscArraycpy(an->sys->disc.bonds.intact, e->intact, an->sys->disc.bonds.nbonds));
-  PetscCall(PeriFamilySync(an->sys));
-  if (reassemble) {
-    PetscCall(PeriSystemAssemble(an->sys));
-    if (an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
-  }
-  if (restore_u) {
-    if (!an->sys->u) PetscCall(VecDuplicate(e->u, &an->sys->u));
-    PetscCall(VecCopy(e->u, an->sys->u));
-    /* summary.json's solver section describes the solve of this state, not the abandoned one */
-    if (e->solve.ksp_type[0]) an->sys->solve = e->solve;
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode EquilibriumDestroy(Equilibrium *e)
-{
-  PetscFunctionBeginUser;
-  PetscCall(VecDestroy(&e->u));
-  PetscCall(PetscFree(e->live));
-  PetscCall(PetscFree(e->intact));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* particles_NNNN.vtu (or another name; .pvtu on several ranks) of the present state, in the output
  * set, through the snapshot callback the problem installed (the analysis does not know where the
  * set lives). */
@@ -340,7 +211,7 @@ static PetscErrorCode WriteState(PeriAnalysis an, const char name[])
 {
   PetscFunctionBeginUser;
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
-  PetscCall(PeriDamage(an->sys, &an->sys->damage));
+  PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
   PetscCall(an->snapshot(an->snapshotctx, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -357,7 +228,7 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an)
 
 static PetscErrorCode PrintCriteria(PeriAnalysis an, const Settings *st)
 {
-  const PeriFailure *F = &an->sys->failure;
+  const PeriFailure *F = &an->sys->bond_state.failure;
 
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
@@ -402,10 +273,10 @@ static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, Pets
 
   PetscFunctionBeginUser;
   *end = TRIAL_INTERRUPTED;
-  PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
-  if (an->sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
+  if (an->sys->run.interrupted) PetscFunctionReturn(PETSC_SUCCESS);
   *end = TRIAL_FAILED;
-  PetscCall(PeriProgressUpdate(an->sys->progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", load factor %g, %" PetscInt_FMT " bonds broken", q->nsteps + 1, (double)lam, broken));
+  PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", load factor %g, %" PetscInt_FMT " bonds broken", q->nsteps + 1, (double)lam, broken));
   /* the pieces change only when bonds do */
   if (L->stale) {
     PetscCall(PetscFree2(L->hold, L->held));
@@ -440,9 +311,9 @@ static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, Pets
   /* later solves start from the last solution: few bonds change between them */
   PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
   q->solves++;
-  s->ksp_iterations += an->sys->solve.iterations;
-  PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
-  if (an->sys->interrupted) {
+  s->ksp_iterations += an->sys->fields.solve.iterations;
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
+  if (an->sys->run.interrupted) {
     *end = TRIAL_INTERRUPTED;
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -450,7 +321,7 @@ static PetscErrorCode SolveAt(PeriAnalysis an, const Settings *st, Loop *L, Pets
     /* the body as set up is linear: a solve that fails before any bond broke fails at every
        load, so it is the solver's failure, not the body's */
     if (broken == 0) PetscCall(PeriStaticCheckConverged(an->sys, reason));
-    PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)an->sys->solve.residual_norm));
+    PetscCall(PetscSNPrintf(why, len, "the solve failed (%s, true relative residual %.3g): the body can no longer carry the load", KSPConvergedReasons[reason], (double)an->sys->fields.solve.residual_norm));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   *end = TRIAL_SETTLED;
@@ -474,7 +345,7 @@ static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscR
       PetscCall(SolveAt(an, st, L, trial, total + s->broken, loose, s, end, why, len));
       if (*end != TRIAL_SETTLED) PetscFunctionReturn(PETSC_SUCCESS);
     }
-    PetscCall(BreakBonds(an, st, &nb));
+    PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, st->all, st->fraction, &nb));
     L->stale = (PetscBool)(nb > 0);
     if (!nb && !loose) {
       *end = TRIAL_SETTLED;
@@ -485,7 +356,7 @@ static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscR
     s->broken += nb;
     L->since_setup += nb;
     /* a twist carried by the bonds themselves loses the broken bonds' share */
-    if (nb && an->sys->torsion.active && !an->sys->layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->f));
+    if (nb && an->sys->conditions.torsion.active && !an->sys->conditions.layers.nfaces) PetscCall(PeriLoadsAssemble(an->sys, an->sys->fields.f));
     if (runaway && s->broken > st->runaway * L->nbonds) {
       /* a crack running away at this load: a smaller step tells whether it would settle */
       PetscCall(PetscSNPrintf(why, len, "runaway: %" PetscInt_FMT " bonds (more than %g of them) broke at this load without equilibrium", s->broken, (double)st->runaway));
@@ -498,7 +369,7 @@ static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscR
 
 /* The body failed at trial: the trial's state goes to failed_trial.vtu (named as such), and
  * everything else describes the last equilibrium. */
-static PetscErrorCode Failed(PeriAnalysis an, Equilibrium *eq, PetscReal trial, const PeriStep *s, const char why[])
+static PetscErrorCode Failed(PeriAnalysis an, PeriCheckpoint *eq, PetscReal trial, const PeriStep *s, const char why[])
 {
   PeriQuasistatic *q = QS(an);
 
@@ -508,14 +379,14 @@ static PetscErrorCode Failed(PeriAnalysis an, Equilibrium *eq, PetscReal trial, 
   q->failure_step         = q->nsteps + 1;
   q->failed_trial_broken  = s->broken;
   PetscCall(PetscStrncpy(q->ending, why, sizeof(q->ending)));
-  if (an->vtk && an->sys->u) PetscCall(WriteState(an, "failed_trial"));
+  if (an->vtk && an->sys->fields.u) PetscCall(WriteState(an, "failed_trial"));
   PetscCall(PeriDamage(an->sys, &q->trial_damage)); /* where the failure went, for the caller */
-  PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
+  PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_FALSE, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* An accepted step: recorded, reported, saved, and the next step size chosen. */
-static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, Equilibrium *eq, PeriStep *s, PetscReal *dl, PetscInt nbonds)
+static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint *eq, PeriStep *s, PetscReal *dl, PetscInt nbonds)
 {
   PeriQuasistatic *q = QS(an);
 
@@ -523,12 +394,12 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, Equilibrium *e
   PetscCall(ControlValue(an, st->control, st->component, &s->control_u));
   /* the reactions of this equilibrium (and the check that they balance the loads) */
   PetscCall(PeriSystemEvaluateReactions(an->sys, s->lambda));
-  s->imbalance = an->sys->reactions.relative_imbalance;
-  if (st->reaction >= 0) s->reaction = an->sys->reactions.force[st->reaction * PERI_MAX_DOF + st->component];
-  PetscCall(RecordStep(q, s, &an->sys->reactions));
+  s->imbalance = an->sys->conditions.reactions.relative_imbalance;
+  if (st->reaction >= 0) s->reaction = an->sys->conditions.reactions.force[st->reaction * PERI_MAX_DOF + st->component];
+  PetscCall(RecordStep(q, s, &an->sys->conditions.reactions));
   q->peak_load_factor = s->lambda;
   q->broken_bonds     = s->broken_total;
-  PetscCall(EquilibriumSave(an, eq));
+  PetscCall(PeriCheckpointSave(an->sys, eq));
   PetscCall(Progress(an, st, s));
   if (an->every && q->nsteps % an->every == 0 && an->vtk) PetscCall(WriteSnapshot(an));
   /* many breaks: smaller steps; none: back towards the scene's step */
@@ -542,14 +413,14 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   PeriQuasistatic *q = QS(an);
 
   PetscFunctionBeginUser;
-  q->complete = an->sys->interrupted ? PETSC_FALSE : PETSC_TRUE;
-  if (an->sys->interrupted)
-    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", an->sys->interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  q->complete = an->sys->run.interrupted ? PETSC_FALSE : PETSC_TRUE;
+  if (an->sys->run.interrupted)
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", an->sys->run.interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
   else if (!q->failed)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st->max));
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
   PetscCall(PeriSystemEvaluateReactions(an->sys, q->peak_load_factor));
-  PetscCall(PeriDamage(an->sys, &an->sys->damage));
+  PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(an->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
   if (q->failed) PetscCall(PetscPrintf(an->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
@@ -568,7 +439,7 @@ static PetscErrorCode NextEvent(PeriAnalysis an, PetscReal lam, PetscReal *next)
 
   PetscFunctionBeginUser;
   *next = PETSC_INFINITY;
-  PetscCall(PeriSystemLocalDOFs(an->sys, an->sys->u, &u));
+  PetscCall(PeriSystemLocalDOFs(an->sys, an->sys->fields.u, &u));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PeriBondGeometry g;
@@ -589,7 +460,7 @@ static PetscErrorCode NextEvent(PeriAnalysis an, PetscReal lam, PetscReal *next)
 
 /* An equilibrium at load factor lam without a solve: the present state, whose response is linear
  * in the load factor until the next break, scaled from the load factor it was solved at. */
-static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, Equilibrium *eq, PetscReal *at, PetscReal lam, PeriStep *solved, PetscInt nbonds)
+static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, PeriCheckpoint *eq, PetscReal *at, PetscReal lam, PeriStep *solved, PetscInt nbonds)
 {
   PeriStep  s  = {0};
   PetscReal dl = 0;
@@ -598,7 +469,7 @@ static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, Equilibr
   /* the solves that found this state (the first: the intact body's) count here */
   s.ksp_iterations       = solved->ksp_iterations;
   solved->ksp_iterations = 0;
-  PetscCall(VecScale(an->sys->u, lam / *at));
+  PetscCall(VecScale(an->sys->fields.u, lam / *at));
   *at            = lam;
   s.lambda       = lam;
   s.broken_total = QS(an)->broken_bonds;
@@ -614,7 +485,7 @@ static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, Equilibr
  * or failure. The load-displacement path comes out as its saw-tooth, event by event, with no
  * bisection and no retries. */
 #define PERI_EVENT_WINDOW 1e-6
-static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Equilibrium *eq)
+static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, PeriCheckpoint *eq)
 {
   PetscReal lambda = st->max;
   PeriStep  s0     = {0};
@@ -637,7 +508,7 @@ static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Eq
     }
     PetscCall(AcceptScaled(an, st, eq, &lambda, next, &s0, L->nbonds));
     trial = next * (1 + PERI_EVENT_WINDOW);
-    PetscCall(VecScale(an->sys->u, trial / lambda)); /* the same bonds: the solution at trial */
+    PetscCall(VecScale(an->sys->fields.u, trial / lambda)); /* the same bonds: the solution at trial */
     PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, PETSC_TRUE, PETSC_TRUE, &s, &end, why, sizeof(why)));
     if (end == TRIAL_FAILED) PetscCall(Failed(an, eq, trial, &s, why));
     if (end != TRIAL_SETTLED) break;
@@ -651,14 +522,14 @@ static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Eq
       PetscCall(Accept(an, st, eq, &s, &dl, L->nbonds));
     }
   }
-  if (end == TRIAL_INTERRUPTED) PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
+  if (end == TRIAL_INTERRUPTED) PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_FALSE, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Incremental stepping (stepping: increments): steps of load_factor_step; with adaptive steps a
  * failed trial is retried from the last equilibrium with half the step, down to min_step, so the
  * critical load factor is bracketed. */
-static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L, Equilibrium *eq)
+static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L, PeriCheckpoint *eq)
 {
   PetscReal lambda = 0, dl = st->step;
 
@@ -672,12 +543,12 @@ static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L
     PetscCall(PetscTime(&tstep));
     PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, st->adaptive, PETSC_FALSE, &s, &end, why, sizeof(why)));
     if (end == TRIAL_INTERRUPTED) {
-      PetscCall(EquilibriumRestore(an, eq, PETSC_FALSE, PETSC_TRUE));
+      PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_FALSE, PETSC_TRUE));
       break;
     }
     if (end == TRIAL_FAILED && st->adaptive && dl > st->min_step * (1 + 1e-12)) {
       /* back to the last equilibrium, with half the step */
-      PetscCall(EquilibriumRestore(an, eq, PETSC_TRUE, PETSC_FALSE));
+      PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_TRUE, PETSC_FALSE));
       L->stale       = PETSC_TRUE;
       L->since_setup = L->nbonds;
       dl             = PetscMax(0.5 * dl, st->min_step);
@@ -706,7 +577,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
 {
   Settings         st;
   Loop             L  = {0};
-  Equilibrium      eq = {0};
+  PeriCheckpoint   eq = {0};
   PeriQuasistatic *q;
   PetscLogDouble   t0, t;
 
@@ -718,10 +589,10 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   q->control_component = st.component;
   q->reaction_region   = st.reaction;
   PetscCall(PetscStrncpy(q->stepping, st.events ? "events" : "increments", sizeof(q->stepping)));
-  PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
-  an->sys->matrix_free_ok = PETSC_TRUE; /* K is applied, and changed through PeriStiffnessScaleBond */
+  PetscCall(PeriStaticDefaultMatType(an->sys->stiffness.mat_type, sizeof(an->sys->stiffness.mat_type)));
+  an->sys->stiffness.matrix_free_ok = PETSC_TRUE; /* K is applied, and changed through PeriStiffnessScaleBond */
   PetscCall(PeriSystemAssemble(an->sys));
-  PetscCall(EquilibriumCreate(an, &eq));
+  PetscCall(PeriCheckpointCreate(an->sys, &eq));
   PetscCallMPI(MPI_Allreduce(&an->sys->disc.bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
   L.stale = PETSC_TRUE;
   PetscCall(PetscTime(&t0));
@@ -732,9 +603,9 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
     PetscCall(RunIncrements(an, &st, &L, &eq));
   PetscCall(KSPDestroy(&L.ksp));
   PetscCall(PetscFree2(L.hold, L.held));
-  PetscCall(EquilibriumDestroy(&eq));
+  PetscCall(PeriCheckpointDestroy(&eq));
   PetscCall(PetscTime(&t));
-  an->sys->log.solve_s = t - t0;
+  an->sys->run.log.solve_s = t - t0;
   PetscCall(Finish(an, &st));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -745,7 +616,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
 static int ReactionColumns(PeriAnalysis an, FILE *fp, PetscInt k)
 {
   const PeriQuasistatic *q   = QS(an);
-  const PeriReactions   *R   = &an->sys->reactions;
+  const PeriReactions   *R   = &an->sys->conditions.reactions;
   int                    bad = 0;
 
   if (q->reaction_region >= 0) bad |= (k < 0 ? fprintf(fp, ",reaction") : fprintf(fp, ",%.10g", (double)q->steps[k].reaction)) < 0;
@@ -839,7 +710,7 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
     PetscCall(PeriJSONInt(j, "failed_trial_broken_bonds", q->failed_trial_broken));
   }
   PetscCall(PeriJSONInt(j, "broken_bonds", q->broken_bonds));
-  PetscCall(PeriJSONInt(j, "precracked_bonds", an->sys->failure.precracked_bonds));
+  PetscCall(PeriJSONInt(j, "precracked_bonds", an->sys->bond_state.failure.precracked_bonds));
   PetscCall(PeriJSONBool(j, "failed", q->failed));
   PetscCall(PeriJSONBool(j, "complete", q->complete));
   PetscCall(PeriJSONString(j, "ending", q->ending));

@@ -17,7 +17,7 @@ static PetscErrorCode Run_Setup(PeriAnalysis an)
 static PetscErrorCode Report_Setup(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(an->comm, "perilin: set-up only, nothing solved: %" PetscInt_FMT " bonds between ranks; results in %s/\n", an->sys->log.edge_cut, an->output_dir));
+  PetscCall(PetscPrintf(an->comm, "perilin: set-up only, nothing solved: %" PetscInt_FMT " bonds between ranks; results in %s/\n", an->sys->run.log.edge_cut, an->output_dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

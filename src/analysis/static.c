@@ -15,27 +15,27 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   PetscBool          released = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Allreduce(&an->sys->nconstrained, &nc, 1, MPIU_INT, MPI_SUM, an->comm));
+  PetscCallMPI(MPI_Allreduce(&an->sys->conditions.nconstrained, &nc, 1, MPIU_INT, MPI_SUM, an->comm));
   if (nc == an->sys->disc.N * an->sys->model->dofs) {
     /* every DOF prescribed: the solution is known, K is not needed */
-    PetscCall(VecDestroy(&an->sys->u));
-    PetscCall(PeriSystemCreateVec(an->sys, &an->sys->u));
-    PetscCall(VecSetValues(an->sys->u, an->sys->nconstrained, an->sys->constrained, an->sys->constrained_value, INSERT_VALUES));
-    PetscCall(VecAssemblyBegin(an->sys->u));
-    PetscCall(VecAssemblyEnd(an->sys->u));
-    PetscCall(PetscStrncpy(an->sys->solve.ksp_type, "none", sizeof(an->sys->solve.ksp_type)));
-    PetscCall(PetscStrncpy(an->sys->solve.pc_type, "none", sizeof(an->sys->solve.pc_type)));
-    PetscCall(PetscStrncpy(an->sys->solve.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(an->sys->solve.converged_reason)));
+    PetscCall(VecDestroy(&an->sys->fields.u));
+    PetscCall(PeriSystemCreateVec(an->sys, &an->sys->fields.u));
+    PetscCall(VecSetValues(an->sys->fields.u, an->sys->conditions.nconstrained, an->sys->conditions.constrained, an->sys->conditions.constrained_value, INSERT_VALUES));
+    PetscCall(VecAssemblyBegin(an->sys->fields.u));
+    PetscCall(VecAssemblyEnd(an->sys->fields.u));
+    PetscCall(PetscStrncpy(an->sys->fields.solve.ksp_type, "none", sizeof(an->sys->fields.solve.ksp_type)));
+    PetscCall(PetscStrncpy(an->sys->fields.solve.pc_type, "none", sizeof(an->sys->fields.solve.pc_type)));
+    PetscCall(PetscStrncpy(an->sys->fields.solve.converged_reason, "ALL_DOFS_PRESCRIBED", sizeof(an->sys->fields.solve.converged_reason)));
     PetscCall(PeriSystemEvaluateEnergy(an->sys));
     PetscCall(PeriSystemEvaluateReactions(an->sys, 1.0));
     PetscCall(PeriReferenceEvaluate(an->sys));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(PeriStaticDefaultMatType(an->sys->mat_type, sizeof(an->sys->mat_type)));
-  an->sys->matrix_free_ok = PETSC_TRUE; /* K is only applied: it may be matrix-free */
-  if (!an->sys->K) PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(PeriStaticDefaultMatType(an->sys->stiffness.mat_type, sizeof(an->sys->stiffness.mat_type)));
+  an->sys->stiffness.matrix_free_ok = PETSC_TRUE; /* K is only applied: it may be matrix-free */
+  if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscTime(&t0));
-  PetscCall(VecDestroy(&an->sys->u));
+  PetscCall(VecDestroy(&an->sys->fields.u));
   {
     /* pieces cut off by cracks: held in place when unloaded, an error when loaded */
     PetscInt   nhold, npieces, *hold;
@@ -49,8 +49,8 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscCall(PeriStaticSolve(an->sys, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));
     PetscCall(PetscFree2(hold, held));
   }
-  PetscCall(PeriSignalReceived(an->comm, &an->sys->interrupted));
-  if (an->sys->interrupted) {
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
+  if (an->sys->run.interrupted) {
     /* an unfinished solve is no result: the output will say so and hold no fields */
     PetscCall(KSPDestroy(&ksp));
     PetscCall(PeriSystemRestoreBondGeometry(an->sys, released));
@@ -64,7 +64,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   PetscCall(PeriSystemRestoreBondGeometry(an->sys, released));
   PetscCall(PeriStaticCheckConverged(an->sys, reason));
   PetscCall(PetscTime(&t1));
-  an->sys->log.solve_s = t1 - t0;
+  an->sys->run.log.solve_s = t1 - t0;
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
   PetscCall(PeriSystemEvaluateReactions(an->sys, 1.0));
   PetscCall(PeriReferenceEvaluate(an->sys));

@@ -213,7 +213,7 @@ static PetscErrorCode AssembleFamilies(PeriSystem sys, Mat *K)
   PetscCall(CreateBlockMatrix(sys, MATPREALLOCATOR, &pre));
   PetscCall(MatSetUp(pre));
   PetscCall(InsertElements(sys, pre));
-  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
+  PetscCall(CreateBlockMatrix(sys, sys->stiffness.mat_type[0] ? sys->stiffness.mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, *K));
   PetscCall(MatDestroy(&pre));
@@ -234,7 +234,7 @@ static PetscErrorCode CreateBondStiffness(PeriSystem sys, const BondFilter *f, M
   PetscCall(Preallocation(sys, f, &dnz, &onz, &dnzu, &onzu));
   *maxcol = 1;
   for (PetscInt i = 0; i < nloc; i++) *maxcol = PetscMax(*maxcol, dnz[i] + onz[i]);
-  PetscCall(CreateBlockMatrix(sys, sys->mat_type[0] ? sys->mat_type : MATBAIJ, K));
+  PetscCall(CreateBlockMatrix(sys, sys->stiffness.mat_type[0] ? sys->stiffness.mat_type : MATBAIJ, K));
   PetscCall(MatSetFromOptions(*K));
   PetscCall(MatXAIJSetPreallocation(*K, sys->model->dofs, dnz, onz, dnzu, onzu));
   PetscCall(PetscFree4(dnz, onz, dnzu, onzu));
@@ -390,7 +390,7 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, const BondFilter *f, Mat *K)
 
 /*@C
   PeriAssembleStiffness - assembles K = sum over live bonds of the model's bond blocks. The type is
-  sys->mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
+  sys->stiffness.mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
   only). Collective.
 
   Each owned block row is gathered in full (its stored bonds and the bonds other owned particles
@@ -426,7 +426,7 @@ PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pe
   PetscInt         idx[2];
 
   PetscFunctionBeginUser;
-  if (sys->op) {
+  if (sys->stiffness.op) {
     PetscCall(BondBlock(sys, &same, i, k, &g, Ke));
     PetscCall(PeriOperatorScaleBond(sys, i, k, factor, Ke));
     PetscFunctionReturn(PETSC_SUCCESS);
@@ -434,7 +434,7 @@ PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pe
   PetscCall(BondBlock(sys, &change, i, k, &g, Ke)); /* the change of the bond's block */
   idx[0] = sys->disc.particles.global[i];
   idx[1] = sys->disc.particles.global[g.j];
-  PetscCall(MatSetValuesBlocked(sys->K, 2, idx, 2, idx, Ke, ADD_VALUES));
+  PetscCall(MatSetValuesBlocked(sys->stiffness.K, 2, idx, 2, idx, Ke, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -442,11 +442,11 @@ PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pe
 PetscErrorCode PeriStiffnessScaled(PeriSystem sys)
 {
   PetscFunctionBeginUser;
-  if (sys->op)
+  if (sys->stiffness.op)
     PetscCall(PeriOperatorScaled(sys));
   else {
-    PetscCall(MatAssemblyBegin(sys->K, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(sys->K, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyBegin(sys->stiffness.K, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(sys->stiffness.K, MAT_FINAL_ASSEMBLY));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -182,16 +182,16 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
     }
   }
   for (PetscInt k = 0; k < nloc; k++) n += set[k] ? 1 : 0;
-  sys->nconstrained = n;
-  PetscCall(PetscMalloc1(n, &sys->constrained));
-  PetscCall(PetscMalloc1(n, &sys->constrained_value));
-  PetscCall(PetscMalloc1(n, &sys->constrained_region));
+  sys->conditions.nconstrained = n;
+  PetscCall(PetscMalloc1(n, &sys->conditions.constrained));
+  PetscCall(PetscMalloc1(n, &sys->conditions.constrained_value));
+  PetscCall(PetscMalloc1(n, &sys->conditions.constrained_region));
   n = 0;
   for (PetscInt k = 0; k < nloc; k++)
     if (set[k]) {
-      sys->constrained[n]        = sys->disc.rstart * bs + k;
-      sys->constrained_value[n]  = value[k];
-      sys->constrained_region[n] = region[k];
+      sys->conditions.constrained[n]        = sys->disc.rstart * bs + k;
+      sys->conditions.constrained_value[n]  = value[k];
+      sys->conditions.constrained_region[n] = region[k];
       n++;
     }
   PetscCall(PetscFree3(value, set, region));
@@ -322,8 +322,8 @@ static PetscErrorCode RigidGramConstrained(PeriSystem sys, PetscInt nm, Vec mode
   PetscFunctionBeginUser;
   PetscCall(VecGetOwnershipRange(modes[0], &rstart, NULL));
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecGetArrayRead(modes[k], &a[k]));
-  for (PetscInt c = 0; c < sys->nconstrained; c++) {
-    PetscInt row = sys->constrained[c] - rstart;
+  for (PetscInt c = 0; c < sys->conditions.nconstrained; c++) {
+    PetscInt row = sys->conditions.constrained[c] - rstart;
     for (PetscInt k = 0; k < nm; k++)
       for (PetscInt l = 0; l < nm; l++) G[k][l] += PetscRealPart(a[k][row] * a[l][row]);
   }
@@ -348,9 +348,9 @@ static PetscErrorCode RigidGramLayers(PeriSystem sys, PetscInt nm, const PetscRe
     PetscReal          sign;
     if (mi < 0) continue;
     mi = PeriDiscLocal(&sys->disc, mi); /* the image is a ghost at worst (SetLocalView) */
-    PetscCall(MatGetRow(sys->layers.T, pt->global[i], &ncols, &cols, &vals));
+    PetscCall(MatGetRow(sys->conditions.layers.T, pt->global[i], &ncols, &cols, &vals));
     sign = PetscRealPart(vals[0]);
-    PetscCall(MatRestoreRow(sys->layers.T, pt->global[i], &ncols, &cols, &vals));
+    PetscCall(MatRestoreRow(sys->conditions.layers.T, pt->global[i], &ncols, &cols, &vals));
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - centre[d];
     m->ops.rigid_modes(m, X, vf);
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * mi + d] - centre[d];
@@ -435,7 +435,7 @@ PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[],
   PetscFunctionBeginUser;
   PetscCall(PeriRigidModes(sys, &nm, modes, norm));
   PetscCall(RigidGramConstrained(sys, nm, modes, G));
-  if (sys->layers.T) PetscCall(RigidGramLayers(sys, nm, norm, G));
+  if (sys->conditions.layers.T) PetscCall(RigidGramLayers(sys, nm, norm, G));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, G, PERI_MAX_MODES * PERI_MAX_MODES, MPIU_REAL, MPI_SUM, sys->comm));
   /* G holds sums of squares of unit vectors' entries: a free motion gives an eigenvalue of about
    * round-off; one constrained particle already gives ~1/N */
@@ -449,5 +449,17 @@ PetscErrorCode PeriRigidMotionFree(PeriSystem sys, PetscInt *nfree, char what[],
     PetscCall(RigidMotionName(sys, nm, norm, V, k, what, len));
   }
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Frees what the conditions hold. */
+PetscErrorCode PeriConditionsDestroy(PeriConditions *C)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriLayersDestroy(&C->layers));
+  PetscCall(PetscFree(C->constrained));
+  PetscCall(PetscFree(C->constrained_value));
+  PetscCall(PetscFree(C->constrained_region));
+  PetscCall(PeriReactionsDestroy(&C->reactions));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -37,7 +37,7 @@ const PeriSchema PeriFailureSchema[] = {
 PetscErrorCode PeriFailureSetUp(PeriSystem sys)
 {
   PeriScene    s = sys->scene;
-  PeriFailure *F = &sys->failure;
+  PeriFailure *F = &sys->bond_state.failure;
   PeriModel    m = sys->model;
   PeriNode     node;
   PetscBool    has[9];
@@ -156,7 +156,7 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
   if (sys->disc.family.offset) CutBonds(&sys->disc.particles, &sys->disc.family, list->n, seg);
   PetscCall(PetscFree(seg));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, sys->comm));
-  sys->failure.precracked_bonds = cut;
+  sys->bond_state.failure.precracked_bonds = cut;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -168,7 +168,7 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
 @*/
 PetscReal PeriBondFailureIndex(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause)
 {
-  const PeriFailure *F   = &sys->failure;
+  const PeriFailure *F   = &sys->bond_state.failure;
   PetscReal          idx = 0, crit = 0;
   PeriFailureCause   c = PERI_CAUSE_CRACK;
 
@@ -252,7 +252,7 @@ PetscReal PeriBondCriticalLoad(PeriSystem sys, const PeriBondGeometry *g, const 
 @*/
 PetscReal PeriBondSoftening(PeriSystem sys, const PetscReal meas[])
 {
-  const PeriFailure *F = &sys->failure;
+  const PeriFailure *F = &sys->bond_state.failure;
   PetscReal          s = F->istretch >= 0 ? meas[F->istretch] : 0, mu = 1;
 
   if (F->ultimate > 0 && s > F->stretch) mu = PetscMax(0, (F->ultimate - s) / (F->ultimate - F->stretch));
@@ -388,17 +388,17 @@ static PetscErrorCode PieceFlags(PeriSystem sys, PetscInt flags[])
 
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < sys->disc.nowned; i++) flags[2 * i] = flags[2 * i + 1] = 0;
-  for (PetscInt k = 0; k < sys->nconstrained; k++) flags[2 * (sys->constrained[k] / bs - sys->disc.rstart)] = 1;
-  PetscCall(VecGetArrayRead(sys->f, &f));
+  for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) flags[2 * (sys->conditions.constrained[k] / bs - sys->disc.rstart)] = 1;
+  PetscCall(VecGetArrayRead(sys->fields.f, &f));
   for (PetscInt i = 0; i < sys->disc.nowned; i++) {
     if (PeriParticleIsFictitious(pt, i)) {
       for (PetscInt face = 0; face < 4; face++)
-        if ((pt->crossed[i] & (1 << face)) && sys->layers.kind[face] == PERI_LAYER_DISPLACEMENT) flags[2 * i] = 1;
+        if ((pt->crossed[i] & (1 << face)) && sys->conditions.layers.kind[face] == PERI_LAYER_DISPLACEMENT) flags[2 * i] = 1;
     }
     for (PetscInt c = 0; c < bs; c++)
       if (f[i * bs + c] != 0) flags[2 * i + 1] = 1;
   }
-  PetscCall(VecRestoreArrayRead(sys->f, &f));
+  PetscCall(VecRestoreArrayRead(sys->fields.f, &f));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -428,7 +428,7 @@ PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, Pets
   if (anchored) main = -1;
   PetscCall(PetscMalloc2(no * bs, hold, no * bs, held));
   *nhold = 0;
-  if (sys->u) PetscCall(VecGetArrayRead(sys->u, &u));
+  if (sys->fields.u) PetscCall(VecGetArrayRead(sys->fields.u, &u));
   for (PetscInt i = 0; i < no; i++) {
     if (flags[2 * i] || label[i] == main) continue;
     if (flags[2 * i + 1]) lostl = 1;
@@ -437,7 +437,7 @@ PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, Pets
       (*held)[(*nhold)++] = u ? PetscRealPart(u[i * bs + c]) : 0;
     }
   }
-  if (sys->u) PetscCall(VecRestoreArrayRead(sys->u, &u));
+  if (sys->fields.u) PetscCall(VecRestoreArrayRead(sys->fields.u, &u));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lostl, 1, MPIU_INT, MPI_MAX, sys->comm));
   *lost = lostl ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PetscFree2(label, flags));
@@ -448,19 +448,19 @@ PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, Pets
  * Casolo eqs. 47, 48, 51). */
 PetscErrorCode PeriFailureAddFields(PeriSystem sys, PeriFieldList fl)
 {
-  const PeriFailure *F      = &sys->failure;
-  const PetscBool    used[] = {(PetscBool)(sys->failure.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
+  const PeriFailure *F      = &sys->bond_state.failure;
+  const PetscBool    used[] = {(PetscBool)(sys->bond_state.failure.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
   const PetscInt     map0   = 0;
 
   PetscFunctionBeginUser;
-  if (!sys->damage) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->damage, PERI_NCAUSES + 1, &map0));
+  if (!sys->bond_state.damage) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->bond_state.damage, PERI_NCAUSES + 1, &map0));
   for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
     char           name[32];
     const PetscInt map = 1 + c;
     if (!used[c]) continue;
     PetscCall(PetscSNPrintf(name, sizeof(name), "damage_%s", PeriFailureCauses[c]));
-    PetscCall(PeriFieldListAddReal(fl, name, 1, sys->damage, PERI_NCAUSES + 1, &map));
+    PetscCall(PeriFieldListAddReal(fl, name, 1, sys->bond_state.damage, PERI_NCAUSES + 1, &map));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

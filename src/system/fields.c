@@ -70,10 +70,10 @@ PetscErrorCode PeriReadProbes(PeriSystem sys)
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "probes", PETSC_FALSE, &map));
   if (!map) PetscFunctionReturn(PETSC_SUCCESS);
-  sys->nprobes = map->n;
-  PetscCall(PetscCalloc1(map->n, &sys->probes));
+  sys->fields.nprobes = map->n;
+  PetscCall(PetscCalloc1(map->n, &sys->fields.probes));
   for (PetscInt k = 0; k < map->n; k++) {
-    PeriProbe *pr   = &sys->probes[k];
+    PeriProbe *pr   = &sys->fields.probes[k];
     PetscReal  dist = 0, h = 0;
     PetscInt   n;
     PetscCall(PetscStrncpy(pr->name, map->child[k]->key, sizeof(pr->name)));
@@ -91,16 +91,16 @@ static PetscErrorCode ProbesEvaluate(PeriSystem sys, const PetscScalar u[])
   const PetscInt bs = sys->model->dofs;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < sys->nprobes; k++) {
-    PeriProbe     *pr = &sys->probes[k];
+  for (PetscInt k = 0; k < sys->fields.nprobes; k++) {
+    PeriProbe     *pr = &sys->fields.probes[k];
     const PetscInt p  = pr->particle;
     if (p >= 0) {
       for (PetscInt c = 0; c < bs; c++) pr->u[c] = PetscRealPart(u[p * bs + c]);
-      pr->W = sys->W[p];
-      if (sys->stress) {
-        PetscCall(PetscArraycpy(pr->sigma, &sys->stress[9 * p], 9));
-        PetscCall(PetscArraycpy(pr->epsilon, &sys->strain[9 * p], 9));
-        PetscCall(PetscArraycpy(pr->sigma_elastic, &sys->elastic_stress[9 * p], 9));
+      pr->W = sys->fields.W[p];
+      if (sys->fields.stress) {
+        PetscCall(PetscArraycpy(pr->sigma, &sys->fields.stress[9 * p], 9));
+        PetscCall(PetscArraycpy(pr->epsilon, &sys->fields.strain[9 * p], 9));
+        PetscCall(PetscArraycpy(pr->sigma_elastic, &sys->fields.elastic_stress[9 * p], 9));
       }
     }
     /* u, W and the three tensors are contiguous: PERI_MAX_DOF + 28 reals */
@@ -167,12 +167,12 @@ static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
       }
     }
   PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 5, MPI_SUM, acc));
-  PetscCall(PetscFree(sys->tau));
+  PetscCall(PetscFree(sys->fields.tau));
   {
-    PetscCall(PetscMalloc1(3 * sys->disc.nowned, &sys->tau));
+    PetscCall(PetscMalloc1(3 * sys->disc.nowned, &sys->fields.tau));
     for (PetscInt i = 0; i < sys->disc.nowned; i++) {
       const PetscReal *A   = &acc[5 * i];
-      PetscReal        det = A[0] * A[2] - A[1] * A[1], gx = 0, gy = 0, mu = sys->mu ? sys->mu[i] : sys->model->material.G;
+      PetscReal        det = A[0] * A[2] - A[1] * A[1], gx = 0, gy = 0, mu = sys->materials.mu ? sys->materials.mu[i] : sys->model->material.G;
       if (det > 1e-12 * PetscSqr(A[0] + A[2])) {
         gx = (A[2] * A[3] - A[1] * A[4]) / det;
         gy = (A[0] * A[4] - A[1] * A[3]) / det;
@@ -180,20 +180,20 @@ static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
         gx = A[0] > 0 ? A[3] / A[0] : 0;
         gy = A[2] > 0 ? A[4] / A[2] : 0;
       }
-      if (sys->torsion.active) {
-        gx -= sys->torsion.twist * (pt->x[3 * i + 1] - sys->torsion.center[1]);
-        gy += sys->torsion.twist * (pt->x[3 * i] - sys->torsion.center[0]);
+      if (sys->conditions.torsion.active) {
+        gx -= sys->conditions.torsion.twist * (pt->x[3 * i + 1] - sys->conditions.torsion.center[1]);
+        gy += sys->conditions.torsion.twist * (pt->x[3 * i] - sys->conditions.torsion.center[0]);
       }
-      sys->tau[3 * i]     = mu * gx;
-      sys->tau[3 * i + 1] = mu * gy;
-      sys->tau[3 * i + 2] = mu * PetscSqrtReal(gx * gx + gy * gy);
+      sys->fields.tau[3 * i]     = mu * gx;
+      sys->fields.tau[3 * i + 1] = mu * gy;
+      sys->fields.tau[3 * i + 2] = mu * PetscSqrtReal(gx * gx + gy * gy);
     }
   }
   PetscCall(PetscFree(acc));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* sys->u_owned: this rank's particles' DOFs, from the distributed sys->u (no gather), so that its
+/* sys->fields.u_owned: this rank's particles' DOFs, from the distributed sys->fields.u (no gather), so that its
  * piece of the output shows the state the other results describe. */
 static PetscErrorCode KeepOwnedSolution(PeriSystem sys)
 {
@@ -201,13 +201,13 @@ static PetscErrorCode KeepOwnedSolution(PeriSystem sys)
   PetscInt           nl;
 
   PetscFunctionBeginUser;
-  PetscCall(VecGetLocalSize(sys->u, &nl));
+  PetscCall(VecGetLocalSize(sys->fields.u, &nl));
   PetscCheck(nl == (sys->disc.bonds.rend - sys->disc.bonds.rstart) * sys->model->dofs, PETSC_COMM_SELF, PETSC_ERR_PLIB, "The solution's local size %" PetscInt_FMT " is not the owned particles' DOFs", nl);
-  PetscCall(PetscFree(sys->u_owned));
-  PetscCall(PetscMalloc1(nl, &sys->u_owned));
-  PetscCall(VecGetArrayRead(sys->u, &u));
-  for (PetscInt k = 0; k < nl; k++) sys->u_owned[k] = PetscRealPart(u[k]);
-  PetscCall(VecRestoreArrayRead(sys->u, &u));
+  PetscCall(PetscFree(sys->fields.u_owned));
+  PetscCall(PetscMalloc1(nl, &sys->fields.u_owned));
+  PetscCall(VecGetArrayRead(sys->fields.u, &u));
+  for (PetscInt k = 0; k < nl; k++) sys->fields.u_owned[k] = PetscRealPart(u[k]);
+  PetscCall(VecRestoreArrayRead(sys->fields.u, &u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -239,12 +239,12 @@ static PetscErrorCode MaxDisplacement(PeriSystem sys, const PetscScalar u[])
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < sys->disc.nowned; i++)
     for (PetscInt c = 0; c < bs && !PeriParticleIsFictitious(&sys->disc.particles, i); c++) umax[c] = PetscMax(umax[c], PetscAbsReal(PetscRealPart(u[i * bs + c])));
-  PetscCallMPI(MPI_Allreduce(umax, sys->max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscCallMPI(MPI_Allreduce(umax, sys->fields.max_abs_u, (PetscMPIInt)bs, MPIU_REAL, MPI_MAX, sys->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
-  PeriSystemEvaluateEnergy - from the solution sys->u: the strain energy of the body, the energy
+  PeriSystemEvaluateEnergy - from the solution sys->fields.u: the strain energy of the body, the energy
   density W_i = (1/2) sum_j (pair energy) / V_i of the owned particles (the ghosts' shares reach
   their owners), the owned particles' DOFs (u_owned), the probes, the largest displacement per
   component, and for antiplane models the shear stresses and the torsion results. Collective.
@@ -255,22 +255,22 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   EnergyCtx    E;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSystemLocalDOFs(sys, sys->u, &u));
-  PetscCall(PetscFree(sys->W));
-  PetscCall(PetscCalloc1(sys->disc.particles.n, &sys->W));
+  PetscCall(PeriSystemLocalDOFs(sys, sys->fields.u, &u));
+  PetscCall(PetscFree(sys->fields.W));
+  PetscCall(PetscCalloc1(sys->disc.particles.n, &sys->fields.W));
   E.u      = u;
-  E.W      = sys->W;
+  E.W      = sys->fields.W;
   E.energy = 0;
   PetscCall(PeriElementsForEach(sys, ElementEnergy, &E));
-  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 1, MPI_SUM, sys->W));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 1, MPI_SUM, sys->fields.W));
   PetscCall(MaxDisplacement(sys, u));
-  PetscCallMPI(MPI_Allreduce(&E.energy, &sys->strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(&E.energy, &sys->fields.strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
   if (sys->model->antiplane) PetscCall(ShearStresses(sys, u));
   PetscCall(PeriSystemEvaluateStress(sys, u));
   PetscCall(KeepOwnedSolution(sys));
   PetscCall(ProbesEvaluate(sys, u));
   PetscCall(PeriTorsionEvaluate(sys));
-  sys->has_solution = PETSC_TRUE;
+  sys->fields.has_solution = PETSC_TRUE;
   PetscCall(PetscFree(u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -279,8 +279,8 @@ PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe 
 {
   PetscFunctionBeginUser;
   *probe = NULL;
-  for (PetscInt k = 0; k < sys->nprobes; k++)
-    if (!strcmp(sys->probes[k].name, name)) *probe = &sys->probes[k];
+  for (PetscInt k = 0; k < sys->fields.nprobes; k++)
+    if (!strcmp(sys->fields.probes[k].name, name)) *probe = &sys->fields.probes[k];
   PetscCheck(*probe, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "no probe named %s", name);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -297,16 +297,16 @@ PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
   PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->disc.particles.volume, 1, NULL));
   PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count));
   PetscCall(PeriFieldListAddIntConstant(fl, "rank", sys->rank));
-  if (sys->W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->W, 1, NULL));
-  if (sys->tau) {
+  if (sys->fields.W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->fields.W, 1, NULL));
+  if (sys->fields.tau) {
     const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
-    PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
-    PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->tau, 3, &nmap));
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress", 3, sys->fields.tau, 3, tmap)); /* tau_xz, tau_yz, 0 */
+    PetscCall(PeriFieldListAddReal(fl, "shear_stress_norm", 1, sys->fields.tau, 3, &nmap));
   }
-  if (sys->stress) {
-    PetscCall(PeriFieldListAddReal(fl, "stress", 9, sys->stress, 9, NULL));
-    PetscCall(PeriFieldListAddReal(fl, "strain", 9, sys->strain, 9, NULL));
-    PetscCall(PeriFieldListAddReal(fl, "elastic_stress", 9, sys->elastic_stress, 9, NULL));
+  if (sys->fields.stress) {
+    PetscCall(PeriFieldListAddReal(fl, "stress", 9, sys->fields.stress, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "strain", 9, sys->fields.strain, 9, NULL));
+    PetscCall(PeriFieldListAddReal(fl, "elastic_stress", 9, sys->fields.elastic_stress, 9, NULL));
   }
   PetscCall(PeriFailureAddFields(sys, fl));
   PetscCall(PeriLayersAddFields(sys, fl));
@@ -360,15 +360,15 @@ PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
 {
   PetscFunctionBeginUser;
   PetscCall(PeriJSONBeginObject(j, "probes"));
-  for (PetscInt k = 0; sys->has_solution && k < sys->nprobes; k++) {
-    const PeriProbe *pr = &sys->probes[k];
+  for (PetscInt k = 0; sys->fields.has_solution && k < sys->fields.nprobes; k++) {
+    const PeriProbe *pr = &sys->fields.probes[k];
     PetscCall(PeriJSONBeginObject(j, pr->name));
     PetscCall(PeriJSONRealArray(j, "x", sys->disc.particles.dim, pr->x));
     PetscCall(PeriJSONRealArray(j, "particle_x", sys->disc.particles.dim, pr->particle_x));
     PetscCall(PeriJSONString(j, "sampling", "nearest particle"));
     PetscCall(PeriJSONRealArray(j, "u", sys->model->dofs, pr->u));
     PetscCall(PeriJSONReal(j, "W", pr->W));
-    if (sys->stress) {
+    if (sys->fields.stress) {
       PetscCall(ProbeTensor(j, "sigma", sys->disc.particles.dim, pr->sigma));
       PetscCall(ProbeTensor(j, "epsilon", sys->disc.particles.dim, pr->epsilon));
       PetscCall(ProbeTensor(j, "sigma_elastic", sys->disc.particles.dim, pr->sigma_elastic));
@@ -376,5 +376,19 @@ PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
     PetscCall(PeriJSONEndObject(j));
   }
   PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Frees what the fields hold. */
+PetscErrorCode PeriFieldsDestroy(PeriFields *F)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecDestroy(&F->u));
+  PetscCall(VecDestroy(&F->f));
+  PetscCall(PetscFree(F->tau));
+  PetscCall(PetscFree3(F->stress, F->strain, F->elastic_stress));
+  PetscCall(PetscFree(F->probes));
+  PetscCall(PetscFree(F->W));
+  PetscCall(PetscFree(F->u_owned));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

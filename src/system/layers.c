@@ -43,12 +43,12 @@ static PetscErrorCode ReadTorsion(PeriSystem sys)
   if (!t) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckSection(s, t, "torsion"));
   PeriInputCheck(sys->model->antiplane, s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", sys->model->type);
-  PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &sys->torsion.twist, NULL));
-  PeriInputCheck(sys->torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
-  sys->torsion.center[0] = 0.5 * (sys->disc.particles.lower[0] + sys->disc.particles.upper[0]);
-  sys->torsion.center[1] = 0.5 * (sys->disc.particles.lower[1] + sys->disc.particles.upper[1]);
-  PetscCall(PeriSceneGetRealArray(s, t, "center", PETSC_FALSE, 2, 2, sys->torsion.center, &n));
-  sys->torsion.active = PETSC_TRUE;
+  PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &sys->conditions.torsion.twist, NULL));
+  PeriInputCheck(sys->conditions.torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
+  sys->conditions.torsion.center[0] = 0.5 * (sys->disc.particles.lower[0] + sys->disc.particles.upper[0]);
+  sys->conditions.torsion.center[1] = 0.5 * (sys->disc.particles.lower[1] + sys->disc.particles.upper[1]);
+  PetscCall(PeriSceneGetRealArray(s, t, "center", PETSC_FALSE, 2, 2, sys->conditions.torsion.center, &n));
+  sys->conditions.torsion.active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -61,11 +61,11 @@ static PetscInt LayerCells(PeriSystem sys, PetscReal h)
   return (sys->model->ops.family_stiffness ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
 }
 
-/* Reads one boundary_layers item into sys->layers and sets the depth nl of its face in lo or hi. */
+/* Reads one boundary_layers item into sys->conditions.layers and sets the depth nl of its face in lo or hi. */
 static PetscErrorCode LayerRead(PeriSystem sys, PeriNode item, const PetscInt cells[], PetscInt nl, PetscInt lo[], PetscInt hi[])
 {
   PeriScene   s    = sys->scene;
-  PeriLayers *L    = &sys->layers;
+  PeriLayers *L    = &sys->conditions.layers;
   PetscInt    side = 0, kind = 0, face;
   PetscBool   hasv;
 
@@ -213,7 +213,7 @@ PetscErrorCode PeriLayersAddParticles(PeriSystem sys)
 /* The relation u(X) = sign u(Y) + offset across one face: Y is X mirrored through it. */
 static void FaceRelation(PeriSystem sys, PetscInt face, const PetscReal X[], const PetscReal Y[], PetscReal mu, PetscReal *sign, PetscReal *offset)
 {
-  const PeriLayers *L    = &sys->layers;
+  const PeriLayers *L    = &sys->conditions.layers;
   const PetscInt    a    = face / 2;
   PetscReal         grad = 0;
 
@@ -223,7 +223,7 @@ static void FaceRelation(PeriSystem sys, PetscInt face, const PetscReal X[], con
     return;
   }
   if (L->kind[face] == PERI_LAYER_SHEAR_STRESS) grad = L->value[face] / mu;
-  if (sys->torsion.active) grad += a == 0 ? sys->torsion.twist * (X[1] - sys->torsion.center[1]) : -sys->torsion.twist * (X[0] - sys->torsion.center[0]);
+  if (sys->conditions.torsion.active) grad += a == 0 ? sys->conditions.torsion.twist * (X[1] - sys->conditions.torsion.center[1]) : -sys->conditions.torsion.twist * (X[0] - sys->conditions.torsion.center[0]);
   *sign   = 1;
   *offset = grad * (X[a] - Y[a]);
 }
@@ -236,7 +236,7 @@ static void FaceRelation(PeriSystem sys, PetscInt face, const PetscReal X[], con
 PetscErrorCode PeriLayersSetUp(PeriSystem sys)
 {
   const PeriParticles *pt     = &sys->disc.particles;
-  PeriLayers          *L      = &sys->layers;
+  PeriLayers          *L      = &sys->conditions.layers;
   const PetscInt       rstart = sys->disc.bonds.rstart, rend = sys->disc.bonds.rend;
 
   PetscFunctionBeginUser;
@@ -253,7 +253,7 @@ PetscErrorCode PeriLayersSetUp(PeriSystem sys)
     }
     m = PeriDiscLocal(&sys->disc, gm); /* the halo reaches every image (SetLocalView) */
     PetscCheck(m >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the mirror image %" PetscInt_FMT " of fictitious particle %" PetscInt_FMT " is not in the local view", gm, gi);
-    mu = sys->mu ? sys->mu[m] : sys->model->material.G;
+    mu = sys->materials.mu ? sys->materials.mu[m] : sys->model->material.G;
     for (PetscInt f = 0; f < 4; f++)
       if (pt->crossed[i] & (1 << f)) faces[nf++] = f;
     if (nf == 1)
@@ -291,8 +291,8 @@ PetscErrorCode PeriLayersSetUp(PeriSystem sys)
 PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
 {
   const PeriParticles *pt = &sys->disc.particles;
-  PeriLayers          *L  = &sys->layers;
-  Mat                  K = sys->K, Kaij = NULL;
+  PeriLayers          *L  = &sys->conditions.layers;
+  Mat                  K = sys->stiffness.K, Kaij = NULL;
   Vec                  w;
   PetscInt            *rows, nf = 0, N;
   PetscReal            diag, kmax;
@@ -329,7 +329,7 @@ PetscErrorCode PeriLayersApply(PeriSystem sys, PetscReal lambda, Mat *A, Vec f)
   PetscCall(MatNorm(*A, NORM_INFINITY, &kmax));
   PetscCall(MatIsSymmetric(*A, 1e-12 * kmax, &sym));
   PetscCall(MatSetOption(*A, MAT_SYMMETRIC, sym));
-  sys->solve.symmetric = sym;
+  sys->fields.solve.symmetric = sym;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -339,10 +339,10 @@ PetscErrorCode PeriLayersComplete(PeriSystem sys, PetscReal lambda, Vec u)
   Vec t;
 
   PetscFunctionBeginUser;
-  if (!sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->conditions.layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecDuplicate(u, &t));
-  PetscCall(MatMult(sys->layers.T, u, t));
-  PetscCall(VecWAXPY(u, lambda, sys->layers.g, t));
+  PetscCall(MatMult(sys->conditions.layers.T, u, t));
+  PetscCall(VecWAXPY(u, lambda, sys->conditions.layers.g, t));
   PetscCall(VecDestroy(&t));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -359,7 +359,7 @@ PetscErrorCode PeriLayersDestroy(PeriLayers *L)
  * rigid twist's relative displacement of particle t from the element's particle i (one DOF). */
 static PetscErrorCode TorsionElementLoad(PeriSystem sys, const PeriElement *el, void *ctx)
 {
-  const PetscReal *x = sys->disc.particles.x, psi = sys->torsion.twist, *c = sys->torsion.center;
+  const PetscReal *x = sys->disc.particles.x, psi = sys->conditions.torsion.twist, *c = sys->conditions.torsion.center;
   const PetscInt   i = el->idx[0], n = el->n;
   PetscReal       *e = el->work, *fe = el->work + n;
 
@@ -387,7 +387,7 @@ static PetscErrorCode TorsionElementLoad(PeriSystem sys, const PeriElement *el, 
 PetscErrorCode PeriTorsionLoads(PeriSystem sys, Vec f)
 {
   PetscFunctionBeginUser;
-  if (!sys->torsion.active || sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->conditions.torsion.active || sys->conditions.layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriElementsForEach(sys, TorsionElementLoad, f));
   PetscCall(VecAssemblyBegin(f));
   PetscCall(VecAssemblyEnd(f));
@@ -411,8 +411,8 @@ static PetscErrorCode TorsionMaxStress(PeriSystem sys, PeriTorsion *t)
 
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < sys->disc.nowned; i++)
-    if (!PeriParticleIsFictitious(pt, i) && sys->tau[3 * i + 2] > mine[0]) {
-      mine[0] = sys->tau[3 * i + 2];
+    if (!PeriParticleIsFictitious(pt, i) && sys->fields.tau[3 * i + 2] > mine[0]) {
+      mine[0] = sys->fields.tau[3 * i + 2];
       mine[1] = pt->x[3 * i];
       mine[2] = pt->x[3 * i + 1];
     }
@@ -430,21 +430,21 @@ static PetscErrorCode TorsionMaxStress(PeriSystem sys, PeriTorsion *t)
 }
 
 /*@C
-  PeriTorsionEvaluate - from the shear stresses sys->tau of the owned particles: the torque per
+  PeriTorsionEvaluate - from the shear stresses sys->fields.tau of the owned particles: the torque per
   unit length T = sum (x tau_yz - y tau_xz) A over the body's particles (A = V / l), the torsion
   constant J = T / (mu psi), the largest stress |tau| and where. Collective.
 @*/
 PetscErrorCode PeriTorsionEvaluate(PeriSystem sys)
 {
   const PeriParticles *pt = &sys->disc.particles;
-  PeriTorsion         *t  = &sys->torsion;
+  PeriTorsion         *t  = &sys->conditions.torsion;
 
   PetscFunctionBeginUser;
   if (!t->active) PetscFunctionReturn(PETSC_SUCCESS); /* the antiplane models' tau exists on every rank */
   t->torque = 0;
   for (PetscInt i = 0; i < sys->disc.nowned; i++) {
     PetscReal x = pt->x[3 * i] - t->center[0], y = pt->x[3 * i + 1] - t->center[1];
-    if (!PeriParticleIsFictitious(pt, i)) t->torque += (x * sys->tau[3 * i + 1] - y * sys->tau[3 * i]) * pt->volume[i] / pt->thickness;
+    if (!PeriParticleIsFictitious(pt, i)) t->torque += (x * sys->fields.tau[3 * i + 1] - y * sys->fields.tau[3 * i]) * pt->volume[i] / pt->thickness;
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &t->torque, 1, MPIU_REAL, MPI_SUM, sys->comm));
   PetscCall(TorsionMaxStress(sys, t));
@@ -455,10 +455,10 @@ PetscErrorCode PeriTorsionEvaluate(PeriSystem sys)
 
 PetscErrorCode PeriTorsionSummary(PeriSystem sys, PeriJSON j)
 {
-  const PeriTorsion *t = &sys->torsion;
+  const PeriTorsion *t = &sys->conditions.torsion;
 
   PetscFunctionBeginUser;
-  if (!t->active || !sys->tau) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!t->active || !sys->fields.tau) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONBeginObject(j, "torsion"));
   PetscCall(PeriJSONReal(j, "twist", t->twist));
   PetscCall(PeriJSONRealArray(j, "center", 2, t->center));
@@ -478,11 +478,11 @@ PetscErrorCode PeriLayersSummary(PeriSystem sys, PeriJSON j)
   static const char *const faces[] = {"x-", "x+", "y-", "y+"};
 
   PetscFunctionBeginUser;
-  if (!sys->layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->conditions.layers.nfaces) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONBeginObject(j, "boundary_layers"));
   PetscCall(PeriJSONInt(j, "fictitious_particles", sys->disc.particles.nfictitious));
   for (PetscInt f = 0; f < 4; f++)
-    if (sys->layers.kind[f]) PetscCall(PeriJSONString(j, faces[f], PeriLayerKinds[sys->layers.kind[f]]));
+    if (sys->conditions.layers.kind[f]) PetscCall(PeriJSONString(j, faces[f], PeriLayerKinds[sys->conditions.layers.kind[f]]));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -276,10 +276,10 @@ PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released
   PetscFunctionBeginUser;
   *released = PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_release_bond_geometry", &release, NULL));
-  PetscCall(PetscStrncpy(pc, sys->pc_default, sizeof(pc)));
+  PetscCall(PetscStrncpy(pc, sys->stiffness.pc_default, sizeof(pc)));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
-  if (!release || !sys->K || sys->layers.T || !sys->disc.bonds.xi) PetscFunctionReturn(PETSC_SUCCESS);
-  if (sys->op) {
+  if (!release || !sys->stiffness.K || sys->conditions.layers.T || !sys->disc.bonds.xi) PetscFunctionReturn(PETSC_SUCCESS);
+  if (sys->stiffness.op) {
     if (strcmp(pc, PCGAMG)) PetscFunctionReturn(PETSC_SUCCESS);
     PetscCall(PeriOperatorPreconditioner(sys));
   }

@@ -220,17 +220,17 @@ static PetscErrorCode ShellDestroy(void *ctx)
 PetscErrorCode PeriOperatorCreateMat(PeriSystem sys, Mat *A)
 {
   Shell         *sh;
-  const PetscInt n = sys->op->nloc * sys->op->bs;
+  const PetscInt n = sys->stiffness.op->nloc * sys->stiffness.op->bs;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&sh));
-  sh->op    = sys->op;
+  sh->op    = sys->stiffness.op;
   sh->scale = 1;
-  sys->op->refct++;
+  sys->stiffness.op->refct++;
   PetscCall(MatCreateShell(sys->comm, n, n, PETSC_DETERMINE, PETSC_DETERMINE, sh, A));
   PetscCall(MatShellSetContextDestroy(*A, ShellDestroy));
   PetscCall(MatShellSetManageScalingShifts(*A));
-  PetscCall(MatSetBlockSize(*A, sys->op->bs));
+  PetscCall(MatSetBlockSize(*A, sys->stiffness.op->bs));
   PetscCall(MatShellSetOperation(*A, MATOP_MULT, (void (*)(void))ShellMult));
   PetscCall(MatShellSetOperation(*A, MATOP_MULT_TRANSPOSE, (void (*)(void))ShellMult));
   PetscCall(MatShellSetOperation(*A, MATOP_GET_DIAGONAL, (void (*)(void))ShellGetDiagonal));
@@ -273,7 +273,7 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->bs, &op->w));
   PetscCall(PetscMalloc1(b->nbonds, &op->len));
   PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
-  if (sys->failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
+  if (sys->bond_state.failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
   op->nghost = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     op->ptr[i - b->rstart] = nb;
@@ -399,22 +399,22 @@ PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator
 }
 
 /*@C
-  PeriOperatorPreconditioner - sys->Kpc, the preconditioning matrix of the matrix-free K, assembled
+  PeriOperatorPreconditioner - sys->stiffness.Kpc, the preconditioning matrix of the matrix-free K, assembled
   on first use: the short bonds' blocks (k e e^T = w w^T, the assembly's own), restricted and
   scaled, broken ones with PERI_BROKEN_SHARE of theirs. Collective.
 @*/
 PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
 {
   PetscFunctionBeginUser;
-  if (sys->Kpc) PetscFunctionReturn(PETSC_SUCCESS);
+  if (sys->stiffness.Kpc) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
-  PetscCall(PeriAssembleShortRange(sys, sys->op->rmax, sys->op->pscale, PERI_BROKEN_SHARE, &sys->Kpc));
+  PetscCall(PeriAssembleShortRange(sys, sys->stiffness.op->rmax, sys->stiffness.op->pscale, PERI_BROKEN_SHARE, &sys->stiffness.Kpc));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
-  if (!sys->log.pc_matrix_counted) { /* summary.json's matrix_mb counts it with the operator */
+  if (!sys->run.log.pc_matrix_counted) { /* summary.json's matrix_mb counts it with the operator */
     PetscReal mb;
-    sys->log.pc_matrix_counted = PETSC_TRUE;
-    PetscCall(PeriMatrixMB(sys->Kpc, &mb));
-    sys->log.matrix_mb += mb;
+    sys->run.log.pc_matrix_counted = PETSC_TRUE;
+    PetscCall(PeriMatrixMB(sys->stiffness.Kpc, &mb));
+    sys->run.log.matrix_mb += mb;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -437,7 +437,7 @@ PetscErrorCode PeriOperatorMemoryMB(PeriSystem sys, PeriOperator op, PetscReal *
 @*/
 PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, PetscReal factor, const PetscReal Ke[])
 {
-  PeriOperator   op = sys->op;
+  PeriOperator   op = sys->stiffness.op;
   const PetscInt t = op->slot ? op->slot[k] : -1, n = 2 * op->bs;
   PetscInt       idx[2] = {sys->disc.particles.global[i], sys->disc.particles.global[sys->disc.bonds.j[k]]};
   PetscReal      dP[4 * PERI_MAX_DOF * PERI_MAX_DOF];
@@ -445,9 +445,9 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
   for (PetscInt d = 0; d < op->bs; d++) op->w[op->bs * t + d] *= PetscSqrtReal(factor);
-  if (!sys->Kpc || factor > 0 || sys->disc.bonds.length[k] > op->rmax) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->stiffness.Kpc || factor > 0 || sys->disc.bonds.length[k] > op->rmax) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * op->pscale * Ke[a];
-  PetscCall(MatSetValuesBlocked(sys->Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
+  PetscCall(MatSetValuesBlocked(sys->stiffness.Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -455,11 +455,11 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
 PetscErrorCode PeriOperatorScaled(PeriSystem sys)
 {
   PetscFunctionBeginUser;
-  if (sys->Kpc) {
-    PetscCall(MatAssemblyBegin(sys->Kpc, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(sys->Kpc, MAT_FINAL_ASSEMBLY));
+  if (sys->stiffness.Kpc) {
+    PetscCall(MatAssemblyBegin(sys->stiffness.Kpc, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(sys->stiffness.Kpc, MAT_FINAL_ASSEMBLY));
   }
-  PetscCall(ComputeDiagonal(sys->op));
+  PetscCall(ComputeDiagonal(sys->stiffness.op));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -480,5 +480,15 @@ PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
   PetscCall(VecDestroy(&(*op)->ym));
   PetscCall(VecDestroy(&(*op)->kdiag));
   PetscCall(PetscFree(*op));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Frees K, its preconditioning matrix and the matrix-free operator. */
+PetscErrorCode PeriStiffnessDestroy(PeriStiffness *S)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&S->K));
+  PetscCall(MatDestroy(&S->Kpc));
+  PetscCall(PeriOperatorDestroy(&S->op));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -31,18 +31,18 @@ static PetscErrorCode Translations(PeriModel m, PetscBool trans[])
 @*/
 PetscErrorCode PeriReactionsSetUp(PeriSystem sys)
 {
-  PeriReactions *R  = &sys->reactions;
+  PeriReactions *R  = &sys->conditions.reactions;
   const PetscInt bs = sys->model->dofs, nr = sys->disc.nregions;
 
   PetscFunctionBeginUser;
   PetscCall(PeriReactionsDestroy(R));
   R->nregions = nr;
   PetscCall(PetscCalloc3(nr * PERI_MAX_DOF, &R->holds, nr, &R->moves, nr * PERI_MAX_DOF, &R->force));
-  for (PetscInt k = 0; k < sys->nconstrained; k++) {
-    PetscInt r = sys->constrained_region[k], c = sys->constrained[k] % bs;
+  for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) {
+    PetscInt r = sys->conditions.constrained_region[k], c = sys->conditions.constrained[k] % bs;
     if (r < 0) continue;
     R->holds[r * PERI_MAX_DOF + c] = PETSC_TRUE;
-    if (sys->constrained_value[k] != 0) R->moves[r] = PETSC_TRUE;
+    if (sys->conditions.constrained_value[k] != 0) R->moves[r] = PETSC_TRUE;
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, R->holds, (PetscMPIInt)(nr * PERI_MAX_DOF), MPIU_BOOL, MPI_LOR, sys->comm));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, R->moves, (PetscMPIInt)nr, MPIU_BOOL, MPI_LOR, sys->comm));
@@ -63,9 +63,9 @@ PetscErrorCode PeriReactionsFindRegion(PeriSystem sys, const char name[], PetscI
 {
   PetscFunctionBeginUser;
   *r = -1;
-  for (PetscInt k = 0; k < sys->reactions.nregions; k++) {
+  for (PetscInt k = 0; k < sys->conditions.reactions.nregions; k++) {
     PetscBool any = PETSC_FALSE;
-    for (PetscInt c = 0; c < PERI_MAX_DOF; c++) any = (PetscBool)(any || sys->reactions.holds[k * PERI_MAX_DOF + c]);
+    for (PetscInt c = 0; c < PERI_MAX_DOF; c++) any = (PetscBool)(any || sys->conditions.reactions.holds[k * PERI_MAX_DOF + c]);
     if (any && !strcmp(sys->disc.regions[k].name, name)) *r = k;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -100,7 +100,7 @@ static PetscErrorCode InternalForce(PeriSystem sys, Vec fint)
   PetscScalar *u;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSystemLocalDOFs(sys, sys->u, &u));
+  PetscCall(PeriSystemLocalDOFs(sys, sys->fields.u, &u));
   F.u = u;
   PetscCall(PetscMalloc1((nmax + 1) * sys->model->dofs, &F.rows));
   F.fint = fint;
@@ -141,7 +141,7 @@ static PetscErrorCode MomentModes(PeriSystem sys, const PetscBool trans[], Petsc
   for (PetscInt c = 0; c < PERI_MAX_DOF; c++) *ntrans += trans[c];
   PetscCall(PeriModelTypeGet(sys->model->type, &desc));
   nm = sys->model->ops.rigid_modes(sys->model, X, vals);
-  if (!desc->rotation_invariant || sys->layers.T) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!desc->rotation_invariant || sys->conditions.layers.T) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt d = 0; d < 3; d++)
     if (sys->disc.particles.periodic[d]) PetscFunctionReturn(PETSC_SUCCESS);
   *nrot = PetscMax(0, nm - *ntrans);
@@ -165,7 +165,7 @@ static void MomentAdd(PeriSystem sys, const PetscReal X[], PetscInt ntrans, Pets
 /* The per-region reactions (R->force, R->applied) and the sums of the check over the owned DOFs. */
 static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const PetscBool trans[], Sums *S)
 {
-  PeriReactions       *R  = &sys->reactions;
+  PeriReactions       *R  = &sys->conditions.reactions;
   const PeriParticles *pt = &sys->disc.particles;
   const PetscInt       bs = sys->model->dofs, nloc = sys->disc.nowned, r0 = sys->disc.rstart * bs; /* r0: the first owned global row */
   const PetscScalar   *fi, *fa;
@@ -175,7 +175,7 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
   PetscCall(MomentModes(sys, trans, &ntrans, &nrot));
   R->nmoments = nrot;
   PetscCall(VecGetArrayRead(fint, &fi));
-  PetscCall(VecGetArrayRead(sys->f, &fa));
+  PetscCall(VecGetArrayRead(sys->fields.f, &fa));
   for (PetscInt i = 0; i < nloc; i++) {
     PetscReal p2 = 0, r2 = 0, X[3];
     for (PetscInt d = 0; d < 3; d++) X[d] = pt->x[3 * i + d] - 0.5 * (pt->lower[d] + pt->upper[d]);
@@ -185,10 +185,10 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
       PetscInt        region = -1;
       PetscBool       held   = PETSC_FALSE;
       /* the constrained rows are sorted: walk them alongside */
-      while (k < sys->nconstrained && sys->constrained[k] < r0 + row) k++;
-      if (k < sys->nconstrained && sys->constrained[k] == r0 + row) {
+      while (k < sys->conditions.nconstrained && sys->conditions.constrained[k] < r0 + row) k++;
+      if (k < sys->conditions.nconstrained && sys->conditions.constrained[k] == r0 + row) {
         held   = PETSC_TRUE;
-        region = sys->constrained_region[k];
+        region = sys->conditions.constrained_region[k];
       }
       if (region >= 0) R->force[region * PERI_MAX_DOF + c] += Fi - F;
       MomentAdd(sys, X, ntrans, nrot, c, held, Fi, F, S);
@@ -205,7 +205,7 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
     }
     S->scale += PetscSqrtReal(p2) + PetscSqrtReal(r2);
   }
-  PetscCall(VecRestoreArrayRead(sys->f, &fa));
+  PetscCall(VecRestoreArrayRead(sys->fields.f, &fa));
   PetscCall(VecRestoreArrayRead(fint, &fi));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -215,7 +215,7 @@ static PetscErrorCode SumOwned(PeriSystem sys, Vec fint, PetscReal lambda, const
  * weight is 1), so the force bound times L; round-off 1e-9 of the moments' magnitude. */
 static PetscErrorCode CheckMoments(PeriSystem sys, PetscReal force_allowed, const Sums *S)
 {
-  PeriReactions       *R  = &sys->reactions;
+  PeriReactions       *R  = &sys->conditions.reactions;
   const PeriParticles *pt = &sys->disc.particles;
   PetscReal            L2 = 0, m2 = 0, allowed;
 
@@ -238,7 +238,7 @@ static PetscErrorCode CheckMoments(PeriSystem sys, PetscReal force_allowed, cons
  * or the free DOFs are not in equilibrium (K u differs from what the solver applied). */
 static PetscErrorCode CheckEquilibrium(PeriSystem sys, PetscReal lambda, const PetscBool trans[], const Sums *S)
 {
-  PeriReactions  *R    = &sys->reactions;
+  PeriReactions  *R    = &sys->conditions.reactions;
   const PetscReal sqn  = PetscSqrtReal((PetscReal)sys->disc.N);
   PetscReal       imb2 = 0, allowed, factor = 0;
   char            what[256] = "";
@@ -251,15 +251,15 @@ static PetscErrorCode CheckEquilibrium(PeriSystem sys, PetscReal lambda, const P
     for (PetscInt r = 0; r < R->nregions; r++) R->imbalance[c] += R->force[r * PERI_MAX_DOF + c];
     imb2 += PetscSqr(R->imbalance[c]);
   }
-  if (sys->solve.load_factor != 0) factor = PetscAbsReal(lambda / sys->solve.load_factor);
-  allowed               = sqn * (sys->solve.residual_tol * sys->solve.rhs_norm * factor + sys->solve.load_imbalance * PetscSqrtReal(S->load2)) + 1e-9 * S->magnitude;
+  if (sys->fields.solve.load_factor != 0) factor = PetscAbsReal(lambda / sys->fields.solve.load_factor);
+  allowed               = sqn * (sys->fields.solve.residual_tol * sys->fields.solve.rhs_norm * factor + sys->fields.solve.load_imbalance * PetscSqrtReal(S->load2)) + 1e-9 * S->magnitude;
   R->scale              = S->scale;
   R->relative_imbalance = S->scale > 0 ? PetscSqrtReal(imb2) / S->scale : 0;
   R->allowed            = S->scale > 0 ? allowed / S->scale : 0;
   R->load_factor        = lambda;
   R->evaluated          = PETSC_TRUE;
   /* fictitious layers carry their faces' forces in mirror relations, not in constrained DOFs */
-  R->checked = sys->layers.T ? PETSC_FALSE : PETSC_TRUE;
+  R->checked = sys->conditions.layers.T ? PETSC_FALSE : PETSC_TRUE;
   PetscCall(CheckMoments(sys, allowed, S));
   if (!R->checked || PetscSqrtReal(imb2) <= allowed) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt c = 0; c < sys->model->dofs; c++)
@@ -272,13 +272,13 @@ static PetscErrorCode CheckEquilibrium(PeriSystem sys, PetscReal lambda, const P
 }
 
 /*@C
-  PeriSystemEvaluateReactions - from sys->u at load factor lambda: the reaction of every constrained
+  PeriSystemEvaluateReactions - from sys->fields.u at load factor lambda: the reaction of every constrained
   region (sum of K u - lambda f over the DOFs its bc items hold, K the unconstrained stiffness), the
   total applied load, and the check that they balance (an error when they do not). Collective.
 @*/
 PetscErrorCode PeriSystemEvaluateReactions(PeriSystem sys, PetscReal lambda)
 {
-  PeriReactions *R = &sys->reactions;
+  PeriReactions *R = &sys->conditions.reactions;
   PetscBool      trans[PERI_MAX_DOF];
   Sums           S;
   Vec            fint;
@@ -313,11 +313,11 @@ static PetscErrorCode ComponentObject(PeriSystem sys, PeriJSON j, const char nam
 /* applied_load, reactions (per region, the components it holds) and equilibrium, when evaluated. */
 PetscErrorCode PeriReactionsSummary(PeriSystem sys, PeriJSON j)
 {
-  const PeriReactions *R = &sys->reactions;
+  const PeriReactions *R = &sys->conditions.reactions;
   PetscBool            trans[PERI_MAX_DOF];
 
   PetscFunctionBeginUser;
-  if (!R->evaluated || !sys->has_solution) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!R->evaluated || !sys->fields.has_solution) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(Translations(sys->model, trans));
   PetscCall(ComponentObject(sys, j, "applied_load", R->applied, trans));
   PetscCall(PeriJSONBeginObject(j, "reactions"));

@@ -150,7 +150,7 @@ static PetscErrorCode InteriorFit(PeriSystem sys, PetscInt ux, PetscInt uy, FitS
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(F, sizeof(*F)));
   for (PetscInt i = 0; i < sys->disc.nowned; i++) {
-    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_owned[i * bs];
+    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->fields.u_owned[i * bs];
     PetscReal        phi[3] = {1, X[0] - c[0], X[1] - c[1]}, ref[2], d[2], rig[3][2];
     if (!Interior(sys, i)) continue;
     F->n++;
@@ -183,7 +183,7 @@ static PetscErrorCode InteriorError(PeriSystem sys, PetscInt ux, PetscInt uy, co
   PetscFunctionBeginUser;
   err[0] = err[1] = err[2] = err[3] = 0;
   for (PetscInt i = 0; i < sys->disc.nowned; i++) {
-    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->u_owned[i * bs];
+    const PetscReal *X = &sys->disc.particles.x[3 * i], *u = &sys->fields.u_owned[i * bs];
     PetscReal        ref[2], e[2];
     if (!Interior(sys, i)) continue;
     PeriReferenceDisplacement(sys, X, ref);

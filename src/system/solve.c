@@ -24,8 +24,8 @@ static const char *Advice(KSPConvergedReason reason)
 /* What to tell the user when KSP claims convergence but the true residual is too large. */
 static const char *AdviceResidual(PeriSystem sys)
 {
-  if (sys->op && !strcmp(sys->solve.ksp_type, KSPPREONLY)) return "with solver.operator: matrix_free the preconditioner is built from the short-range stiffness only, so preonly cannot solve the system: use solver.operator: assembled (-solver_operator assembled) for a direct solve, or drop -ksp_type preonly";
-  if (!strcmp(sys->solve.ksp_type, KSPPREONLY)) return "preonly applies the preconditioner once, which solves the system only when it is a direct factorization: use -pc_type cholesky (or lu), or drop -ksp_type preonly for the default CG + GAMG";
+  if (sys->stiffness.op && !strcmp(sys->fields.solve.ksp_type, KSPPREONLY)) return "with solver.operator: matrix_free the preconditioner is built from the short-range stiffness only, so preonly cannot solve the system: use solver.operator: assembled (-solver_operator assembled) for a direct solve, or drop -ksp_type preonly";
+  if (!strcmp(sys->fields.solve.ksp_type, KSPPREONLY)) return "preonly applies the preconditioner once, which solves the system only when it is a direct factorization: use -pc_type cholesky (or lu), or drop -ksp_type preonly for the default CG + GAMG";
   return "tighten -ksp_rtol, or check -ksp_norm_type (the preconditioned norm can be far below the true one); a larger solver.residual_tol accepts the answer as it is";
 }
 
@@ -152,9 +152,9 @@ static PetscErrorCode HandleFreeMotions(PeriSystem sys, Mat A, Mat P, Vec u, Vec
     PetscCall(VecDot(b, free[q], &dot));
     share += PetscSqr(PetscRealPart(dot));
   }
-  share                     = bnorm > 0 ? PetscSqrtReal(share) / bnorm : 0;
-  sys->solve.free_modes     = *nfree;
-  sys->solve.load_imbalance = share;
+  share                            = bnorm > 0 ? PetscSqrtReal(share) / bnorm : 0;
+  sys->fields.solve.free_modes     = *nfree;
+  sys->fields.solve.load_imbalance = share;
   PetscCheck(bnorm > 0 && share<1e-6, sys->comm, PETSC_ERR_USER_INPUT, "%s: the boundary conditions leave a rigid-body motion free (mainly %s): the stiffness matrix is singular%s. Constrain it in bc (e.g. fix the component on a small region)", sys->scene->file, what, bnorm> 0 ? " and the loads are not balanced along it" : "");
   for (PetscInt q = 0; q < *nfree; q++) {
     PetscScalar dot;
@@ -164,8 +164,8 @@ static PetscErrorCode HandleFreeMotions(PeriSystem sys, Mat A, Mat P, Vec u, Vec
   PetscCall(PinFreeMotions(sys, *nfree, free, &npin, pins));
   PetscCall(MatZeroRowsColumns(A, npin, pins, diag, u, b));
   if (P != A) PetscCall(MatZeroRowsColumns(P, npin, pins, diag, NULL, NULL));
-  if (!sys->log.free_modes_noted) PetscCall(PetscPrintf(sys->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
-  sys->log.free_modes_noted = PETSC_TRUE;
+  if (!sys->run.log.free_modes_noted) PetscCall(PetscPrintf(sys->comm, "perilin: note: the constraints leave %" PetscInt_FMT " rigid motion(s) free (mainly %s) and the loads are balanced along them (share %.2e): the solution orthogonal to them is computed\n", *nfree, what, (double)share));
+  sys->run.log.free_modes_noted = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -243,7 +243,7 @@ static PetscErrorCode CheckRightHandSide(PeriSystem sys, Vec b)
   PetscFunctionBeginUser;
   PetscCall(VecNorm(b, NORM_INFINITY, &norm));
   if (norm == 0 || (norm < 1e150 && norm > 1e-150)) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt k = 0; k < sys->nconstrained; k++) vmax = PetscMax(vmax, PetscAbsReal(sys->constrained_value[k]));
+  for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) vmax = PetscMax(vmax, PetscAbsReal(sys->conditions.constrained_value[k]));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &vmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
   PetscCheck(!PetscIsInfOrNanReal(norm), sys->comm, PETSC_ERR_USER_INPUT, "%s: the loads and prescribed values overflow double precision (the right-hand side holds inf or NaN; largest prescribed value %g): give bc values and loads of a physical size", sys->scene->file, (double)vmax);
   SETERRQ(sys->comm, PETSC_ERR_USER_INPUT, "%s: the displacements would be of the order of %g (largest prescribed value %g), beyond what double precision can solve for (1e-150 to 1e150): check the units of the moduli, the loads and the bc values", sys->scene->file, (double)norm, (double)vmax);
@@ -257,7 +257,7 @@ static PetscBool DefaultJacobi(PeriSystem sys)
 
   PetscOptionsHasName(NULL, NULL, "-pc_type", &pc);
   PetscOptionsHasName(NULL, NULL, "-ksp_max_it", &maxit);
-  return (PetscBool)(!strcmp(sys->pc_default, PCJACOBI) && !pc && !maxit);
+  return (PetscBool)(!strcmp(sys->stiffness.pc_default, PCJACOBI) && !pc && !maxit);
 }
 
 /* The status line's solver slot (src/sys/progress.c): the iteration and the residual norm KSP
@@ -282,7 +282,7 @@ static PetscErrorCode StaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *
   PetscCall(KSPCreate(sys->comm, ksp));
   PetscCall(KSPSetType(*ksp, symmetric ? KSPCG : KSPGMRES));
   PetscCall(KSPGetPC(*ksp, &pc));
-  PetscCall(PCSetType(pc, sys->pc_default[0] ? sys->pc_default : PCGAMG));
+  PetscCall(PCSetType(pc, sys->stiffness.pc_default[0] ? sys->stiffness.pc_default : PCGAMG));
   /* no absolute tolerance: the system is scaled to O(1) numbers (ScaleToUnits), and atol = 1e-50
      would stop CG at once on a tiny right-hand side */
   PetscCall(KSPSetTolerances(*ksp, 1e-10, 0.0, PETSC_DEFAULT, DefaultJacobi(sys) ? PERI_JACOBI_BUDGET : 10000));
@@ -294,7 +294,7 @@ static PetscErrorCode StaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *
   if (cg && !set) PetscCall(KSPSetNormType(*ksp, KSP_NORM_UNPRECONDITIONED));
   PetscCall(DefaultFactorSolver(*ksp));
   PetscCall(KSPSetInterruptible(*ksp, sys->comm));
-  if (PeriProgressActive(sys->progress)) PetscCall(KSPMonitorSet(*ksp, ProgressMonitor, sys->progress, NULL));
+  if (PeriProgressActive(sys->run.progress)) PetscCall(KSPMonitorSet(*ksp, ProgressMonitor, sys->run.progress, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -333,7 +333,7 @@ static PetscBool NeedsPreconditioningMatrix(PeriSystem sys)
 {
   char pc[64];
 
-  PetscStrncpy(pc, sys->pc_default[0] ? sys->pc_default : PCGAMG, sizeof(pc));
+  PetscStrncpy(pc, sys->stiffness.pc_default[0] ? sys->stiffness.pc_default : PCGAMG, sizeof(pc));
   PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL);
   return (PetscBool)!PeriOperatorPCWithoutMatrix(pc);
 }
@@ -356,20 +356,20 @@ static PetscErrorCode ReferenceOrCopy(Mat K, PetscBool inplace, Mat *A)
 static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool inplace, Mat *A, Mat *P, Vec *b)
 {
   PetscFunctionBeginUser;
-  if (!sys->u) PetscCall(MatCreateVecs(sys->K, &sys->u, NULL));
-  PetscCall(VecDuplicate(sys->f, b));
-  PetscCall(VecCopy(sys->f, *b));
+  if (!sys->fields.u) PetscCall(MatCreateVecs(sys->stiffness.K, &sys->fields.u, NULL));
+  PetscCall(VecDuplicate(sys->fields.f, b));
+  PetscCall(VecCopy(sys->fields.f, *b));
   PetscCall(VecScale(*b, lambda));
-  sys->solve.symmetric = PETSC_TRUE;
-  if (sys->layers.T)
+  sys->fields.solve.symmetric = PETSC_TRUE;
+  if (sys->conditions.layers.T)
     PetscCall(PeriLayersApply(sys, lambda, A, *b));
-  else if (sys->op)
+  else if (sys->stiffness.op)
     PetscCall(PeriOperatorCreateMat(sys, A)); /* a fresh shell: the held DOFs are its own */
   else
-    PetscCall(ReferenceOrCopy(sys->K, inplace, A));
-  if (sys->op && NeedsPreconditioningMatrix(sys)) {
+    PetscCall(ReferenceOrCopy(sys->stiffness.K, inplace, A));
+  if (sys->stiffness.op && NeedsPreconditioningMatrix(sys)) {
     PetscCall(PeriOperatorPreconditioner(sys));
-    PetscCall(ReferenceOrCopy(sys->Kpc, inplace, P));
+    PetscCall(ReferenceOrCopy(sys->stiffness.Kpc, inplace, P));
   } else {
     PetscCall(PetscObjectReference((PetscObject)*A));
     *P = *A;
@@ -379,12 +379,12 @@ static PetscErrorCode StaticOperator(PeriSystem sys, PetscReal lambda, PetscBool
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Sets the prescribed (lambda times their values) and held DOFs in sys->u and eliminates them
+/* Sets the prescribed (lambda times their values) and held DOFs in sys->fields.u and eliminates them
  * symmetrically from A and b, with the system scaled to O(1) numbers first (ScaleToUnits); *diag
  * gets the value left on the eliminated rows, *scale the factor b was divided by. */
 static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, PetscReal lambda, PetscInt nhold, const PetscInt hold[], const PetscReal held[], PetscReal *diag, PetscReal *scale)
 {
-  const PetscInt nrows = sys->nconstrained + nhold;
+  const PetscInt nrows = sys->conditions.nconstrained + nhold;
   PetscReal     *values;
   PetscInt      *rows, N;
   PetscBool      mpisbaij;
@@ -392,17 +392,17 @@ static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, P
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc2(nrows, &rows, nrows, &values));
-  for (PetscInt k = 0; k < sys->nconstrained; k++) {
-    rows[k]   = sys->constrained[k];
-    values[k] = lambda * sys->constrained_value[k];
+  for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) {
+    rows[k]   = sys->conditions.constrained[k];
+    values[k] = lambda * sys->conditions.constrained_value[k];
   }
   for (PetscInt k = 0; k < nhold; k++) {
-    rows[sys->nconstrained + k]   = hold[k];
-    values[sys->nconstrained + k] = held[k];
+    rows[sys->conditions.nconstrained + k]   = hold[k];
+    values[sys->conditions.nconstrained + k] = held[k];
   }
-  PetscCall(VecSetValues(sys->u, nrows, rows, values, INSERT_VALUES));
-  PetscCall(VecAssemblyBegin(sys->u));
-  PetscCall(VecAssemblyEnd(sys->u));
+  PetscCall(VecSetValues(sys->fields.u, nrows, rows, values, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(sys->fields.u));
+  PetscCall(VecAssemblyEnd(sys->fields.u));
   /* a unit of the mean diagonal on eliminated rows keeps the conditioning of the free block */
   PetscCall(MatCreateVecs(A, &d, NULL));
   PetscCall(MatGetDiagonal(A, d));
@@ -414,13 +414,13 @@ static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, P
   PetscCall(ScaleToUnits(sys, A, P, b, diag));
   PetscCall(PetscObjectTypeCompare((PetscObject)P, MATMPISBAIJ, &mpisbaij));
   PetscCheck(!mpisbaij, sys->comm, PETSC_ERR_SUP, "-mat_type sbaij on several ranks cannot eliminate the prescribed DOFs (PETSc has no MatZeroRowsColumns for MPISBAIJ): use -mat_type baij or aij (MUMPS Cholesky works on both)");
-  PetscCall(MatZeroRowsColumns(A, nrows, rows, *diag, sys->u, b));
+  PetscCall(MatZeroRowsColumns(A, nrows, rows, *diag, sys->fields.u, b));
   if (P != A) PetscCall(MatZeroRowsColumns(P, nrows, rows, *diag, NULL, NULL));
   PetscCall(PetscFree2(rows, values));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Solves A u = b for sys->u with *ksp (created on first use), once more with SOR smoothing when
+/* Solves A u = b for sys->fields.u with *ksp (created on first use), once more with SOR smoothing when
  * GAMG's Chebyshev smoother fails (SmootherFallback). */
 static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, Vec b, KSPConvergedReason *reason)
 {
@@ -428,25 +428,25 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, 
   PC        pc;
 
   PetscFunctionBeginUser;
-  if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->solve.symmetric, ksp));
+  if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
   PetscCall(KSPSetOperators(*ksp, A, P));
   /* a factorization uses the BLAS threads (src/sys/threads.c) */
   PetscCall(KSPGetPC(*ksp, &pc));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, ""));
   PetscCall(PeriBLASThreads(factor));
-  PetscCall(PeriProgressUpdate(sys->progress, PERI_PROGRESS_PHASE, "solve"));
-  PetscCall(KSPSolve(*ksp, b, sys->u));
+  PetscCall(PeriProgressUpdate(sys->run.progress, PERI_PROGRESS_PHASE, "solve"));
+  PetscCall(KSPSolve(*ksp, b, sys->fields.u));
   PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(KSPGetConvergedReason(*ksp, reason));
   PetscCall(SmootherFallback(sys, *ksp, *reason, &retry));
   if (retry) {
-    PetscCall(KSPSolve(*ksp, b, sys->u));
+    PetscCall(KSPSolve(*ksp, b, sys->fields.u));
     PetscCall(KSPGetConvergedReason(*ksp, reason));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* sys->solve: iterations, the true relative residual (whatever norm the KSP
+/* sys->fields.solve: iterations, the true relative residual (whatever norm the KSP
  * monitored), the KSP and PC types and the converged reason. */
 static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConvergedReason reason)
 {
@@ -457,21 +457,21 @@ static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConv
   PC        pc;
 
   PetscFunctionBeginUser;
-  PetscCall(KSPGetIterationNumber(ksp, &sys->solve.iterations));
+  PetscCall(KSPGetIterationNumber(ksp, &sys->fields.solve.iterations));
   PetscCall(MatCreateVecs(A, &r, NULL));
-  PetscCall(MatMult(A, sys->u, r));
+  PetscCall(MatMult(A, sys->fields.u, r));
   PetscCall(VecAYPX(r, -1, b));
   PetscCall(VecNorm(r, NORM_2, &rnorm));
   PetscCall(VecNorm(b, NORM_2, &fnorm));
   PetscCall(VecDestroy(&r));
-  sys->solve.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
-  sys->solve.rhs_norm      = fnorm; /* of the scaled system: SolveAttempt restores the units */
+  sys->fields.solve.residual_norm = fnorm > 0 ? rnorm / fnorm : rnorm;
+  sys->fields.solve.rhs_norm      = fnorm; /* of the scaled system: SolveAttempt restores the units */
   PetscCall(KSPGetType(ksp, &kt));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pt));
-  PetscCall(PetscStrncpy(sys->solve.ksp_type, kt, sizeof(sys->solve.ksp_type)));
-  PetscCall(PetscStrncpy(sys->solve.pc_type, pt, sizeof(sys->solve.pc_type)));
-  PetscCall(PetscStrncpy(sys->solve.converged_reason, KSPConvergedReasons[reason], sizeof(sys->solve.converged_reason)));
+  PetscCall(PetscStrncpy(sys->fields.solve.ksp_type, kt, sizeof(sys->fields.solve.ksp_type)));
+  PetscCall(PetscStrncpy(sys->fields.solve.pc_type, pt, sizeof(sys->fields.solve.pc_type)));
+  PetscCall(PetscStrncpy(sys->fields.solve.converged_reason, KSPConvergedReasons[reason], sizeof(sys->fields.solve.converged_reason)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -487,21 +487,21 @@ static PetscErrorCode SolveAttempt(PeriSystem sys, KSP *ksp, PetscReal lambda, P
   PetscCall(StaticOperator(sys, lambda, inplace, &A, &P, &b));
   PetscCall(EliminatePrescribed(sys, A, P, b, lambda, nhold, hold, held, &diag, &scale));
   PetscCall(CheckRightHandSide(sys, b));
-  PetscCall(HandleFreeMotions(sys, A, P, sys->u, b, diag, nhold, hold, &nfree, free));
+  PetscCall(HandleFreeMotions(sys, A, P, sys->fields.u, b, diag, nhold, hold, &nfree, free));
   PetscCall(SolveWithFallback(sys, ksp, A, P, b, reason));
   PetscCall(RecordSolve(sys, *ksp, A, b, *reason));
   /* the residual's scale in the scene's units and the load factor: the equilibrium check of the
      reactions (reactions.c) allows what this residual explains */
-  sys->solve.rhs_norm *= scale;
-  sys->solve.load_factor = lambda;
+  sys->fields.solve.rhs_norm *= scale;
+  sys->fields.solve.load_factor = lambda;
   /* the solution orthogonal to the free rigid motions */
   for (PetscInt q = 0; q < nfree; q++) {
     PetscScalar dot;
-    PetscCall(VecDot(sys->u, free[q], &dot));
-    PetscCall(VecAXPY(sys->u, -dot, free[q]));
+    PetscCall(VecDot(sys->fields.u, free[q], &dot));
+    PetscCall(VecAXPY(sys->fields.u, -dot, free[q]));
     PetscCall(VecDestroy(&free[q]));
   }
-  PetscCall(PeriLayersComplete(sys, lambda, sys->u));
+  PetscCall(PeriLayersComplete(sys, lambda, sys->fields.u));
   PetscCall(VecDestroy(&b));
   PetscCall(MatDestroy(&A));
   PetscCall(MatDestroy(&P));
@@ -509,14 +509,14 @@ static PetscErrorCode SolveAttempt(PeriSystem sys, KSP *ksp, PetscReal lambda, P
 }
 
 /*@C
-  PeriStaticSolve - solves K u = lambda f for sys->u with the prescribed values and the layers'
+  PeriStaticSolve - solves K u = lambda f for sys->fields.u with the prescribed values and the layers'
   offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
   eliminated (A = R K T), prescribed DOFs symmetrically; a free body with balanced loads is solved
-  orthogonal to its rigid motions. sys->K is kept unless inplace. *ksp is created on first use
+  orthogonal to its rigid motions. sys->stiffness.K is kept unless inplace. *ksp is created on first use
   (CG + GAMG, or Jacobi for a small 3D body with a matrix-free K, or GMRES for an unsymmetric
   operator, then the options). A default Jacobi that has not converged after PERI_JACOBI_BUDGET
   iterations hands over to GAMG, which starts from its iterate, for this solve and the next ones.
-  Sets sys->solve's solver fields and returns the converged reason instead of failing. Collective.
+  Sets sys->fields.solve's solver fields and returns the converged reason instead of failing. Collective.
 @*/
 PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
 {
@@ -525,9 +525,9 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
   PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));
   if (*reason == KSP_DIVERGED_ITS && DefaultJacobi(sys)) {
     PetscCall(PetscPrintf(sys->comm, "perilin: note: CG + Jacobi did not converge in %d iterations; GAMG on the short-range stiffness goes on from there\n", PERI_JACOBI_BUDGET));
-    PetscCall(PetscStrncpy(sys->pc_default, PCGAMG, sizeof(sys->pc_default)));
+    PetscCall(PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default)));
     PetscCall(KSPDestroy(ksp));
-    PetscCall(StaticKSPCreate(sys, sys->solve.symmetric, ksp));
+    PetscCall(StaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
     PetscCall(KSPSetInitialGuessNonzero(*ksp, PETSC_TRUE));
     PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));
   }
@@ -544,19 +544,19 @@ PetscErrorCode PeriStaticConverged(PeriSystem sys, KSP ksp, KSPConvergedReason r
 
   PetscFunctionBeginUser;
   PetscCall(KSPGetTolerances(ksp, &rtol, NULL, NULL, NULL));
-  sys->solve.residual_tol = PeriResidualTolerance(sys, rtol);
-  *ok                     = (PetscBool)(reason > 0 && !PetscIsInfOrNanReal(sys->solve.residual_norm) && sys->solve.residual_norm <= sys->solve.residual_tol);
+  sys->fields.solve.residual_tol = PeriResidualTolerance(sys, rtol);
+  *ok                            = (PetscBool)(reason > 0 && !PetscIsInfOrNanReal(sys->fields.solve.residual_norm) && sys->fields.solve.residual_norm <= sys->fields.solve.residual_tol);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* What a failed static solve tells the user (after PeriStaticConverged). */
 PetscErrorCode PeriStaticCheckConverged(PeriSystem sys, KSPConvergedReason reason)
 {
-  PetscBool ok = (PetscBool)(reason > 0 && sys->solve.residual_norm <= sys->solve.residual_tol);
+  PetscBool ok = (PetscBool)(reason > 0 && sys->fields.solve.residual_norm <= sys->fields.solve.residual_tol);
 
   PetscFunctionBeginUser;
-  PetscCheck(!PetscIsInfOrNanReal(sys->solve.residual_norm), sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: the solution contains NaN or Inf (%s/%s, %s): %s", sys->solve.ksp_type, sys->solve.pc_type, KSPConvergedReasons[reason], Advice(KSP_DIVERGED_NANORINF));
-  PetscCheck(reason > 0, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g (tolerance %.3g), %s/%s stopped with %s after %" PetscInt_FMT " iterations: %s", (double)sys->solve.residual_norm, (double)sys->solve.residual_tol, sys->solve.ksp_type, sys->solve.pc_type, KSPConvergedReasons[reason], sys->solve.iterations, Advice(reason));
-  PetscCheck(ok, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g > tolerance %.3g although %s/%s reported %s after %" PetscInt_FMT " iterations: %s", (double)sys->solve.residual_norm, (double)sys->solve.residual_tol, sys->solve.ksp_type, sys->solve.pc_type, KSPConvergedReasons[reason], sys->solve.iterations, AdviceResidual(sys));
+  PetscCheck(!PetscIsInfOrNanReal(sys->fields.solve.residual_norm), sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: the solution contains NaN or Inf (%s/%s, %s): %s", sys->fields.solve.ksp_type, sys->fields.solve.pc_type, KSPConvergedReasons[reason], Advice(KSP_DIVERGED_NANORINF));
+  PetscCheck(reason > 0, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g (tolerance %.3g), %s/%s stopped with %s after %" PetscInt_FMT " iterations: %s", (double)sys->fields.solve.residual_norm, (double)sys->fields.solve.residual_tol, sys->fields.solve.ksp_type, sys->fields.solve.pc_type, KSPConvergedReasons[reason], sys->fields.solve.iterations, Advice(reason));
+  PetscCheck(ok, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g > tolerance %.3g although %s/%s reported %s after %" PetscInt_FMT " iterations: %s", (double)sys->fields.solve.residual_norm, (double)sys->fields.solve.residual_tol, sys->fields.solve.ksp_type, sys->fields.solve.pc_type, KSPConvergedReasons[reason], sys->fields.solve.iterations, AdviceResidual(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -119,7 +119,7 @@ static void ElasticStress(PeriModel m, PetscInt dim, const PetscReal eps[9], Pet
 }
 
 /*@C
-  PeriSystemEvaluateStress - sys->stress, sys->strain and sys->elastic_stress of the owned
+  PeriSystemEvaluateStress - sys->fields.stress, sys->fields.strain and sys->fields.elastic_stress of the owned
   particles (9 per particle, row-major 3 x 3, symmetric; the ghosts' shares reach their owners)
   from the local view's DOFs u (PeriSystemLocalDOFs), when output.stress
   asks for them. Nothing for the antiplane models. Collective.
@@ -131,8 +131,8 @@ PetscErrorCode PeriSystemEvaluateStress(PeriSystem sys, const PetscScalar u[])
   StressCtx      sc;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscFree3(sys->stress, sys->strain, sys->elastic_stress));
-  if (!sys->stress_output || sys->model->antiplane || sys->model->dofs < sys->disc.particles.dim) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscFree3(sys->fields.stress, sys->fields.strain, sys->fields.elastic_stress));
+  if (!sys->fields.stress_output || sys->model->antiplane || sys->model->dofs < sys->disc.particles.dim) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscCalloc2(9 * n, &S, 18 * n, &acc));
   sc.u = u;
   sc.S = S;
@@ -142,12 +142,12 @@ PetscErrorCode PeriSystemEvaluateStress(PeriSystem sys, const PetscScalar u[])
   PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 18, MPI_SUM, acc));
   {
     const PetscInt no = sys->disc.nowned;
-    PetscCall(PetscMalloc3(9 * no, &sys->stress, 9 * no, &sys->strain, 9 * no, &sys->elastic_stress));
+    PetscCall(PetscMalloc3(9 * no, &sys->fields.stress, 9 * no, &sys->fields.strain, 9 * no, &sys->fields.elastic_stress));
     for (PetscInt i = 0; i < no; i++) {
       for (PetscInt a = 0; a < 3; a++)
-        for (PetscInt b = 0; b < 3; b++) sys->stress[9 * i + 3 * a + b] = 0.5 * (S[9 * i + 3 * a + b] + S[9 * i + 3 * b + a]);
-      StrainFromMoments(&acc[18 * i], &acc[18 * i + 9], sys->disc.particles.dim, &sys->strain[9 * i]);
-      ElasticStress(sys->model, sys->disc.particles.dim, &sys->strain[9 * i], &sys->elastic_stress[9 * i]);
+        for (PetscInt b = 0; b < 3; b++) sys->fields.stress[9 * i + 3 * a + b] = 0.5 * (S[9 * i + 3 * a + b] + S[9 * i + 3 * b + a]);
+      StrainFromMoments(&acc[18 * i], &acc[18 * i + 9], sys->disc.particles.dim, &sys->fields.strain[9 * i]);
+      ElasticStress(sys->model, sys->disc.particles.dim, &sys->fields.strain[9 * i], &sys->fields.elastic_stress[9 * i]);
     }
   }
   PetscCall(PetscFree2(S, acc));

@@ -23,10 +23,10 @@ PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
 
   PetscFunctionBeginUser;
   PetscCall(PeriJSONInt(j, "particles", sys->disc.N));
-  PetscCall(PeriJSONInt(j, "bonds", sys->log.nbonds_total));
+  PetscCall(PeriJSONInt(j, "bonds", sys->run.log.nbonds_total));
   PetscCall(PeriJSONInt(j, "dofs", sys->disc.N * m->dofs));
   PetscCall(PeriJSONInt(j, "ranks", sys->size));
-  PetscCall(PeriJSONInt(j, "edge_cut", sys->log.edge_cut));
+  PetscCall(PeriJSONInt(j, "edge_cut", sys->run.log.edge_cut));
   PetscCall(PeriJSONReal(j, "horizon", sys->disc.delta));
   PetscCall(PeriJSONString(j, "partial_volume", PeriPartialVolumes[sys->disc.partial_volume]));
   PetscCall(PeriJSONString(j, "surface_correction", PeriSurfaceCorrections[sys->disc.surface]));
@@ -45,21 +45,21 @@ PetscErrorCode PeriSystemSummaryCost(PeriSystem sys, PeriJSON j)
 
   PetscFunctionBeginUser;
   PetscCall(PeriJSONBeginObject(j, "timing"));
-  PetscCall(PeriJSONReal(j, "neighbors_s", sys->log.neighbors_s));
-  PetscCall(PeriJSONReal(j, "assembly_s", sys->log.assembly_s));
-  PetscCall(PeriJSONReal(j, "solve_s", sys->log.solve_s));
-  PetscCall(PeriJSONReal(j, "total_s", sys->log.total_s));
+  PetscCall(PeriJSONReal(j, "neighbors_s", sys->run.log.neighbors_s));
+  PetscCall(PeriJSONReal(j, "assembly_s", sys->run.log.assembly_s));
+  PetscCall(PeriJSONReal(j, "solve_s", sys->run.log.solve_s));
+  PetscCall(PeriJSONReal(j, "total_s", sys->run.log.total_s));
   PetscCall(PeriJSONEndObject(j));
-  PetscCall(PeriJSONReal(j, "memory_mb", sys->log.memory_mb));
-  PetscCall(PeriJSONReal(j, "memory_mb_max_rank", sys->log.memory_mb_max_rank));
+  PetscCall(PeriJSONReal(j, "memory_mb", sys->run.log.memory_mb));
+  PetscCall(PeriJSONReal(j, "memory_mb_max_rank", sys->run.log.memory_mb_max_rank));
   /* where the peak was reached (issue 14, item 4): the largest rank's peak at the end of each
      phase, and K's own bytes for comparison */
   PetscCall(PeriJSONBeginObject(j, "memory_phases_mb"));
-  PetscCall(PeriJSONReal(j, "setup", sys->log.memory_phase_mb[0]));
-  if (sys->log.memory_phase_mb[1] > 0) PetscCall(PeriJSONReal(j, "assembly", sys->log.memory_phase_mb[1]));
-  PetscCall(PeriJSONReal(j, "run", sys->log.memory_phase_mb[2]));
+  PetscCall(PeriJSONReal(j, "setup", sys->run.log.memory_phase_mb[0]));
+  if (sys->run.log.memory_phase_mb[1] > 0) PetscCall(PeriJSONReal(j, "assembly", sys->run.log.memory_phase_mb[1]));
+  PetscCall(PeriJSONReal(j, "run", sys->run.log.memory_phase_mb[2]));
   PetscCall(PeriJSONEndObject(j));
-  if (sys->log.matrix_mb > 0) PetscCall(PeriJSONReal(j, "matrix_mb", sys->log.matrix_mb));
+  if (sys->run.log.matrix_mb > 0) PetscCall(PeriJSONReal(j, "matrix_mb", sys->run.log.matrix_mb));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -69,21 +69,21 @@ PetscErrorCode PeriSystemSummarySolver(PeriSystem sys, PeriJSON j)
 {
 
   PetscFunctionBeginUser;
-  if (!sys->solve.ksp_type[0] && !sys->interrupted) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->fields.solve.ksp_type[0] && !sys->run.interrupted) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriJSONBeginObject(j, "solver"));
-  PetscCall(PeriJSONString(j, "ksp_type", sys->solve.ksp_type));
-  PetscCall(PeriJSONString(j, "pc_type", sys->solve.pc_type));
-  PetscCall(PeriJSONInt(j, "iterations", sys->solve.iterations));
-  PetscCall(PeriJSONString(j, "converged_reason", sys->solve.converged_reason));
-  PetscCall(PeriJSONReal(j, "residual_norm", sys->solve.residual_norm));
-  if (sys->solve.residual_tol > 0) PetscCall(PeriJSONReal(j, "residual_tol", sys->solve.residual_tol));
+  PetscCall(PeriJSONString(j, "ksp_type", sys->fields.solve.ksp_type));
+  PetscCall(PeriJSONString(j, "pc_type", sys->fields.solve.pc_type));
+  PetscCall(PeriJSONInt(j, "iterations", sys->fields.solve.iterations));
+  PetscCall(PeriJSONString(j, "converged_reason", sys->fields.solve.converged_reason));
+  PetscCall(PeriJSONReal(j, "residual_norm", sys->fields.solve.residual_norm));
+  if (sys->fields.solve.residual_tol > 0) PetscCall(PeriJSONReal(j, "residual_tol", sys->fields.solve.residual_tol));
   /* written results passed every check; an interrupted solve did not finish */
-  PetscCall(PeriJSONBool(j, "converged", sys->interrupted && !sys->has_solution ? PETSC_FALSE : PETSC_TRUE));
-  PetscCall(PeriJSONString(j, "operator", sys->solve.symmetric ? "symmetric" : "unsymmetric"));
-  PetscCall(PeriJSONString(j, "stiffness", sys->op ? "matrix_free" : "assembled"));
-  if (sys->solve.free_modes) {
-    PetscCall(PeriJSONInt(j, "free_rigid_motions", sys->solve.free_modes));
-    PetscCall(PeriJSONReal(j, "load_share_removed", sys->solve.load_imbalance));
+  PetscCall(PeriJSONBool(j, "converged", sys->run.interrupted && !sys->fields.has_solution ? PETSC_FALSE : PETSC_TRUE));
+  PetscCall(PeriJSONString(j, "operator", sys->fields.solve.symmetric ? "symmetric" : "unsymmetric"));
+  PetscCall(PeriJSONString(j, "stiffness", sys->stiffness.op ? "matrix_free" : "assembled"));
+  if (sys->fields.solve.free_modes) {
+    PetscCall(PeriJSONInt(j, "free_rigid_motions", sys->fields.solve.free_modes));
+    PetscCall(PeriJSONReal(j, "load_share_removed", sys->fields.solve.load_imbalance));
   }
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -94,10 +94,10 @@ PetscErrorCode PeriSystemSummaryFields(PeriSystem sys, PeriJSON j)
 {
 
   PetscFunctionBeginUser;
-  if (!sys->has_solution) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriJSONReal(j, "strain_energy", sys->strain_energy));
+  if (!sys->fields.has_solution) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriJSONReal(j, "strain_energy", sys->fields.strain_energy));
   PetscCall(PeriJSONBeginObject(j, "max_abs_u"));
-  for (PetscInt c = 0; c < sys->model->dofs; c++) PetscCall(PeriJSONReal(j, sys->model->components[c], sys->max_abs_u[c]));
+  for (PetscInt c = 0; c < sys->model->dofs; c++) PetscCall(PeriJSONReal(j, sys->model->components[c], sys->fields.max_abs_u[c]));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -107,16 +107,16 @@ static PetscErrorCode ReadSolver(PeriSystem sys)
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &node));
   PetscCall(PeriSceneCheckSection(s, node, "solver"));
-  PetscCall(PeriSceneGetReal(s, node, "residual_tol", PETSC_FALSE, &sys->residual_tol, NULL));
-  PeriInputCheck(sys->residual_tol >= 0 && sys->residual_tol < 1, s, node, "residual_tol", "must lie in [0, 1) (0: the default, max(100 rtol, 1e-6)), got %g", (double)sys->residual_tol);
+  PetscCall(PeriSceneGetReal(s, node, "residual_tol", PETSC_FALSE, &sys->stiffness.residual_tol, NULL));
+  PeriInputCheck(sys->stiffness.residual_tol >= 0 && sys->stiffness.residual_tol < 1, s, node, "residual_tol", "must lie in [0, 1) (0: the default, max(100 rtol, 1e-6)), got %g", (double)sys->stiffness.residual_tol);
   {
     PetscInt kind = PERI_OPERATOR_AUTO;
     PetscCall(PeriSceneGetChoice(s, node, "operator", PeriOperatorKinds, &kind, NULL));
-    sys->operator_kind = (PeriOperatorKind)kind;
+    sys->stiffness.operator_kind = (PeriOperatorKind)kind;
   }
-  sys->pc_radius = 1.75;
-  PetscCall(PeriSceneGetReal(s, node, "pc_radius", PETSC_FALSE, &sys->pc_radius, NULL));
-  PeriInputCheck(sys->pc_radius >= 1, s, node, "pc_radius", "must be at least 1 (the nearest neighbours), got %g", (double)sys->pc_radius);
+  sys->stiffness.pc_radius = 1.75;
+  PetscCall(PeriSceneGetReal(s, node, "pc_radius", PETSC_FALSE, &sys->stiffness.pc_radius, NULL));
+  PeriInputCheck(sys->stiffness.pc_radius >= 1, s, node, "pc_radius", "must be at least 1 (the nearest neighbours), got %g", (double)sys->stiffness.pc_radius);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -129,7 +129,7 @@ static PetscErrorCode ReadSolver(PeriSystem sys)
 @*/
 PetscReal PeriResidualTolerance(PeriSystem sys, PetscReal rtol)
 {
-  return sys->residual_tol > 0 ? sys->residual_tol : PetscMin(PetscMax(100 * rtol, 1e-6), 1e-3);
+  return sys->stiffness.residual_tol > 0 ? sys->stiffness.residual_tol : PetscMin(PetscMax(100 * rtol, 1e-6), 1e-3);
 }
 
 /* model.* against the chosen model's schema (s->owners holds every plug-in's); a model registered
@@ -263,11 +263,11 @@ static PetscErrorCode ReadShearModuli(PeriSystem sys)
     PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &val[k], NULL));
     PeriInputCheck(val[k] > 0, s, map, map->child[k]->key, "must be positive, got %g", (double)val[k]);
   }
-  PetscCall(PetscMalloc1(pt->n, &sys->mu));
-  for (PetscInt i = 0; i < pt->n; i++) sys->mu[i] = ShearModulusAt(sys, nr, reg, val, &pt->x[3 * i]);
-  PetscCall(PetscMalloc1(b->nbonds, &sys->bond_mu));
+  PetscCall(PetscMalloc1(pt->n, &sys->materials.mu));
+  for (PetscInt i = 0; i < pt->n; i++) sys->materials.mu[i] = ShearModulusAt(sys, nr, reg, val, &pt->x[3 * i]);
+  PetscCall(PetscMalloc1(b->nbonds, &sys->materials.bond_mu));
   for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) sys->bond_mu[k] = BondShearModulus(sys, nr, reg, val, &pt->x[3 * i], &b->xi[3 * k], cut);
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) sys->materials.bond_mu[k] = BondShearModulus(sys, nr, reg, val, &pt->x[3 * i], &b->xi[3 * k], cut);
   PetscCall(PetscFree3(reg, val, cut));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -282,7 +282,7 @@ PetscErrorCode PeriSystemCreate(MPI_Comm comm, PeriScene scene, PeriSystem *syst
   sys->scene = scene;
   PetscCallMPI(MPI_Comm_rank(comm, &sys->rank));
   PetscCallMPI(MPI_Comm_size(comm, &sys->size));
-  PetscCall(PeriProgressCreate(comm, &sys->progress));
+  PetscCall(PeriProgressCreate(comm, &sys->run.progress));
   *system = sys;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -301,9 +301,9 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscCall(CreateModel(sys));
   PetscCall(ReadSolver(sys));
   PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
-  sys->thickness = 1;
-  PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->thickness, NULL));
-  PeriInputCheck(sys->thickness > 0, s, mat, "thickness", "must be positive, got %g", (double)sys->thickness);
+  sys->materials.thickness = 1;
+  PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
+  PeriInputCheck(sys->materials.thickness > 0, s, mat, "thickness", "must be positive, got %g", (double)sys->materials.thickness);
   /* before any large allocation: a scene that cannot fit is refused with its size */
   PetscCall(PeriParticlesCheckMemory(sys->comm, s, sys->model));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -367,10 +367,10 @@ static PetscErrorCode SetUpBonds(PeriSystem sys)
   PetscCall(PeriSurfaceCorrectionApply(d->surface, &d->particles, d->delta, d->family_volume, &d->bonds));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Neighbors, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
-  sys->log.neighbors_s = t1 - t0;
-  PetscCallMPI(MPI_Allreduce(&d->bonds.nbonds, &sys->log.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
+  sys->run.log.neighbors_s = t1 - t0;
+  PetscCallMPI(MPI_Allreduce(&d->bonds.nbonds, &sys->run.log.nbonds_total, 1, MPIU_INT, MPI_SUM, sys->comm));
   for (PetscInt k = 0; k < d->bonds.nbonds; k++) cut += d->bonds.j[k] >= d->nowned;
-  PetscCallMPI(MPI_Allreduce(&cut, &sys->log.edge_cut, 1, MPIU_INT, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(&cut, &sys->run.log.edge_cut, 1, MPIU_INT, MPI_SUM, sys->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -396,7 +396,7 @@ static PetscErrorCode Calibrate(PeriSystem sys)
   cal.nowned        = sys->disc.nowned;
   cal.N             = sys->disc.N;
   cal.family_volume = sys->disc.family_volume;
-  cal.mu            = sys->mu;
+  cal.mu            = sys->materials.mu;
   cal.comm          = sys->comm;
   cal.particles     = &sys->disc.particles;
   cal.bonds         = &sys->disc.bonds;
@@ -418,7 +418,7 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   const PeriParticles *pt = &sys->disc.particles;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->thickness, &sys->disc.particles, &sys->disc.N));
+  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
   PetscCall(ReadHorizon(sys));
   PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
   PetscCall(ReadCorrections(sys));
@@ -434,8 +434,8 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PeriBoundarySetUp(sys));
   PetscCall(PeriLayersSetUp(sys));
   /* the loads too, so that a bad load is reported before any solve */
-  PetscCall(PeriSystemCreateVec(sys, &sys->f));
-  PetscCall(PeriLoadsAssemble(sys, sys->f));
+  PetscCall(PeriSystemCreateVec(sys, &sys->fields.f));
+  PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -445,28 +445,16 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
 
   PetscFunctionBeginUser;
   if (!sys) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(MatDestroy(&sys->K));
-  PetscCall(MatDestroy(&sys->Kpc));
-  PetscCall(PeriOperatorDestroy(&sys->op));
+  PetscCall(PeriStiffnessDestroy(&sys->stiffness));
   PetscCall(PeriMassDestroy(&sys->mass));
-  PetscCall(VecDestroy(&sys->u));
-  PetscCall(VecDestroy(&sys->f));
+  PetscCall(PeriFieldsDestroy(&sys->fields));
+  PetscCall(PeriBondStateDestroy(&sys->bond_state));
+  PetscCall(PeriConditionsDestroy(&sys->conditions));
   PetscCall(PeriModelDestroy(&sys->model));
   PetscCall(PeriDiscDestroy(&sys->disc));
-  PetscCall(PeriLayersDestroy(&sys->layers));
-  PetscCall(PetscFree(sys->mu));
-  PetscCall(PetscFree(sys->bond_mu));
-  PetscCall(PetscFree(sys->tau));
-  PetscCall(PetscFree3(sys->stress, sys->strain, sys->elastic_stress));
-  PetscCall(PetscFree(sys->damage));
-  PetscCall(PetscFree(sys->probes));
-  PetscCall(PetscFree(sys->constrained));
-  PetscCall(PetscFree(sys->constrained_value));
-  PetscCall(PetscFree(sys->constrained_region));
-  PetscCall(PeriReactionsDestroy(&sys->reactions));
-  PetscCall(PetscFree(sys->W));
-  PetscCall(PetscFree(sys->u_owned));
-  PetscCall(PeriProgressDestroy(&sys->progress));
+  PetscCall(PetscFree(sys->materials.mu));
+  PetscCall(PetscFree(sys->materials.bond_mu));
+  PetscCall(PeriProgressDestroy(&sys->run.progress));
   PetscCall(PetscFree(sys));
   *system = NULL;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -499,7 +487,7 @@ static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const Pets
 PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, PeriBondGeometry *g)
 {
   PetscFunctionBeginUser;
-  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->bond_mu, i, k, g);
+  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->materials.bond_mu, i, k, g);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -530,19 +518,19 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
   PetscFunctionBeginUser;
   if (!sys->model->central_force)
     why = "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
-  else if (!sys->matrix_free_ok)
+  else if (!sys->stiffness.matrix_free_ok)
     why = "the analysis needs K's entries (matrix_free serves the static and quasi-static analyses)";
-  else if (sys->layers.T)
+  else if (sys->conditions.layers.T)
     why = "fictitious layers eliminate K's rows through its entries";
-  *mf = (PetscBool)(!why && (sys->operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->operator_kind == PERI_OPERATOR_AUTO));
-  if (*mf && sys->operator_kind == PERI_OPERATOR_AUTO) {
+  *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->stiffness.operator_kind == PERI_OPERATOR_AUTO));
+  if (*mf && sys->stiffness.operator_kind == PERI_OPERATOR_AUTO) {
     /* the short-range stiffness serves AMG, the diagonal Jacobi; another -pc_type (a
        factorization) gets K itself */
     char pc[64] = PCGAMG;
     PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
     *mf = PeriOperatorServesPC(pc);
   }
-  if (sys->operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
+  if (sys->stiffness.operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetMap(sys->scene, sys->scene->root, "solver", PETSC_FALSE, &node));
   PeriInputCheck(PETSC_FALSE, sys->scene, node, "operator", "matrix_free cannot apply here: %s; use assembled or auto", why);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -557,10 +545,10 @@ static void DefaultPC(PeriSystem sys)
   PetscReal            extent = 0;
 
   for (PetscInt d = 0; d < pt->dim; d++) extent = PetscMax(extent, pt->upper[d] - pt->lower[d]);
-  if (sys->op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
-    PetscStrncpy(sys->pc_default, PCJACOBI, sizeof(sys->pc_default));
+  if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
+    PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
   else
-    PetscStrncpy(sys->pc_default, PCGAMG, sizeof(sys->pc_default));
+    PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default));
 }
 
 PetscErrorCode PeriSystemAssemble(PeriSystem sys)
@@ -570,31 +558,31 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Assembly));
-  PetscCall(PeriProgressUpdate(sys->progress, PERI_PROGRESS_PHASE, "assembly"));
+  PetscCall(PeriProgressUpdate(sys->run.progress, PERI_PROGRESS_PHASE, "assembly"));
   PetscCall(PetscTime(&t0));
-  PetscCall(MatDestroy(&sys->K));
-  PetscCall(MatDestroy(&sys->Kpc));
-  PetscCall(PeriOperatorDestroy(&sys->op));
-  sys->pc_default[0] = 0;
+  PetscCall(MatDestroy(&sys->stiffness.K));
+  PetscCall(MatDestroy(&sys->stiffness.Kpc));
+  PetscCall(PeriOperatorDestroy(&sys->stiffness.op));
+  sys->stiffness.pc_default[0] = 0;
   PetscCall(UseMatrixFree(sys, &mf));
   if (mf) {
     PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
-    PetscCall(PeriOperatorCreate(sys, sys->pc_radius, &sys->op));
+    PetscCall(PeriOperatorCreate(sys, sys->stiffness.pc_radius, &sys->stiffness.op));
     DefaultPC(sys);
-    PetscCall(PeriOperatorCreateMat(sys, &sys->K));
+    PetscCall(PeriOperatorCreateMat(sys, &sys->stiffness.K));
     PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   } else
-    PetscCall(PeriAssembleStiffness(sys, &sys->K));
+    PetscCall(PeriAssembleStiffness(sys, &sys->stiffness.K));
   PetscCall(PetscTime(&t1));
-  sys->log.assembly_s = t1 - t0;
-  if (sys->log.matrix_mb == 0) { /* the first assembly: K's size and the memory it took */
+  sys->run.log.assembly_s = t1 - t0;
+  if (sys->run.log.matrix_mb == 0) { /* the first assembly: K's size and the memory it took */
     PetscReal opmb = 0;
-    if (sys->op)
-      PetscCall(PeriOperatorMemoryMB(sys, sys->op, &opmb));
+    if (sys->stiffness.op)
+      PetscCall(PeriOperatorMemoryMB(sys, sys->stiffness.op, &opmb));
     else
-      PetscCall(PeriMatrixMB(sys->K, &sys->log.matrix_mb));
-    sys->log.matrix_mb += opmb;
-    sys->log.memory_phase_mb[1] = PeriPeakMemoryMB();
+      PetscCall(PeriMatrixMB(sys->stiffness.K, &sys->run.log.matrix_mb));
+    sys->run.log.matrix_mb += opmb;
+    sys->run.log.memory_phase_mb[1] = PeriPeakMemoryMB();
   }
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -86,8 +86,8 @@ static PetscErrorCode TestUniform(const char scene[], PetscReal tol)
     for (PetscInt d = 0; d < pt->dim; d++)
       if (pt->x[3 * k + d] < pt->lower[d] + delta || pt->x[3 * k + d] > pt->upper[d] - delta) in[k] = PETSC_FALSE;
   }
-  PetscCall(PeriTestSlope(PETSC_COMM_WORLD, no, &pt->x[0], 3, &p->sys->u_owned[0], bs, in, &sx));
-  PetscCall(PeriTestSlope(PETSC_COMM_WORLD, no, &pt->x[1], 3, &p->sys->u_owned[1], bs, in, &sy));
+  PetscCall(PeriTestSlope(PETSC_COMM_WORLD, no, &pt->x[0], 3, &p->sys->fields.u_owned[0], bs, in, &sx));
+  PetscCall(PeriTestSlope(PETSC_COMM_WORLD, no, &pt->x[1], 3, &p->sys->fields.u_owned[1], bs, in, &sy));
   PeriTestClose("interior strain xx (ux slope along x)", sx, eps, tol * eps);
   PeriTestClose("interior strain yy (uy slope along y)", sy, -eps / 3, tol * eps / 3);
   PetscCall(PetscFree(in));

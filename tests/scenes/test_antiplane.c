@@ -75,7 +75,7 @@ static PetscErrorCode FieldErrorBelow(PeriProblem p, PetscReal (*exact)(const Pe
     PetscReal ue;
     if (PeriParticleIsFictitious(pt, i) || pt->x[3 * i + 1] > ymax) continue;
     ue = exact(&pt->x[3 * i]);
-    nd[0] += PetscSqr(p->sys->u_owned[i] - ue) * pt->volume[i];
+    nd[0] += PetscSqr(p->sys->fields.u_owned[i] - ue) * pt->volume[i];
     nd[1] += ue * ue * pt->volume[i];
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, nd, 2, MPIU_REAL, MPI_SUM, p->comm));
@@ -100,7 +100,7 @@ static PetscErrorCode StressError(PeriProblem p, PetscReal *err)
     PetscReal w, txz, tyz;
     if (PeriParticleIsFictitious(pt, i)) continue;
     Torsion(&pt->x[3 * i], &w, &txz, &tyz);
-    nd[0] += (PetscSqr(p->sys->tau[3 * i] - txz) + PetscSqr(p->sys->tau[3 * i + 1] - tyz)) * pt->volume[i];
+    nd[0] += (PetscSqr(p->sys->fields.tau[3 * i] - txz) + PetscSqr(p->sys->fields.tau[3 * i + 1] - tyz)) * pt->volume[i];
     nd[1] += (txz * txz + tyz * tyz) * pt->volume[i];
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, nd, 2, MPIU_REAL, MPI_SUM, p->comm));
@@ -118,7 +118,7 @@ static PetscErrorCode InteriorSlope(PeriProblem p, PetscReal *slope)
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(no, &in));
   for (PetscInt i = 0; i < no; i++) in[i] = PetscAbsReal(pt->x[3 * i + 1]) <= 0.25 ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PeriTestSlope(p->comm, no, &pt->x[1], 3, p->sys->u_owned, 1, in, slope));
+  PetscCall(PeriTestSlope(p->comm, no, &pt->x[1], 3, p->sys->fields.u_owned, 1, in, slope));
   *slope *= MU / S;
   PetscCall(PetscFree(in));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -239,9 +239,9 @@ int main(int argc, char **argv)
     /* Timoshenko's table: J = beta (2a)^3 (2b), beta = 0.229 at b/a = 2 */
     PeriTestClose("exact J of the 1 x 2 rectangle vs Timoshenko's beta = 0.229", J, 0.229 * 2, 0.0005 * 2);
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s torsion J / J_exact - 1 at dx = 0.02", models[k]));
-    PeriTestClose(what, q->sys->torsion.J / J - 1, 0, 0.001);
+    PeriTestClose(what, q->sys->conditions.torsion.J / J - 1, 0, 0.001);
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s torsion |J error| shrinks with dx", models[k]));
-    PeriTestClose(what, PetscAbsReal(q->sys->torsion.J / J - 1) / PetscAbsReal(p->sys->torsion.J / J - 1), 0.5, 0.5 - 1e-3);
+    PeriTestClose(what, PetscAbsReal(q->sys->conditions.torsion.J / J - 1) / PetscAbsReal(p->sys->conditions.torsion.J / J - 1), 0.5, 0.5 - 1e-3);
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriProblemDestroy(&q));
   }
@@ -316,7 +316,7 @@ int main(int argc, char **argv)
       PetscCall(PeriTestSetOption("-horizon_m", ms[q]));
       PetscCall(Run(argv[3], models[k], "0.04", &p));
       PetscCall(PetscSNPrintf(what, sizeof(what), "%s torsion m = %s, dx = 0.04: J / 0.45733 - 1", models[k], ms[q]));
-      PeriTestClose(what, p->sys->torsion.J / 0.4573300474 - 1, 0, 0.01);
+      PeriTestClose(what, p->sys->conditions.torsion.J / 0.4573300474 - 1, 0, 0.01);
       PetscCall(PeriProblemDestroy(&p));
     }
     PetscCall(PeriTestSetOption("-horizon_m", NULL));

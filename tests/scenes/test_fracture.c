@@ -53,7 +53,7 @@ int main(int argc, char **argv)
     if (p->rank == 0) {
       /* the stable growth at the last equilibrium, then the failed trial's run-away crack */
       for (PetscInt t = 0; t < 2; t++) {
-        const PetscReal *damage = t ? PeriTestQuasistatic(p)->trial_damage : p->sys->damage;
+        const PetscReal *damage = t ? PeriTestQuasistatic(p)->trial_damage : p->sys->bond_state.damage;
         PetscReal        ymax = 0, xmin = 0, xmax = 0;
         for (PetscInt i = 0; i < p->sys->disc.particles.n; i++) {
           const PetscReal *X = &p->sys->disc.particles.x[3 * i];
@@ -89,14 +89,14 @@ int main(int argc, char **argv)
         PetscReal            syz = 0, sxz = 0, n = 0, best = 0, bx = 0, by = 0;
         for (PetscInt i = 0; i < pt->n; i++) {
           const PetscReal *X = &pt->x[3 * i];
-          if (p->sys->tau[3 * i + 2] > best) {
-            best = p->sys->tau[3 * i + 2];
+          if (p->sys->fields.tau[3 * i + 2] > best) {
+            best = p->sys->fields.tau[3 * i + 2];
             bx   = X[0];
             by   = X[1];
           }
           if (PetscAbsReal(PetscAbsReal(X[1]) - 0.5 * pt->mean_spacing) > 1e-9 || X[0] > tip - p->sys->disc.delta) continue;
-          syz += PetscAbsReal(p->sys->tau[3 * i + 1]);
-          sxz += PetscAbsReal(p->sys->tau[3 * i]);
+          syz += PetscAbsReal(p->sys->fields.tau[3 * i + 1]);
+          sxz += PetscAbsReal(p->sys->fields.tau[3 * i]);
           n += 1;
         }
         PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: mean |tau_yz| on the faces / uncracked peak", tips[k]));
@@ -107,8 +107,8 @@ int main(int argc, char **argv)
         PeriTestClose(what, PetscSqrtReal(PetscSqr(bx - tip) + by * by), 0, 2 * p->sys->disc.delta);
       }
       PetscCall(PetscSNPrintf(what, sizeof(what), "torsion crack tip %s: J below the shallower crack's", tips[k]));
-      PeriTestClose(what, (PetscReal)(p->sys->torsion.J < Jprev), 1, 0);
-      Jprev = p->sys->torsion.J;
+      PeriTestClose(what, (PetscReal)(p->sys->conditions.torsion.J < Jprev), 1, 0);
+      Jprev = p->sys->conditions.torsion.J;
       PetscCall(PeriProblemDestroy(&p));
     }
     PetscCall(PeriTestSetOption("-cracks_0_to_0", NULL));

@@ -191,7 +191,7 @@ static PetscErrorCode StressChecks(PeriProblem p, const char model[], const char
   if (p->rank) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt i = 0; i < pt->n; i++) {
     PetscReal d2 = PetscSqr(pt->x[3 * i] - 0.305) + PetscSqr(pt->x[3 * i + 1] - 0.305);
-    for (PetscInt k = 0; k < 9; k++) V[k] += pt->volume[i] * p->sys->stress[9 * i + k];
+    for (PetscInt k = 0; k < 9; k++) V[k] += pt->volume[i] * p->sys->fields.stress[9 * i + k];
     if (d2 < best) best = d2, c = i;
   }
   PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=%s traction: sum V sigma_yy / virial of the loads", model, nu));
@@ -200,11 +200,11 @@ static PetscErrorCode StressChecks(PeriProblem p, const char model[], const char
   PeriTestClose(what, PetscMax(PetscAbsReal(V[0]), PetscAbsReal(V[1])) / virial_yy, 0.0, 1e-6);
   if (strcmp(nu, "0")) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=0 traction: centre sigma_yy (bond forces) / sigma", model));
-  PeriTestClose(what, p->sys->stress[9 * c + 4] / sigma, 1.0, 0.01);
+  PeriTestClose(what, p->sys->fields.stress[9 * c + 4] / sigma, 1.0, 0.01);
   PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=0 traction: centre sigma_yy (C : eps) / sigma", model));
-  PeriTestClose(what, p->sys->elastic_stress[9 * c + 4] / sigma, 1.0, 0.01);
+  PeriTestClose(what, p->sys->fields.elastic_stress[9 * c + 4] / sigma, 1.0, 0.01);
   PetscCall(PetscSNPrintf(what, sizeof(what), "lattice %s nu=0 traction: centre eps_yy E / sigma", model));
-  PeriTestClose(what, p->sys->strain[9 * c + 4] * 7e10 / sigma, 1.0, 0.01);
+  PeriTestClose(what, p->sys->fields.strain[9 * c + 4] * 7e10 / sigma, 1.0, 0.01);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

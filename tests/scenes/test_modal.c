@@ -227,7 +227,7 @@ static PetscErrorCode Extremes(const char lamina[], const char tiny[])
     slash = strrchr(file, '/');
     PetscCall(PetscStrncpy(slash + 1, "heavy_tip_static.yaml", sizeof(file) - (size_t)(slash + 1 - file)));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, file, &s));
-    k = 1000.0 * 1000.0 / (2 * s->sys->strain_energy);
+    k = 1000.0 * 1000.0 / (2 * s->sys->fields.strain_energy);
     for (PetscInt r = 0; r < s->sys->disc.nregions; r++)
       if (!strcmp(s->sys->disc.regions[r].name, "tip")) M = 2.5e9 * s->sys->disc.regions[r].volume;
     f = PetscSqrtReal(k / M) / (2 * PETSC_PI);
@@ -389,9 +389,9 @@ static PetscErrorCode Checks(const char lamina[])
   PetscCall(PeriTestSetOption("-grid_spacing", "0.02"));
   /* the default (preonly + Cholesky): accepted, its inner residual recorded */
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, lamina, &a));
-  PetscCheck(a->sys->solve.residual_norm > 0 && a->sys->solve.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "direct inner solve: worst true residual %g, expected in (0, 1e-6]", (double)a->sys->solve.residual_norm);
+  PetscCheck(a->sys->fields.solve.residual_norm > 0 && a->sys->fields.solve.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "direct inner solve: worst true residual %g, expected in (0, 1e-6]", (double)a->sys->fields.solve.residual_norm);
   for (PetscInt m = 0; m < PeriTestModal(a)->nmodes; m++) PetscCheck(PeriTestModal(a)->modes[m].residual <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "mode %" PetscInt_FMT " residual %g", m + 1, (double)PeriTestModal(a)->modes[m].residual);
-  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: direct inner solve: worst true residual %.2g <= 1e-6, the %" PetscInt_FMT " modes' residuals <= 1e-6\n", (double)a->sys->solve.residual_norm, PeriTestModal(a)->nmodes));
+  PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: direct inner solve: worst true residual %.2g <= 1e-6, the %" PetscInt_FMT " modes' residuals <= 1e-6\n", (double)a->sys->fields.solve.residual_norm, PeriTestModal(a)->nmodes));
   /* a preconditioner alone as the inner solve: refused at its first solve */
   PetscCall(ExpectRefused(lamina, jacobi, "inner solve 1 of the spectral transform", "-st_ksp_type preonly -st_pc_type cholesky"));
   /* CG to 1e-3: each inner solve within its own tolerance (100 rtol), the modes not: refused by the
@@ -406,7 +406,7 @@ static PetscErrorCode Checks(const char lamina[])
   PetscCall(PeriTestSetOption("-st_pc_type", NULL));
   PetscCall(PeriTestSetOption("-st_ksp_rtol", NULL));
   PetscCheck(PeriTestModal(b)->nmodes == PeriTestModal(a)->nmodes, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: %" PetscInt_FMT " modes, direct %" PetscInt_FMT, PeriTestModal(b)->nmodes, PeriTestModal(a)->nmodes);
-  PetscCheck(b->sys->solve.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: worst true residual %g", (double)b->sys->solve.residual_norm);
+  PetscCheck(b->sys->fields.solve.residual_norm <= 1e-6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cg inner solve: worst true residual %g", (double)b->sys->fields.solve.residual_norm);
   for (PetscInt m = 0; m < PeriTestModal(a)->nmodes; m++) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "cg + jacobi to 1e-12 inner solves: mode %" PetscInt_FMT " f / f with Cholesky", m + 1));
     PeriTestClose(what, PeriTestModal(b)->modes[m].f_hz / PeriTestModal(a)->modes[m].f_hz, 1.0, 1e-8);

@@ -38,10 +38,10 @@ static PetscErrorCode Compare(PeriProblem p, PeriProblem q, const char *type)
 
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %" PetscInt_FMT " ranks vs 1", type, (PetscInt)p->sys->size));
-  PeriTestClose(what, p->sys->strain_energy, q->sys->strain_energy, 1e-8 * q->sys->strain_energy);
+  PeriTestClose(what, p->sys->fields.strain_energy, q->sys->fields.strain_energy, 1e-8 * q->sys->fields.strain_energy);
   for (PetscInt c = 0; c < p->sys->model->dofs; c++) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s| on %" PetscInt_FMT " ranks vs 1", type, p->sys->model->components[c], (PetscInt)p->sys->size));
-    PeriTestClose(what, p->sys->max_abs_u[c], q->sys->max_abs_u[c], 1e-7 * q->sys->max_abs_u[c] + 1e-300);
+    PeriTestClose(what, p->sys->fields.max_abs_u[c], q->sys->fields.max_abs_u[c], 1e-7 * q->sys->fields.max_abs_u[c] + 1e-300);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

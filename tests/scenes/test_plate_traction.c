@@ -85,12 +85,12 @@ int main(int argc, char **argv)
       PeriProblem q;
       PetscCall(PeriTestRunScene(PETSC_COMM_SELF, argv[1], &q));
       if (rank == 0) {
-        for (PetscInt i = 0; i < p->sys->nprobes; i++)
+        for (PetscInt i = 0; i < p->sys->fields.nprobes; i++)
           for (PetscInt c = 0; c < 2; c++) {
-            PetscCall(PetscSNPrintf(what, sizeof(what), "surface %s: probe %s u[%" PetscInt_FMT "], %d ranks vs 1", surfaces[k], p->sys->probes[i].name, c, size));
-            PeriTestClose(what, p->sys->probes[i].u[c], q->sys->probes[i].u[c], 1e-7 * p->sys->max_abs_u[c]);
+            PetscCall(PetscSNPrintf(what, sizeof(what), "surface %s: probe %s u[%" PetscInt_FMT "], %d ranks vs 1", surfaces[k], p->sys->fields.probes[i].name, c, size));
+            PeriTestClose(what, p->sys->fields.probes[i].u[c], q->sys->fields.probes[i].u[c], 1e-7 * p->sys->fields.max_abs_u[c]);
           }
-        PeriTestClose("strain energy, ranks vs 1", p->sys->strain_energy, q->sys->strain_energy, 1e-8 * q->sys->strain_energy);
+        PeriTestClose("strain energy, ranks vs 1", p->sys->fields.strain_energy, q->sys->fields.strain_energy, 1e-8 * q->sys->fields.strain_energy);
       }
       PetscCall(PeriProblemDestroy(&q));
     }

@@ -27,12 +27,12 @@ static PetscErrorCode CompareFields(PeriProblem p, PeriProblem q, PetscMPIInt si
   const char *const names[] = {"stress", "strain"};
 
   PetscFunctionBeginUser;
-  if (!q->sys->stress) PetscFunctionReturn(PETSC_SUCCESS); /* q: the whole body on one rank */
+  if (!q->sys->fields.stress) PetscFunctionReturn(PETSC_SUCCESS); /* q: the whole body on one rank */
   for (int f = 0; f < 2; f++) {
     PetscReal sp[9], bp[9], sq[9], bq[9], scale = 0;
     char      what[128];
-    PetscCall(FieldMeasures(p, f ? p->sys->strain : p->sys->stress, sp, bp));
-    PetscCall(FieldMeasures(q, f ? q->sys->strain : q->sys->stress, sq, bq));
+    PetscCall(FieldMeasures(p, f ? p->sys->fields.strain : p->sys->fields.stress, sp, bp));
+    PetscCall(FieldMeasures(q, f ? q->sys->fields.strain : q->sys->fields.stress, sq, bq));
     for (PetscInt k = 0; k < 9; k++) scale = PetscMax(scale, bq[k]);
     for (PetscInt k = 0; k < 9; k++) {
       PetscCall(PetscSNPrintf(what, sizeof(what), "%s: %s component %" PetscInt_FMT ", max |.| on %d ranks vs 1", p->sys->model->type, names[f], k, size));
@@ -78,15 +78,15 @@ int main(int argc, char **argv)
     return 0;
   }
   PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy on %d ranks vs 1", p->sys->model->type, size));
-  PeriTestClose(what, p->sys->strain_energy, q->sys->strain_energy, 1e-8 * q->sys->strain_energy);
+  PeriTestClose(what, p->sys->fields.strain_energy, q->sys->fields.strain_energy, 1e-8 * q->sys->fields.strain_energy);
   for (PetscInt c = 0; c < p->sys->model->dofs; c++) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s| on %d ranks vs 1", p->sys->model->type, p->sys->model->components[c], size));
-    PeriTestClose(what, p->sys->max_abs_u[c], q->sys->max_abs_u[c], 1e-7 * q->sys->max_abs_u[c] + 1e-300);
+    PeriTestClose(what, p->sys->fields.max_abs_u[c], q->sys->fields.max_abs_u[c], 1e-7 * q->sys->fields.max_abs_u[c] + 1e-300);
   }
   PetscCall(CompareFields(p, q, size));
-  if (p->sys->torsion.active) {
+  if (p->sys->conditions.torsion.active) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s: torsion constant J on %d ranks vs 1", p->sys->model->type, size));
-    PeriTestClose(what, p->sys->torsion.J, q->sys->torsion.J, 1e-8 * q->sys->torsion.J);
+    PeriTestClose(what, p->sys->conditions.torsion.J, q->sys->conditions.torsion.J, 1e-8 * q->sys->conditions.torsion.J);
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));

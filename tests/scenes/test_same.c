@@ -13,10 +13,10 @@ int main(int argc, char **argv)
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[1], &p));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &q));
   PetscCall(PetscSNPrintf(what, sizeof(what), "strain energy, %s vs %s", argv[2], argv[1]));
-  PeriTestClose(what, q->sys->strain_energy, p->sys->strain_energy, 1e-8 * p->sys->strain_energy);
+  PeriTestClose(what, q->sys->fields.strain_energy, p->sys->fields.strain_energy, 1e-8 * p->sys->fields.strain_energy);
   for (PetscInt c = 0; c < p->sys->model->dofs; c++) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "max |%s|", p->sys->model->components[c]));
-    PeriTestClose(what, q->sys->max_abs_u[c], p->sys->max_abs_u[c], 1e-7 * p->sys->max_abs_u[c]);
+    PeriTestClose(what, q->sys->fields.max_abs_u[c], p->sys->fields.max_abs_u[c], 1e-7 * p->sys->fields.max_abs_u[c]);
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));

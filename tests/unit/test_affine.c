@@ -18,10 +18,10 @@ static PetscErrorCode CheckFields(PeriProblem p, Vec u, const PetscReal A[3][3],
   PetscInt             have;
 
   PetscFunctionBeginUser;
-  if (!p->sys->u) PetscCall(VecDuplicate(u, &p->sys->u));
-  PetscCall(VecCopy(u, p->sys->u));
+  if (!p->sys->fields.u) PetscCall(VecDuplicate(u, &p->sys->fields.u));
+  PetscCall(VecCopy(u, p->sys->fields.u));
   PetscCall(PeriSystemEvaluateEnergy(p->sys));
-  have = p->sys->strain ? 1 : 0;
+  have = p->sys->fields.strain ? 1 : 0;
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &have, 1, MPIU_INT, MPI_MAX, p->comm));
   if (!have) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt a = 0; a < dim; a++)
@@ -31,10 +31,10 @@ static PetscErrorCode CheckFields(PeriProblem p, Vec u, const PetscReal A[3][3],
     for (PetscInt d = 0; d < dim; d++) inner = (PetscBool)(inner && (pt->periodic[d] || (pt->x[3 * i + d] - pt->lower[d] >= reach && pt->upper[d] - pt->x[3 * i + d] >= reach)));
     for (PetscInt a = 0; a < dim; a++)
       for (PetscInt b = 0; b < dim; b++) {
-        err[0] = PetscMax(err[0], PetscAbsReal(p->sys->strain[9 * i + 3 * a + b] - 0.5 * (A[a][b] + A[b][a])));
+        err[0] = PetscMax(err[0], PetscAbsReal(p->sys->fields.strain[9 * i + 3 * a + b] - 0.5 * (A[a][b] + A[b][a])));
         if (!inner) continue;
-        err[1] = PetscMax(err[1], PetscAbsReal(p->sys->stress[9 * i + 3 * a + b] - p->sys->elastic_stress[9 * i + 3 * a + b]));
-        err[2] = PetscMax(err[2], PetscAbsReal(p->sys->elastic_stress[9 * i + 3 * a + b]));
+        err[1] = PetscMax(err[1], PetscAbsReal(p->sys->fields.stress[9 * i + 3 * a + b] - p->sys->fields.elastic_stress[9 * i + 3 * a + b]));
+        err[2] = PetscMax(err[2], PetscAbsReal(p->sys->fields.elastic_stress[9 * i + 3 * a + b]));
       }
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, err, 3, MPIU_REAL, MPI_MAX, p->comm));
@@ -59,7 +59,7 @@ static PetscErrorCode CheckAffine(const char file[])
   PetscCall(PeriProblemLoad(p, file));
   PetscCall(PeriProblemSetUp(p));
   PetscCall(PeriSystemAssemble(p->sys));
-  PetscCall(MatCreateVecs(p->sys->K, &u, &f));
+  PetscCall(MatCreateVecs(p->sys->stiffness.K, &u, &f));
   PetscCall(VecGetArray(u, &a));
   for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++)
     for (PetscInt c = 0; c < p->sys->disc.particles.dim; c++) {
@@ -70,12 +70,12 @@ static PetscErrorCode CheckAffine(const char file[])
       if (p->sys->model->dofs == 3 && p->sys->disc.particles.dim == 2) a[(i - p->sys->disc.bonds.rstart) * 3 + 2] = 0.5 * (A[1][0] - A[0][1]);
     }
   PetscCall(VecRestoreArray(u, &a));
-  PetscCall(MatMult(p->sys->K, u, f));
+  PetscCall(MatMult(p->sys->stiffness.K, u, f));
   /* the scale of the force from the strain alone: the diagonal block times the strain times dx */
   {
     Vec dg;
-    PetscCall(MatCreateVecs(p->sys->K, &dg, NULL));
-    PetscCall(MatGetDiagonal(p->sys->K, dg));
+    PetscCall(MatCreateVecs(p->sys->stiffness.K, &dg, NULL));
+    PetscCall(MatGetDiagonal(p->sys->stiffness.K, dg));
     PetscCall(VecNorm(dg, NORM_INFINITY, &scale));
     PetscCall(VecDestroy(&dg));
     scale *= 2e-3 * p->sys->disc.particles.mean_spacing;

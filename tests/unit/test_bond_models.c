@@ -30,7 +30,7 @@ static PetscErrorCode Energy(PeriProblem p, const PetscReal A[2][2], PetscReal t
   PetscInt     bs = p->sys->model->dofs;
 
   PetscFunctionBeginUser;
-  PetscCall(MatCreateVecs(p->sys->K, &u, &Ku));
+  PetscCall(MatCreateVecs(p->sys->stiffness.K, &u, &Ku));
   PetscCall(VecGetArray(u, &a));
   for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++) {
     PetscReal x                                 = p->sys->disc.particles.x[3 * i] - 0.5 * (p->sys->disc.particles.lower[0] + p->sys->disc.particles.upper[0]);
@@ -40,7 +40,7 @@ static PetscErrorCode Energy(PeriProblem p, const PetscReal A[2][2], PetscReal t
     if (bs == 3) a[(i - p->sys->disc.bonds.rstart) * bs + 2] = th;
   }
   PetscCall(VecRestoreArray(u, &a));
-  PetscCall(MatMult(p->sys->K, u, Ku));
+  PetscCall(MatMult(p->sys->stiffness.K, u, Ku));
   PetscCall(VecDot(u, Ku, &e));
   *E = 0.5 * PetscRealPart(e);
   PetscCall(VecDestroy(&u));
@@ -62,9 +62,9 @@ int main(int argc, char **argv)
     PetscReal diff, norm;
     PetscCall(Setup(argv[1], "pds", nus[k], planes[k], &p));
     PetscCall(Setup(argv[1], "pmb", nus[k], planes[k], &q));
-    PetscCall(MatNorm(q->sys->K, NORM_FROBENIUS, &norm));
-    PetscCall(MatAXPY(p->sys->K, -1, q->sys->K, SAME_NONZERO_PATTERN));
-    PetscCall(MatNorm(p->sys->K, NORM_FROBENIUS, &diff));
+    PetscCall(MatNorm(q->sys->stiffness.K, NORM_FROBENIUS, &norm));
+    PetscCall(MatAXPY(p->sys->stiffness.K, -1, q->sys->stiffness.K, SAME_NONZERO_PATTERN));
+    PetscCall(MatNorm(p->sys->stiffness.K, NORM_FROBENIUS, &diff));
     PetscCall(PetscSNPrintf(what, sizeof(what), "plane %s, nu = %s: |K_pds - K_pmb| / |K_pmb|", planes[k], nus[k]));
     PeriTestClose(what, diff / norm, 0, 1e-13);
     PetscCall(PeriProblemDestroy(&p));

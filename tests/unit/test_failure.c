@@ -24,19 +24,19 @@ int main(int argc, char **argv)
   meas[0] = -0.03;
   PeriTestClose("compression index -s/s_cc", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1.5, 1e-14);
   /* the cut-off piece: held, the rest loaded and solved */
-  PeriTestClose("static solve converged with a held piece", (PetscReal)(p->sys->solve.residual_norm < 1e-8), 1, 0);
-  PetscCall(PeriDamage(p->sys, &p->sys->damage));
+  PeriTestClose("static solve converged with a held piece", (PetscReal)(p->sys->fields.solve.residual_norm < 1e-8), 1, 0);
+  PetscCall(PeriDamage(p->sys, &p->sys->bond_state.damage));
   {
     PetscReal dmax = 0;
-    for (PetscInt i = 0; i < p->sys->disc.nowned; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
+    for (PetscInt i = 0; i < p->sys->disc.nowned; i++) dmax = PetscMax(dmax, p->sys->bond_state.damage[(PERI_NCAUSES + 1) * i]);
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &dmax, 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD));
     PeriTestClose("largest damage of the cut particles in (0, 1)", (PetscReal)(dmax > 0.2 && dmax < 1), 1, 0);
   }
-  PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->sys->failure.precracked_bonds > 0), 1, 0);
+  PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->sys->bond_state.failure.precracked_bonds > 0), 1, 0);
   /* G: pmb, plane stress: s_c = sqrt(4 pi G / (9 E delta)) */
-  p->sys->failure.stretch = 0;
-  p->sys->failure.G       = 100;
-  meas[0]                 = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->sys->disc.delta));
+  p->sys->bond_state.failure.stretch = 0;
+  p->sys->bond_state.failure.G       = 100;
+  meas[0]                            = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->sys->disc.delta));
   PeriTestClose("pmb plane stress: s at s_c from G gives index 1", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1, 1e-12);
   PetscCall(PeriProblemDestroy(&p));
 
@@ -48,11 +48,11 @@ int main(int argc, char **argv)
   meas[0] = 0;
   meas[1] = -0.008;
   PeriTestClose("pds sliding index |gamma|/gamma_0", PeriBondFailureIndex(p->sys, &g, meas, NULL), 0.8, 1e-14);
-  p->sys->failure.sliding        = 0;
-  p->sys->failure.friction_angle = 30;
-  p->sys->failure.cohesion       = 0.005;
-  meas[0]                        = -0.004; /* compression raises the limit to a - s tan(beta) */
-  meas[1]                        = 0.006;
+  p->sys->bond_state.failure.sliding        = 0;
+  p->sys->bond_state.failure.friction_angle = 30;
+  p->sys->bond_state.failure.cohesion       = 0.005;
+  meas[0]                                   = -0.004; /* compression raises the limit to a - s tan(beta) */
+  meas[1]                                   = 0.006;
   PeriTestClose("frictional sliding index", PeriBondFailureIndex(p->sys, &g, meas, NULL), 0.006 / (0.005 + 0.004 * PetscTanReal(PETSC_PI / 6)), 1e-14);
   meas[0] = 0.01; /* tension beyond a / tan(beta): no sliding strength left */
   PeriTestClose("frictional sliding in tension breaks", (PetscReal)(PeriBondFailureIndex(p->sys, &g, meas, NULL) >= 1), 1, 0);
@@ -69,12 +69,12 @@ int main(int argc, char **argv)
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
     meas[0] = 2e-3;
     PeriTestClose("softening share at (s_0 + s_u)/2", PeriBondSoftening(p->sys, meas), 0.5, 1e-14);
-    E1 = p->sys->strain_energy;
+    E1 = p->sys->fields.strain_energy;
     PetscCall(PeriProblemDestroy(&p));
     PetscCall(PeriTestSetOption("-analysis_load_factor_max", "4"));
     PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, argv[2], &p));
-    E2 = p->sys->strain_energy;
-    for (PetscInt i = 0; i < p->sys->disc.nowned; i++) dmax = PetscMax(dmax, p->sys->damage[(PERI_NCAUSES + 1) * i]);
+    E2 = p->sys->fields.strain_energy;
+    for (PetscInt i = 0; i < p->sys->disc.nowned; i++) dmax = PetscMax(dmax, p->sys->bond_state.damage[(PERI_NCAUSES + 1) * i]);
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &dmax, 1, MPIU_REAL, MPI_MAX, PETSC_COMM_WORLD));
     PeriTestClose("strip below s_0 at load 0.5: nothing softened", (PetscReal)(E1 > 0), 1, 0);
     PeriTestClose("softened strip: energy at load 4 / (64 x energy at load 0.5) below 0.95", (PetscReal)(E2 / (64 * E1) < 0.95), 1, 0);

@@ -110,8 +110,8 @@ static PetscErrorCode CheckDense(PeriProblem p, const Case *c, PetscReal *norm2)
   PetscReal zero = 0;                         /* eigenvalues below 1e-10 ||K||_2 */
 
   PetscFunctionBeginUser;
-  PetscCall(MatGetSize(p->sys->K, &N, NULL));
-  PetscCall(MatConvert(p->sys->K, MATAIJ, MAT_INITIAL_MATRIX, &A));
+  PetscCall(MatGetSize(p->sys->stiffness.K, &N, NULL));
+  PetscCall(MatConvert(p->sys->stiffness.K, MATAIJ, MAT_INITIAL_MATRIX, &A));
   PetscCall(ISCreateStride(PETSC_COMM_SELF, p->rank ? 0 : N, 0, 1, &is));
   PetscCall(MatCreateSubMatrices(A, 1, &is, &is, MAT_INITIAL_MATRIX, &sub));
   if (p->rank == 0) {
@@ -176,14 +176,14 @@ static PetscErrorCode CheckRigid(PeriProblem p, const Case *c, PetscReal norm2)
   PetscCall(PeriRigidModes(p->sys, &nm, modes, NULL));
   m->ops.rigid_modes(m, X0, v0);
   m->ops.rigid_modes(m, X1, v1);
-  PetscCall(MatCreateVecs(p->sys->K, NULL, &Kr));
+  PetscCall(MatCreateVecs(p->sys->stiffness.K, NULL, &Kr));
   for (PetscInt k = 0; k < nm; k++) {
     PetscBool rotation = PETSC_FALSE;
     PetscReal r, kr;
     char      what[128];
     for (PetscInt d = 0; d < m->dofs; d++) rotation = (PetscBool)(rotation || v0[k][d] != v1[k][d]);
     PetscCall(VecNorm(modes[k], NORM_2, &r));
-    PetscCall(MatMult(p->sys->K, modes[k], Kr));
+    PetscCall(MatMult(p->sys->stiffness.K, modes[k], Kr));
     PetscCall(VecNorm(Kr, NORM_2, &kr));
     PetscCall(PetscSNPrintf(what, sizeof(what), "rigid mode %" PetscInt_FMT " (%s) ||K r|| / (||K||_2 ||r||)", k, rotation ? "rotation" : "translation"));
     if (!rotation || c->desc->rotation_invariant)
@@ -234,27 +234,27 @@ static PetscErrorCode EnergyError(PeriProblem p, PetscReal norm2, const PetscRea
     PetscCall(PeriModelComponentIndex(m, names[a], &comp[a]));
     centre[a] = 0.5 * (pt->lower[a] + pt->upper[a]);
   }
-  if (!p->sys->u) PetscCall(MatCreateVecs(p->sys->K, &p->sys->u, NULL));
-  PetscCall(VecSet(p->sys->u, 0));
-  PetscCall(VecGetArray(p->sys->u, &u));
+  if (!p->sys->fields.u) PetscCall(MatCreateVecs(p->sys->stiffness.K, &p->sys->fields.u, NULL));
+  PetscCall(VecSet(p->sys->fields.u, 0));
+  PetscCall(VecGetArray(p->sys->fields.u, &u));
   for (PetscInt i = p->sys->disc.bonds.rstart; i < p->sys->disc.bonds.rend; i++)
     for (PetscInt a = 0; a < 3; a++)
       if (comp[a] >= 0)
         for (PetscInt b = 0; b < pt->dim; b++) u[(i - p->sys->disc.bonds.rstart) * m->dofs + comp[a]] += G[a][b] * (pt->x[3 * i + b] - centre[b]);
-  PetscCall(VecRestoreArray(p->sys->u, &u));
+  PetscCall(VecRestoreArray(p->sys->fields.u, &u));
   PetscCall(PeriSystemEvaluateEnergy(p->sys));
   /* the energy is evaluated from the model's blocks, bond by bond: it must be the assembled K's */
   {
     Vec         Ku;
     PetscScalar uKu;
     PetscReal   unorm;
-    PetscCall(MatCreateVecs(p->sys->K, NULL, &Ku));
-    PetscCall(MatMult(p->sys->K, p->sys->u, Ku));
-    PetscCall(VecDot(p->sys->u, Ku, &uKu));
-    PetscCall(VecNorm(p->sys->u, NORM_2, &unorm));
+    PetscCall(MatCreateVecs(p->sys->stiffness.K, NULL, &Ku));
+    PetscCall(MatMult(p->sys->stiffness.K, p->sys->fields.u, Ku));
+    PetscCall(VecDot(p->sys->fields.u, Ku, &uKu));
+    PetscCall(VecNorm(p->sys->fields.u, NORM_2, &unorm));
     PetscCall(VecDestroy(&Ku));
     /* relative to the round-off scale ||K||_2 ||u||^2 / 2: a smooth u cancels much of K */
-    *mismatch = PetscAbsReal(p->sys->strain_energy - 0.5 * PetscRealPart(uKu)) / (0.5 * norm2 * unorm * unorm);
+    *mismatch = PetscAbsReal(p->sys->fields.strain_energy - 0.5 * PetscRealPart(uKu)) / (0.5 * norm2 * unorm * unorm);
   }
   W      = TargetEnergy(m, G, comp);
   reach  = 2 * PeriSearchRadius(p->sys->disc.partial_volume, p->sys->disc.delta, pt->mean_spacing);
@@ -263,12 +263,12 @@ static PetscErrorCode EnergyError(PeriProblem p, PetscReal norm2, const PetscRea
   *total = 0;
   for (PetscInt i = 0; i < p->sys->disc.nowned; i++) *total += PeriParticleIsFictitious(pt, i) ? 0 : W * pt->volume[i];
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, total, 1, MPIU_REAL, MPI_SUM, p->comm));
-  *total = PetscAbsReal(p->sys->strain_energy - *total) / *total;
+  *total = PetscAbsReal(p->sys->fields.strain_energy - *total) / *total;
   for (PetscInt i = 0; i < p->sys->disc.nowned; i++) {
     PetscBool inner = (PetscBool)!PeriParticleIsFictitious(pt, i);
     for (PetscInt b = 0; b < pt->dim; b++) inner = (PetscBool)(inner && pt->x[3 * i + b] - pt->lower[b] >= reach && pt->upper[b] - pt->x[3 * i + b] >= reach);
     if (!inner) continue;
-    *err = PetscMax(*err, PetscAbsReal(p->sys->W[i] - W) / W);
+    *err = PetscMax(*err, PetscAbsReal(p->sys->fields.W[i] - W) / W);
     (*count)++;
   }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, err, 1, MPIU_REAL, MPI_MAX, p->comm));
@@ -318,7 +318,7 @@ static PetscErrorCode LatticeAtOtherM(const char scene[], Case *c, const char *c
     PetscCall(PeriTestSetOption("-horizon_m", ms[k]));
     PetscCall(PetscSNPrintf(c->name, sizeof(c->name), "%s dim 2 plane %s nu %.4g calibration lattice m %s (23 x 23)", c->type, c->plane, (double)c->nu, ms[k]));
     PetscCall(SetUp(scene, c, &p));
-    PetscCall(MatNorm(p->sys->K, NORM_FROBENIUS, &norm2)); /* an upper bound of ||K||_2: scales the round-off check only */
+    PetscCall(MatNorm(p->sys->stiffness.K, NORM_FROBENIUS, &norm2)); /* an upper bound of ||K||_2: scales the round-off check only */
     PetscCall(CheckEnergy(p, c, norm2, surfaces));
     PetscCall(PeriProblemDestroy(&p));
   }

@@ -141,7 +141,7 @@ static PetscErrorCode CheckPreconditioner(const char name[], PeriSystem sys, Mat
 
   PetscFunctionBeginUser;
   PetscCall(ExpansionAndTranslations(sys, K, &eK, &tK));
-  PetscCall(ExpansionAndTranslations(sys, sys->Kpc, &eP, &tP));
+  PetscCall(ExpansionAndTranslations(sys, sys->stiffness.Kpc, &eP, &tP));
   PetscCall(Assert(name, "P: ||P t|| / (||P||_1 ||t||) over translations", tP, TOL));
   PetscCall(Assert(name, "P: |X^T P X - X^T K X| / X^T K X", PetscAbsReal(eP - eK) / eK, 1e-10));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -164,21 +164,21 @@ static PetscErrorCode CheckCase(const char scene[], const char type[], const cha
   PetscCall(PeriProblemLoad(p, scene));
   PetscCall(PeriProblemSetUp(p));
   PetscCall(PeriSystemAssemble(p->sys)); /* no analysis declared a single solve: assembled */
-  K                      = p->sys->K;
-  p->sys->K              = NULL;
-  p->sys->matrix_free_ok = PETSC_TRUE;
-  p->sys->operator_kind  = PERI_OPERATOR_MATRIX_FREE;
+  K                                = p->sys->stiffness.K;
+  p->sys->stiffness.K              = NULL;
+  p->sys->stiffness.matrix_free_ok = PETSC_TRUE;
+  p->sys->stiffness.operator_kind  = PERI_OPERATOR_MATRIX_FREE;
   PetscCall(PeriSystemAssemble(p->sys));
   PetscCall(PeriOperatorPreconditioner(p->sys));
-  PetscCheck(p->sys->op && p->sys->Kpc, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: solver.operator matrix_free gave no matrix-free operator", name);
+  PetscCheck(p->sys->stiffness.op && p->sys->stiffness.Kpc, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: solver.operator matrix_free gave no matrix-free operator", name);
   PetscCall(MatCreateVecs(K, &x, NULL));
   PetscCall(VecSetRandom(x, NULL));
-  PetscCall(ProductError(p->sys->K, K, x, &err));
+  PetscCall(ProductError(p->sys->stiffness.K, K, x, &err));
   PetscCall(Assert(name, "||A x - K x|| / ||K x||", err, TOL));
-  PetscCall(DiagonalError(p->sys->K, K, &err));
+  PetscCall(DiagonalError(p->sys->stiffness.K, K, &err));
   PetscCall(Assert(name, "||diag A - diag K|| / ||diag K||", err, TOL));
   PetscCall(CheckPreconditioner(name, p->sys, K));
-  PetscCall(CheckElimination(name, p->sys->K, K, x));
+  PetscCall(CheckElimination(name, p->sys->stiffness.K, K, x));
   PetscCall(VecDestroy(&x));
   PetscCall(MatDestroy(&K));
   PetscCall(PeriProblemDestroy(&p));
@@ -217,14 +217,14 @@ static PetscErrorCode CheckSolve(const char scene[], const char pc_after[])
   PetscCall(PeriTestSetOption("-solver_operator", "matrix_free"));
   PetscCall(PeriTestRunScene(PETSC_COMM_WORLD, scene, &q));
   PetscCall(PeriTestSetOption("-solver_operator", NULL));
-  PetscCheck(q->sys->op, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: the static run did not use the matrix-free operator", scene);
-  PetscCheck(!strcmp(q->sys->solve.pc_type, pc_after), PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: the matrix-free solve ended with PC %s, expected %s", scene, q->sys->solve.pc_type, pc_after);
+  PetscCheck(q->sys->stiffness.op, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: the static run did not use the matrix-free operator", scene);
+  PetscCheck(!strcmp(q->sys->fields.solve.pc_type, pc_after), PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: the matrix-free solve ended with PC %s, expected %s", scene, q->sys->fields.solve.pc_type, pc_after);
   PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: %s: the matrix-free solve ended with PC %s\n", scene, pc_after));
   PetscCall(PetscSNPrintf(what, sizeof(what), "%s: strain energy, matrix_free vs assembled", scene));
-  PeriTestClose(what, q->sys->strain_energy, p->sys->strain_energy, 1e-8 * p->sys->strain_energy);
+  PeriTestClose(what, q->sys->fields.strain_energy, p->sys->fields.strain_energy, 1e-8 * p->sys->fields.strain_energy);
   for (PetscInt c = 0; c < p->sys->model->dofs; c++) {
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s: max |%s|, matrix_free vs assembled", scene, p->sys->model->components[c]));
-    PeriTestClose(what, q->sys->max_abs_u[c], p->sys->max_abs_u[c], 1e-7 * p->sys->max_abs_u[c]);
+    PeriTestClose(what, q->sys->fields.max_abs_u[c], p->sys->fields.max_abs_u[c], 1e-7 * p->sys->fields.max_abs_u[c]);
   }
   PetscCall(PeriProblemDestroy(&p));
   PetscCall(PeriProblemDestroy(&q));

@@ -1,0 +1,59 @@
+/* The stiffness operator of the system (src/system/assembly.c, operator.c, solve.c): K assembled or
+ * applied bond by bond, the matrix that preconditions a matrix-free K, and the checked linear solve
+ * K u = f with the prescribed DOFs eliminated. */
+#pragma once
+
+#include <petscksp.h>
+#include "perilin/private/disc.h"
+
+typedef struct _p_PeriSystem *PeriSystem;
+
+/* How K is applied (solver.operator, src/system/operator.c), and the bodies small enough for
+ * CG + Jacobi on a matrix-free K (PeriSystemAssemble). */
+#define PERI_JACOBI_MAX_PARTICLES 500000
+#define PERI_JACOBI_MAX_SPAN      200
+#define PERI_JACOBI_BUDGET        400 /* iterations, about the cost of GAMG's set-up and solve */
+typedef enum {
+  PERI_OPERATOR_AUTO,
+  PERI_OPERATOR_ASSEMBLED,
+  PERI_OPERATOR_MATRIX_FREE
+} PeriOperatorKind;
+PETSC_EXTERN const char *const  PeriOperatorKinds[];
+typedef struct _p_PeriOperator *PeriOperator;
+
+/* K and how it is applied and solved. */
+typedef struct {
+  Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
+  Mat              Kpc;                     /* with op: the assembled short-range stiffness that preconditions K */
+  PeriOperator     op;                      /* solver.operator: matrix_free, else NULL */
+  PeriOperatorKind operator_kind;           /* solver.operator */
+  PetscReal        pc_radius;               /* solver.pc_radius */
+  char             pc_default[16];          /* the static solve's PC unless -pc_type: gamg, or jacobi (matrix-free K on a small 3D body) */
+  PetscBool        matrix_free_ok;          /* set by an analysis that uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free */
+  char             mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
+  PetscReal        residual_tol;            /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
+} PeriStiffness;
+
+PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
+PETSC_EXTERN PetscErrorCode PeriMatrixMB(Mat, PetscReal *);
+PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, PetscReal, Mat *);
+PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *);
+PETSC_EXTERN PetscErrorCode PeriOperatorPreconditioner(PeriSystem);
+PETSC_EXTERN PetscBool      PeriOperatorServesPC(const char[]);
+PETSC_EXTERN PetscBool      PeriOperatorPCWithoutMatrix(const char[]);
+PETSC_EXTERN PetscErrorCode PeriOperatorCreateMat(PeriSystem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriOperatorMemoryMB(PeriSystem, PeriOperator, PetscReal *);
+PETSC_EXTERN PetscErrorCode PeriOperatorScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriOperatorScaled(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriOperatorDestroy(PeriOperator *);
+PETSC_EXTERN PetscErrorCode PeriStaticSolve(PeriSystem, KSP *, PetscReal, PetscBool, PetscInt, const PetscInt[], const PetscReal[], KSPConvergedReason *);
+PETSC_EXTERN PetscErrorCode PeriStaticCheckConverged(PeriSystem, KSPConvergedReason);
+PETSC_EXTERN PetscErrorCode PeriStaticConverged(PeriSystem, KSP, KSPConvergedReason, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriStaticDefaultMatType(char[], size_t);
+PETSC_EXTERN PetscReal      PeriResidualTolerance(PeriSystem, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriStiffnessDestroy(PeriStiffness *);

@@ -1,0 +1,137 @@
+/* The bond state service (include/perilin/private/bondstate.h): breaking bonds by the scene's
+ * criteria and returning to a saved equilibrium. Any analysis that lets bonds fail (quasi-static,
+ * transient) breaks them here; the criteria themselves are in failure.c. */
+#include "perilin/private/system.h"
+
+/*@C
+  PeriBondsBreak - evaluates every live bond of this rank against the criterion and breaks those past it (all, or
+ * those within the top fraction of the worst index), subtracting their blocks from K; softening
+ * bonds lose stiffness by eqs. 45-46 (irreversibly). Returns the global number of bonds broken or
+ * softened by more than 1 %. With all, every bond past its criterion breaks; else those within
+  the top fraction of [1, worst index]. Collective.
+@*/
+PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fraction, PetscInt *nbroken)
+{
+  PeriBonds        *b  = &sys->disc.bonds;
+  PeriModel         m  = sys->model;
+  const PetscInt    bs = m->dofs;
+  PetscScalar      *u;
+  PeriFailureCause *cause;
+  PetscReal        *index, *soft, worst = 0, threshold = 1;
+  PetscInt          mine = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemLocalDOFs(sys, U, &u));
+  PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PeriBondGeometry g;
+      PetscReal        ui[PERI_MAX_DOF], uj[PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
+      index[k] = 0;
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+      for (PetscInt c = 0; c < bs; c++) {
+        ui[c] = PetscRealPart(u[i * bs + c]);
+        uj[c] = PetscRealPart(u[g.j * bs + c]);
+      }
+      m->ops.bond_measures(m, &g, ui, uj, meas);
+      index[k] = PeriBondFailureIndex(sys, &g, meas, &cause[k]);
+      soft[k]  = b->intact ? PeriBondSoftening(sys, meas) : 1;
+      worst    = PetscMax(worst, index[k]);
+    }
+  PetscCall(PetscFree(u));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, sys->comm));
+  /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
+  if (!all && worst > 1) threshold = worst - fraction * (worst - 1);
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscBool breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
+      if (!b->live[k] || b->j[k] == i) continue;
+      if (!breaks && !(b->intact && soft[k] < b->intact[k])) continue;
+      /* the bond's stiffness becomes new share / old share of itself (state-based models: K is
+         reassembled from the synchronized families below) */
+      if (m->ops.bond_stiffness) PetscCall(PeriStiffnessScaleBond(sys, i, k, breaks ? 0 : soft[k] / b->intact[k]));
+      if (breaks || soft[k] <= 0) {
+        b->live[k]  = 0;
+        b->cause[k] = (unsigned char)cause[k];
+        mine++;
+      } else {
+        /* softening: iterate until no bond loses more than 1 % of its stiffness */
+        if (b->intact[k] - soft[k] > 1e-2) mine++;
+        b->intact[k] = soft[k];
+        b->cause[k]  = (unsigned char)cause[k];
+      }
+    }
+  PetscCall(PetscFree3(index, soft, cause));
+  PetscCall(PeriStiffnessScaled(sys));
+  PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, sys->comm));
+  if (*nbroken && !m->ops.bond_stiffness) {
+    PetscCall(PeriFamilySync(sys));
+    PetscCall(PeriSystemAssemble(sys));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The state of the last equilibrium: what the outputs describe when a later step fails or the
+ * run is interrupted, so that every file of the set shows one state. */
+PetscErrorCode PeriCheckpointCreate(PeriSystem sys, PeriCheckpoint *e)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateVecs(sys->stiffness.K, &e->u, NULL)); /* lambda = 0: no displacement */
+  PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &e->live));
+  PetscCall(PetscArraycpy(e->live, sys->disc.bonds.live, sys->disc.bonds.nbonds));
+  e->intact = NULL;
+  if (sys->disc.bonds.intact) {
+    PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &e->intact));
+    PetscCall(PetscArraycpy(e->intact, sys->disc.bonds.intact, sys->disc.bonds.nbonds));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriCheckpointSave(PeriSystem sys, PeriCheckpoint *e)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecCopy(sys->fields.u, e->u));
+  e->solve = sys->fields.solve;
+  PetscCall(PetscArraycpy(e->live, sys->disc.bonds.live, sys->disc.bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(e->intact, sys->disc.bonds.intact, sys->disc.bonds.nbonds));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Back to the last equilibrium: bonds (and the families and K built from them when the loop goes
+ * on), and, with restore_u, the displacements. */
+PetscErrorCode PeriCheckpointRestore(PeriSystem sys, PeriCheckpoint *e, PetscBool reassemble, PetscBool restore_u)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscArraycpy(sys->disc.bonds.live, e->live, sys->disc.bonds.nbonds));
+  if (e->intact) PetscCall(PetscArraycpy(sys->disc.bonds.intact, e->intact, sys->disc.bonds.nbonds));
+  PetscCall(PeriFamilySync(sys));
+  if (reassemble) {
+    PetscCall(PeriSystemAssemble(sys));
+    if (sys->conditions.torsion.active && !sys->conditions.layers.nfaces) PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
+  }
+  if (restore_u) {
+    if (!sys->fields.u) PetscCall(VecDuplicate(e->u, &sys->fields.u));
+    PetscCall(VecCopy(e->u, sys->fields.u));
+    /* summary.json's solver section describes the solve of this state, not the abandoned one */
+    if (e->solve.ksp_type[0]) sys->fields.solve = e->solve;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriCheckpointDestroy(PeriCheckpoint *e)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecDestroy(&e->u));
+  PetscCall(PetscFree(e->live));
+  PetscCall(PetscFree(e->intact));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Frees what the bond state holds. */
+PetscErrorCode PeriBondStateDestroy(PeriBondState *B)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(B->damage));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
