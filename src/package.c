@@ -38,6 +38,13 @@ PetscErrorCode PeriInitializePackage(void)
   /* the registries are filled here, once, so that neither calls back into the package */
   PetscCall(PeriModelRegisterAll());
   PetscCall(PeriAnalysisRegisterAll());
+  {
+    /* the output sets learn the analyses' files from the analyses themselves */
+    PetscInt                       na;
+    const PeriAnalysisType *const *types;
+    PetscCall(PeriAnalysisGetTypes(&na, &types));
+    for (PetscInt k = 0; k < na; k++) PetscCall(PeriOutputSetAddNames(types[k]->files));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -72,25 +72,34 @@ const PeriSchema PeriProblemSchema[] = {
     {NULL},
 };
 
-/* analysis.type, and analysis.* against that analysis' schema (p->scene->owners holds every
- * plug-in's). An unknown type allows every analysis' keys here: PeriProblemRun reports it with
- * the list of types. */
+/* analysis.type, checked against the registered types; analysis.* against that analysis' schema
+ * (p->scene->owners holds every plug-in's), then read by the analysis itself: every analysis key
+ * is checked before any particle exists. */
 static PetscErrorCode ReadAnalysis(PeriProblem p)
 {
-  PeriScene              s      = p->scene;
-  const PeriSchemaOwner *active = NULL;
-  PeriNode               a;
+  PeriScene               s      = p->scene;
+  const PeriSchemaOwner  *active = NULL;
+  const PeriAnalysisType *type;
+  PeriNode                a;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(p->analysis_type, "static", sizeof(p->analysis_type)));
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
   PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis_type, sizeof(p->analysis_type), NULL));
+  PetscCall(PeriAnalysisFind(p->analysis_type, &type));
+  if (!type) {
+    char list[256];
+    PetscCall(PeriAnalysisListTypes(list, sizeof(list)));
+    PeriInputCheck(PETSC_FALSE, s, a, "type", "unknown analysis '%s'; available: %s", p->analysis_type, list);
+  }
   for (PetscInt o = 0; o < s->nowners; o++)
     if (!strcmp(s->owners[o].kind, "analysis") && !strcmp(s->owners[o].name, p->analysis_type)) active = &s->owners[o];
   /* an analysis without a schema (setup, the dry run) accepts every analysis' keys, so that any
      scene can be checked with -analysis_type setup */
   if (active && !active->schema) active = NULL;
   PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", active));
+  PetscCall(PeriAnalysisCreate(p->comm, type, &p->analysis));
+  PetscCall(PeriAnalysisSetFromScene(p->analysis, s));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -110,7 +119,7 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneCheckSection(s, o, "output"));
   PetscCall(PeriSceneGetString(s, o, "dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
   PetscCall(PeriSceneGetBool(s, o, "vtk", &p->vtk, NULL));
-  PetscCall(PeriSceneGetBool(s, o, "stress", &p->sys->fields.stress_output, NULL));
+  PetscCall(PeriSceneGetBool(s, o, "stress", &p->stress_output, NULL));
   PetscCall(PeriSceneGetInt(s, o, "every", PETSC_FALSE, &p->output_every, NULL));
   PeriInputCheck(p->output_every >= 0, s, o, "every", "must not be negative (0: only the end), got %" PetscInt_FMT, p->output_every);
   PetscCall(ReadAnalysis(p));
@@ -127,12 +136,16 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscFunctionBeginUser;
   PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
   PetscCall(PeriSceneCheckSection(p->scene, p->scene->root, ""));
+  /* the output and the analysis first: their keys are checked before any particle exists */
+  PetscCall(ReadOutput(p, p->scene->file));
   PetscCall(PeriSystemCreate(p->comm, p->scene, &p->sys));
+  p->sys->fields.stress_output = p->stress_output;
+  PetscCall(PeriSystemSetNeeds(p->sys, &p->analysis->type->needs));
   PetscCall(PeriProgressUpdate(p->sys->run.progress, PERI_PROGRESS_PHASE, "setup"));
   PetscCall(PeriSystemSetFromScene(p->sys));
-  PetscCall(ReadOutput(p, p->scene->file));
   if (p->write_output) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   PetscCall(PeriSystemSetUp(p->sys));
+  PetscCall(PeriAnalysisSetUp(p->analysis, p->sys));
   p->sys->run.log.memory_phase_mb[0] = PeriPeakMemoryMB();
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -156,20 +169,10 @@ static PetscErrorCode WriteSnapshot(void *ctx, const char base[])
 @*/
 PetscErrorCode PeriProblemRun(PeriProblem p)
 {
-  const PeriAnalysisType *type;
-  PetscReal               mb;
-  PetscLogDouble          t;
+  PetscReal      mb;
+  PetscLogDouble t;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriAnalysisFind(p->analysis_type, &type));
-  if (!type) {
-    PeriNode a;
-    char     list[256];
-    PetscCall(PeriSceneGetNode(p->scene->root, "analysis", &a));
-    PetscCall(PeriAnalysisListTypes(list, sizeof(list)));
-    PeriInputCheck(PETSC_FALSE, p->scene, a, "type", "unknown analysis '%s'; available: %s", p->analysis_type, list);
-  }
-  PetscCall(PeriAnalysisCreate(type, p->sys, &p->analysis));
   p->analysis->vtk         = p->vtk;
   p->analysis->every       = p->output_every;
   p->analysis->output_dir  = p->output_dir;
@@ -178,7 +181,7 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   /* a signal during the set-up: no analysis, only the summary saying so */
   PetscCall(PeriSignalReceived(p->comm, &p->sys->run.interrupted));
   PetscCall(PetscLogStagePush(PERI_STAGE_Solve));
-  if (!p->sys->run.interrupted) PetscCall(type->ops.run(p->analysis));
+  if (!p->sys->run.interrupted) PetscCall(PeriAnalysisRun(p->analysis));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscTime(&t));
   p->sys->run.log.total_s            = t - p->t_start;
@@ -265,7 +268,7 @@ PetscErrorCode PeriProblemCheckOptions(PeriProblem p)
 
 PetscErrorCode PeriProblemCheckUnusedOptions(PeriProblem p)
 {
-  PeriRunSolvers run = {p->comm, p->scene, p->sys->stiffness.mat_type, p->sys->fields.solve.ksp_type, p->sys->fields.solve.pc_type, p->analysis ? p->analysis->type->eigensolver : PETSC_FALSE};
+  PeriRunSolvers run = {p->comm, p->scene, p->sys->stiffness.mat_type, p->sys->fields.solve.ksp_type, p->sys->fields.solve.pc_type, p->analysis->type->option_prefix, p->analysis->type->ops.solvers_from_options};
 
   PetscFunctionBeginUser;
   /* -mat_type sets the type of the assembled matrix: K, or with a matrix-free K its preconditioner */

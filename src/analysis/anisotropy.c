@@ -96,13 +96,15 @@ static PetscErrorCode OnlyCriterion(PeriAnalysis an, const PeriFailure *all, Pet
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* analysis.{criteria, paths, m, orientations}. */
-static PetscErrorCode ReadSettings(PeriAnalysis an, Anisotropy *A)
+/* analysis.{criteria, paths, m, orientations}, before any particle exists. */
+static PetscErrorCode SetFromScene_Anisotropy(PeriAnalysis an, PeriScene s, PeriNode a)
 {
-  PeriScene s = an->sys->scene;
-  PeriNode  a, list;
+  Anisotropy *A;
+  PeriNode    list;
 
   PetscFunctionBeginUser;
+  PetscCall(PetscNew(&A));
+  an->data = A;
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
   PetscCall(PeriSceneGetNode(a, "criteria", &list));
   PeriInputCheck(list && list->kind == PERI_NODE_SEQ && list->n >= 1 && list->n <= 3, s, list ? list : a, list ? NULL : "criteria", "is required: a list of one to three of stretch, sliding, frictional");
@@ -141,10 +143,8 @@ static PetscErrorCode Run_Anisotropy(PeriAnalysis an)
   const PetscReal   unit = all.stretch > 0 ? all.stretch : 1;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscNew(&A));
-  an->data = A;
-  PetscCall(ReadSettings(an, A));
   PetscCheck(an->sys->disc.particles.dim == 2, an->comm, PETSC_ERR_USER_INPUT, "%s: the anisotropy analysis studies the 2D square lattice: dim must be 2", an->sys->scene->file);
+  A = AN(an);
   PetscCall(PetscMalloc1(A->ncrit * A->npaths * A->nm, &A->emax));
   for (PetscInt c = 0; c < A->ncrit; c++) {
     PetscCall(OnlyCriterion(an, &all, A->crit[c]));
@@ -201,7 +201,6 @@ static PetscErrorCode Report_Anisotropy(PeriAnalysis an)
 static PetscErrorCode Destroy_Anisotropy(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
-  if (!AN(an)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscFree(AN(an)->paths));
   PetscCall(PetscFree(AN(an)->m));
   PetscCall(PetscFree(AN(an)->emax));
@@ -215,5 +214,15 @@ static const PeriKey anisotropy_keys[] = {
     {"orientations", PERI_KEY_INT, "101", "[2, inf)", NULL, NULL, "orientations Theta of each path, evenly over [0, 90] degrees (101: Diana & Casolo's 0.9-degree steps)"},
     {NULL},
 };
-static const PeriSchema anisotropy_schema[]     = {{"analysis", anisotropy_keys}, {NULL}};
-const PeriAnalysisType  PeriAnalysis_Anisotropy = {"anisotropy", "the failure anisotropy of the lattice's unit cell (Diana & Casolo Tables 7-9): anisotropy.csv", anisotropy_schema, PETSC_FALSE, {Run_Anisotropy, NULL, Files_Anisotropy, Summary_Anisotropy, Report_Anisotropy, Destroy_Anisotropy}};
+static const PeriSchema  anisotropy_schema[] = {{"analysis", anisotropy_keys}, {NULL}};
+static const char *const anisotropy_files[]  = {"anisotropy.csv", NULL};
+
+/* Solves nothing: K is never built (the memory estimate sizes it as a static run's, assembled). */
+const PeriAnalysisType PeriAnalysis_Anisotropy = {
+    .name   = "anisotropy",
+    .help   = "the failure anisotropy of the lattice's unit cell (Diana & Casolo Tables 7-9): anisotropy.csv",
+    .schema = anisotropy_schema,
+    .files  = anisotropy_files,
+    .needs  = {.static_solver = PETSC_TRUE},
+    .ops    = {.setfromscene = SetFromScene_Anisotropy, .run = Run_Anisotropy, .files = Files_Anisotropy, .summary = Summary_Anisotropy, .report = Report_Anisotropy, .destroy = Destroy_Anisotropy},
+};

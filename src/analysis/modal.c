@@ -37,19 +37,30 @@ static PetscErrorCode MainAxis(PeriAnalysis an, PetscInt *axis)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ReadSettings(PeriAnalysis an, PetscInt *nev, PetscReal *target_hz)
+/* analysis.nev and analysis.target_hz, before any particle exists (the schema's defaults). */
+static PetscErrorCode SetFromScene_Modal(PeriAnalysis an, PeriScene s, PeriNode a)
 {
-  PeriScene s = an->sys->scene;
-  PeriNode  a, mat;
+  PeriModal *md;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetNode(s->root, "analysis", &a));
-  *nev       = 6;
-  *target_hz = 0;
-  PetscCall(PeriSceneGetInt(s, a, "nev", PETSC_FALSE, nev, NULL));
-  PetscCall(PeriSceneGetReal(s, a, "target_hz", PETSC_FALSE, target_hz, NULL));
-  PeriInputCheck(*nev >= 1, s, a, "nev", "must be at least 1");
-  PeriInputCheck(*target_hz >= 0, s, a, "target_hz", "must not be negative");
+  PetscCall(PetscNew(&md));
+  an->data      = md;
+  md->nev       = 6;
+  md->target_hz = 0;
+  PetscCall(PeriSceneGetInt(s, a, "nev", PETSC_FALSE, &md->nev, NULL));
+  PetscCall(PeriSceneGetReal(s, a, "target_hz", PETSC_FALSE, &md->target_hz, NULL));
+  PeriInputCheck(md->nev >= 1, s, a, "nev", "must be at least 1");
+  PeriInputCheck(md->target_hz >= 0, s, a, "target_hz", "must not be negative");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What the system must offer: a density, and bc only (no fictitious layers). */
+static PetscErrorCode SetUp_Modal(PeriAnalysis an)
+{
+  PeriScene s = an->sys->scene;
+  PeriNode  mat;
+
+  PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "material", &mat));
   PeriInputCheck(an->sys->model->material.rho > 0, s, mat, "rho", "a modal analysis needs the density (material.rho > 0)");
   PeriInputCheck(!an->sys->conditions.layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a modal analysis takes bc only");
@@ -389,18 +400,16 @@ static PetscErrorCode CheckModes(PeriAnalysis an, PetscReal eps_tol)
 }
 
 /* The mass, the free DOFs and the blocks of K and M on them. */
-static PetscErrorCode SetUpModal(PeriAnalysis an, PetscReal target_hz, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff)
+static PetscErrorCode SetUpModal(PeriAnalysis an, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff)
 {
-  PeriModal *md;
+  PeriModal *md = Modal(an);
 
   PetscFunctionBeginUser;
   /* the system's mass service (src/system/mass.c): borrowed */
   PetscCall(PeriMassGetMatrix(an->sys, M));
   PetscCall(PeriMassGetDiagonal(an->sys, mdiag));
-  PetscCall(PetscNew(&md));
-  an->data = md;
+  md->started = PETSC_TRUE;
   PetscCall(PeriMassGetTotal(an->sys, &md->total_mass));
-  md->target_hz = target_hz;
   PetscCall(MainAxis(an, &md->axis));
   PetscCall(FreeDOFs(an, isfree));
   PetscCall(ISGetSize(*isfree, &md->nfree_dofs));
@@ -512,7 +521,7 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
-  PetscCall(SetUpModal(an, target_hz, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff));
+  PetscCall(SetUpModal(an, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff));
   md = Modal(an);
   PetscCall(PeriRigidMotionFree(an->sys, &nfree, what, sizeof(what), NULL));
   md->nrigid = 0;
@@ -569,19 +578,16 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
 @*/
 static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
 {
-  PetscInt       nev;
-  PetscReal      target_hz;
   ModalWork      w;
   PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadSettings(an, &nev, &target_hz));
   PetscCall(PetscStrncpy(an->sys->stiffness.mat_type, MATAIJ, sizeof(an->sys->stiffness.mat_type)));
   if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   /* a failed check may return from deep inside SLEPc: free everything, then pass the error on */
-  ierr = ModalSolve(an, nev, target_hz, &w);
+  ierr = ModalSolve(an, Modal(an)->nev, Modal(an)->target_hz, &w);
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(ModalWorkDestroy(&w));
   PetscCall(ierr);
@@ -599,7 +605,7 @@ static PetscErrorCode PeriWriteModesCSV(PeriAnalysis an, const char path[])
   int   bad = 0;
 
   PetscFunctionBeginUser;
-  if (an->rank || !Modal(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->rank || !Modal(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "mode,f_hz,omega2,residual,kind") < 0;
   for (PetscInt c = 0; c < an->sys->model->dofs; c++) bad |= fprintf(fp, ",share_%s", an->sys->model->components[c]) < 0;
@@ -682,7 +688,7 @@ static PetscErrorCode ModalSummary(PeriAnalysis an, PeriJSON j)
   const PetscInt bs = an->sys->model->dofs;
 
   PetscFunctionBeginUser;
-  if (!Modal(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!Modal(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   const PeriModal *md = Modal(an);
   PetscReal        f[256];
   PetscCall(PeriJSONBeginObject(j, "modal"));
@@ -729,7 +735,7 @@ static PetscErrorCode ModalFiles(PeriAnalysis an, const char dir[])
   char path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  if (!Modal(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!Modal(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", dir));
   PetscCall(PeriWriteModesCSV(an, path));
   if (an->vtk) PetscCall(WriteModeShapes(an, dir));
@@ -744,7 +750,7 @@ static PetscErrorCode ModalDestroy(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The analysis.* keys ReadSettings reads. */
+/* The analysis.* keys SetFromScene_Modal reads. */
 static const PeriKey modal_keys[] = {
     {"nev", PERI_KEY_INT, "6", "[1, inf)", NULL, NULL, "number of modes"},
     {"target_hz", PERI_KEY_REAL, "0", "[0, inf)", "[1/time]", NULL, "compute the modes nearest this frequency (0: the lowest)"},
@@ -752,4 +758,38 @@ static const PeriKey modal_keys[] = {
 };
 static const PeriSchema modal_schema[] = {{"analysis", modal_keys}, {NULL}};
 
-const PeriAnalysisType PeriAnalysis_Modal = {"modal", "natural frequencies and mode shapes (SLEPc, shift-and-invert)", modal_schema, PETSC_TRUE, {PeriAnalysisRun_Modal, ModalAddFields, ModalFiles, ModalSummary, ModalReport, ModalDestroy}};
+/* The spectral transformation's linear solver, shift-and-invert as CreateEPS makes it, of the
+ * given types and set from the options: for the unused-option check (src/scene/options.c). */
+static PetscErrorCode SolversFromOptions_Modal(MPI_Comm comm, const char ksp_type[], const char pc_type[])
+{
+  EPS eps;
+  ST  st;
+  KSP ksp;
+  PC  pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSCreate(comm, &eps));
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STSetType(st, STSINVERT));
+  PetscCall(STGetKSP(st, &ksp));
+  if (ksp_type[0]) PetscCall(KSPSetType(ksp, ksp_type));
+  PetscCall(KSPGetPC(ksp, &pc));
+  if (pc_type[0]) PetscCall(PCSetType(pc, pc_type));
+  PetscCall(EPSSetFromOptions(eps));
+  PetscCall(EPSDestroy(&eps));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static const char *const modal_files[] = {"modes.csv", "modes.pvd", "mode_#.vtu", "mode_#.pvtu", "mode_#", NULL};
+
+/* K is assembled AIJ and factored (its fill measured in docs/performance.md); the mass comes from
+ * the system's mass service. */
+const PeriAnalysisType PeriAnalysis_Modal = {
+    .name          = "modal",
+    .help          = "natural frequencies and mode shapes (SLEPc, shift-and-invert)",
+    .schema        = modal_schema,
+    .option_prefix = "st_",
+    .files         = modal_files,
+    .needs         = {.factor_fill = 0.45},
+    .ops           = {.setfromscene = SetFromScene_Modal, .setup = SetUp_Modal, .run = PeriAnalysisRun_Modal, .fields = ModalAddFields, .files = ModalFiles, .summary = ModalSummary, .report = ModalReport, .solvers_from_options = SolversFromOptions_Modal, .destroy = ModalDestroy},
+};

@@ -8,14 +8,9 @@
 #include "perilin/private/analysis.h"
 #include <signal.h>
 
-/* the analysis' results (its data) */
-static inline PeriQuasistatic *QS(PeriAnalysis an)
-{
-  return (PeriQuasistatic *)an->data;
-}
-
-/* analysis.stepping */
+/* analysis.stepping, analysis.break */
 static const char *const qs_steppings[] = {"increments", "events", NULL};
+static const char *const qs_policies[]  = {"all", "fraction", NULL};
 
 #define PERI_MAX_LOAD_STEPS 100000
 /* the relative tolerance of a cascade's intermediate solves (stepping by events): the breaks need
@@ -30,7 +25,25 @@ typedef struct {
   PetscInt   max_iterations;
   PeriProbe *control;
   PetscInt   component, reaction; /* the control probe's component; the reaction region (index of disc.regions) or -1 */
+  /* the names the scene gives, resolved against the system by SetUp_Quasistatic ("": not given) */
+  char control_probe[PERI_NAME_LEN], control_component[PERI_NAME_LEN], reaction_region[PERI_NAME_LEN];
 } Settings;
+
+/* The analysis' data: its results, then its settings (QS(an) reads the results). */
+typedef struct {
+  PeriQuasistatic q;
+  Settings        st;
+} QSData;
+
+static inline PeriQuasistatic *QS(PeriAnalysis an)
+{
+  return &((QSData *)an->data)->q;
+}
+
+static inline Settings *ST(PeriAnalysis an)
+{
+  return &((QSData *)an->data)->st;
+}
 
 /* The load factor scales the loads, the prescribed values, the layers' values and the twist:
  * with all of them zero every step is the unloaded body, and the loop would run to the end. */
@@ -65,20 +78,18 @@ static PetscInt DefaultReactionRegion(PeriSystem sys, PetscInt c)
  * steps.csv's load-displacement columns. */
 static PetscErrorCode ReadLoadDisplacement(PeriAnalysis an, PeriNode a, Settings *st)
 {
-  PeriScene s                   = an->sys->scene;
-  PeriModel m                   = an->sys->model;
-  char      name[PERI_NAME_LEN] = "", list[128] = "";
-  PetscBool has;
+  PeriScene   s         = an->sys->scene;
+  PeriModel   m         = an->sys->model;
+  const char *name      = st->reaction_region;
+  char        list[128] = "";
 
   PetscFunctionBeginUser;
   for (PetscInt c = 0; c < m->dofs; c++) PeriListAppend(list, sizeof(list), m->components[c]);
   st->component = 0;
-  PetscCall(PeriSceneGetString(s, a, "control_component", PETSC_FALSE, name, sizeof(name), &has));
-  if (has) PetscCall(PeriModelComponentIndex(m, name, &st->component));
-  PeriInputCheck(st->component >= 0, s, a, "control_component", "'%s' is not a component of model %s; its components are: %s", name, m->type, list);
+  if (st->control_component[0]) PetscCall(PeriModelComponentIndex(m, st->control_component, &st->component));
+  PeriInputCheck(st->component >= 0, s, a, "control_component", "'%s' is not a component of model %s; its components are: %s", st->control_component, m->type, list);
   st->reaction = DefaultReactionRegion(an->sys, st->component);
-  PetscCall(PeriSceneGetString(s, a, "reaction_region", PETSC_FALSE, name, sizeof(name), &has));
-  if (!has) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!name[0]) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriReactionsFindRegion(an->sys, name, &st->reaction));
   list[0] = 0;
   for (PetscInt r = 0; r < an->sys->conditions.reactions.nregions; r++) {
@@ -91,21 +102,21 @@ static PetscErrorCode ReadLoadDisplacement(PeriAnalysis an, PeriNode a, Settings
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
+/* analysis.* before any particle exists: stepping, load factors, breaking, and the names of the
+ * control probe, component and reaction region (resolved by SetUp_Quasistatic). */
+static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, PeriNode a)
 {
-  static const char *const policies[] = {"all", "fraction", NULL};
-  PeriScene                s          = an->sys->scene;
-  PeriNode                 a;
-  PetscInt                 policy = 0, stepping = 0;
-  char                     name[PERI_NAME_LEN] = "";
-  PetscBool                has;
+  QSData   *data;
+  Settings *st;
+  PetscInt  policy = 0, stepping = 0;
+  PetscBool has;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
-  PeriInputCheck(an->sys->bond_state.failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
+  PetscCall(PetscNew(&data));
+  an->data = data;
+  st       = &data->st;
   PetscCall(PeriSceneGetChoice(s, a, "stepping", qs_steppings, &stepping, NULL));
   st->events = stepping == 1 ? PETSC_TRUE : PETSC_FALSE;
-  PeriInputCheck(!st->events || !an->sys->disc.bonds.intact, s, a, "stepping", "events needs brittle bonds: with softening (failure.ultimate_stretch) the bonds weaken gradually; use stepping: increments");
   PetscCall(PeriSceneGetReal(s, a, "load_factor_max", PETSC_TRUE, &st->max, NULL));
   st->step = st->max;
   PetscCall(PeriSceneGetReal(s, a, "load_factor_step", (PetscBool)!st->events, &st->step, NULL));
@@ -119,7 +130,7 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
   PeriInputCheck(st->min_step >= st->step / PERI_MAX_BISECTION && st->min_step <= st->step, s, a, "min_step", "must lie in [load_factor_step / 2^20, load_factor_step] = [%g, %g], got %g", (double)(st->step / PERI_MAX_BISECTION), (double)st->step, (double)st->min_step);
   st->adaptive = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "adaptive", &st->adaptive, NULL));
-  PetscCall(PeriSceneGetChoice(s, a, "break", policies, &policy, NULL));
+  PetscCall(PeriSceneGetChoice(s, a, "break", qs_policies, &policy, NULL));
   st->all      = policy == 0 ? PETSC_TRUE : PETSC_FALSE;
   st->fraction = 0.1;
   PetscCall(PeriSceneGetReal(s, a, "break_fraction", PETSC_FALSE, &st->fraction, &has));
@@ -133,18 +144,40 @@ static PetscErrorCode ReadSettings(PeriAnalysis an, Settings *st)
   PeriInputCheck(st->max_iterations >= 1, s, a, "max_iterations", "must be at least 1");
   st->reuse = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));
+  PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, st->control_probe, sizeof(st->control_probe), NULL));
+  PetscCall(PeriSceneGetString(s, a, "control_component", PETSC_FALSE, st->control_component, sizeof(st->control_component), NULL));
+  PetscCall(PeriSceneGetString(s, a, "reaction_region", PETSC_FALSE, st->reaction_region, sizeof(st->reaction_region), NULL));
+  st->quiet = PETSC_FALSE;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-quiet", &st->quiet, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What needs the system: failure criteria, brittle bonds for events, the control probe, the
+ * load-displacement columns, and something to scale. */
+static PetscErrorCode SetUp_Quasistatic(PeriAnalysis an)
+{
+  PeriScene        s  = an->sys->scene;
+  Settings        *st = ST(an);
+  PeriQuasistatic *q  = QS(an);
+  PeriNode         a;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
+  PeriInputCheck(an->sys->bond_state.failure.active, s, a, "type", "a quasistatic analysis needs failure: (the bond failure criteria)");
+  PeriInputCheck(!st->events || !an->sys->disc.bonds.intact, s, a, "stepping", "events needs brittle bonds: with softening (failure.ultimate_stretch) the bonds weaken gradually; use stepping: increments");
   st->control = an->sys->fields.nprobes ? &an->sys->fields.probes[0] : NULL;
-  PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, name, sizeof(name), &has));
-  if (has) {
+  if (st->control_probe[0]) {
     st->control = NULL;
     for (PetscInt k = 0; k < an->sys->fields.nprobes; k++)
-      if (!strcmp(an->sys->fields.probes[k].name, name)) st->control = &an->sys->fields.probes[k];
-    PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", name);
+      if (!strcmp(an->sys->fields.probes[k].name, st->control_probe)) st->control = &an->sys->fields.probes[k];
+    PeriInputCheck(st->control, s, a, "control_probe", "no probe named '%s' (probes: give it under probes:)", st->control_probe);
   }
   PetscCall(ReadLoadDisplacement(an, a, st));
   PetscCall(CheckSomethingLoaded(an, a));
-  st->quiet = PETSC_FALSE;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-quiet", &st->quiet, NULL));
+  PetscCall(PetscStrncpy(q->control, st->control ? st->control->name : "", sizeof(q->control)));
+  q->control_component = st->component;
+  q->reaction_region   = st->reaction;
+  PetscCall(PetscStrncpy(q->stepping, st->events ? "events" : "increments", sizeof(q->stepping)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -575,38 +608,30 @@ static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L
 @*/
 static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
 {
-  Settings         st;
-  Loop             L  = {0};
-  PeriCheckpoint   eq = {0};
-  PeriQuasistatic *q;
-  PetscLogDouble   t0, t;
+  const Settings *st = ST(an);
+  Loop            L  = {0};
+  PeriCheckpoint  eq = {0};
+  PetscLogDouble  t0, t;
 
   PetscFunctionBeginUser;
-  PetscCall(ReadSettings(an, &st));
-  PetscCall(PetscNew(&q));
-  an->data = q;
-  PetscCall(PetscStrncpy(q->control, st.control ? st.control->name : "", sizeof(q->control)));
-  q->control_component = st.component;
-  q->reaction_region   = st.reaction;
-  PetscCall(PetscStrncpy(q->stepping, st.events ? "events" : "increments", sizeof(q->stepping)));
+  QS(an)->started = PETSC_TRUE;
   PetscCall(PeriStaticDefaultMatType(an->sys->stiffness.mat_type, sizeof(an->sys->stiffness.mat_type)));
-  an->sys->stiffness.matrix_free_ok = PETSC_TRUE; /* K is applied, and changed through PeriStiffnessScaleBond */
   PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PeriCheckpointCreate(an->sys, &eq));
   PetscCallMPI(MPI_Allreduce(&an->sys->disc.bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
   L.stale = PETSC_TRUE;
   PetscCall(PetscTime(&t0));
-  PetscCall(PrintCriteria(an, &st));
-  if (st.events)
-    PetscCall(RunEvents(an, &st, &L, &eq));
+  PetscCall(PrintCriteria(an, st));
+  if (st->events)
+    PetscCall(RunEvents(an, st, &L, &eq));
   else
-    PetscCall(RunIncrements(an, &st, &L, &eq));
+    PetscCall(RunIncrements(an, st, &L, &eq));
   PetscCall(KSPDestroy(&L.ksp));
   PetscCall(PetscFree2(L.hold, L.held));
   PetscCall(PeriCheckpointDestroy(&eq));
   PetscCall(PetscTime(&t));
   an->sys->run.log.solve_s = t - t0;
-  PetscCall(Finish(an, &st));
+  PetscCall(Finish(an, st));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -642,7 +667,7 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
   int   bad = 0;
 
   PetscFunctionBeginUser;
-  if (an->rank || !QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,equilibrium_iterations,ksp_iterations,seconds") < 0;
   bad |= ReactionColumns(an, fp, -1);
@@ -673,7 +698,7 @@ static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
   char             base[32];
 
   PetscFunctionBeginUser;
-  if (an->rank || !q || !an->every || !an->vtk || q->nsteps < 1) PetscFunctionReturn(PETSC_SUCCESS);
+  if (an->rank || !q->started || !an->every || !an->vtk || q->nsteps < 1) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc2(q->nsteps + 1, &times, q->nsteps + 1, &files));
   for (PetscInt k = an->every; k <= q->nsteps; k += an->every) {
     times[n] = q->steps[k - 1].lambda;
@@ -697,7 +722,7 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
 {
 
   PetscFunctionBeginUser;
-  if (!QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   const PeriQuasistatic *q = QS(an);
   PetscCall(PeriJSONBeginObject(j, "quasistatic"));
   PetscCall(PeriJSONInt(j, "steps", q->nsteps));
@@ -729,7 +754,7 @@ static PetscErrorCode QSFiles(PeriAnalysis an, const char dir[])
   char path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  if (!QS(an)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/steps.csv", dir));
   PetscCall(PeriWriteStepsCSV(an, path));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.pvd", dir));
@@ -745,23 +770,22 @@ static PetscErrorCode QSDestroy(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The analysis.* keys ReadSettings reads. */
-static const char *const qs_policies[] = {"all", "fraction", NULL};
-static const PeriKey     qs_keys[]     = {
-            {"load_factor_max", PERI_KEY_REAL, "required", "(0, inf)", NULL, NULL, "the largest load factor"},
-            {"stepping", PERI_KEY_CHOICE, "increments", NULL, NULL, qs_steppings, "increments: steps of load_factor_step (bisected at failure); events: straight to each next bond break, computed from the linear response (brittle bonds)"},
-            {"load_factor_step", PERI_KEY_REAL, "required (increments)", "(0, load_factor_max]", NULL, NULL, "the load-factor step (the largest with adaptive steps); stepping: increments"},
-            {"min_step", PERI_KEY_REAL, "load_factor_step/64", "[load_factor_step/2^20, load_factor_step]", NULL, NULL, "the smallest step (adaptive)"},
-            {"adaptive", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "halve the step on failure or runaway"},
-            {"break", PERI_KEY_CHOICE, "all", NULL, NULL, qs_policies, "all | fraction: which violating bonds break per iteration"},
-            {"break_fraction", PERI_KEY_REAL, "0.1", "(0, 1]", NULL, NULL, "break: fraction: those within this top fraction of [1, worst index]"},
-            {"max_iterations", PERI_KEY_INT, "100", "[1, inf)", NULL, NULL, "equilibrium iterations per step"},
-            {"reuse_preconditioner", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "keep the preconditioner while few bonds changed"},
-            {"control_probe", PERI_KEY_STRING, "the first probe", NULL, NULL, NULL, "the probe whose displacement steps.csv reports (control_u)"},
-            {"control_component", PERI_KEY_STRING, "the first component (ux)", NULL, NULL, NULL, "the component of the control probe's displacement in steps.csv's control_u (ux, uy, uz, theta: the model's)"},
-            {"reaction_region", PERI_KEY_STRING, "the first bc region with a nonzero value, else the first holding the component", NULL, NULL, NULL, "the bc region whose reaction along control_component steps.csv reports (reaction): the force of the load-displacement curve"},
-            {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "more bonds than this share breaking at one load is a runaway: adaptive increments retry with a smaller step, events declare the failure"},
-            {NULL},
+/* The analysis.* keys SetFromScene_Quasistatic reads. */
+static const PeriKey qs_keys[] = {
+    {"load_factor_max", PERI_KEY_REAL, "required", "(0, inf)", NULL, NULL, "the largest load factor"},
+    {"stepping", PERI_KEY_CHOICE, "increments", NULL, NULL, qs_steppings, "increments: steps of load_factor_step (bisected at failure); events: straight to each next bond break, computed from the linear response (brittle bonds)"},
+    {"load_factor_step", PERI_KEY_REAL, "required (increments)", "(0, load_factor_max]", NULL, NULL, "the load-factor step (the largest with adaptive steps); stepping: increments"},
+    {"min_step", PERI_KEY_REAL, "load_factor_step/64", "[load_factor_step/2^20, load_factor_step]", NULL, NULL, "the smallest step (adaptive)"},
+    {"adaptive", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "halve the step on failure or runaway"},
+    {"break", PERI_KEY_CHOICE, "all", NULL, NULL, qs_policies, "all | fraction: which violating bonds break per iteration"},
+    {"break_fraction", PERI_KEY_REAL, "0.1", "(0, 1]", NULL, NULL, "break: fraction: those within this top fraction of [1, worst index]"},
+    {"max_iterations", PERI_KEY_INT, "100", "[1, inf)", NULL, NULL, "equilibrium iterations per step"},
+    {"reuse_preconditioner", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "keep the preconditioner while few bonds changed"},
+    {"control_probe", PERI_KEY_STRING, "the first probe", NULL, NULL, NULL, "the probe whose displacement steps.csv reports (control_u)"},
+    {"control_component", PERI_KEY_STRING, "the first component (ux)", NULL, NULL, NULL, "the component of the control probe's displacement in steps.csv's control_u (ux, uy, uz, theta: the model's)"},
+    {"reaction_region", PERI_KEY_STRING, "the first bc region with a nonzero value, else the first holding the component", NULL, NULL, NULL, "the bc region whose reaction along control_component steps.csv reports (reaction): the force of the load-displacement curve"},
+    {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "more bonds than this share breaking at one load is a runaway: adaptive increments retry with a smaller step, events declare the failure"},
+    {NULL},
 };
 /* output.every, which the run's snapshots follow (problem.c reads it with output.*) */
 static const PeriKey qs_output_keys[] = {
@@ -770,4 +794,16 @@ static const PeriKey qs_output_keys[] = {
 };
 static const PeriSchema qs_schema[] = {{"analysis", qs_keys}, {"output", qs_output_keys}, {NULL}};
 
-const PeriAnalysisType PeriAnalysis_Quasistatic = {"quasistatic", "load stepping with bond failure to the critical load", qs_schema, PETSC_FALSE, {PeriAnalysisRun_Quasistatic, NULL, QSFiles, QSSummary, NULL, QSDestroy}};
+static const char *const qs_files[] = {"steps.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", "failed_trial.vtu", "failed_trial.pvtu", "failed_trial", NULL};
+
+/* K is applied and changed bond by bond (matrix-free where the model allows), and the loop solves
+ * on a copy of it. */
+const PeriAnalysisType PeriAnalysis_Quasistatic = {
+    .name          = "quasistatic",
+    .help          = "load stepping with bond failure to the critical load",
+    .schema        = qs_schema,
+    .option_prefix = "",
+    .files         = qs_files,
+    .needs         = {.matrix_free = PETSC_TRUE, .static_solver = PETSC_TRUE, .matrix_copies = 1},
+    .ops           = {.setfromscene = SetFromScene_Quasistatic, .setup = SetUp_Quasistatic, .run = PeriAnalysisRun_Quasistatic, .files = QSFiles, .summary = QSSummary, .destroy = QSDestroy},
+};

@@ -49,20 +49,57 @@ PetscErrorCode PeriAnalysisListTypes(char buf[], size_t len)
 }
 
 /*@C
-  PeriAnalysisCreate - an analysis of the given type on the system sys (borrowed). The caller sets
-  what the output asks (vtk, every, output_dir) and the snapshot callback before ops.run.
+  PeriAnalysisCreate - an analysis of the given type, before the system exists. The caller sets
+  what the output asks (vtk, every, output_dir) and the snapshot callback before PeriAnalysisRun.
+  Not collective.
 @*/
-PetscErrorCode PeriAnalysisCreate(const PeriAnalysisType *type, PeriSystem sys, PeriAnalysis *analysis)
+PetscErrorCode PeriAnalysisCreate(MPI_Comm comm, const PeriAnalysisType *type, PeriAnalysis *analysis)
 {
   PeriAnalysis an;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&an));
-  an->type  = type;
-  an->sys   = sys;
-  an->comm  = sys->comm;
-  an->rank  = sys->rank;
+  an->type = type;
+  an->comm = comm;
+  PetscCallMPI(MPI_Comm_rank(comm, &an->rank));
   *analysis = an;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisSetFromScene - reads and checks the analysis' keys (ops.setfromscene) from the
+  scene's analysis section, before any particle is created. Collective.
+@*/
+PetscErrorCode PeriAnalysisSetFromScene(PeriAnalysis an, PeriScene s)
+{
+  PeriNode a;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
+  if (an->type->ops.setfromscene) PetscCall(an->type->ops.setfromscene(an, s, a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisSetUp - binds the analysis to the set-up system (borrowed) and runs its checks that
+  need the system (ops.setup). Collective.
+@*/
+PetscErrorCode PeriAnalysisSetUp(PeriAnalysis an, PeriSystem sys)
+{
+  PetscFunctionBeginUser;
+  an->sys = sys;
+  if (an->type->ops.setup) PetscCall(an->type->ops.setup(an));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisRun - runs the analysis (ops.run) on its system. Collective.
+@*/
+PetscErrorCode PeriAnalysisRun(PeriAnalysis an)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(an->sys, an->comm, PETSC_ERR_ORDER, "PeriAnalysisSetUp must come before PeriAnalysisRun");
+  if (an->type->ops.run) PetscCall(an->type->ops.run(an));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -5,15 +5,6 @@
  * for. Also the smallest example of an analysis (docs/design.md, "How to add an analysis"). */
 #include "perilin/private/analysis.h"
 
-/* Nothing to run: no solver was used, so summary.json has no solver section and the report no
- * solver line. */
-static PetscErrorCode Run_Setup(PeriAnalysis an)
-{
-  PetscFunctionBeginUser;
-  (void)an;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 static PetscErrorCode Report_Setup(PeriAnalysis an)
 {
   PetscFunctionBeginUser;
@@ -22,5 +13,12 @@ static PetscErrorCode Report_Setup(PeriAnalysis an)
 }
 
 /* No schema: the dry run accepts every analysis' keys (src/problem.c), so that a modal or a
- * quasi-static scene can be checked with -analysis_type setup. */
-const PeriAnalysisType PeriAnalysis_Setup = {"setup", "set up the system and stop: check a scene, size a run", NULL, PETSC_FALSE, {Run_Setup, NULL, NULL, NULL, Report_Setup, NULL}};
+ * quasi-static scene can be checked with -analysis_type setup. No run: no solver is used, so
+ * summary.json has no solver section and the report no solver line. Its memory estimate sizes a
+ * static run with K assembled. */
+const PeriAnalysisType PeriAnalysis_Setup = {
+    .name  = "setup",
+    .help  = "set up the system and stop: check a scene, size a run",
+    .needs = {.static_solver = PETSC_TRUE},
+    .ops   = {.report = Report_Setup},
+};

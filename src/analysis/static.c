@@ -32,7 +32,6 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(PeriStaticDefaultMatType(an->sys->stiffness.mat_type, sizeof(an->sys->stiffness.mat_type)));
-  an->sys->stiffness.matrix_free_ok = PETSC_TRUE; /* K is only applied: it may be matrix-free */
   if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscTime(&t0));
   PetscCall(VecDestroy(&an->sys->fields.u));
@@ -75,4 +74,11 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
  * another analysis' key (nev) an error naming its owner. */
 static const PeriKey    static_keys[]       = {{NULL}};
 static const PeriSchema static_schema[]     = {{"analysis", static_keys}, {NULL}};
-const PeriAnalysisType  PeriAnalysis_Static = {"static", "one linear solve K u = f", static_schema, PETSC_FALSE, {PeriAnalysisRun_Static, NULL, NULL, NULL, NULL, NULL}};
+const PeriAnalysisType  PeriAnalysis_Static = {
+     .name          = "static",
+     .help          = "one linear solve K u = f",
+     .schema        = static_schema,
+     .option_prefix = "",
+     .needs         = {.matrix_free = PETSC_TRUE, .static_solver = PETSC_TRUE},
+     .ops           = {.run = PeriAnalysisRun_Static},
+};

@@ -125,32 +125,53 @@ static int RemoveTree(const char path[])
   return nftw(path, RemoveEntry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
-/* Whether name is prefix followed by digits only (particles_0012, mode_03). */
-static PetscBool DigitsAfter(const char name[], const char prefix[])
-{
-  size_t a = strlen(prefix), n = strlen(name);
+/* The names the analyses write into an output set, as they declare them (PeriOutputSetAddNames):
+ * static strings, kept by reference. */
+#define PERI_OUTPUT_MAX_NAMES 64
+static const char *peri_output_names[PERI_OUTPUT_MAX_NAMES];
+static PetscInt    peri_output_nnames;
 
-  if (n <= a || strncmp(name, prefix, a)) return PETSC_FALSE;
-  for (size_t k = a; k < n; k++)
-    if (name[k] < '0' || name[k] > '9') return PETSC_FALSE;
-  return PETSC_TRUE;
+/*@C
+  PeriOutputSetAddNames - adds names a writer puts into output sets (NULL-terminated; '#' stands
+  for one or more digits: "mode_#.vtu"), so that an output directory holding them may be replaced.
+  The strings must outlive the process' runs (static). Not collective.
+@*/
+PetscErrorCode PeriOutputSetAddNames(const char *const names[])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; names && names[k]; k++) {
+    PetscCheck(peri_output_nnames < PERI_OUTPUT_MAX_NAMES, PETSC_COMM_SELF, PETSC_ERR_PLIB, "more than %d output names", PERI_OUTPUT_MAX_NAMES);
+    peri_output_names[peri_output_nnames++] = names[k];
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether a file name is one perilin writes into an output directory: the files, and the
- * directories of the pieces of a .pvtu (particles/, particles_NNNN/, mode_NN/, failed_trial/). */
+/* Whether name matches pattern, where '#' matches one or more digits. */
+static PetscBool NameMatches(const char *name, const char *pattern)
+{
+  for (; *pattern; pattern++) {
+    if (*pattern != '#') {
+      if (*name++ != *pattern) return PETSC_FALSE;
+      continue;
+    }
+    if (*name < '0' || *name > '9') return PETSC_FALSE;
+    while (*name >= '0' && *name <= '9') name++;
+  }
+  return (PetscBool) !*name;
+}
+
+/* Whether a file name is one perilin writes into an output directory: the set's own files
+ * (summary.json, particles.vtu or .pvtu and the directory of its pieces, the marker, temporary
+ * files), and the names the analyses declared. */
 static PetscBool IsOutputName(const char name[])
 {
-  static const char *const exact[]       = {"summary.json", "particles.vtu", "particles.pvtu", "particles.pvd", "steps.csv", "modes.csv", "modes.pvd", "failed_trial.vtu", "failed_trial.pvtu", "anisotropy.csv", PERI_OUTPUT_MARKER, "particles", "failed_trial", NULL};
-  static const char *const prefixed[][2] = {{"particles_", ".vtu"}, {"mode_", ".vtu"}, {"particles_", ".pvtu"}, {"mode_", ".pvtu"}};
-  size_t                   n             = strlen(name);
+  static const char *const own[] = {"summary.json", "particles.vtu", "particles.pvtu", "particles", PERI_OUTPUT_MARKER, NULL};
+  size_t                   n     = strlen(name);
 
-  for (PetscInt k = 0; exact[k]; k++)
-    if (!strcmp(name, exact[k])) return PETSC_TRUE;
-  for (size_t k = 0; k < sizeof(prefixed) / sizeof(prefixed[0]); k++) {
-    size_t a = strlen(prefixed[k][0]), b = strlen(prefixed[k][1]);
-    if (n > a + b && !strncmp(name, prefixed[k][0], a) && !strcmp(name + n - b, prefixed[k][1])) return PETSC_TRUE;
-  }
-  if (DigitsAfter(name, "particles_") || DigitsAfter(name, "mode_")) return PETSC_TRUE;
+  for (PetscInt k = 0; own[k]; k++)
+    if (NameMatches(name, own[k])) return PETSC_TRUE;
+  for (PetscInt k = 0; k < peri_output_nnames; k++)
+    if (NameMatches(name, peri_output_names[k])) return PETSC_TRUE;
   return (PetscBool)(n > 4 && !strcmp(name + n - 4, ".tmp"));
 }
 

@@ -7,8 +7,8 @@
  *     rank read (PETSc's options-left machinery), which only the run itself can tell.
  * -options_unused_ok makes both warnings, for options meant for other tools (docs/scene.md). */
 #include "perilin/private/scene.h"
+#include <petscksp.h>
 #include "perilin/private/sys.h"
-#include <slepceps.h>
 #include <ctype.h>
 #include <stdarg.h>
 #include <strings.h>
@@ -337,20 +337,9 @@ static PetscErrorCode ObjectsFromOptions(const PeriRunSolvers *p)
   if (p->mat_type[0]) PetscCall(MatSetType(A, p->mat_type));
   PetscCall(MatSetFromOptions(A));
   PetscCall(MatDestroy(&A));
-  if (p->eigen) { /* the spectral transformation's linear solver: shift-and-invert, as in modal.c */
-    EPS eps;
-    ST  st;
-    KSP ksp;
-    PC  pc;
-    PetscCall(EPSCreate(p->comm, &eps));
-    PetscCall(EPSGetST(eps, &st));
-    PetscCall(STSetType(st, STSINVERT));
-    PetscCall(STGetKSP(st, &ksp));
-    if (p->ksp_type[0]) PetscCall(KSPSetType(ksp, p->ksp_type));
-    PetscCall(KSPGetPC(ksp, &pc));
-    if (p->pc_type[0]) PetscCall(PCSetType(pc, p->pc_type));
-    PetscCall(EPSSetFromOptions(eps));
-    PetscCall(EPSDestroy(&eps));
+  /* the analysis' own solvers (an eigensolver's spectral transformation, say), when it says */
+  if (p->solvers_from_options) {
+    PetscCall(p->solvers_from_options(p->comm, p->ksp_type, p->pc_type));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(KSPFromOptions(p->comm, NULL, p->ksp_type, p->pc_type));
@@ -437,7 +426,7 @@ PetscErrorCode PeriOptionsCheckUnused(const PeriRunSolvers *p)
     else {
       Append(msg, sizeof(msg), "%soption %s was read by nothing in this run", k ? "; " : "", unread.name[k]);
       /* a real option for a solver the run did not use, or a misspelling: say what the run used */
-      if (!said && p->ksp_type[0]) Append(msg, sizeof(msg), p->eigen ? " (its eigensolver's linear solves used -st_ksp_type %s -st_pc_type %s)" : " (its linear solves used -ksp_type %s -pc_type %s)", p->ksp_type, p->pc_type);
+      if (!said && p->ksp_type[0]) Append(msg, sizeof(msg), " (its linear solves used -%sksp_type %s -%spc_type %s)", p->prefix ? p->prefix : "", p->ksp_type, p->prefix ? p->prefix : "", p->pc_type);
       said = PETSC_TRUE;
     }
   }

@@ -70,29 +70,18 @@ static PetscErrorCode SearchRadius(PeriScene s, PetscReal h, PetscReal *r)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* analysis.type, when given. */
-static PetscErrorCode AnalysisType(PeriScene s, char type[], size_t len)
-{
-  PeriNode a;
-
-  PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
-  if (a) PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, type, len, NULL));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* Whether the run will apply K matrix-free (PeriSystemAssemble's rule, solver.operator): central
- * springs, a static or quasi-static analysis, and operator matrix_free, or auto with the default
- * or a diagonal PC. Fictitious layers (which turn it off) are not looked at: the estimate is then
+ * springs, an analysis that allows it (needs.matrix_free), and operator matrix_free, or auto with
+ * the default or a diagonal PC. Fictitious layers (which turn it off) are not looked at: the estimate is then
  * low by the matrix. */
-static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const char analysis[], PetscBool *mf)
+static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const PeriSystemNeeds *needs, PetscBool *mf)
 {
   PeriNode solver;
   char     op[32] = "auto", pc[64] = PCGAMG;
 
   PetscFunctionBeginUser;
   *mf = PETSC_FALSE;
-  if (!m->central_force || !strcmp(analysis, "modal") || !strcmp(analysis, "setup")) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!m->central_force || !needs->matrix_free) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &solver));
   if (solver) PetscCall(PeriSceneGetString(s, solver, "operator", PETSC_FALSE, op, sizeof(op), NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
@@ -121,7 +110,7 @@ static PetscReal SurfaceShare(PetscInt dim, PetscReal r, const PetscReal cells[]
  * nonzero; BAIJ: 8, and an index per block) and the solver, for n particles of dofs DOFs, a
  * search radius of r spacings and the share of pairs the faces leave. State-based models also list
  * each family in full and couple particles up to 2 delta apart. */
-static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const char analysis[], PetscBool mf, MemoryEstimate *e)
+static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const PeriSystemNeeds *needs, PetscBool mf, MemoryEstimate *e)
 {
   const PetscReal dofs = m->dofs, ball = BallCount(m->dim, r);
   PetscReal       reserved, per_bond, blocks, nnz, matrix;
@@ -129,10 +118,10 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   PetscBool       aij;
 
   PetscFunctionBeginUser;
-  /* a modal K is AIJ; asking the static default would read -pc_type, which must stay unread in a
-     modal run so that the unknown-option check reports it */
+  /* K is AIJ unless the static solver's default decides; asking that default would read -pc_type,
+     which must stay unread in an eigensolver's run so that the unknown-option check reports it */
   PetscCall(PetscStrncpy(type, MATAIJ, sizeof(type)));
-  if (strcmp(analysis, "modal")) PetscCall(PeriStaticDefaultMatType(type, sizeof(type)));
+  if (needs->static_solver) PetscCall(PeriStaticDefaultMatType(type, sizeof(type)));
   PetscCall(PetscStrcmp(type, MATAIJ, &aij));
   e->n      = n;
   e->nbonds = n * ball / 2 * share;
@@ -151,10 +140,10 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
      PERI_MEMORY_SOLVER graphs, fitted to the peaks of 2D plates (2 DOFs, 1e4-1e6 particles, where
      the whole run peaks at 2.5x the matrix as in docs/performance.md) and 3D blocks (3 DOFs) */
   e->shared = (reserved + e->nbonds * per_bond) * (m->ops.family_stiffness ? 3 : 1) + matrix * (1 + PERI_MEMORY_SOLVER / (dofs * dofs)) + 10 * n * dofs * sizeof(PetscScalar);
-  /* the quasi-static loop solves on a copy of K; the modal shift-and-invert factors K, whose
-     nested-dissection fill grew as 0.45 log2(n) matrices (2D lamina, 3,600 to 230,400 particles) */
-  if (!strcmp(analysis, "quasistatic")) e->shared += matrix;
-  if (!strcmp(analysis, "modal")) e->shared += matrix * 0.45 * PetscLog2Real(n);
+  /* the analysis' copies of K (the quasi-static loop solves on one) and its factorization (the
+     modal shift-and-invert: nested-dissection fill grew as 0.45 log2(n) matrices on the 2D lamina,
+     3,600 to 230,400 particles) */
+  e->shared += matrix * (needs->matrix_copies + needs->factor_fill * PetscLog2Real(n));
   /* coordinates, volume, spacing, line, family volume, neighbour count, the cell list, the local
      view's displacements and energy densities: each rank holds its own particles' (and a thin
      layer of ghosts), so they share out like the rest (docs/distributed.md) */
@@ -222,12 +211,11 @@ static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
   to the readers that report them. Skipped with -peri_memory_check false, and for particles.file.
   Collective.
 @*/
-PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
+PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m, const PeriSystemNeeds *needs)
 {
   MemoryEstimate e = {0};
   PetscReal      h = 0, r = 0, cells[3];
-  PetscBool      run                     = PETSC_TRUE, failure, periodic[3], mf;
-  char           analysis[PERI_NAME_LEN] = "static";
+  PetscBool      run = PETSC_TRUE, failure, periodic[3], mf;
   PeriNode       grid;
   PetscErrorCode ierr;
 
@@ -244,13 +232,12 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m)
     for (PetscInt d = 0; d < m->dim; d++) diag2 += cells[d] * cells[d];
     if (r - 0.5 > PetscSqrtReal(diag2)) r = 0;
   }
-  if (!ierr && r > 0) ierr = AnalysisType(s, analysis, sizeof(analysis));
   PetscCall(PetscPopErrorHandler());
   if (ierr || !(e.n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
   failure = grid ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(MatrixFree(s, m, analysis, &mf));
-  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, analysis, mf, &e));
+  PetscCall(MatrixFree(s, m, needs, &mf));
+  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, needs, mf, &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));

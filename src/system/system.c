@@ -305,7 +305,7 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
   PeriInputCheck(sys->materials.thickness > 0, s, mat, "thickness", "must be positive, got %g", (double)sys->materials.thickness);
   /* before any large allocation: a scene that cannot fit is refused with its size */
-  PetscCall(PeriParticlesCheckMemory(sys->comm, s, sys->model));
+  PetscCall(PeriParticlesCheckMemory(sys->comm, s, sys->model, &sys->stiffness.needs));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -439,6 +439,17 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriSystemSetNeeds - what the analysis asks of the stiffness (its type's needs), before
+  PeriSystemSetUp: the memory estimate of the set-up reads it. Not collective.
+@*/
+PetscErrorCode PeriSystemSetNeeds(PeriSystem sys, const PeriSystemNeeds *needs)
+{
+  PetscFunctionBeginUser;
+  sys->stiffness.needs = *needs;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriSystemDestroy(PeriSystem *system)
 {
   PeriSystem sys = *system;
@@ -518,7 +529,7 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
   PetscFunctionBeginUser;
   if (!sys->model->central_force)
     why = "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
-  else if (!sys->stiffness.matrix_free_ok)
+  else if (!sys->stiffness.needs.matrix_free)
     why = "the analysis needs K's entries (matrix_free serves the static and quasi-static analyses)";
   else if (sys->conditions.layers.T)
     why = "fictitious layers eliminate K's rows through its entries";

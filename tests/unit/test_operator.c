@@ -163,11 +163,12 @@ static PetscErrorCode CheckCase(const char scene[], const char type[], const cha
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
   PetscCall(PeriProblemLoad(p, scene));
   PetscCall(PeriProblemSetUp(p));
-  PetscCall(PeriSystemAssemble(p->sys)); /* no analysis declared a single solve: assembled */
-  K                                = p->sys->stiffness.K;
-  p->sys->stiffness.K              = NULL;
-  p->sys->stiffness.matrix_free_ok = PETSC_TRUE;
-  p->sys->stiffness.operator_kind  = PERI_OPERATOR_MATRIX_FREE;
+  p->sys->stiffness.needs.matrix_free = PETSC_FALSE; /* the reference: K assembled */
+  PetscCall(PeriSystemAssemble(p->sys));
+  K                                   = p->sys->stiffness.K;
+  p->sys->stiffness.K                 = NULL;
+  p->sys->stiffness.needs.matrix_free = PETSC_TRUE;
+  p->sys->stiffness.operator_kind     = PERI_OPERATOR_MATRIX_FREE;
   PetscCall(PeriSystemAssemble(p->sys));
   PetscCall(PeriOperatorPreconditioner(p->sys));
   PetscCheck(p->sys->stiffness.op && p->sys->stiffness.Kpc, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "%s: solver.operator matrix_free gave no matrix-free operator", name);

@@ -19,6 +19,8 @@ typedef struct {
 } PeriMode;
 
 typedef struct {
+  PetscInt   nev;     /* analysis.nev */
+  PetscBool  started; /* the solve began: the outputs have a modal part */
   PetscInt   nmodes, nrigid, nfree_dofs;
   PeriMode  *modes;
   PetscReal  total_mass, target_hz;
@@ -37,6 +39,7 @@ typedef struct {
 } PeriStep;
 
 typedef struct {
+  PetscBool  started; /* the loop began: the outputs have a quasi-static part */
   PetscInt   nsteps, cap;
   PeriStep  *steps;
   PetscReal  peak_load_factor, critical_load_factor;
@@ -53,30 +56,41 @@ typedef struct {
 } PeriQuasistatic;
 
 /* An analysis type (src/analysis/<name>.c): what it does with the system, and what it adds to
- * the output. Each analysis file ends with its descriptor PeriAnalysis_<Id>; src/analysis/list.h
- * names them (one line each) and src/analysis/registry.c registers them. The output code calls
- * the ops and has no branch per analysis. Until the analyses take a PeriSystem only (docs/design.md,
- * "What is left"), the ops receive the problem; their results live in the problem's `modal` or
- * `quasistatic` member, freed by ops.destroy. */
+ * the output. Each analysis file ends with its descriptor PeriAnalysis_<Id>, written with
+ * designated initializers (an op it does not need is left out, and a new op edits no analysis);
+ * src/analysis/list.h names them (one line each) and src/analysis/registry.c registers them. The
+ * problem calls the ops in PETSc's life cycle and has no branch per analysis:
+ *   setfromscene  reads and checks every analysis.* key, before any particle exists (the scene and
+ *                 the options only; no system yet); allocates the analysis' data
+ *   setup         after the system's set-up: checks that need it (probes, regions, components)
+ *   run           the analysis; its results are its data
+ *   fields, files, summary, report   what the output set and stdout show of it
+ *   destroy       frees what data points to (data itself is freed after)
+ * Every op may be NULL. */
 typedef struct {
+  PetscErrorCode (*setfromscene)(PeriAnalysis, PeriScene, PeriNode); /* the analysis section, or NULL when the scene has none */
+  PetscErrorCode (*setup)(PeriAnalysis);
   PetscErrorCode (*run)(PeriAnalysis);
-  PetscErrorCode (*fields)(PeriAnalysis, PeriFieldList); /* its arrays in particles.vtu, or NULL */
-  PetscErrorCode (*files)(PeriAnalysis, const char[]);   /* its files in the output set (the directory), or NULL */
-  PetscErrorCode (*summary)(PeriAnalysis, PeriJSON);     /* its object in summary.json, or NULL */
-  PetscErrorCode (*report)(PeriAnalysis);                /* its result line on stdout, or NULL: the strain energy */
-  PetscErrorCode (*destroy)(PeriAnalysis);               /* frees what data points to (data itself is freed after), or NULL */
+  PetscErrorCode (*fields)(PeriAnalysis, PeriFieldList);                        /* its arrays in particles.vtu */
+  PetscErrorCode (*files)(PeriAnalysis, const char[]);                          /* its files in the output set (the directory) */
+  PetscErrorCode (*summary)(PeriAnalysis, PeriJSON);                            /* its object in summary.json */
+  PetscErrorCode (*report)(PeriAnalysis);                                       /* its result line on stdout; NULL: the strain energy */
+  PetscErrorCode (*solvers_from_options)(MPI_Comm, const char[], const char[]); /* fresh solvers of the kinds it used (ksp and pc types, "" for the default) set from the options, for the unused-option check; NULL: a static KSP */
+  PetscErrorCode (*destroy)(PeriAnalysis);
 } PeriAnalysisOps;
 
 typedef struct {
-  const char       *name;        /* analysis.type */
-  const char       *help;        /* one line, for -help and the "unknown analysis" message */
-  const PeriSchema *schema;      /* its analysis.* keys besides type, ended by {NULL}; NULL: none */
-  PetscBool         eigensolver; /* its linear solves are an eigensolver's (options -st_ksp_type ...) */
-  PeriAnalysisOps   ops;
+  const char        *name;          /* analysis.type */
+  const char        *help;          /* one line, for -help and the "unknown analysis" message */
+  const PeriSchema  *schema;        /* its analysis.* keys besides type, ended by {NULL}; NULL: none */
+  const char        *option_prefix; /* of its linear solvers' options ("st_" for an eigensolver's), NULL: none */
+  const char *const *files;         /* the names of its files in the output set, NULL-terminated ('#': digits), or NULL */
+  PeriSystemNeeds    needs;         /* what it asks of the system: K's kind and memory */
+  PeriAnalysisOps    ops;
 } PeriAnalysisType;
-/* One analysis of one problem: its type, the system it works on (borrowed), what the output
- * asks of it, and its own data (PeriModal, PeriQuasistatic, ...), private to its file and its
- * tests. */
+/* One analysis of one problem: its type, the system it works on (borrowed, from PeriAnalysisSetUp
+ * on), what the output asks of it, and its own data (PeriModal, PeriQuasistatic, ...), private to
+ * its file and its tests. */
 struct _p_PeriAnalysis {
   const PeriAnalysisType *type;
   MPI_Comm                comm;
@@ -89,7 +103,10 @@ struct _p_PeriAnalysis {
   void                   *snapshotctx;
   void                   *data;
 };
-PETSC_EXTERN PetscErrorCode PeriAnalysisCreate(const PeriAnalysisType *, PeriSystem, PeriAnalysis *);
+PETSC_EXTERN PetscErrorCode PeriAnalysisCreate(MPI_Comm, const PeriAnalysisType *, PeriAnalysis *);
+PETSC_EXTERN PetscErrorCode PeriAnalysisSetFromScene(PeriAnalysis, PeriScene);
+PETSC_EXTERN PetscErrorCode PeriAnalysisSetUp(PeriAnalysis, PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriAnalysisRun(PeriAnalysis);
 PETSC_EXTERN PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisFind(const char[], const PeriAnalysisType **);

@@ -35,3 +35,4 @@ PETSC_EXTERN PetscErrorCode      PeriFileCloseCommit(FILE *, const char[], const
 PETSC_EXTERN PetscErrorCode      PeriOutputSetOpen(MPI_Comm, char[], size_t, char[], size_t);
 PETSC_EXTERN PetscErrorCode      PeriOutputSetCommit(MPI_Comm, const char[], const char[]);
 PETSC_EXTERN void                PeriOutputSetDiscard(void);
+PETSC_EXTERN PetscErrorCode      PeriOutputSetAddNames(const char *const[]);

@@ -12,12 +12,13 @@ struct _p_PeriProblem {
   PeriScene      scene;
   PeriSystem     sys;                          /* the discretized physics: everything but the analysis and the output */
   char           analysis_type[PERI_NAME_LEN]; /* analysis.type */
-  PeriAnalysis   analysis;                     /* created by PeriProblemRun; its results are its data */
+  PeriAnalysis   analysis;                     /* created and set from the scene by PeriProblemSetUp, before the system; its results are its data */
   PetscInt       output_every;                 /* output.every (quasi-static snapshots) */
   char           output_dir[PETSC_MAX_PATH_LEN];
   char           staging_dir[PETSC_MAX_PATH_LEN]; /* where the outputs are written until the set is committed */
   PetscBool      write_output;                    /* set by the executable: check output.dir before computing */
   PetscBool      vtk;
+  PetscBool      stress_output; /* output.stress */
   PetscLogDouble t_start;
 };
 

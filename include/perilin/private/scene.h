@@ -26,8 +26,9 @@ PETSC_EXTERN PetscErrorCode PeriOptionsCheckScene(MPI_Comm, PeriScene);
 typedef struct {
   MPI_Comm    comm;
   PeriScene   scene;
-  const char *mat_type, *ksp_type, *pc_type; /* "" when the run had none */
-  PetscBool   eigen;                         /* the linear solves were an eigensolver's (-st_ prefix) */
+  const char *mat_type, *ksp_type, *pc_type;                                    /* "" when the run had none */
+  const char *prefix;                                                           /* the options prefix of its linear solves ("st_": an eigensolver's), or NULL */
+  PetscErrorCode (*solvers_from_options)(MPI_Comm, const char[], const char[]); /* the analysis' solvers of these types, fresh and set from the options; NULL: a KSP */
 } PeriRunSolvers;
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckUnused(const PeriRunSolvers *);
 PETSC_EXTERN void           PeriSceneSuggest(const char[], const char *const[], char[], size_t);

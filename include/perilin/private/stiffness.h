@@ -21,6 +21,15 @@ typedef enum {
 PETSC_EXTERN const char *const  PeriOperatorKinds[];
 typedef struct _p_PeriOperator *PeriOperator;
 
+/* What an analysis asks of the stiffness, declared in its type (PeriAnalysisType.needs): the memory
+ * estimate and K's defaults read it, so that no file of the system names an analysis. */
+typedef struct {
+  PetscBool matrix_free;   /* uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free (solver.operator) */
+  PetscBool static_solver; /* solves with the static KSP, K of its default type (PeriStaticDefaultMatType); else K is AIJ */
+  PetscReal matrix_copies; /* copies of K it holds beside K (the quasi-static loop solves on one: 1) */
+  PetscReal factor_fill;   /* a direct factorization of K, its fill in matrices per log2(particles) (nested dissection measured 0.45), or 0 */
+} PeriSystemNeeds;
+
 /* K and how it is applied and solved. */
 typedef struct {
   Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
@@ -29,8 +38,8 @@ typedef struct {
   PeriOperatorKind operator_kind;           /* solver.operator */
   PetscReal        pc_radius;               /* solver.pc_radius */
   char             pc_default[16];          /* the static solve's PC unless -pc_type: gamg, or jacobi (matrix-free K on a small 3D body) */
-  PetscBool        matrix_free_ok;          /* set by an analysis that uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free */
   char             mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
+  PeriSystemNeeds  needs;                   /* the analysis' (PeriSystemSetNeeds), before the set-up */
   PetscReal        residual_tol;            /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
 } PeriStiffness;
 

@@ -83,6 +83,7 @@ struct _p_PeriSystem {
 
 PETSC_EXTERN PetscErrorCode PeriSystemCreate(MPI_Comm, PeriScene, PeriSystem *);
 PETSC_EXTERN PetscErrorCode PeriSystemSetFromScene(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemSetNeeds(PeriSystem, const PeriSystemNeeds *);
 PETSC_EXTERN PetscErrorCode PeriSystemSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemDestroy(PeriSystem *);
 PETSC_EXTERN PetscErrorCode PeriSystemCreateVec(PeriSystem, Vec *);
@@ -118,7 +119,7 @@ PETSC_EXTERN PetscErrorCode PeriReferenceEvaluate(PeriSystem);
 PETSC_EXTERN void           PeriReferenceDisplacement(PeriSystem, const PetscReal[], PetscReal[]);
 /* failure, cracks, damage, pieces (src/system/failure.c) */
 /* fictitious boundary layers and torsion (src/system/layers.c) */
-PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel);
+PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel, const PeriSystemNeeds *);
 PETSC_EXTERN PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem, PetscBool);
 
