@@ -20,8 +20,12 @@ typedef struct _p_PeriProblem *PeriProblem;
 /* SLEPc (which starts PETSc) once per process, the signal handlers and the registries. */
 PETSC_EXTERN PetscErrorCode PeriInitialize(int *, char ***, const char[]);
 PETSC_EXTERN PetscErrorCode PeriFinalize(void);
-/* Every scene key with its meaning (perilin -help). */
+/* The usage, perilin's own options and every scene key with its meaning (perilin -help). */
 PETSC_EXTERN PetscErrorCode PeriPrintHelp(MPI_Comm);
+/* perilin's version as built, PETSc's and SLEPc's (perilin -version, summary.json's "build"). */
+#define PERI_VERSION_LEN 128
+PETSC_EXTERN PetscErrorCode PeriGetVersions(char[], char[], char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriPrintVersion(MPI_Comm);
 PETSC_EXTERN PetscErrorCode PeriSceneDoc(MPI_Comm, const char[], PetscBool);
 
 PETSC_EXTERN PetscErrorCode PeriProblemCreate(MPI_Comm, PeriProblem *);

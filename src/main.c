@@ -1,11 +1,123 @@
-/* perilin SCENE.yaml [PETSc options]: run a scene, write summary.json and particles.vtu. */
+/* perilin SCENE.yaml [options]: run a scene, write its output set; perilin -help, perilin -version. */
 #include "perilin.h"
 #include "perilin/private/output.h" /* PeriOutputSetDiscard: the error path */
 #include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
 #include <unistd.h>
 
-static const char help[] = "perilin: implicit static and modal peridynamics.\n"
-                           "Usage: perilin SCENE.yaml [-material_nu 0.25 -model_type npmb ... PETSc options]\n";
+/* What the command line asks for, decided before PETSc starts (ParseMode). */
+typedef enum {
+  MODE_RUN,
+  MODE_HELP,       /* -help, -h, --help: perilin's help only */
+  MODE_HELP_PETSC, /* -help petsc: perilin's help, then PETSc's and SLEPc's generic list */
+  MODE_VERSION     /* -version, --version */
+} Mode;
+
+static int IsArg(const char *arg, const char *a, const char *b, const char *c)
+{
+  return !strcmp(arg, a) || !strcmp(arg, b) || (c && !strcmp(arg, c));
+}
+
+/* Takes -help, -h, --help (with "petsc" after it) and -version, --version out of the arguments
+ * PETSc sees: PETSc would print its banner and generic list at initialization, before anything of
+ * perilin's. -help petsc leaves "-help" in, and main gathers what PETSc prints (GatherPetscHelp)
+ * to print it after perilin's help. Runs before PETSc starts: plain C. */
+static Mode ParseMode(int *argc, char **argv)
+{
+  Mode mode = MODE_RUN;
+  int  n    = 1;
+
+  for (int k = 1; k < *argc; k++) {
+    if (IsArg(argv[k], "-help", "-h", "--help")) {
+      if (k + 1 < *argc && !strcmp(argv[k + 1], "petsc")) {
+        mode      = MODE_HELP_PETSC;
+        argv[n++] = (char *)"-help";
+        k++;
+      } else if (mode != MODE_HELP_PETSC)
+        mode = MODE_HELP;
+      continue;
+    }
+    if (IsArg(argv[k], "-version", "--version", NULL)) {
+      if (mode == MODE_RUN) mode = MODE_VERSION;
+      continue;
+    }
+    argv[n++] = argv[k];
+  }
+  argv[n] = NULL;
+  *argc   = n;
+  return mode;
+}
+
+/* What PETSc prints through PetscHelpPrintf while it starts under -help petsc, held for after
+ * perilin's help. Installed before PETSc starts: plain C, rank 0 of comm only, as PETSc prints. */
+static char  *petsc_help;
+static size_t petsc_help_len, petsc_help_cap;
+
+static PetscErrorCode GatherPetscHelp(MPI_Comm comm, const char fmt[], ...)
+{
+  va_list ap;
+  int     rank = 0, n;
+
+  if (MPI_Comm_rank(comm, &rank) != MPI_SUCCESS || rank) return PETSC_SUCCESS;
+  va_start(ap, fmt);
+  n = vsnprintf(NULL, 0, fmt, ap);
+  va_end(ap);
+  if (n <= 0) return PETSC_SUCCESS;
+  if (petsc_help_len + (size_t)n + 1 > petsc_help_cap) {
+    size_t cap  = 2 * (petsc_help_len + (size_t)n + 1);
+    char  *more = realloc(petsc_help, cap);
+    if (!more) return PETSC_ERR_MEM;
+    petsc_help     = more;
+    petsc_help_cap = cap;
+  }
+  va_start(ap, fmt);
+  vsnprintf(petsc_help + petsc_help_len, (size_t)n + 1, fmt, ap);
+  va_end(ap);
+  petsc_help_len += (size_t)n;
+  return PETSC_SUCCESS;
+}
+
+/* perilin -help [petsc]: perilin's help, then what PETSc printed at its start. */
+static PetscErrorCode PrintHelp(Mode mode)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriPrintHelp(PETSC_COMM_WORLD));
+  if (mode == MODE_HELP_PETSC && petsc_help) {
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "----------------------------------------\nPETSc's and SLEPc's generic options:\n"));
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "%s", petsc_help));
+  }
+  free(petsc_help);
+  petsc_help = NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The scene file must be the first argument. An option before it ("perilin -quiet scene.yaml")
+ * gets the command line in the right order when a later argument looks like the scene. */
+static PetscErrorCode CheckSceneFirst(int argc, char **argv)
+{
+  char order[1024] = "";
+  int  scene       = 0;
+
+  PetscFunctionBeginUser;
+  PetscCheck(argc >= 2, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "usage: perilin SCENE.yaml [options]; perilin -help lists the options and the scene keys");
+  if (argv[1][0] != '-') PetscFunctionReturn(PETSC_SUCCESS);
+  for (int k = 2; k < argc && !scene; k++) {
+    size_t len = strlen(argv[k]);
+    if (argv[k][0] == '-') continue;
+    if ((len > 5 && !strcmp(argv[k] + len - 5, ".yaml")) || (len > 4 && !strcmp(argv[k] + len - 4, ".yml")) || !access(argv[k], R_OK)) scene = k;
+  }
+  PetscCheck(scene, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "the scene file comes first: perilin SCENE.yaml [options] (the first argument is the option %s); perilin -help lists the options", argv[1]);
+  PetscCall(PetscStrlcat(order, argv[scene], sizeof(order)));
+  for (int k = 1; k < argc; k++) {
+    if (k == scene) continue;
+    PetscCall(PetscStrlcat(order, " ", sizeof(order)));
+    PetscCall(PetscStrlcat(order, argv[k], sizeof(order)));
+  }
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "the scene file comes first, then the options: perilin %s", order);
+}
 
 /* The first error's message, printed once by main instead of PETSc's traceback. */
 static char first_error[4096];
@@ -41,20 +153,24 @@ static PetscErrorCode SceneDoc(PetscBool *done)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode Run(int argc, char **argv, PeriProblem *problem, int *status)
+static PetscErrorCode Run(int argc, char **argv, Mode mode, PeriProblem *problem, int *status)
 {
   PeriProblem p;
   PetscBool   help_asked;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsHasHelp(NULL, &help_asked));
-  if (help_asked) {
-    PetscCall(PeriPrintHelp(PETSC_COMM_WORLD));
+  if (mode == MODE_VERSION) {
+    PetscCall(PeriPrintVersion(PETSC_COMM_WORLD));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscOptionsHasHelp(NULL, &help_asked)); /* also -help from PETSC_OPTIONS or a file */
+  if (mode != MODE_RUN || help_asked) {
+    PetscCall(PrintHelp(mode));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(SceneDoc(&help_asked));
   if (help_asked) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(argc >= 2 && argv[1][0] != '-', PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "usage: perilin SCENE.yaml [options]; perilin -help lists the scene keys");
+  PetscCall(CheckSceneFirst(argc, argv));
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, problem));
   p = *problem;
   PetscCall(PeriProblemSetWriteOutput(p, PETSC_TRUE));
@@ -95,10 +211,13 @@ int main(int argc, char **argv)
   PetscMPIInt    size, rank;
   int            status = 0;
   PeriProblem    p      = NULL;
+  Mode           mode   = ParseMode(&argc, argv);
 
-  PetscCall(PeriInitialize(&argc, &argv, help));
+  if (mode == MODE_HELP_PETSC) PetscHelpPrintf = GatherPetscHelp;
+  PetscCall(PeriInitialize(&argc, &argv, NULL)); /* the usage is perilin's help, PeriPrintHelp */
+  PetscHelpPrintf = PetscHelpPrintfDefault;
   PetscCall(PetscPushErrorHandler(CaptureError, NULL));
-  ierr = Run(argc, argv, &p, &status);
+  ierr = Run(argc, argv, mode, &p, &status);
   PetscCall(PetscPopErrorHandler());
   if (ierr) {
     PetscBool all;

@@ -108,14 +108,75 @@ PetscErrorCode PeriSchemaOwners(PetscInt max, PeriSchemaOwner owners[], PetscInt
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* perilin's own options, those that are no scene key (every scene key is an option too): -help
+ * lists them before the keys. Keep in step with the PetscOptionsGet* calls that read them. */
+static const char *const own_options[][2] = {
+    {"-help, -h, --help", "this help; -help petsc adds PETSc's and SLEPc's generic options after it"},
+    {"-version, --version", "perilin's version (from the build), PETSc's and SLEPc's"},
+    {"-quiet", "no status line and no per-step log"},
+    {"-progress <bool>", "the status line on or off (default: on when stdout is a terminal, outside mpiexec)"},
+    {"-output_dir DIR", "the output directory (the scene key output.dir; default SCENE-out)"},
+    {"-options_unused_ok", "options that nothing reads are warnings, not errors"},
+    {"-peri_partition TYPE", "how the particles are shared out on several ranks: geometric (default), metis, ptscotch"},
+    {"-peri_memory_check <bool>", "refuse a scene that does not fit in the node's available memory; default true"},
+    {"-peri_release_bond_geometry <bool>", "free the bonds' geometry while a static solve runs; default true"},
+    {"-peri_read_chunk N", "particles per chunk rank 0 deals out from particles.file or .mesh; default 65536"},
+    {"-peri_malloc_mmap_threshold N", "arrays of N bytes and more (N <= 32 MiB) are mapped on their own; default 0 (off)"},
+    {"-scene_doc_update FILE", "rewrite the key tables of FILE (docs/scene.md) from the declared keys"},
+    {"-scene_doc_check FILE", "fail when the key tables of FILE are out of date"},
+};
+
+/*@C
+  PeriPrintHelp - perilin's usage, its own options, then every scene key with its meaning (perilin
+  -help). PETSc's options are not listed: perilin -help petsc prints them after this. Collective.
+@*/
 PetscErrorCode PeriPrintHelp(MPI_Comm comm)
 {
   PeriSchemaOwner owners[PERI_MAX_SCHEMA_OWNERS];
   PetscInt        n;
 
   PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(comm, "perilin: implicit static and modal peridynamics.\n"
+                              "Usage: perilin SCENE.yaml [-KEY VALUE ...] [perilin options] [PETSc options]\n"
+                              "       perilin -help [petsc] | -version\n"
+                              "The scene file comes first; every option follows it.\n"
+                              "perilin options:\n"));
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(own_options); k++) PetscCall(PetscPrintf(comm, "  %-36s %s\n", own_options[k][0], own_options[k][1]));
   PetscCall(PeriSchemaOwners(PERI_MAX_SCHEMA_OWNERS, owners, &n));
   PetscCall(PeriSceneHelp(comm, n, owners));
+  PetscCall(PetscPrintf(comm, "PETSc and SLEPc options (-ksp_*, -pc_*, -eps_*, -st_*, -log_view, ...) follow the scene file too;\n"
+                              "perilin -help petsc lists PETSc's generic ones after this help (docs/scene.md).\n"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriGetVersions - perilin's version as built (the CMake project version, plus `git describe
+  --always --dirty` of the checkout it was built from: "0.1.0+a163e3b"), and the versions of the
+  PETSc and SLEPc libraries it runs with ("3.18.5"), each at most len characters. Not collective.
+@*/
+PetscErrorCode PeriGetVersions(char perilin[], char petsc[], char slepc[], size_t len)
+{
+  PetscInt major, minor, sub;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(perilin, PeriBuildVersion(), len));
+  PetscCall(PetscGetVersionNumber(&major, &minor, &sub, NULL));
+  PetscCall(PetscSNPrintf(petsc, len, "%" PetscInt_FMT ".%" PetscInt_FMT ".%" PetscInt_FMT, major, minor, sub));
+  PetscCall(SlepcGetVersionNumber(&major, &minor, &sub, NULL));
+  PetscCall(PetscSNPrintf(slepc, len, "%" PetscInt_FMT ".%" PetscInt_FMT ".%" PetscInt_FMT, major, minor, sub));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriPrintVersion - "perilin V", "PETSc V", "SLEPc V", one a line (perilin -version). Collective.
+@*/
+PetscErrorCode PeriPrintVersion(MPI_Comm comm)
+{
+  char perilin[PERI_VERSION_LEN], petsc[PERI_VERSION_LEN], slepc[PERI_VERSION_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriGetVersions(perilin, petsc, slepc, PERI_VERSION_LEN));
+  PetscCall(PetscPrintf(comm, "perilin %s\nPETSc %s\nSLEPc %s\n", perilin, petsc, slepc));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -3,12 +3,35 @@
 #include "perilin/private/problem.h"
 #include <signal.h>
 
+/* What made the run, to repeat it: "build" (perilin's version as built, PETSc's and SLEPc's) and
+ * "command_line" (the arguments PETSc was started with, the program first). */
+static PetscErrorCode WriteProvenance(PeriJSON j)
+{
+  char   perilin[PERI_VERSION_LEN], petsc[PERI_VERSION_LEN], slepc[PERI_VERSION_LEN];
+  int    argc = 0;
+  char **args = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriGetVersions(perilin, petsc, slepc, PERI_VERSION_LEN));
+  PetscCall(PeriJSONBeginObject(j, "build"));
+  PetscCall(PeriJSONString(j, "perilin", perilin));
+  PetscCall(PeriJSONString(j, "petsc", petsc));
+  PetscCall(PeriJSONString(j, "slepc", slepc));
+  PetscCall(PeriJSONEndObject(j));
+  PetscCall(PetscGetArgs(&argc, &args));
+  PetscCall(PeriJSONBeginArray(j, "command_line"));
+  for (int k = 0; k < argc; k++) PetscCall(PeriJSONString(j, NULL, args[k]));
+  PetscCall(PeriJSONEndArray(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
 {
   PeriSystem sys = p->sys;
 
   PetscFunctionBeginUser;
   PetscCall(PeriJSONString(j, "scene", p->scene->file));
+  PetscCall(WriteProvenance(j));
   PetscCall(PeriSystemSummaryModel(sys, j));
   PetscCall(PeriJSONString(j, "analysis", p->analysis_type));
   /* false only for a run stopped by a signal: then the fields below describe the last complete

@@ -8,7 +8,10 @@
                                            so the git diff of an update shows only real changes)
 
 Normalized files (see run.sh for why these are guards against unintended change, not physics tests):
-  summary.json   perilin's summary minus the volatile keys (VOLATILE below)
+  summary.json   perilin's summary minus the volatile keys (VOLATILE below), with the values of the
+                 keys that vary by build and invocation (VARIES: build.perilin, which `git describe`
+                 changes at every commit, the PETSc and SLEPc versions, the command line with its
+                 temporary paths) replaced by "<varies>", so their presence is still compared
   modes.csv      as written
   steps.csv      minus the `seconds` column
   files.txt      the names of the files in the output directory (hidden ones included)
@@ -64,6 +67,7 @@ import sys
 # checked by running every scene twice; only these differed (and `scene` is the path given).
 VOLATILE = [("scene",), ("timing",), ("memory_mb",), ("memory_mb_max_rank",), ("memory_phases_mb",), ("matrix_mb",),
             ("modal", "factorization_s"), ("modal", "eigensolve_s")]
+VARIES = [("build", "perilin"), ("build", "petsc"), ("build", "slepc"), ("command_line",)]
 ROUNDOFF_JSON = {"solver.residual_norm", "solver.load_share_removed", "modal.modes.residual",
                  "interior_strain", "equilibrium.relative_imbalance", "equilibrium.moment_imbalance",
                  "equilibrium.relative_moment_imbalance"}
@@ -118,6 +122,12 @@ def normalize(outdir, dest):
             d = d.get(k, {}) if isinstance(d, dict) else {}
         if isinstance(d, dict):
             d.pop(key[-1], None)
+    for key in VARIES:
+        d = s
+        for k in key[:-1]:
+            d = d.get(k, {}) if isinstance(d, dict) else {}
+        if isinstance(d, dict) and key[-1] in d:
+            d[key[-1]] = "<varies>"
     with open(os.path.join(dest, "summary.json"), "w") as f:
         json.dump(s, f, indent=2)
         f.write("\n")

@@ -12,7 +12,8 @@
 #
 # Compared (the rules, and why some keys are left out, are in golden.py's header):
 #   summary.json     minus the volatile keys (timing, memory_mb, memory_mb_max_rank, scene,
-#                    modal.factorization_s, modal.eigensolve_s); numbers to 1e-9 relative;
+#                    modal.factorization_s, modal.eigensolve_s), the values of build.* and
+#                    command_line as "<varies>"; numbers to 1e-9 relative;
 #                    round-off quantities (residual norms, load_share_removed, the mean interior
 #                    strain of the bending scene) by order of magnitude only
 #   modes.csv        same numeric rule, column names exactly
@@ -20,8 +21,9 @@
 #   *.vtu, *.pvd     the set of DataArray names and NumberOfComponents (XML header only, not the
 #                    appended binary data); the files a .pvd indexes
 #   the names of the files in the output directory
-#   perilin -help    exactly (expected/help.txt; it includes the PETSc/SLEPc banner, so it is tied
-#                    to the installed PETSc 3.18.5 / SLEPc 3.18.2)
+#   perilin -help    exactly (expected/help.txt: perilin's usage, options and scene keys; PETSc's
+#                    generic list is printed only under -help petsc, so this does not depend on
+#                    the installed PETSc)
 #
 # --update regenerates the expectations, for a step that changes an output on purpose: files
 # that still compare equal are left untouched, so `git diff tests/golden/expected` shows exactly
