@@ -33,7 +33,7 @@ hdr_order=(sys scene output disc model mass fields conditions stiffness bondstat
 folder_of() { # a source path relative to the repo -> its folder key
   case $1 in
     src/main.c) echo src/main ;;
-    version.c) echo src/sys ;; # generated in the build tree (cmake/version.cmake), declared in sys.h
+    version.c) echo src/sys ;; # generated in the build tree (src/sys/version.cmake), declared in sys.h
     src/*/*) dirname "$1" ;;
     src/*) echo src ;;
     models/*) echo models ;;
