@@ -85,6 +85,48 @@ static const PeriSchemaOwner core_owners[] = {
     {"core", "failure", PeriFailureSchema},
 };
 
+/* The problem's keys, read by src/problem.c: the root keys, in the order "allowed here" lists
+ * them, and the core's keys of analysis and output (the analyses declare theirs). Declared here,
+ * with the table of every owner, so that the package sits below the problem. */
+static const PeriKey root_keys[] = {
+    {"dim", PERI_KEY_INT, "required", "{2, 3}", NULL, NULL, "the space dimension"},
+    {"model", PERI_KEY_MAP, "required", NULL, NULL, NULL, "the bond model and its constants"},
+    {"material", PERI_KEY_MAP, "required", NULL, NULL, NULL, "the elastic constants and the density"},
+    {"grid", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "particles on a regular grid filling a box (or particles)"},
+    {"particles", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "particles read from a CSV file (or grid)"},
+    {"horizon", PERI_KEY_MAP, "required", NULL, NULL, NULL, "the horizon radius"},
+    {"corrections", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "partial-volume and surface corrections"},
+    {"regions", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "named boxes and boundary layers"},
+    {"bc", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "boundary conditions, applied in order"},
+    {"loads", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "forces, tractions and body forces"},
+    {"probes", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "named points reported after the solve"},
+    {"analysis", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "what to compute"},
+    {"output", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "where and what to write"},
+    {"reference", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an exact plane elasticity field to compare with"},
+    {"boundary_layers", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "fictitious layers outside the faces (cross-section models)"},
+    {"torsion", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the twist of a bar (cross-section models)"},
+    {"failure", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "bond failure criteria"},
+    {"cracks", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "pre-existing cracks"},
+    {"solver", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "checks of the linear solves"},
+    {NULL},
+};
+static const PeriKey analysis_keys[] = {
+    {"type", PERI_KEY_STRING, "static", NULL, NULL, NULL, "the analysis"},
+    {NULL},
+};
+static const PeriKey output_keys[] = {
+    {"dir", PERI_KEY_STRING, "<scene file name without directory and last extension>-out", NULL, NULL, NULL, "output directory"},
+    {"vtk", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "write particles.vtu"},
+    {"stress", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "per-particle stress and strain (vector models): arrays stress, strain, elastic_stress in particles.vtu and sigma, epsilon, sigma_elastic in the probes (docs/stress.md); costs a pass over the bonds and 27 numbers per particle"},
+    {NULL},
+};
+const PeriSchema PeriProblemSchema[] = {
+    {"", root_keys},
+    {"analysis", analysis_keys},
+    {"output", output_keys},
+    {NULL},
+};
+
 /*@C
   PeriSchemaOwners - the core's schemas, then every built-in model's and analysis' schema, for the
   scene layer, which cannot ask the modules and registries itself: it validates, documents and

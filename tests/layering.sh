@@ -5,6 +5,8 @@
 #   1. the #include lines of every source and header against the allow-list below;
 #   2. the call graph of the built library (nm on the object files): the folders' dependencies
 #      must form no cycle and must respect the order below.
+#   3. within each folder, the calls between its files form no cycle (issue 25): every file can be
+#      read knowing only the files it calls, and a folder's files have an order from the top down.
 # Usage: layering.sh REPO OBJDIR   (OBJDIR: the perilin_core object directory of a build)
 set -euo pipefail
 repo=$1 objdir=$2
@@ -74,9 +76,13 @@ obj_folder() { # .../perilin_core.dir/src/system/solve.c.o -> src/system
   rel=${rel%.o}
   folder_of "$rel"
 }
+declare -A def_file
 for o in $objs; do
   fo=$(obj_folder "$o")
-  for s in $(nm --defined-only -g "$o" | awk '$2 ~ /[TDBR]/ {print $3}'); do def_folder[$s]=$fo; done
+  for s in $(nm --defined-only -g "$o" | awk '$2 ~ /[TDBR]/ {print $3}'); do
+    def_folder[$s]=$fo
+    def_file[$s]=${o#"$objdir"/}
+  done
 done
 rank() { for ((k = 0; k < ${#order[@]}; k++)); do [[ ${order[k]} == "$1" ]] && { echo $k; return; }; done; echo -1; }
 for o in $objs; do
@@ -89,5 +95,21 @@ for o in $objs; do
     if ((rd < ro)); then echo "layering: ${o#"$objdir"/} ($fo) calls $s, defined in $fd, a higher layer"; fail=1; fi
   done
 done
-if [[ $fail == 0 ]]; then echo "ok: includes follow the layers; no call from a lower folder to a higher one (${#order[@]} folders)"; fi
+
+# 3. file-level cycles within a folder: tsort names the files of any loop
+edges=$(for o in $objs; do
+  fo=$(obj_folder "$o")
+  for s in $(nm -u "$o" | awk '{print $2}'); do
+    fd=${def_file[$s]:-}
+    [[ -n $fd && ${def_folder[$s]} == "$fo" && $fd != "${o#"$objdir"/}" ]] && echo "${o#"$objdir"/} $fd"
+  done
+done | sed 's/\.o / /; s/\.o$//' | sort -u)
+loops=$(printf '%s\n' "$edges" | tsort 2>&1 > /dev/null | grep -v 'input contains a loop' | sed 's/^tsort: //' || true)
+if [[ -n $loops ]]; then
+  echo "layering: files of one folder call each other in a cycle (move the shared function down, or split the file):"
+  printf '%s\n' "$loops" | sort -u | sed 's/^/  /'
+  printf '%s\n' "$edges" | while read -r a b; do printf '%s\n' "$loops" | grep -qx "$a" && printf '%s\n' "$loops" | grep -qx "$b" && echo "    $a -> $b"; done
+  fail=1
+fi
+if [[ $fail == 0 ]]; then echo "ok: includes follow the layers; no call from a lower folder to a higher one (${#order[@]} folders); no call cycle between the files of a folder"; fi
 exit $fail

@@ -500,3 +500,18 @@ PetscErrorCode PeriMeshGroupsDestroy(PetscInt *ngroups, PeriMeshGroup **groups)
   *ngroups = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The file named by node.key (required), relative to the scene file's directory unless absolute:
+ * particles.file and particles.mesh. */
+PetscErrorCode PeriParticlesInputPath(PeriScene scene, PeriNode node, const char key[], char path[], size_t size)
+{
+  char name[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetString(scene, node, key, PETSC_TRUE, name, sizeof(name), NULL));
+  if (name[0] == '/')
+    PetscCall(PetscStrncpy(path, name, size));
+  else
+    PetscCall(PetscSNPrintf(path, size, "%s/%s", scene->dir, name));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

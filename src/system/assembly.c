@@ -291,16 +291,27 @@ typedef struct {
 } RowBuffer;
 
 /* The block of bond k of owned particle i, times the filter's scale. */
-static PetscErrorCode BondBlock(PeriSystem sys, const BondFilter *f, PetscInt i, PetscInt k, PeriBondGeometry *g, PetscReal Ke[])
+/*@C
+  PeriBondStiffness - the (2 dofs)^2 stiffness block of bond k of particle i times scale, and the
+  bond's geometry. Not collective.
+@*/
+PetscErrorCode PeriBondStiffness(PeriSystem sys, PetscInt i, PetscInt k, PetscReal scale, PeriBondGeometry *g, PetscReal Ke[])
 {
-  const PetscInt  nb    = 2 * sys->model->dofs;
-  const PetscReal scale = sys->disc.bonds.live[k] ? f->scale : f->scale * f->broken_share;
+  const PetscInt nb = 2 * sys->model->dofs;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemBondGeometry(sys, i, k, g));
   sys->model->ops.bond_stiffness(sys->model, g, Ke);
   if (scale != 1)
     for (PetscInt a = 0; a < nb * nb; a++) Ke[a] *= scale;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The block of bond k under the filter: scaled, broken bonds by their share. */
+static PetscErrorCode BondBlock(PeriSystem sys, const BondFilter *f, PetscInt i, PetscInt k, PeriBondGeometry *g, PetscReal Ke[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriBondStiffness(sys, i, k, sys->disc.bonds.live[k] ? f->scale : f->scale * f->broken_share, g, Ke));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -414,44 +425,6 @@ PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 }
 
 /*@C
-  PeriStiffnessScaleBond - scales the stiffness of bond k of owned particle i (live, not a
-  self-image) by factor >= 0 in K: 0 breaks it (PeriOperatorScaleBond says what a matrix-free K's
-  preconditioning matrix does). Call PeriStiffnessScaled after the last. Not collective.
-@*/
-PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, PetscReal factor)
-{
-  const BondFilter change = {PETSC_MAX_REAL, factor - 1, 0}, same = {PETSC_MAX_REAL, 1, 0};
-  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
-  PeriBondGeometry g;
-  PetscInt         idx[2];
-
-  PetscFunctionBeginUser;
-  if (sys->stiffness.op) {
-    PetscCall(BondBlock(sys, &same, i, k, &g, Ke));
-    PetscCall(PeriOperatorScaleBond(sys, i, k, factor, Ke));
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(BondBlock(sys, &change, i, k, &g, Ke)); /* the change of the bond's block */
-  idx[0] = sys->disc.particles.global[i];
-  idx[1] = sys->disc.particles.global[g.j];
-  PetscCall(MatSetValuesBlocked(sys->stiffness.K, 2, idx, 2, idx, Ke, ADD_VALUES));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* After the last PeriStiffnessScaleBond: the matrices' assembly. Collective. */
-PetscErrorCode PeriStiffnessScaled(PeriSystem sys)
-{
-  PetscFunctionBeginUser;
-  if (sys->stiffness.op)
-    PetscCall(PeriOperatorScaled(sys));
-  else {
-    PetscCall(MatAssemblyBegin(sys->stiffness.K, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(sys->stiffness.K, MAT_FINAL_ASSEMBLY));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
   PeriAssembleShortRange - assembles scale times the sum of the blocks of the bonds no longer than
   rmax, broken ones with broken_share of theirs (bond-based models), as PeriAssembleStiffness does
   K. Collective.
@@ -549,5 +522,21 @@ PetscErrorCode PeriSetNearNullSpace(PeriSystem sys, Mat A, IS rows)
   PetscCall(MatNullSpaceDestroy(&nsp));
   for (PetscInt k = 0; k < nk; k++) PetscCall(VecDestroy(&kept[k]));
   for (PetscInt k = 0; k < nm; k++) PetscCall(VecDestroy(&modes[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The bytes PETSc holds for an assembled matrix, all ranks. Collective. */
+PetscErrorCode PeriMatrixMB(Mat K, PetscReal *mb)
+{
+  MatInfo   info;
+  PetscBool blocked;
+  PetscInt  bs;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetInfo(K, MAT_GLOBAL_SUM, &info));
+  PetscCall(MatGetBlockSize(K, &bs));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)K, &blocked, MATSEQBAIJ, MATMPIBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  /* PETSc 3.18 leaves info.memory 0 for AIJ: the values and the column indices (one per block) */
+  *mb = (info.memory > 0 ? info.memory : info.nz_allocated * (sizeof(PetscScalar) + (PetscReal)sizeof(PetscInt) / (blocked ? bs * bs : 1))) / 1048576.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -211,25 +211,6 @@ static PetscErrorCode KeepOwnedSolution(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriSystemLocalDOFs - the DOFs of the local view from the distributed u: the owned particles'
-  from u, the ghosts' from their owners. *ul (particles.n x dofs) is freed with PetscFree.
-  Collective.
-@*/
-PetscErrorCode PeriSystemLocalDOFs(PeriSystem sys, Vec u, PetscScalar **ul)
-{
-  const PetscInt     bs = sys->model->dofs;
-  const PetscScalar *a;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(sys->disc.particles.n * bs, ul));
-  PetscCall(VecGetArrayRead(u, &a));
-  PetscCall(PetscArraycpy(*ul, a, sys->disc.nowned * bs));
-  PetscCall(VecRestoreArrayRead(u, &a));
-  PetscCall(PeriDiscOwnersToGhosts(&sys->disc, MPIU_SCALAR, bs, *ul));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The largest |u| per component over the body's particles (fictitious ones excluded). */
 static PetscErrorCode MaxDisplacement(PeriSystem sys, const PetscScalar u[])
 {

@@ -482,13 +482,3 @@ PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
   PetscCall(PetscFree(*op));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
-
-/* Frees K, its preconditioning matrix and the matrix-free operator. */
-PetscErrorCode PeriStiffnessDestroy(PeriStiffness *S)
-{
-  PetscFunctionBeginUser;
-  PetscCall(MatDestroy(&S->K));
-  PetscCall(MatDestroy(&S->Kpc));
-  PetscCall(PeriOperatorDestroy(&S->op));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}

@@ -560,3 +560,15 @@ PetscErrorCode PeriStaticCheckConverged(PeriSystem sys, KSPConvergedReason reaso
   PetscCheck(ok, sys->comm, PETSC_ERR_NOT_CONVERGED, "the static solve did not converge: true relative residual %.3g > tolerance %.3g although %s/%s reported %s after %" PetscInt_FMT " iterations: %s", (double)sys->fields.solve.residual_norm, (double)sys->fields.solve.residual_tol, sys->fields.solve.ksp_type, sys->fields.solve.pc_type, KSPConvergedReasons[reason], sys->fields.solve.iterations, AdviceResidual(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriResidualTolerance - the largest true relative residual a solve run with relative tolerance
+  rtol may leave: solver.residual_tol, or by default max(100 rtol, 1e-6), but never above 1e-3.
+  The factor 100 leaves room for the preconditioned norm that some KSPs monitor; the floor, for
+  round-off in K; the cap keeps a loose -ksp_rtol from passing a wrong answer (an answer that
+  crude must be asked for with solver.residual_tol).
+@*/
+PetscReal PeriResidualTolerance(PeriSystem sys, PetscReal rtol)
+{
+  return sys->stiffness.residual_tol > 0 ? sys->stiffness.residual_tol : PetscMin(PetscMax(100 * rtol, 1e-6), 1e-3);
+}

@@ -45,6 +45,7 @@ typedef struct {
 
 PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriBondStiffness(PeriSystem, PetscInt, PetscInt, PetscReal, PeriBondGeometry *, PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
 PETSC_EXTERN PetscErrorCode PeriMatrixMB(Mat, PetscReal *);

@@ -1,0 +1,76 @@
+/* The system's layout and bond geometry (bottom of src/system/): vectors with one block of DOFs per
+ * owned particle, a bond's or a family's geometry for the model's kernels, and the local DOFs of a
+ * state (owned and ghosts). Every other file of the system builds on these. */
+#include "perilin/private/system.h"
+
+/* A vector with one block of DOFs per owned particle. */
+PetscErrorCode PeriSystemCreateVec(PeriSystem sys, Vec *v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecCreate(sys->comm, v));
+  PetscCall(VecSetSizes(*v, (sys->disc.bonds.rend - sys->disc.bonds.rstart) * sys->model->dofs, PETSC_DETERMINE));
+  PetscCall(VecSetBlockSize(*v, sys->model->dofs));
+  PetscCall(VecSetFromOptions(*v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The kernel's view of bond k of owned particle i in the list b (bond_mu: per bond, or NULL). */
+static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const PetscReal bond_mu[], PetscInt i, PetscInt k, PeriBondGeometry *g)
+{
+  g->i = i;
+  g->j = b->j[k];
+  for (PetscInt d = 0; d < 3; d++) g->xi[d] = b->xi[3 * k + d];
+  g->length = b->length[k];
+  g->Vi     = pt->volume[i];
+  g->Vj     = pt->volume[g->j];
+  g->weight = b->alpha[k] * b->lambda[k] * (b->intact ? b->intact[k] : 1);
+  g->mu     = bond_mu ? bond_mu[k] : 0;
+}
+
+/* The kernel's view of local bond k of owned particle i. */
+PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, PeriBondGeometry *g)
+{
+  PetscFunctionBeginUser;
+  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->materials.bond_mu, i, k, g);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Gathers the family of owned particle i from sys->disc.family (state-based models). */
+PetscErrorCode PeriSystemFamilyGeometry(PeriSystem sys, PetscInt i, PetscInt *n, PeriBondGeometry fam[])
+{
+  const PeriBonds     *b  = &sys->disc.family;
+  const PeriParticles *pt = &sys->disc.particles;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+    if (b->live[k]) FillGeometry(pt, b, NULL, i, k, &fam[(*n)++]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Largest family in sys->disc.family, for workspace. */
+PetscInt PeriSystemMaxFamily(PeriSystem sys)
+{
+  PetscInt nmax = 0;
+  for (PetscInt i = sys->disc.family.rstart; i < sys->disc.family.rend; i++) nmax = PetscMax(nmax, sys->disc.family.offset[i - sys->disc.family.rstart + 1] - sys->disc.family.offset[i - sys->disc.family.rstart]);
+  return nmax;
+}
+
+/*@C
+  PeriSystemLocalDOFs - the DOFs of the local view from the distributed u: the owned particles'
+  from u, the ghosts' from their owners. *ul (particles.n x dofs) is freed with PetscFree.
+  Collective.
+@*/
+PetscErrorCode PeriSystemLocalDOFs(PeriSystem sys, Vec u, PetscScalar **ul)
+{
+  const PetscInt     bs = sys->model->dofs;
+  const PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(sys->disc.particles.n * bs, ul));
+  PetscCall(VecGetArrayRead(u, &a));
+  PetscCall(PetscArraycpy(*ul, a, sys->disc.nowned * bs));
+  PetscCall(VecRestoreArrayRead(u, &a));
+  PetscCall(PeriDiscOwnersToGhosts(&sys->disc, MPIU_SCALAR, bs, *ul));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,133 @@
+/* The stiffness part (include/perilin/private/stiffness.h): K built as the scene and the analysis
+ * ask (assembled, or matrix-free with its preconditioning matrix), changed bond by bond as bonds
+ * break or soften, and freed. Assembly itself is in assembly.c, the matrix-free operator in
+ * operator.c, the checked solve in solve.c. */
+#include "perilin/private/system.h"
+
+/* solver.operator: matrix_free applies to central-force models solved once as assembled (the
+ * static analysis), without fictitious layers; auto takes it with GAMG (the default), where
+ * it wins (docs/performance.md), and assembled K elsewhere. */
+static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
+{
+  const char *why = NULL;
+  PeriNode    node;
+
+  PetscFunctionBeginUser;
+  if (!sys->model->central_force)
+    why = "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
+  else if (!sys->stiffness.needs.matrix_free)
+    why = "the analysis needs K's entries (matrix_free serves the static and quasi-static analyses)";
+  else if (sys->conditions.layers.T)
+    why = "fictitious layers eliminate K's rows through its entries";
+  *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->stiffness.operator_kind == PERI_OPERATOR_AUTO));
+  if (*mf && sys->stiffness.operator_kind == PERI_OPERATOR_AUTO) {
+    /* the short-range stiffness serves AMG, the diagonal Jacobi; another -pc_type (a
+       factorization) gets K itself */
+    char pc[64] = PCGAMG;
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
+    *mf = PeriOperatorServesPC(pc);
+  }
+  if (sys->stiffness.operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetMap(sys->scene, sys->scene->root, "solver", PETSC_FALSE, &node));
+  PeriInputCheck(PETSC_FALSE, sys->scene, node, "operator", "matrix_free cannot apply here: %s; use assembled or auto", why);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The static solves' default PC: GAMG, but Jacobi on a matrix-free K of a small 3D body, where CG
+ * needs a few hundred of the cheap products and no preconditioning matrix is stored: faster and
+ * lighter up to about 5e5 particles and 200 spacings across (docs/performance.md, "Matrix-free"). */
+static void DefaultPC(PeriSystem sys)
+{
+  const PeriParticles *pt     = &sys->disc.particles;
+  PetscReal            extent = 0;
+
+  for (PetscInt d = 0; d < pt->dim; d++) extent = PetscMax(extent, pt->upper[d] - pt->lower[d]);
+  if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
+    PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
+  else
+    PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default));
+}
+
+PetscErrorCode PeriSystemAssemble(PeriSystem sys)
+{
+  PetscLogDouble t0, t1;
+  PetscBool      mf;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogStagePush(PERI_STAGE_Assembly));
+  PetscCall(PeriProgressUpdate(sys->run.progress, PERI_PROGRESS_PHASE, "assembly"));
+  PetscCall(PetscTime(&t0));
+  PetscCall(MatDestroy(&sys->stiffness.K));
+  PetscCall(MatDestroy(&sys->stiffness.Kpc));
+  PetscCall(PeriOperatorDestroy(&sys->stiffness.op));
+  sys->stiffness.pc_default[0] = 0;
+  PetscCall(UseMatrixFree(sys, &mf));
+  if (mf) {
+    PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
+    PetscCall(PeriOperatorCreate(sys, sys->stiffness.pc_radius, &sys->stiffness.op));
+    DefaultPC(sys);
+    PetscCall(PeriOperatorCreateMat(sys, &sys->stiffness.K));
+    PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
+  } else
+    PetscCall(PeriAssembleStiffness(sys, &sys->stiffness.K));
+  PetscCall(PetscTime(&t1));
+  sys->run.log.assembly_s = t1 - t0;
+  if (sys->run.log.matrix_mb == 0) { /* the first assembly: K's size and the memory it took */
+    PetscReal opmb = 0;
+    if (sys->stiffness.op)
+      PetscCall(PeriOperatorMemoryMB(sys, sys->stiffness.op, &opmb));
+    else
+      PetscCall(PeriMatrixMB(sys->stiffness.K, &sys->run.log.matrix_mb));
+    sys->run.log.matrix_mb += opmb;
+    sys->run.log.memory_phase_mb[1] = PeriPeakMemoryMB();
+  }
+  PetscCall(PetscLogStagePop());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriStiffnessScaleBond - scales the stiffness of bond k of owned particle i (live, not a
+  self-image) by factor >= 0 in K: 0 breaks it (PeriOperatorScaleBond says what a matrix-free K's
+  preconditioning matrix does). Call PeriStiffnessScaled after the last. Not collective.
+@*/
+PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, PetscReal factor)
+{
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PeriBondGeometry g;
+  PetscInt         idx[2];
+
+  PetscFunctionBeginUser;
+  if (sys->stiffness.op) {
+    PetscCall(PeriBondStiffness(sys, i, k, 1, &g, Ke));
+    PetscCall(PeriOperatorScaleBond(sys, i, k, factor, Ke));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PeriBondStiffness(sys, i, k, factor - 1, &g, Ke)); /* the change of the bond's block */
+  idx[0] = sys->disc.particles.global[i];
+  idx[1] = sys->disc.particles.global[g.j];
+  PetscCall(MatSetValuesBlocked(sys->stiffness.K, 2, idx, 2, idx, Ke, ADD_VALUES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After the last PeriStiffnessScaleBond: the matrices' assembly. Collective. */
+PetscErrorCode PeriStiffnessScaled(PeriSystem sys)
+{
+  PetscFunctionBeginUser;
+  if (sys->stiffness.op)
+    PetscCall(PeriOperatorScaled(sys));
+  else {
+    PetscCall(MatAssemblyBegin(sys->stiffness.K, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(sys->stiffness.K, MAT_FINAL_ASSEMBLY));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Frees K, its preconditioning matrix and the matrix-free operator. */
+PetscErrorCode PeriStiffnessDestroy(PeriStiffness *S)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&S->K));
+  PetscCall(MatDestroy(&S->Kpc));
+  PetscCall(PeriOperatorDestroy(&S->op));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
