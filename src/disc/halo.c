@@ -52,71 +52,47 @@ static PetscErrorCode Boxes(MPI_Comm comm, const PeriParticles *p, PetscReal **b
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-typedef struct {
-  PetscMPIInt *scount, *sdispl, *rcount, *rdispl;
-  PetscInt    *sidx, nsend, nrecv;
-} Exchange;
-
-/* Which owned particles go to which rank: those within r of the rank's box. */
-static PetscErrorCode PlanSends(MPI_Comm comm, const PeriParticles *p, PetscReal r, Exchange *ex)
+/* Which owned particles go to which rank (those within r of the rank's box): the exchange, and
+ * the local index of each particle sent, grouped by rank. */
+static PetscErrorCode PlanSends(MPI_Comm comm, const PeriParticles *p, PetscReal r, PeriExchange *ex, PetscInt **sidx)
 {
   PetscReal  *boxes;
-  PetscMPIInt rank, size;
+  PetscMPIInt rank, size, *dest;
+  PetscInt    nsend = 0;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(Boxes(comm, p, &boxes));
-  PetscCall(PetscCalloc4(size, &ex->scount, size + 1, &ex->sdispl, size, &ex->rcount, size + 1, &ex->rdispl));
   for (PetscMPIInt q = 0; q < size; q++)
-    for (PetscInt k = 0; k < p->n && q != rank; k++) ex->scount[q] += NearBox(p, &p->x[3 * k], &boxes[6 * q], r);
-  for (PetscMPIInt q = 0; q < size; q++) ex->sdispl[q + 1] = ex->sdispl[q] + ex->scount[q];
-  ex->nsend = ex->sdispl[size];
-  PetscCall(PetscMalloc1(ex->nsend, &ex->sidx));
+    for (PetscInt k = 0; k < p->n && q != rank; k++) nsend += NearBox(p, &p->x[3 * k], &boxes[6 * q], r);
+  PetscCall(PetscMalloc1(nsend, &dest));
+  PetscCall(PetscMalloc1(nsend, sidx));
   for (PetscMPIInt q = 0, s = 0; q < size; q++)
     for (PetscInt k = 0; k < p->n && q != rank; k++)
-      if (NearBox(p, &p->x[3 * k], &boxes[6 * q], r)) ex->sidx[s++] = k;
+      if (NearBox(p, &p->x[3 * k], &boxes[6 * q], r)) {
+        dest[s]      = q;
+        (*sidx)[s++] = k;
+      }
   PetscCall(PetscFree(boxes));
-  PetscCallMPI(MPI_Alltoall(ex->scount, 1, MPI_INT, ex->rcount, 1, MPI_INT, comm));
-  for (PetscMPIInt q = 0; q < size; q++) ex->rdispl[q + 1] = ex->rdispl[q] + ex->rcount[q];
-  ex->nrecv = ex->rdispl[size];
+  PetscCall(PeriExchangeCreate(comm, nsend, dest, ex));
+  PetscCall(PetscFree(dest));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The candidates' positions and their owners' local indices, grouped by owner rank. */
-static PetscErrorCode SendCandidates(MPI_Comm comm, const PeriParticles *p, const Exchange *ex, PetscReal **y, PetscInt **from)
+static PetscErrorCode SendCandidates(const PeriParticles *p, const PeriExchange *ex, const PetscInt sidx[], PetscReal **y, PetscInt **from)
 {
-  PetscReal  *sx;
-  PetscMPIInt size, *c3;
+  PetscReal *sx;
 
   PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscMalloc1(3 * ex->nsend, &sx));
   for (PetscInt s = 0; s < ex->nsend; s++)
-    for (PetscInt d = 0; d < 3; d++) sx[3 * s + d] = p->x[3 * ex->sidx[s] + d];
+    for (PetscInt d = 0; d < 3; d++) sx[3 * s + d] = p->x[3 * sidx[s] + d];
   PetscCall(PetscMalloc2(3 * ex->nrecv, y, ex->nrecv, from));
-  PetscCallMPI(MPI_Alltoallv(ex->sidx, ex->scount, ex->sdispl, MPIU_INT, *from, ex->rcount, ex->rdispl, MPIU_INT, comm));
-  PetscCall(PetscMalloc1(4 * size + 2, &c3));
-  {
-    PetscMPIInt *sc = c3, *sd = c3 + size, *rc = c3 + 2 * size, *rd = c3 + 3 * size;
-    for (PetscMPIInt q = 0; q < size; q++) {
-      sc[q] = 3 * ex->scount[q];
-      sd[q] = 3 * ex->sdispl[q];
-      rc[q] = 3 * ex->rcount[q];
-      rd[q] = 3 * ex->rdispl[q];
-    }
-    PetscCallMPI(MPI_Alltoallv(sx, sc, sd, MPIU_REAL, *y, rc, rd, MPIU_REAL, comm));
-  }
-  PetscCall(PetscFree(c3));
+  PetscCall(PeriExchangeSend(ex, MPIU_INT, 1, sidx, *from));
+  PetscCall(PeriExchangeSend(ex, MPIU_REAL, 3, sx, *y));
   PetscCall(PetscFree(sx));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode ExchangeDestroy(Exchange *ex)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFree4(ex->scount, ex->sdispl, ex->rcount, ex->rdispl));
-  PetscCall(PetscFree(ex->sidx));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -174,7 +150,7 @@ static PetscErrorCode AppendGhosts(PeriParticles *p, const PeriHalo *h, const Pe
 }
 
 /* The SF from owners to the kept candidates, and the ghosts' global indices. */
-static PetscErrorCode BuildSF(MPI_Comm comm, const Exchange *ex, const PetscInt from[], const PetscInt kept[], PeriHalo *h)
+static PetscErrorCode BuildSF(MPI_Comm comm, const PeriExchange *ex, const PetscInt from[], const PetscInt kept[], PeriHalo *h)
 {
   PetscSFNode *remote;
   PetscInt    *starts;
@@ -186,13 +162,12 @@ static PetscErrorCode BuildSF(MPI_Comm comm, const Exchange *ex, const PetscInt 
   PetscCallMPI(MPI_Allgather(&h->rstart, 1, MPIU_INT, starts, 1, MPIU_INT, comm));
   PetscCall(PetscMalloc1(h->nghost, &remote));
   PetscCall(PetscMalloc1(h->nghost, &h->global));
-  for (PetscInt g = 0; g < h->nghost; g++) {
-    PetscInt    c = kept[g];
-    PetscMPIInt q = 0;
-    while (ex->rdispl[q + 1] <= c) q++;
-    remote[g].rank  = q;
+  for (PetscInt g = 0, i = 0; g < h->nghost; g++) { /* kept ascends: so do the senders i */
+    PetscInt c = kept[g];
+    while (ex->fromstart[i + 1] <= c) i++;
+    remote[g].rank  = ex->from[i];
     remote[g].index = from[c];
-    h->global[g]    = starts[q] + from[c];
+    h->global[g]    = starts[ex->from[i]] + from[c];
   }
   PetscCall(PetscFree(starts));
   PetscCall(PetscSFCreate(comm, &h->sf));
@@ -206,14 +181,14 @@ static PetscErrorCode BuildSF(MPI_Comm comm, const Exchange *ex, const PetscInt 
   lower ranks' counts); appends as ghosts every other rank's particle within r of one of them
   (minimum image on periodic axes), in ascending global index, sets p->global and describes the
   ghosts in h.
-  Collective: two all-to-all exchanges and an O(P) all-gather; no array of the whole body.
+  Collective: one sparse exchange (PeriExchange) and O(P) all-gathers; no array of the whole body.
 @*/
 PetscErrorCode PeriHaloCreate(MPI_Comm comm, PeriParticles *p, PetscReal r, PeriHalo *h)
 {
-  Exchange   ex;
-  PetscReal *y;
-  PetscInt  *from, *kept;
-  PetscBool *near;
+  PeriExchange ex;
+  PetscReal   *y;
+  PetscInt    *sidx, *from, *kept;
+  PetscBool   *near;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(h, sizeof(*h)));
@@ -225,8 +200,8 @@ PetscErrorCode PeriHaloCreate(MPI_Comm comm, PeriParticles *p, PetscReal r, Peri
     PetscCallMPI(MPI_Comm_rank(comm, &rank));
     if (!rank) h->rstart = 0; /* MPI_Exscan leaves rank 0's result undefined */
   }
-  PetscCall(PlanSends(comm, p, r, &ex));
-  PetscCall(SendCandidates(comm, p, &ex, &y, &from));
+  PetscCall(PlanSends(comm, p, r, &ex, &sidx));
+  PetscCall(SendCandidates(p, &ex, sidx, &y, &from));
   PetscCall(PetscMalloc2(ex.nrecv, &near, ex.nrecv, &kept));
   PetscCall(PeriParticlesNear(p, r, ex.nrecv, y, near));
   for (PetscInt c = 0; c < ex.nrecv; c++)
@@ -235,7 +210,8 @@ PetscErrorCode PeriHaloCreate(MPI_Comm comm, PeriParticles *p, PetscReal r, Peri
   PetscCall(AppendGhosts(p, h, y, kept));
   PetscCall(PetscFree2(near, kept));
   PetscCall(PetscFree2(y, from));
-  PetscCall(ExchangeDestroy(&ex));
+  PetscCall(PetscFree(sidx));
+  PetscCall(PeriExchangeDestroy(&ex));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

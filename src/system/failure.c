@@ -314,20 +314,20 @@ static PetscErrorCode DeadPairs(PeriSystem sys, PetscInt *npairs, PetscInt **pai
 {
   const PeriBonds *b = &sys->disc.bonds;
   const PetscInt  *G = sys->disc.particles.global;
-  PetscMPIInt     *sc, *rc, *sd, *rd;
-  PetscInt        *send, nself = 0, nrecv = 0;
+  PeriExchange     ex;
+  PetscMPIInt     *dest;
+  PetscInt        *send, nself = 0, nsend = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc4(sys->size, &sc, sys->size, &rc, sys->size + 1, &sd, sys->size + 1, &rd));
+  *npairs = 0;
   for (PetscInt k = 0; k < b->nbonds; k++)
     if (!b->live[k]) {
       nself++;
-      if (b->j[k] >= sys->disc.nowned) sc[PeriDiscOwner(&sys->disc, G[b->j[k]])] += 2;
+      nsend += b->j[k] >= sys->disc.nowned;
     }
-  for (PetscMPIInt r = 0; r < sys->size; r++) sd[r + 1] = sd[r] + sc[r];
-  PetscCall(PetscMalloc1(sd[sys->size] + 1, &send));
+  PetscCall(PetscMalloc2(nsend, &dest, 2 * nsend, &send));
   PetscCall(PetscMalloc1(2 * nself + 1, pairs));
-  *npairs = 0;
+  nsend = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       const PetscInt j = b->j[k];
@@ -335,21 +335,17 @@ static PetscErrorCode DeadPairs(PeriSystem sys, PetscInt *npairs, PetscInt **pai
       (*pairs)[2 * *npairs]         = G[i];
       (*pairs)[2 * (*npairs)++ + 1] = G[j];
       if (j >= sys->disc.nowned) {
-        const PetscMPIInt r = PeriDiscOwner(&sys->disc, G[j]);
-        send[sd[r]++]       = G[i];
-        send[sd[r]++]       = G[j];
+        dest[nsend]           = PeriDiscOwner(&sys->disc, G[j]);
+        send[2 * nsend]       = G[i];
+        send[2 * nsend++ + 1] = G[j];
       }
     }
-  for (PetscMPIInt r = sys->size; r > 0; r--) sd[r] = sd[r - 1]; /* the fill moved each start to the next */
-  sd[0] = 0;
-  PetscCallMPI(MPI_Alltoall(sc, 1, MPI_INT, rc, 1, MPI_INT, sys->comm));
-  for (PetscMPIInt r = 0; r < sys->size; r++) rd[r + 1] = rd[r] + rc[r];
-  nrecv = rd[sys->size] / 2;
-  PetscCall(PetscRealloc(sizeof(PetscInt) * (2 * (nself + nrecv) + 1), pairs));
-  PetscCallMPI(MPI_Alltoallv(send, sc, sd, MPIU_INT, *pairs + 2 * nself, rc, rd, MPIU_INT, sys->comm));
-  *npairs = nself + nrecv;
-  PetscCall(PetscFree(send));
-  PetscCall(PetscFree4(sc, rc, sd, rd));
+  PetscCall(PeriExchangeCreate(sys->comm, nsend, dest, &ex));
+  PetscCall(PetscRealloc(sizeof(PetscInt) * (2 * (nself + ex.nrecv) + 1), pairs));
+  PetscCall(PeriExchangeSend(&ex, MPIU_INT, 2, send, *pairs + 2 * nself));
+  *npairs = nself + ex.nrecv;
+  PetscCall(PeriExchangeDestroy(&ex));
+  PetscCall(PetscFree2(dest, send));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

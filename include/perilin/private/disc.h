@@ -103,6 +103,23 @@ PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, co
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
 PETSC_EXTERN PetscErrorCode PeriPartitionBlocks(MPI_Comm, const PeriParticles *, PetscReal, PetscMPIInt **);
 
+/* ------------------------------------------------------------------ exchange (src/disc/exchange.c) */
+/* A sparse all-to-all: each rank sends each of its items to one rank and receives, ordered by the
+ * sending rank and then by the sender's order, what is sent to it. One plan, any number of arrays. */
+typedef struct {
+  PetscSF      sf;        /* roots: the items sent, grouped by destination; leaves: those received */
+  PetscInt     nsend;     /* items sent */
+  PetscInt    *order;     /* nsend: the items in the order sent (by destination rank, stable) */
+  PetscInt     nrecv;     /* items received */
+  PetscMPIInt  nfrom;     /* ranks sending to this one */
+  PetscMPIInt *from;      /* nfrom: those ranks, ascending */
+  PetscInt    *fromstart; /* nfrom + 1: the items from from[i] are fromstart[i]..fromstart[i+1]-1 */
+} PeriExchange;
+
+PETSC_EXTERN PetscErrorCode PeriExchangeCreate(MPI_Comm, PetscInt, const PetscMPIInt[], PeriExchange *);
+PETSC_EXTERN PetscErrorCode PeriExchangeSend(const PeriExchange *, MPI_Datatype, PetscInt, const void *, void *);
+PETSC_EXTERN PetscErrorCode PeriExchangeDestroy(PeriExchange *);
+
 PETSC_EXTERN PetscErrorCode PeriParticlesMigrate(MPI_Comm, PeriParticles *, const PetscMPIInt[]);
 PETSC_EXTERN PetscErrorCode PeriParticlesGather(MPI_Comm, const PeriParticles *, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesNear(const PeriParticles *, PetscReal, PetscInt, const PetscReal[], PetscBool[]);
