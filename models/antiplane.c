@@ -290,6 +290,7 @@ static PetscErrorCode Create(PeriModel m)
   m->data                = ap;
   m->dofs                = 1;
   m->components          = components;
+  m->axis[0]             = 2; /* uz, out of the cross-section's plane */
   m->nmeasures           = 1;
   m->measure_names       = measures;
   m->antiplane           = PETSC_TRUE;

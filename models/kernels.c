@@ -102,12 +102,13 @@ void PeriModelSetCentralForce(PeriModel m)
   static const char *const measures[] = {"stretch"};
   m->dofs                             = m->dim;
   m->components                       = m->dim == 2 ? components2 : components3;
-  m->nmeasures                        = 1;
-  m->measure_names                    = measures;
-  m->ops.nu_range                     = PeriBondBasedNuRange;
-  m->ops.bond_measures                = PeriBondStretch;
-  m->ops.rigid_modes                  = PeriTranslationalRigidModes;
-  m->central_force                    = PETSC_TRUE;
+  for (PetscInt d = 0; d < m->dim; d++) m->axis[d] = d;
+  m->nmeasures         = 1;
+  m->measure_names     = measures;
+  m->ops.nu_range      = PeriBondBasedNuRange;
+  m->ops.bond_measures = PeriBondStretch;
+  m->ops.rigid_modes   = PeriTranslationalRigidModes;
+  m->central_force     = PETSC_TRUE;
 }
 
 /* Translations, and rotations u = w x X, of models whose DOFs are the dim displacements. */

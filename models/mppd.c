@@ -167,7 +167,9 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->components          = components;
   m->nmeasures           = 3;
   m->measure_names       = measures;
-  m->rotational[2]       = PETSC_TRUE;
+  m->rotational[2]       = PETSC_TRUE; /* theta, about z */
+  m->axis[0]             = 0;
+  m->axis[1]             = 1;
   m->ops.setfromscene    = gerstle ? NULL : SetFromScene;
   m->ops.nu_range        = PeriShearBondNuRange;
   m->ops.calibrate       = Calibrate;

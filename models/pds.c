@@ -85,6 +85,8 @@ static PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   m->data                = pds;
   m->dofs                = 2;
   m->components          = components;
+  m->axis[0]             = 0;
+  m->axis[1]             = 1;
   m->nmeasures           = 2;
   m->measure_names       = measures;
   m->ops.nu_range        = PeriShearBondNuRange;

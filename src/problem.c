@@ -161,7 +161,7 @@ static PetscErrorCode WriteParticles(PeriProblem p)
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemFieldListCreate(sys, &fl));
-  if (sys->fields.u_owned) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->fields.u_owned));
+  if (sys->fields.u_owned) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->model->axis, sys->fields.u_owned));
   if (p->analysis && p->analysis->type->ops.fields) PetscCall(p->analysis->type->ops.fields(p->analysis, fl));
   PetscCall(PeriSystemAddFields(sys, fl));
   PetscCall(PeriWriteParticles(p->comm, fl, p->staging_dir, "particles"));

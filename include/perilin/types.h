@@ -8,7 +8,7 @@
 #  define PETSC_SUCCESS 0
 #endif
 
-#define PERI_MAX_DOF     3
+#define PERI_MAX_DOF     6 /* room for 3D micropolar (3 translations, 3 rotations); models declare their own count */
 #define PERI_MAX_MODES   6
 #define PERI_NAME_LEN    64
 #define PERI_MAX_MEASURE 3

@@ -96,10 +96,7 @@ static PetscErrorCode Classify(PeriAnalysis an, Vec x, Vec mdiag, PeriMode *mode
   PetscInt           comp[3];
 
   PetscFunctionBeginUser;
-  for (PetscInt d = 0; d < 3; d++) {
-    static const char *const names[] = {"ux", "uy", "uz"};
-    PetscCall(PeriModelComponentIndex(an->sys->model, names[d], &comp[d]));
-  }
+  for (PetscInt d = 0; d < 3; d++) comp[d] = PeriModelTranslation(an->sys->model, d);
   PetscCall(VecGetArrayRead(x, &xa));
   PetscCall(VecGetArrayRead(mdiag, &ma));
   for (PetscInt i = 0; i < nloc; i++)
@@ -631,7 +628,7 @@ static PetscErrorCode ModalAddFields(PeriAnalysis an, PeriFieldList fl)
   for (PetscInt k = 0; md && k < md->nshapes; k++) {
     char prefix[32];
     PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "mode_%" PetscInt_FMT, k + 1));
-    PetscCall(PeriFieldListAddSolution(fl, prefix, an->sys->model->dofs, an->sys->model->components, &md->shapes[k * nd]));
+    PetscCall(PeriFieldListAddSolution(fl, prefix, an->sys->model->dofs, an->sys->model->components, an->sys->model->axis, &md->shapes[k * nd]));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

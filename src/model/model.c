@@ -77,6 +77,7 @@ PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_
   m->dim                       = dim;
   m->plane_strain              = plane_strain;
   m->allows_surface_correction = PETSC_TRUE;
+  for (PetscInt c = 0; c < PERI_MAX_DOF; c++) m->axis[c] = -1; /* the model declares its translations */
   /* a model may refuse the setting (pds in 3D): an input error, after which nothing may leak */
   ierr = (*create)(m);
   if (ierr) PetscCall(PeriModelDestroy(&m));
@@ -169,4 +170,12 @@ PetscErrorCode PeriModelComponentIndex(PeriModel m, const char name[], PetscInt 
   for (PetscInt k = 0; k < m->dofs; k++)
     if (!strcmp(m->components[k], name)) *c = k;
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The component that translates along axis d (0, 1, 2), or -1 when the model has none. */
+PetscInt PeriModelTranslation(PeriModel m, PetscInt d)
+{
+  for (PetscInt c = 0; c < m->dofs; c++)
+    if (m->axis[c] == d) return c;
+  return -1;
 }

@@ -141,26 +141,25 @@ PetscErrorCode PeriFieldListAddIntConstant(PeriFieldList fl, const char name[], 
 }
 
 /*@C
-  PeriFieldListAddSolution - the DOFs u (dofs per particle, named components[]) as fields: ux, uy,
-  uz as one vector "displacement" (none when the model has no translation: a zero vector would
+  PeriFieldListAddSolution - the DOFs u (dofs per particle, named components[], the translations
+  along axis[c] >= 0) as fields: the translations as one vector "displacement" (none when the model has no translation: a zero vector would
   mislead), every other component as its own field ("theta"). With a prefix ("mode_3") the vector
   is named by the prefix and the others "mode_3_theta".
 @*/
-PetscErrorCode PeriFieldListAddSolution(PeriFieldList fl, const char prefix[], PetscInt dofs, const char *const components[], const PetscReal *u)
+PetscErrorCode PeriFieldListAddSolution(PeriFieldList fl, const char prefix[], PetscInt dofs, const char *const components[], const PetscInt axis[], const PetscReal *u)
 {
-  static const char *const axes[] = {"ux", "uy", "uz"};
-  PetscInt                 map[3] = {-1, -1, -1}, ntrans = 0;
-  char                     name[PERI_NAME_LEN + 32];
+  PetscInt map[3] = {-1, -1, -1}, ntrans = 0;
+  char     name[PERI_NAME_LEN + 32];
 
   PetscFunctionBeginUser;
   PetscCheck(components && dofs >= 1 && dofs <= PERI_MAX_DOF, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Cannot write a solution of %" PetscInt_FMT " named DOFs per particle", dofs);
-  for (PetscInt c = 0; c < dofs; c++)
-    for (PetscInt d = 0; d < 3; d++)
-      if (!strcmp(components[c], axes[d])) {
-        PetscCheck(map[d] < 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Component %s named twice", components[c]);
-        map[d] = c;
-        ntrans++;
-      }
+  for (PetscInt c = 0; c < dofs; c++) {
+    const PetscInt d = axis[c];
+    if (d < 0) continue;
+    PetscCheck(d < 3 && map[d] < 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Component %s: axis %" PetscInt_FMT " out of range or taken twice", components[c], d);
+    map[d] = c;
+    ntrans++;
+  }
   if (ntrans) PetscCall(PeriFieldListAddReal(fl, prefix[0] ? prefix : "displacement", 3, u, dofs, map));
   for (PetscInt c = 0; c < dofs; c++) {
     if (c == map[0] || c == map[1] || c == map[2]) continue;

@@ -2,13 +2,11 @@
  * rigid-body motion free. */
 #include "perilin/private/system.h"
 
-/* Translational component of axis a (ux, uy, uz), or -1 when the model has none. */
+/* Translational component of axis a, or -1 when the model has none. */
 static PetscErrorCode AxisComponent(PeriModel m, PetscInt a, PetscInt *c)
 {
-  static const char *const names[] = {"ux", "uy", "uz"};
-
   PetscFunctionBeginUser;
-  PetscCall(PeriModelComponentIndex(m, names[a], c));
+  *c = PeriModelTranslation(m, a);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -215,7 +213,7 @@ PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
 
   PetscFunctionBeginUser;
   /* a 2D cross-section model's loads act along z: they take 3 components, [0, 0, F] */
-  PetscCall(PeriModelComponentIndex(m, "uz", &uz));
+  uz    = PeriModelTranslation(m, 2);
   ncomp = dim == 2 && uz >= 0 ? 3 : dim;
   PetscCall(VecSet(f, 0));
   PetscCall(PeriTorsionLoads(sys, f));

@@ -315,7 +315,7 @@ PetscErrorCode PeriSystemWriteParticles(PeriSystem sys, const PetscReal *u, cons
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemFieldListCreate(sys, &fl));
-  if (u) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, u));
+  if (u) PetscCall(PeriFieldListAddSolution(fl, "", sys->model->dofs, sys->model->components, sys->model->axis, u));
   PetscCall(PeriSystemAddFields(sys, fl));
   PetscCall(PeriWriteParticles(sys->comm, fl, dir, base));
   PetscCall(PeriFieldListDestroy(&fl));

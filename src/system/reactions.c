@@ -10,18 +10,11 @@
  * up to what the free DOFs' residual leaves: that is the check. */
 #include "perilin/private/system.h"
 
-/* Which components are translations (ux, uy, uz): the ones a force balance sums. */
+/* Which components are translations (the model's axis[]): the ones a force balance sums. */
 static PetscErrorCode Translations(PeriModel m, PetscBool trans[])
 {
-  static const char *const names[] = {"ux", "uy", "uz"};
-
   PetscFunctionBeginUser;
-  for (PetscInt c = 0; c < PERI_MAX_DOF; c++) trans[c] = PETSC_FALSE;
-  for (PetscInt a = 0; a < 3; a++) {
-    PetscInt c;
-    PetscCall(PeriModelComponentIndex(m, names[a], &c));
-    if (c >= 0) trans[c] = PETSC_TRUE;
-  }
+  for (PetscInt c = 0; c < PERI_MAX_DOF; c++) trans[c] = (PetscBool)(c < m->dofs && m->axis[c] >= 0);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

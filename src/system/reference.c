@@ -32,8 +32,8 @@ PetscErrorCode PeriReferenceSetUp(PeriSystem sys)
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckSection(s, node, "reference"));
   PeriInputCheck(sys->disc.particles.dim == 2, s, node, NULL, "reference fields are plane elasticity solutions: dim must be 2");
-  PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
-  PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
+  ux = PeriModelTranslation(sys->model, 0);
+  uy = PeriModelTranslation(sys->model, 1);
   /* checked here, not only after the solve, so that a bad scene fails before any work */
   PeriInputCheck(ux >= 0 && uy >= 0, s, node, NULL, "reference fields need the in-plane displacements ux, uy; model %s has none", sys->model->type);
   PetscCall(PeriSceneGetChoice(s, node, "type", PeriReferenceTypes, &type, NULL));
@@ -215,8 +215,8 @@ PetscErrorCode PeriReferenceEvaluate(PeriSystem sys)
   PetscFunctionBeginUser;
   r->evaluated = PETSC_FALSE;
   if (r->type == PERI_REFERENCE_NONE) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriModelComponentIndex(sys->model, "ux", &ux));
-  PetscCall(PeriModelComponentIndex(sys->model, "uy", &uy));
+  ux = PeriModelTranslation(sys->model, 0);
+  uy = PeriModelTranslation(sys->model, 1);
   PetscCheck(ux >= 0 && uy >= 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "reference fields need the in-plane displacements ux, uy; model %s has none", sys->model->type);
   PetscCall(InteriorFit(sys, ux, uy, &F));
   PetscCheck(F.n >= 3, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: only %" PetscInt_FMT " particles lie farther than 2 delta from the edges: too few to measure the interior strain", sys->scene->file, (PetscInt)F.n);

@@ -22,7 +22,7 @@ PETSC_EXTERN PetscErrorCode      PeriFieldListCreate(PetscInt, const PetscReal[]
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddReal(PeriFieldList, const char[], PetscInt, const PetscReal *, PetscInt, const PetscInt[]);
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddInt(PeriFieldList, const char[], const PetscInt *);
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddIntConstant(PeriFieldList, const char[], PetscInt);
-PETSC_EXTERN PetscErrorCode      PeriFieldListAddSolution(PeriFieldList, const char[], PetscInt, const char *const[], const PetscReal *);
+PETSC_EXTERN PetscErrorCode      PeriFieldListAddSolution(PeriFieldList, const char[], PetscInt, const char *const[], const PetscInt[], const PetscReal *);
 PETSC_EXTERN PetscErrorCode      PeriFieldListDestroy(PeriFieldList *);
 PETSC_EXTERN PetscErrorCode      PeriWriteVTU(PeriFieldList, const char[]);
 PETSC_EXTERN PetscErrorCode      PeriWriteParticles(MPI_Comm, PeriFieldList, const char[], const char[]);
