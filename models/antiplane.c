@@ -293,7 +293,6 @@ static PetscErrorCode Create(PeriModel m)
   m->axis[0]             = 2; /* uz, out of the cross-section's plane */
   m->nmeasures           = 1;
   m->measure_names       = measures;
-  m->antiplane           = PETSC_TRUE;
   m->ops.nu_range        = NuRange;
   m->ops.bond_measures   = BondMeasures;
   m->ops.rigid_modes     = RigidModes;

@@ -66,7 +66,6 @@ struct _p_PeriModel {
   const char *const  *measure_names;
   PetscBool           allows_surface_correction;
   const char *const  *surface_corrections;      /* allowed corrections.surface values; NULL: none, volume */
-  PetscBool           antiplane;                /* one DOF, the out-of-plane displacement uz: stresses tau_xz, tau_yz */
   PetscBool           inactive[PERI_MAX_DOF];   /* components without stiffness after calibration: held at 0 */
   PetscBool           rotational[PERI_MAX_DOF]; /* rotations: their lumped mass is an inertia rho V r^2 */
   PetscInt            axis[PERI_MAX_DOF];       /* the axis (0, 1, 2) of each translation, -1 for a rotation: the force balance, loads, reactions and outputs read these, never the names */
@@ -92,6 +91,8 @@ PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);
 PETSC_EXTERN PetscInt       PeriTranslationalRigidModes(PeriModel, const PetscReal[], PetscReal[][PERI_MAX_DOF]);
 PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], PetscInt *);
 PETSC_EXTERN PetscInt       PeriModelTranslation(PeriModel, PetscInt);
+PETSC_EXTERN PetscBool      PeriModelOutOfPlane(PeriModel);
+PETSC_EXTERN PetscBool      PeriModelInPlane(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriLatticeCreate(PeriModel, const PeriCalibrationData *, PetscInt, PetscReal (*)(PeriModel, PetscReal), PeriLattice *);
 PETSC_EXTERN PetscReal      PeriLatticeFactor(PeriLattice, const PeriBondGeometry *);
 PETSC_EXTERN PetscReal      PeriProfileLength(PeriModel, PetscReal);

@@ -126,8 +126,8 @@ PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal del
   PeriInputCheck(!hasmu || mu > 0, scene, mat, "mu", "must be positive, got %g", (double)mu);
   m->ops.nu_range(m, &lo, &hi);
   if (!hasnu) {
-    /* antiplane models need only the shear modulus: nu is then irrelevant and taken as 0 */
-    PeriInputCheck(lo == hi || m->antiplane, scene, mat, "nu", "is required by model %s (admissible range %g to %g)", m->type, (double)lo, (double)hi);
+    /* an out-of-plane field needs only the shear modulus: nu is then irrelevant and taken as 0 */
+    PeriInputCheck(lo == hi || PeriModelOutOfPlane(m), scene, mat, "nu", "is required by model %s (admissible range %g to %g)", m->type, (double)lo, (double)hi);
     nu = lo == hi ? lo : 0;
   } else if (lo == hi) {
     /* 0.333 means 1/3: bond-based models have one Poisson ratio, accept it to 3 digits */
@@ -178,4 +178,21 @@ PetscInt PeriModelTranslation(PeriModel m, PetscInt d)
   for (PetscInt c = 0; c < m->dofs; c++)
     if (m->axis[c] == d) return c;
   return -1;
+}
+
+/* Whether the model's field is the displacement normal to a 2D body, as its DOFs declare it (one
+ * translation, along z): antiplane shear and the torsion of a cross-section. Such a field needs
+ * the shear modulus only, takes fictitious layers and a twist, and its stress is the shear vector
+ * (tau_xz, tau_yz). */
+PetscBool PeriModelOutOfPlane(PeriModel m)
+{
+  return (PetscBool)(m->dim == 2 && m->dofs == 1 && m->axis[0] == 2);
+}
+
+/* Whether the model translates along every axis of the body: a stress tensor is then defined. */
+PetscBool PeriModelInPlane(PeriModel m)
+{
+  for (PetscInt d = 0; d < m->dim; d++)
+    if (PeriModelTranslation(m, d) < 0) return PETSC_FALSE;
+  return PETSC_TRUE;
 }

@@ -246,7 +246,7 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, 1, MPI_SUM, sys->fields.W));
   PetscCall(MaxDisplacement(sys, u));
   PetscCallMPI(MPI_Allreduce(&E.energy, &sys->fields.strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
-  if (sys->model->antiplane) PetscCall(ShearStresses(sys, u));
+  if (PeriModelOutOfPlane(sys->model)) PetscCall(ShearStresses(sys, u));
   PetscCall(PeriSystemEvaluateStress(sys, u));
   PetscCall(KeepOwnedSolution(sys));
   PetscCall(ProbesEvaluate(sys, u));

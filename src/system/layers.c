@@ -42,7 +42,7 @@ static PetscErrorCode ReadTorsion(PeriSystem sys)
   PetscCall(PeriSceneGetMap(s, s->root, "torsion", PETSC_FALSE, &t));
   if (!t) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckSection(s, t, "torsion"));
-  PeriInputCheck(sys->model->antiplane, s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", sys->model->type);
+  PeriInputCheck(PeriModelOutOfPlane(sys->model), s, t, NULL, "torsion needs a cross-section model (antiplane or antiplane_os), not %s", sys->model->type);
   PetscCall(PeriSceneGetReal(s, t, "twist", PETSC_TRUE, &sys->conditions.torsion.twist, NULL));
   PeriInputCheck(sys->conditions.torsion.twist != 0, s, t, "twist", "must not be zero (the angle of twist per unit length [1/length])");
   sys->conditions.torsion.center[0] = 0.5 * (sys->disc.particles.lower[0] + sys->disc.particles.upper[0]);
@@ -199,7 +199,7 @@ PetscErrorCode PeriLayersAddParticles(PeriSystem sys)
   PetscCall(PeriSceneGetNode(s->root, "boundary_layers", &list));
   if (!list) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(list->kind == PERI_NODE_SEQ && list->n > 0, s, list, NULL, "must be a list of layers, each {side: x-|x+|y-|y+, condition: displacement|shear_stress|free, value: ..}");
-  PeriInputCheck(sys->model->antiplane, s, list, NULL, "fictitious layers carry the conditions of the cross-section models (antiplane, antiplane_os); for model %s use bc and loads", sys->model->type);
+  PeriInputCheck(PeriModelOutOfPlane(sys->model), s, list, NULL, "fictitious layers carry the conditions of the cross-section models (antiplane, antiplane_os); for model %s use bc and loads", sys->model->type);
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(grid, s, list, NULL, "need a grid body (grid:), whose faces the layers mirror; particles.file is not supported");
   h = pt->mean_spacing;

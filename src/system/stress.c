@@ -132,7 +132,7 @@ PetscErrorCode PeriSystemEvaluateStress(PeriSystem sys, const PetscScalar u[])
 
   PetscFunctionBeginUser;
   PetscCall(PetscFree3(sys->fields.stress, sys->fields.strain, sys->fields.elastic_stress));
-  if (!sys->fields.stress_output || sys->model->antiplane || sys->model->dofs < sys->disc.particles.dim) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sys->fields.stress_output || !PeriModelInPlane(sys->model)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscCalloc2(9 * n, &S, 18 * n, &acc));
   sc.u = u;
   sc.S = S;

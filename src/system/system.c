@@ -243,7 +243,7 @@ static PetscErrorCode ReadShearModuli(PeriSystem sys)
   PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
   PetscCall(PeriSceneGetMap(s, mat, "mu_by_region", PETSC_FALSE, &map));
   if (!map) PetscFunctionReturn(PETSC_SUCCESS);
-  PeriInputCheck(sys->model->antiplane, s, map, NULL, "applies to the cross-section models (antiplane, antiplane_os), not %s", sys->model->type);
+  PeriInputCheck(PeriModelOutOfPlane(sys->model), s, map, NULL, "applies to the cross-section models (antiplane, antiplane_os), not %s", sys->model->type);
   nr = map->n;
   PetscCall(PetscMalloc3(nr, &reg, nr, &val, 6 * (nr + 1) + 2, &cut));
   for (PetscInt k = 0; k < nr; k++) {
