@@ -42,9 +42,7 @@ static PetscErrorCode SetFromSceneState(PeriModel m, PeriScene scene, PeriNode n
   Antiplane *ap = (Antiplane *)m->data;
 
   PetscFunctionBeginUser;
-  ap->stabilization = 1;
   PetscCall(PeriSceneGetReal(scene, node, "stabilization", PETSC_FALSE, &ap->stabilization, NULL));
-  PeriInputCheck(ap->stabilization >= 0, scene, node, "stabilization", "must not be negative, got %g", (double)ap->stabilization);
   if (ap->stabilization == 0) PetscSNPrintf(m->warning, sizeof(m->warning), "antiplane_os without stabilization has zero-energy modes (a checkerboard has no shear angle): the stiffness is singular");
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -30,13 +30,10 @@ static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
   PetscBool has_k, has_f;
 
   PetscFunctionBeginUser;
-  mp->k_theta        = -1;
-  mp->k_theta_factor = 1;
+  mp->k_theta = -1;
   PetscCall(PeriSceneGetReal(scene, node, "k_theta", PETSC_FALSE, &mp->k_theta, &has_k));
   PetscCall(PeriSceneGetReal(scene, node, "k_theta_factor", PETSC_FALSE, &mp->k_theta_factor, &has_f));
   PeriInputCheck(!(has_k && has_f), scene, node, "k_theta_factor", "give model.k_theta or model.k_theta_factor, not both");
-  PeriInputCheck(!has_k || mp->k_theta >= 0, scene, node, "k_theta", "must not be negative");
-  PeriInputCheck(mp->k_theta_factor >= 0, scene, node, "k_theta_factor", "must not be negative");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

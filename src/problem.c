@@ -42,9 +42,9 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
   PeriNode                a;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscStrncpy(p->analysis_type, "static", sizeof(p->analysis_type)));
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
-  PetscCall(PeriSceneGetString(s, a, "type", PETSC_FALSE, p->analysis_type, sizeof(p->analysis_type), NULL));
+  /* from the root, so that an absent analysis: takes the declared default too */
+  PetscCall(PeriSceneGetString(s, s->root, "analysis.type", PETSC_FALSE, p->analysis_type, sizeof(p->analysis_type), NULL));
   PetscCall(PeriAnalysisFind(p->analysis_type, &type));
   if (!type) {
     char list[256];
@@ -73,14 +73,13 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PetscStrncpy(base, (slash = strrchr(file, '/')) ? slash + 1 : file, sizeof(base)));
   if ((dot = strrchr(base, '.'))) *dot = 0;
   PetscCall(PetscSNPrintf(p->output_dir, sizeof(p->output_dir), "%s-out", base));
-  p->vtk = PETSC_TRUE;
   PetscCall(PeriSceneGetMap(s, s->root, "output", PETSC_FALSE, &o));
   PetscCall(PeriSceneCheckSection(s, o, "output"));
-  PetscCall(PeriSceneGetString(s, o, "dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
-  PetscCall(PeriSceneGetBool(s, o, "vtk", &p->vtk, NULL));
-  PetscCall(PeriSceneGetBool(s, o, "stress", &p->stress_output, NULL));
-  PetscCall(PeriSceneGetInt(s, o, "every", PETSC_FALSE, &p->output_every, NULL));
-  PeriInputCheck(p->output_every >= 0, s, o, "every", "must not be negative (0: only the end), got %" PetscInt_FMT, p->output_every);
+  /* from the root, so that an absent output: takes the declared defaults too */
+  PetscCall(PeriSceneGetString(s, s->root, "output.dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
+  PetscCall(PeriSceneGetBool(s, s->root, "output.vtk", &p->vtk, NULL));
+  PetscCall(PeriSceneGetBool(s, s->root, "output.stress", &p->stress_output, NULL));
+  PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
   PetscCall(ReadAnalysis(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

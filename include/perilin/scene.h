@@ -34,11 +34,29 @@ typedef enum {
   PERI_KEY_MAP,
   PERI_KEY_LIST
 } PeriKeyType;
+/* The typed getters apply the declaration of the key they read (PeriSceneFindKey finds it by the
+ * section of the map, "bc.0" matching "bc.<k>"; in a section several plug-ins share, the core's,
+ * else the active plug-in's, the one its kind's type key names, "model.type", else the first):
+ *  - absent, the key takes its default when the default parses whole for the key's type: a
+ *    number or a fraction a/b (number), a whole number, true or false, one of the choices, a
+ *    single word of letters, digits and _-./ (string), a flow list "[0, 0]" (list of numbers).
+ *    Any other default (NULL, "required", "required for a .geo", "material.E",
+ *    "load_factor_step/64", "<scene file name ...>-out", "all false") is documentation only: the
+ *    reader computes it and the getter leaves the variable alone. found still says "given";
+ *  - present, a numeric value (each entry of a list) must lie in the range, whose forms are
+ *    "[a, b]", "(a, b]", ... with ends numbers, fractions or inf, and "{a, b, ..}"; an end that
+ *    names another key of the section, maybe scaled ("(0, load_factor_max]",
+ *    "[load_factor_step/2^20, ..]"), is the reader's to check. A declared range of any other form,
+ *    or an applying default outside its range, is refused at start-up (PeriSchemaCheck);
+ *  - a getter of another type than the declaration's is an internal error (the string getter
+ *    reads choices too).
+ * A NULL map (an absent section) has no section: read such keys from the parent with a dotted key
+ * ("output.dir" from the root) to get their defaults. */
 typedef struct {
   const char        *name; /* "k_theta"; {NULL} ends a list */
   PeriKeyType        type;
   const char        *deflt;   /* "1", "required", or NULL: absent means not given */
-  const char        *range;   /* "[0, inf)", "(0, 1]" or NULL; printed verbatim */
+  const char        *range;   /* "[0, inf)", "(0, 1]", "{2, 3}" or NULL; printed verbatim */
   const char        *units;   /* "[stress]" or NULL */
   const char *const *choices; /* PERI_KEY_CHOICE: NULL-terminated; else NULL */
   const char        *help;    /* one line */
@@ -74,6 +92,13 @@ PETSC_EXTERN PetscErrorCode PeriSceneCheckKeys(PeriScene, PeriNode, const char *
 PETSC_EXTERN PetscErrorCode PeriSceneCheckSection(PeriScene, PeriNode, const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneCheckKeysSchema(PeriScene, PeriNode, const char[], const PeriSchemaOwner *);
 PETSC_EXTERN const PeriKey *PeriSchemaFindKey(const PeriSchema *, const char[], const char[]);
+PETSC_EXTERN PetscErrorCode PeriSceneFindKey(PeriScene, PeriNode, const char[], const PeriSchema **, const PeriKey **);
+PETSC_EXTERN PetscErrorCode PeriSceneCheckRange(PeriScene, PeriNode, const PeriSchema *, const PeriKey *, PetscReal, const char[]);
+PETSC_EXTERN PetscBool      PeriKeyDefaultReal(const PeriKey *, PetscReal *);
+PETSC_EXTERN PetscBool      PeriKeyDefaultInt(const PeriKey *, PetscInt *);
+PETSC_EXTERN PetscBool      PeriKeyDefaultBool(const PeriKey *, PetscBool *);
+PETSC_EXTERN PetscBool      PeriKeyDefaultString(const PeriKey *, const char **);
+PETSC_EXTERN PetscBool      PeriKeyDefaultReals(const PeriKey *, PetscInt, PetscReal[], PetscInt *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetReal(PeriScene, PeriNode, const char[], PetscBool, PetscReal *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetInt(PeriScene, PeriNode, const char[], PetscBool, PetscInt *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetBool(PeriScene, PeriNode, const char[], PetscBool *, PetscBool *);

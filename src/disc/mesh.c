@@ -231,7 +231,6 @@ static PetscErrorCode MeshSource(PeriScene scene, PeriNode node, char path[], si
   PetscCall(PeriSceneGetReal(scene, node, "size", PETSC_FALSE, lc, &has));
   PeriInputCheck(!*geo || has, scene, node, "mesh", "%s is a .geo file: give particles.size, the characteristic length Gmsh meshes it with", path);
   PeriInputCheck(*geo || !has, scene, node, "size", "applies to a .geo file only; %s is a mesh already", path);
-  PeriInputCheck(!has || *lc > 0, scene, node, "size", "must be positive, got %g", (double)*lc);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -243,7 +242,7 @@ static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[]
   int       ierr = 0, *types;
   size_t    ntypes;
   PetscInt  top = -1, ed, ec;
-  PetscBool simplex, verbose = PETSC_FALSE;
+  PetscBool simplex, verbose;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetBool(scene, node, "verbose", &verbose, NULL));

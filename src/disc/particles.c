@@ -46,7 +46,6 @@ static PetscErrorCode GridParse(PeriScene scene, PeriNode grid, PetscInt dim, Pe
   PetscCall(PeriSceneGetRealArray(scene, grid, "lower", PETSC_TRUE, dim, dim, lower, &nl));
   PetscCall(PeriSceneGetRealArray(scene, grid, "upper", PETSC_TRUE, dim, dim, upper, &nu));
   PetscCall(PeriSceneGetReal(scene, grid, "spacing", PETSC_TRUE, h, NULL));
-  PeriInputCheck(*h > 0, scene, grid, "spacing", "must be positive, got %g", (double)*h);
   PetscCall(PeriSceneGetNode(grid, "periodic", &per));
   if (per) {
     PeriInputCheck(per->kind == PERI_NODE_SEQ && per->n == dim, scene, per, NULL, "must be a list of %" PetscInt_FMT " booleans, e.g. [false, true]", dim);

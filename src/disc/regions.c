@@ -119,7 +119,6 @@ static PetscErrorCode RegionFromScene(PeriScene scene, PeriNode node, const Peri
     r->depth = delta;
     PetscCall(PeriSceneGetChoice(scene, node, "side", sides, &side, NULL));
     PetscCall(PeriSceneGetReal(scene, node, "depth", PETSC_FALSE, &r->depth, NULL));
-    PeriInputCheck(r->depth > 0, scene, node, "depth", "must be positive");
     r->axis = side / 2;
     r->side = side % 2 ? 1 : -1;
     PeriInputCheck(r->axis < dim, scene, node, "side", "axis %c does not exist in %" PetscInt_FMT "D", (char)('x' + r->axis), dim);

@@ -121,9 +121,6 @@ PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal del
   PetscCall(PeriSceneGetReal(scene, mat, "mu", PETSC_FALSE, &mu, &hasmu));
   PeriInputCheck(hasE || hasK || hasmu, scene, mat, "E", "is required (or give the bulk modulus K or the shear modulus mu)");
   PeriInputCheck((hasE ? 1 : 0) + (hasK ? 1 : 0) + (hasmu ? 1 : 0) == 1, scene, mat, hasE ? (hasK ? "K" : "mu") : "mu", "give one of E, K and mu");
-  PeriInputCheck(!hasE || E > 0, scene, mat, "E", "must be positive, got %g", (double)E);
-  PeriInputCheck(!hasK || K > 0, scene, mat, "K", "must be positive, got %g", (double)K);
-  PeriInputCheck(!hasmu || mu > 0, scene, mat, "mu", "must be positive, got %g", (double)mu);
   m->ops.nu_range(m, &lo, &hi);
   if (!hasnu) {
     /* an out-of-plane field needs only the shear modulus: nu is then irrelevant and taken as 0 */
@@ -138,16 +135,12 @@ PetscErrorCode PeriModelSetFromScene(PeriModel m, PeriScene scene, PetscReal del
   PeriInputCheck(nu > -1 && nu < 0.5, scene, mat, "nu", "must lie in (-1, 1/2), got %g", (double)nu);
   if (hasK) E = 3 * K * (1 - 2 * nu);
   if (hasmu) E = 2 * mu * (1 + nu);
-  m->material.E   = E;
-  m->material.nu  = nu;
-  m->material.K   = E / (3 * (1 - 2 * nu));
-  m->material.G   = E / (2 * (1 + nu));
-  m->material.rho = 0;
+  m->material.E  = E;
+  m->material.nu = nu;
+  m->material.K  = E / (3 * (1 - 2 * nu));
+  m->material.G  = E / (2 * (1 + nu));
   PetscCall(PeriSceneGetReal(scene, mat, "rho", PETSC_FALSE, &m->material.rho, NULL));
-  PeriInputCheck(m->material.rho >= 0, scene, mat, "rho", "must not be negative");
-  m->material.thickness = 1;
   PetscCall(PeriSceneGetReal(scene, mat, "thickness", PETSC_FALSE, &m->material.thickness, NULL));
-  PeriInputCheck(m->material.thickness > 0, scene, mat, "thickness", "must be positive");
   PetscCall(PeriSceneGetNode(scene->root, "model", &node));
   if (m->ops.setfromscene) PetscCall(m->ops.setfromscene(m, scene, node));
   PetscFunctionReturn(PETSC_SUCCESS);

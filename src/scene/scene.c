@@ -444,6 +444,7 @@ static PetscErrorCode CopyOwners(PeriScene s, PetscInt n, const PeriSchemaOwner 
   PetscFunctionBeginUser;
   if (!n) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc1(n, &copy));
+  PetscCall(PeriSchemaCheck(n, owners));
   for (PetscInt k = 0; k < n; k++) copy[k] = owners[k];
   s->owners  = copy;
   s->nowners = n;
@@ -678,9 +679,27 @@ PetscErrorCode PeriSceneCheckKeysSchema(PeriScene scene, PeriNode map, const cha
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode GetScalar(PeriScene scene, PeriNode map, const char key[], PetscBool required, PeriNode *node)
+/* A key's declaration, as the getters apply it (scene.h). */
+typedef struct {
+  const PeriSchema *sec;
+  const PeriKey    *key;
+} Decl;
+
+/* The declaration of key in map, read by a getter of type: another type is a bug. */
+static PetscErrorCode GetDecl(PeriScene scene, PeriNode map, const char key[], PeriKeyType type, Decl *d)
+{
+  static const char *const names[] = {"number", "whole number", "boolean", "string", "choice", "list of numbers", "list of booleans", "mapping", "list"};
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneFindKey(scene, map, key, &d->sec, &d->key));
+  PetscCheck(!d->key || d->key->type == type || (type == PERI_KEY_STRING && d->key->type == PERI_KEY_CHOICE), PETSC_COMM_SELF, PETSC_ERR_PLIB, "key '%s%s%s' is declared as a %s but read as a %s", map->path, map->path[0] ? "." : "", key, names[d->key->type], names[type]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode GetScalar(PeriScene scene, PeriNode map, const char key[], PetscBool required, PeriKeyType type, PeriNode *node, Decl *d)
 {
   PetscFunctionBeginUser;
+  PetscCall(GetDecl(scene, map, key, type, d));
   PetscCall(PeriSceneGetNode(map, key, node));
   PeriInputCheck(*node || !required, scene, map, key, "is required");
   PeriInputCheck(!*node || (*node)->kind == PERI_NODE_SCALAR, scene, *node, NULL, "must be a single value, not a list or mapping");
@@ -711,30 +730,40 @@ PetscErrorCode PeriSceneParseReal(PeriScene scene, PeriNode node, PetscReal *v)
 
 PetscErrorCode PeriSceneGetReal(PeriScene scene, PeriNode map, const char key[], PetscBool required, PetscReal *v, PetscBool *found)
 {
-  PeriNode node;
+  PeriNode  node;
+  Decl      d;
+  PetscReal x;
 
   PetscFunctionBeginUser;
-  PetscCall(GetScalar(scene, map, key, required, &node));
+  PetscCall(GetScalar(scene, map, key, required, PERI_KEY_REAL, &node, &d));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
-  if (node) PetscCall(PeriSceneParseReal(scene, node, v));
+  if (node) {
+    PetscCall(PeriSceneParseReal(scene, node, v));
+    PetscCall(PeriSceneCheckRange(scene, node, d.sec, d.key, *v, node->value));
+  } else if (d.key && PeriKeyDefaultReal(d.key, &x))
+    *v = x;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode PeriSceneGetInt(PeriScene scene, PeriNode map, const char key[], PetscBool required, PetscInt *v, PetscBool *found)
 {
   PeriNode node;
+  Decl     d;
+  PetscInt i;
   char    *end;
   long     l;
 
   PetscFunctionBeginUser;
-  PetscCall(GetScalar(scene, map, key, required, &node));
+  PetscCall(GetScalar(scene, map, key, required, PERI_KEY_INT, &node, &d));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
+  if (!node && d.key && PeriKeyDefaultInt(d.key, &i)) *v = i;
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   errno = 0;
   l     = strtol(node->value, &end, 10);
   PeriInputCheck(end != node->value && !*end, scene, node, NULL, "expected a whole number, got '%s'", node->value);
   /* strtol saturates, and PetscInt may be 32 bits: an overflow must not become another number */
   PeriInputCheck(errno != ERANGE && l >= PETSC_MIN_INT && l <= PETSC_MAX_INT, scene, node, NULL, "the whole number %s is out of range (at most %" PetscInt_FMT ")", node->value, (PetscInt)PETSC_MAX_INT);
+  PetscCall(PeriSceneCheckRange(scene, node, d.sec, d.key, (PetscReal)l, node->value));
   *v = (PetscInt)l;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -760,35 +789,63 @@ PetscErrorCode PeriSceneParseBool(PeriScene scene, PeriNode node, PetscBool *v)
 
 PetscErrorCode PeriSceneGetBool(PeriScene scene, PeriNode map, const char key[], PetscBool *v, PetscBool *found)
 {
-  PeriNode node;
+  PeriNode  node;
+  Decl      d;
+  PetscBool b;
 
   PetscFunctionBeginUser;
-  PetscCall(GetScalar(scene, map, key, PETSC_FALSE, &node));
+  PetscCall(GetScalar(scene, map, key, PETSC_FALSE, PERI_KEY_BOOL, &node, &d));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
-  if (node) PetscCall(PeriSceneParseBool(scene, node, v));
+  if (node)
+    PetscCall(PeriSceneParseBool(scene, node, v));
+  else if (d.key && PeriKeyDefaultBool(d.key, &b))
+    *v = b;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode PeriSceneGetString(PeriScene scene, PeriNode map, const char key[], PetscBool required, char buf[], size_t len, PetscBool *found)
 {
-  PeriNode node;
+  PeriNode    node;
+  Decl        d;
+  const char *s;
 
   PetscFunctionBeginUser;
-  PetscCall(GetScalar(scene, map, key, required, &node));
+  PetscCall(GetScalar(scene, map, key, required, PERI_KEY_STRING, &node, &d));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
-  if (node) PetscCall(PetscStrncpy(buf, node->value, len));
+  if (node)
+    PetscCall(PetscStrncpy(buf, node->value, len));
+  else if (d.key && PeriKeyDefaultString(d.key, &s))
+    PetscCall(PetscStrncpy(buf, s, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* choices is NULL-terminated; *idx is left alone when the key is absent. */
+/* The index of the declared default of d in the reader's choices (which may differ from the
+ * declared ones: a leading "none"); *idx left alone without a default. */
+static PetscErrorCode ChoiceDefault(const Decl *d, const char *const choices[], PetscInt *idx)
+{
+  const char *s;
+
+  PetscFunctionBeginUser;
+  if (!d->key || !PeriKeyDefaultString(d->key, &s)) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; choices[k]; k++)
+    if (!strcmp(choices[k], s)) {
+      *idx = k;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_PLIB, "the declared default '%s' of key '%s' is not among the choices its reader knows", s, d->key->name);
+}
+
+/* choices is NULL-terminated; absent, *idx is the declared default's, or is left alone. */
 PetscErrorCode PeriSceneGetChoice(PeriScene scene, PeriNode map, const char key[], const char *const choices[], PetscInt *idx, PetscBool *found)
 {
   PeriNode node;
+  Decl     d;
   char     list[512] = "";
 
   PetscFunctionBeginUser;
-  PetscCall(GetScalar(scene, map, key, PETSC_FALSE, &node));
+  PetscCall(GetScalar(scene, map, key, PETSC_FALSE, PERI_KEY_CHOICE, &node, &d));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
+  if (!node) PetscCall(ChoiceDefault(&d, choices, idx));
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt k = 0; choices[k]; k++) {
     if (!strcmp(node->value, choices[k])) {
@@ -817,12 +874,23 @@ PetscErrorCode PeriSceneParseRealArray(PeriScene scene, PeriNode node, PetscInt 
 
 PetscErrorCode PeriSceneGetRealArray(PeriScene scene, PeriNode map, const char key[], PetscBool required, PetscInt nmin, PetscInt nmax, PetscReal v[], PetscInt *n)
 {
-  PeriNode node;
+  PeriNode  node;
+  Decl      d;
+  PetscReal x[64];
+  PetscInt  nx;
 
   PetscFunctionBeginUser;
   *n = 0;
+  PetscCall(GetDecl(scene, map, key, PERI_KEY_REALS, &d));
   PetscCall(PeriSceneGetNode(map, key, &node));
   PeriInputCheck(node || !required, scene, map, key, "is required");
-  if (node) PetscCall(PeriSceneParseRealArray(scene, node, nmin, nmax, v, n));
+  if (node) {
+    PetscCall(PeriSceneParseRealArray(scene, node, nmin, nmax, v, n));
+    for (PetscInt k = 0; k < *n; k++) PetscCall(PeriSceneCheckRange(scene, node, d.sec, d.key, v[k], node->child[k]->value));
+  } else if (d.key && PeriKeyDefaultReals(d.key, 64, x, &nx)) {
+    PetscCheck(nx >= nmin && nx <= nmax, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the declared default %s of key '%s' does not have %" PetscInt_FMT " to %" PetscInt_FMT " entries", d.key->deflt, d.key->name, nmin, nmax);
+    for (PetscInt k = 0; k < nx; k++) v[k] = x[k];
+    *n = nx;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -157,6 +157,7 @@ PetscErrorCode PeriSceneHelp(MPI_Comm comm, PetscInt nowners, const PeriSchemaOw
 
   PetscFunctionBeginUser;
   PetscCheck(root, PETSC_COMM_SELF, PETSC_ERR_PLIB, "no core schema declares the root keys");
+  PetscCall(PeriSchemaCheck(nowners, owners));
   PetscCall(PetscPrintf(comm, "Scene keys (YAML; every scalar key is also an option: its path joined with '_', e.g. -material_nu 0.1):\n"));
   for (const PeriKey *top = root->keys; top->name; top++) PetscCall(ForEachRow(nowners, owners, root, top, HelpRow, &c));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -319,6 +320,7 @@ PetscErrorCode PeriSceneDocUpdate(MPI_Comm comm, const char file[], PetscBool ch
 
   PetscFunctionBeginUser;
   PetscCheck(root, PETSC_COMM_SELF, PETSC_ERR_PLIB, "no core schema declares the root keys");
+  PetscCall(PeriSchemaCheck(nowners, owners));
   PetscCall(ReadWhole(file, &text));
   for (p = text; (mark = strstr(p, DOC_OPEN)); p = strstr(p, DOC_CLOSE)) {
     const PeriKey *top;

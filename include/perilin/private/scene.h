@@ -14,6 +14,7 @@ PETSC_EXTERN PetscErrorCode PeriSceneDocUpdate(MPI_Comm, const char[], PetscBool
 #define PERI_SECTION_MAX_KEYS 64
 PETSC_EXTERN PetscErrorCode PeriSceneSectionKeys(PeriScene, const char[], PetscBool, const char *[PERI_SECTION_MAX_KEYS]);
 PETSC_EXTERN void           PeriSchemaPath(const PeriSchema *, const PeriKey *, char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriSchemaCheck(PetscInt, const PeriSchemaOwner[]);
 
 /* Options that name nothing (src/scene/options.c; docs/scene.md): an option naming no scene key is an
  * error before any computation, and an option nothing read is one after the analysis, both with a
