@@ -129,10 +129,7 @@ static PetscErrorCode SetFromScene_Anisotropy(PeriAnalysis an, PeriScene s, Peri
   }
   PetscCall(PetscMalloc1(16, &A->m));
   PetscCall(PeriSceneGetRealArray(s, a, "m", PETSC_TRUE, 1, 16, A->m, &A->nm));
-  for (PetscInt k = 0; k < A->nm; k++) PeriInputCheck(A->m[k] >= 1 && A->m[k] <= 20, s, a, "m", "each m must lie in [1, 20], got %g", (double)A->m[k]);
-  A->norient = 101;
   PetscCall(PeriSceneGetInt(s, a, "orientations", PETSC_FALSE, &A->norient, NULL));
-  PeriInputCheck(A->norient >= 2, s, a, "orientations", "must be at least 2, got %" PetscInt_FMT, A->norient);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -37,20 +37,17 @@ static PetscErrorCode MainAxis(PeriAnalysis an, PetscInt *axis)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* analysis.nev and analysis.target_hz, before any particle exists (the schema's defaults). */
+/* analysis.nev and analysis.target_hz, before any particle exists (the getters apply the declared
+ * defaults and ranges). */
 static PetscErrorCode SetFromScene_Modal(PeriAnalysis an, PeriScene s, PeriNode a)
 {
   PeriModal *md;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&md));
-  an->data      = md;
-  md->nev       = 6;
-  md->target_hz = 0;
+  an->data = md;
   PetscCall(PeriSceneGetInt(s, a, "nev", PETSC_FALSE, &md->nev, NULL));
   PetscCall(PeriSceneGetReal(s, a, "target_hz", PETSC_FALSE, &md->target_hz, NULL));
-  PeriInputCheck(md->nev >= 1, s, a, "nev", "must be at least 1");
-  PeriInputCheck(md->target_hz >= 0, s, a, "target_hz", "must not be negative");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -103,7 +103,8 @@ static PetscErrorCode ReadLoadDisplacement(PeriAnalysis an, PeriNode a, Settings
 }
 
 /* analysis.* before any particle exists: stepping, load factors, breaking, and the names of the
- * control probe, component and reaction region (resolved by SetUp_Quasistatic). */
+ * control probe, component and reaction region (resolved by SetUp_Quasistatic). The getters apply
+ * the declared defaults and ranges; the checks here are those between keys. */
 static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, PeriNode a)
 {
   QSData   *data;
@@ -120,7 +121,6 @@ static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, Per
   PetscCall(PeriSceneGetReal(s, a, "load_factor_max", PETSC_TRUE, &st->max, NULL));
   st->step = st->max;
   PetscCall(PeriSceneGetReal(s, a, "load_factor_step", (PetscBool)!st->events, &st->step, NULL));
-  PeriInputCheck(st->max > 0, s, a, "load_factor_max", "must be positive, got %g", (double)st->max);
   PeriInputCheck(st->step > 0 && st->step <= st->max, s, a, "load_factor_step", "must lie in (0, load_factor_max], got %g", (double)st->step);
   st->min_step = st->step / 64;
   PetscCall(PeriSceneGetReal(s, a, "min_step", PETSC_FALSE, &st->min_step, NULL));
@@ -128,21 +128,13 @@ static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, Per
      a bracket finer than 2^-20 of a step does not change the critical load meaningfully */
   PeriInputCheck(st->max / st->step <= PERI_MAX_LOAD_STEPS, s, a, "load_factor_step", "%g would take %.3g steps to reach load_factor_max %g (at most %d): use a larger step (adaptive steps refine it where bonds break)", (double)st->step, (double)(st->max / st->step), (double)st->max, PERI_MAX_LOAD_STEPS);
   PeriInputCheck(st->min_step >= st->step / PERI_MAX_BISECTION && st->min_step <= st->step, s, a, "min_step", "must lie in [load_factor_step / 2^20, load_factor_step] = [%g, %g], got %g", (double)(st->step / PERI_MAX_BISECTION), (double)st->step, (double)st->min_step);
-  st->adaptive = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "adaptive", &st->adaptive, NULL));
   PetscCall(PeriSceneGetChoice(s, a, "break", qs_policies, &policy, NULL));
-  st->all      = policy == 0 ? PETSC_TRUE : PETSC_FALSE;
-  st->fraction = 0.1;
+  st->all = policy == 0 ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PeriSceneGetReal(s, a, "break_fraction", PETSC_FALSE, &st->fraction, &has));
   PeriInputCheck(!has || !st->all, s, a, "break_fraction", "applies to break: fraction only");
-  PeriInputCheck(st->fraction > 0 && st->fraction <= 1, s, a, "break_fraction", "must lie in (0, 1], got %g", (double)st->fraction);
-  st->runaway = 0.01;
   PetscCall(PeriSceneGetReal(s, a, "runaway_fraction", PETSC_FALSE, &st->runaway, NULL));
-  PeriInputCheck(st->runaway > 0 && st->runaway <= 1, s, a, "runaway_fraction", "must lie in (0, 1], got %g", (double)st->runaway);
-  st->max_iterations = 100;
   PetscCall(PeriSceneGetInt(s, a, "max_iterations", PETSC_FALSE, &st->max_iterations, NULL));
-  PeriInputCheck(st->max_iterations >= 1, s, a, "max_iterations", "must be at least 1");
-  st->reuse = PETSC_TRUE;
   PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));
   PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, st->control_probe, sizeof(st->control_probe), NULL));
   PetscCall(PeriSceneGetString(s, a, "control_component", PETSC_FALSE, st->control_component, sizeof(st->control_component), NULL));

@@ -156,14 +156,6 @@ static PetscErrorCode ParseNode(Reader *r, yaml_event_t *ev, const char key[], P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Appends ", item" (or "item" to an empty list), truncating: PetscStrlcat in PETSc 3.18 can
- * write past the end of the buffer. */
-void PeriListAppend(char buf[], size_t len, const char item[])
-{
-  size_t used = strlen(buf);
-  if (used + 1 < len) snprintf(buf + used, len - used, "%s%s", used ? ", " : "", item);
-}
-
 /* The names registered in a function list, comma-separated, in the order of registration (for
  * "unknown type; registered: ..." messages). */
 PetscErrorCode PeriFunctionListNames(PetscFunctionList list, char buf[], size_t len)
@@ -178,14 +170,6 @@ PetscErrorCode PeriFunctionListNames(PetscFunctionList list, char buf[], size_t 
     if (names[k]) PeriListAppend(buf, len, names[k]);
   PetscCall(PetscFree(names));
   PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static void OptionName(const char path[], char opt[], size_t len)
-{
-  size_t k = 0;
-  opt[k++] = '-';
-  for (const char *c = path; *c && k + 1 < len; c++) opt[k++] = (*c == '.') ? '_' : *c;
-  opt[k] = 0;
 }
 
 /* Whether the option for path may be looked up. PETSc looks an option that is not set up again
@@ -215,7 +199,7 @@ static PetscErrorCode ApplyOptions(PeriNode node)
   if (node->kind == PERI_NODE_SEQ && node->n > 0 && node->child[0]->kind == PERI_NODE_SCALAR) {
     char      opt[512], val[PETSC_MAX_PATH_LEN], *tok, *save;
     PetscBool set;
-    OptionName(node->path, opt, sizeof(opt));
+    PeriSceneOptionName(node->path, opt, sizeof(opt));
     set = PETSC_FALSE;
     if (OptionQueryable(opt)) PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
     if (set) {
@@ -236,7 +220,7 @@ static PetscErrorCode ApplyOptions(PeriNode node)
   if (node->kind == PERI_NODE_SCALAR) {
     char      opt[512], val[PETSC_MAX_PATH_LEN];
     PetscBool set;
-    OptionName(node->path, opt, sizeof(opt));
+    PeriSceneOptionName(node->path, opt, sizeof(opt));
     set = PETSC_FALSE;
     if (OptionQueryable(opt)) PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
     if (set) {
@@ -260,7 +244,7 @@ static PetscErrorCode AddOptionKey(PeriNode root, const char path[])
 
   PetscFunctionBeginUser;
   if (strchr(path, '<')) PetscFunctionReturn(PETSC_SUCCESS);
-  OptionName(path, opt, sizeof(opt));
+  PeriSceneOptionName(path, opt, sizeof(opt));
   PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
   if (!set) PetscFunctionReturn(PETSC_SUCCESS);
   dot = strrchr(path, '.');
@@ -333,7 +317,7 @@ static PetscErrorCode NameListAdd(NameList *l, const char path[])
   char opt[512];
 
   PetscFunctionBeginUser;
-  OptionName(path, opt, sizeof(opt));
+  PeriSceneOptionName(path, opt, sizeof(opt));
   for (PetscInt k = 0; k < l->n; k++)
     if (!strcasecmp(l->name[k], opt)) PetscFunctionReturn(PETSC_SUCCESS);
   if (l->n + 1 >= l->cap) {
@@ -525,54 +509,6 @@ PetscErrorCode PeriSceneDestroy(PeriScene *scene)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* "file:line: key 'material.nu' (option -material_nu)" for node (or its child key when given). */
-PetscErrorCode PeriSceneWhere(PeriScene scene, PeriNode node, const char key[], char buf[], size_t len)
-{
-  char        path[512], opt[512];
-  const char *p = node ? node->path : "";
-
-  PetscFunctionBeginUser;
-  if (key && key[0])
-    PetscCall(PetscSNPrintf(path, sizeof(path), "%s%s%s", p, p[0] ? "." : "", key));
-  else
-    PetscCall(PetscStrncpy(path, p, sizeof(path)));
-  OptionName(path, opt, sizeof(opt));
-  if (node && node->line > 0) {
-    PeriNode child = NULL;
-    int      line  = node->line;
-    if (key && key[0]) PetscCall(PeriSceneGetNode(node, key, &child));
-    if (child && child->line > 0) line = child->line;
-    PetscCall(PetscSNPrintf(buf, len, "%s:%d: key '%s'", scene->file, line, path));
-  } else if (node)
-    PetscCall(PetscSNPrintf(buf, len, "%s: key '%s' (set by option %s)", scene->file, path, opt));
-  else
-    PetscCall(PetscSNPrintf(buf, len, "%s: key '%s'", scene->file, path));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The child of map named key; the key may be dotted ("material.nu"). NULL when absent. */
-PetscErrorCode PeriSceneGetNode(PeriNode map, const char key[], PeriNode *child)
-{
-  const char *dot;
-  size_t      len;
-
-  PetscFunctionBeginUser;
-  *child = NULL;
-  if (!map || map->kind != PERI_NODE_MAP) PetscFunctionReturn(PETSC_SUCCESS);
-  dot = strchr(key, '.');
-  len = dot ? (size_t)(dot - key) : strlen(key);
-  for (PetscInt k = 0; k < map->n; k++) {
-    if (strlen(map->child[k]->key) == len && !strncmp(map->child[k]->key, key, len)) {
-      if (dot)
-        PetscCall(PeriSceneGetNode(map->child[k], dot + 1, child));
-      else
-        *child = map->child[k];
-      break;
-    }
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 PetscErrorCode PeriSceneGetMap(PeriScene scene, PeriNode map, const char key[], PetscBool required, PeriNode *child)
 {
   PetscFunctionBeginUser;
@@ -580,38 +516,6 @@ PetscErrorCode PeriSceneGetMap(PeriScene scene, PeriNode map, const char key[], 
   PeriInputCheck(*child || !required, scene, map, key, "is required");
   PeriInputCheck(!*child || (*child)->kind == PERI_NODE_MAP, scene, *child, NULL, "must be a mapping of keys");
   PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-PetscErrorCode PeriSceneCheckKeys(PeriScene scene, PeriNode map, const char *const allowed[])
-{
-  PetscFunctionBeginUser;
-  if (!map) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt k = 0; k < map->n; k++) {
-    PetscBool ok = PETSC_FALSE;
-    for (PetscInt a = 0; allowed[a]; a++)
-      if (!strcmp(map->child[k]->key, allowed[a])) ok = PETSC_TRUE;
-    if (!ok) {
-      char list[512] = "", hint[160];
-      for (PetscInt a = 0; allowed[a]; a++) PeriListAppend(list, sizeof(list), allowed[a]);
-      PeriSceneSuggest(map->child[k]->key, allowed, hint, sizeof(hint));
-      PeriInputCheck(PETSC_FALSE, scene, map->child[k], NULL, "unknown key; allowed here: %s%s%s", list, hint[0] ? "; " : "", hint);
-    }
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriSchemaFindKey - the key name that schema (a {NULL}-ended array, or NULL) declares in section,
-  or NULL.
-@*/
-const PeriKey *PeriSchemaFindKey(const PeriSchema *schema, const char section[], const char name[])
-{
-  for (const PeriSchema *sec = schema; sec && sec->section; sec++) {
-    if (strcmp(sec->section, section)) continue;
-    for (const PeriKey *key = sec->keys; key->name; key++)
-      if (!strcmp(key->name, name)) return key;
-  }
-  return NULL;
 }
 
 /* The plug-in other than active that declares name in section, or NULL. */

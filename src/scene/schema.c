@@ -7,14 +7,6 @@
 #include <errno.h>
 
 /*@C
-  PeriSchemaPath - "section.key" of a schema key; a root key ("dim") is its name alone.
-@*/
-void PeriSchemaPath(const PeriSchema *sec, const PeriKey *key, char path[], size_t len)
-{
-  snprintf(path, len, "%s%s%s", sec->section, sec->section[0] ? "." : "", key->name);
-}
-
-/*@C
   PeriSceneSectionKeys - the names of the keys declared in section, NULL-ended, in the order of
   the declarations: the core's, then with plugins the plug-ins' (a shared section such as output,
   where quasistatic declares every). A section no core module declares is a bug. Not collective.

@@ -53,7 +53,6 @@ static PetscErrorCode ReadHorizon(PeriSystem sys)
   PeriInputCheck(hasm || hasd, s, h, "m", "is required (or give horizon.delta)");
   PeriInputCheck(!(hasm && hasd), s, h, "delta", "give horizon.m or horizon.delta, not both");
   if (hasm) {
-    PeriInputCheck(m >= 1, s, h, "m", "must be at least 1 (the horizon may not be smaller than the spacing), got %g", (double)m);
     sys->disc.delta = m * sys->disc.particles.mean_spacing;
   }
   {
@@ -107,16 +106,14 @@ static PetscErrorCode ReadSolver(PeriSystem sys)
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &node));
   PetscCall(PeriSceneCheckSection(s, node, "solver"));
-  PetscCall(PeriSceneGetReal(s, node, "residual_tol", PETSC_FALSE, &sys->stiffness.residual_tol, NULL));
-  PeriInputCheck(sys->stiffness.residual_tol >= 0 && sys->stiffness.residual_tol < 1, s, node, "residual_tol", "must lie in [0, 1) (0: the default, max(100 rtol, 1e-6)), got %g", (double)sys->stiffness.residual_tol);
+  /* from the root, so that an absent solver: takes the declared defaults and ranges too */
+  PetscCall(PeriSceneGetReal(s, s->root, "solver.residual_tol", PETSC_FALSE, &sys->stiffness.residual_tol, NULL));
   {
     PetscInt kind = PERI_OPERATOR_AUTO;
-    PetscCall(PeriSceneGetChoice(s, node, "operator", PeriOperatorKinds, &kind, NULL));
+    PetscCall(PeriSceneGetChoice(s, s->root, "solver.operator", PeriOperatorKinds, &kind, NULL));
     sys->stiffness.operator_kind = (PeriOperatorKind)kind;
   }
-  sys->stiffness.pc_radius = 1.75;
-  PetscCall(PeriSceneGetReal(s, node, "pc_radius", PETSC_FALSE, &sys->stiffness.pc_radius, NULL));
-  PeriInputCheck(sys->stiffness.pc_radius >= 1, s, node, "pc_radius", "must be at least 1 (the nearest neighbours), got %g", (double)sys->stiffness.pc_radius);
+  PetscCall(PeriSceneGetReal(s, s->root, "solver.pc_radius", PETSC_FALSE, &sys->stiffness.pc_radius, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -144,7 +141,6 @@ static PetscErrorCode CreateModel(PeriSystem sys)
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetInt(s, s->root, "dim", PETSC_TRUE, &dim, NULL));
-  PeriInputCheck(dim == 2 || dim == 3, s, s->root, "dim", "must be 2 or 3, got %" PetscInt_FMT, dim);
   PetscCall(PeriSceneGetMap(s, s->root, "model", PETSC_TRUE, &m));
   PetscCall(PeriSceneGetString(s, m, "type", PETSC_TRUE, type, sizeof(type), NULL));
   PetscCall(PeriSceneGetChoice(s, m, "plane", planes, &plane, &found));
@@ -289,9 +285,7 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscCall(CreateModel(sys));
   PetscCall(ReadSolver(sys));
   PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
-  sys->materials.thickness = 1;
   PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
-  PeriInputCheck(sys->materials.thickness > 0, s, mat, "thickness", "must be positive, got %g", (double)sys->materials.thickness);
   /* before any large allocation: a scene that cannot fit is refused with its size */
   PetscCall(PeriParticlesCheckMemory(sys->comm, s, sys->model, &sys->stiffness.needs));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -12,6 +12,7 @@ PETSC_EXTERN PetscErrorCode PeriSceneDocUpdate(MPI_Comm, const char[], PetscBool
 /* The schemas (src/scene/schema.c): the keys declared in a section, the core's (and with plugins
  * the plug-ins' too) in declaration order, NULL-ended; a schema key's dotted path. */
 #define PERI_SECTION_MAX_KEYS 64
+#define PERI_OPTION_LEN       256 /* the longest option name compared for suggestions */
 PETSC_EXTERN PetscErrorCode PeriSceneSectionKeys(PeriScene, const char[], PetscBool, const char *[PERI_SECTION_MAX_KEYS]);
 PETSC_EXTERN void           PeriSchemaPath(const PeriSchema *, const PeriKey *, char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriSchemaCheck(PetscInt, const PeriSchemaOwner[]);
@@ -33,3 +34,5 @@ typedef struct {
 } PeriRunSolvers;
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckUnused(const PeriRunSolvers *);
 PETSC_EXTERN void           PeriSceneSuggest(const char[], const char *const[], char[], size_t);
+PETSC_EXTERN void           PeriSuggest(const char[], char *const[], char[], size_t, PetscBool *);
+PETSC_EXTERN void           PeriSceneOptionName(const char[], char[], size_t);
