@@ -4,7 +4,7 @@
  * c from the energy density of u = s X over the continuous horizon, as pmb's:
  * c = 4 W0 / (M1 - M2/delta), M_p the horizon moment of |xi|^p (docs/models/cpmb.md).
  * Also the worked example of docs/design.md, "How to add a model": this file and one line in
- * models/list.h are all it took. */
+ * models/model_list.h are all it took. */
 #include <perilin/model.h>
 
 typedef struct {

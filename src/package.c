@@ -1,8 +1,8 @@
 /* The perilin package: log events and stages, the registries, their finalizer. */
 #include "perilin.h"
 #include "perilin/private/sys.h"
-#include "perilin/private/scene.h"
-#include "perilin/private/model.h"
+#include "perilin/private/scene_file.h"
+#include "perilin/private/model_registry.h"
 #include "perilin/private/problem.h"
 #include "perilin/private/system.h"
 #include <slepcsys.h>

@@ -13,24 +13,24 @@ repo=$1 objdir=$2
 fail=0
 
 # Folders from the top down. A folder may use the folders after it, never those before it.
-order=(src/main src src/analysis src/system src/disc src/model models src/scene src/output src/sys)
+order=(src/main src src/analysis src/system src/disc src/model_api models src/scene src/output src/sys)
 # Headers a folder may include (besides system and library headers).
 declare -A allow=(
   [src/main]="perilin.h perilin/private/output.h"
-  [src]="perilin.h perilin/private/problem.h perilin/private/analysis.h perilin/private/system.h perilin/private/scene.h perilin/private/model.h perilin/private/sys.h"
-  [src/analysis]="perilin/private/analysis.h perilin/private/system.h list.h"
-  [src/system]="perilin/private/system.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/disc.h perilin/private/model.h perilin/private/output.h perilin/private/scene.h perilin/private/sys.h"
+  [src]="perilin.h perilin/private/problem.h perilin/private/analysis.h perilin/private/system.h perilin/private/scene_file.h perilin/private/model_registry.h perilin/private/sys.h"
+  [src/analysis]="perilin/private/analysis.h perilin/private/system.h analysis_list.h"
+  [src/system]="perilin/private/system.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/disc.h perilin/private/model_registry.h perilin/private/output.h perilin/private/scene_file.h perilin/private/sys.h"
   [src/disc]="perilin/private/disc.h perilin/private/sys.h"
-  [src/model]="perilin/private/model.h perilin/private/sys.h ../../models/list.h"
+  [src/model_api]="perilin/private/model_registry.h perilin/private/sys.h ../../models/model_list.h"
   [models]="perilin/model.h"
-  [src/scene]="perilin/private/scene.h perilin/private/sys.h"
+  [src/scene]="perilin/private/scene_file.h perilin/private/sys.h"
   [src/output]="perilin/private/output.h perilin/private/sys.h"
   [src/sys]="perilin/private/sys.h"
   [include/perilin]="perilin/types.h perilin/scene.h"
-  [include/perilin/private]="perilin/types.h perilin/scene.h perilin/model.h perilin.h perilin/private/sys.h perilin/private/scene.h perilin/private/output.h perilin/private/disc.h perilin/private/model.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/system.h perilin/private/analysis.h"
+  [include/perilin/private]="perilin/types.h perilin/scene.h perilin/model.h perilin.h perilin/private/sys.h perilin/private/scene_file.h perilin/private/output.h perilin/private/disc.h perilin/private/model_registry.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/system.h perilin/private/analysis.h"
 )
 # Within include/perilin/private, a header may include only those listed before it here.
-hdr_order=(sys scene output disc model mass fields conditions stiffness bondstate system analysis problem)
+hdr_order=(sys scene_file output disc model_registry mass fields conditions stiffness bondstate system analysis problem)
 
 folder_of() { # a source path relative to the repo -> its folder key
   case $1 in
@@ -53,8 +53,8 @@ while IFS= read -r f; do
     ok=0
     for a in ${allow[$key]}; do [[ $inc == "$a" ]] && ok=1; done
     if [[ $ok == 0 ]]; then echo "layering: $f includes \"$inc\", not allowed in $key (allowed: ${allow[$key]})"; fail=1; fi
-  done < <(sed -n 's/^#include [<"]\(perilin[^>"]*\|list.h\|..\/..\/models\/list.h\)[>"].*/\1/p' "$f")
-done < <(find src models include/perilin -name '*.[ch]' ! -name list.h | sort)
+  done < <(sed -n 's/^#include [<"]\(perilin[^>"]*\|analysis_list.h\|..\/..\/models\/model_list.h\)[>"].*/\1/p' "$f")
+done < <(find src models include/perilin -name '*.[ch]' ! -name '*_list.h' | sort)
 
 # private headers: only those before it in hdr_order
 for ((i = 0; i < ${#hdr_order[@]}; i++)); do

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The repository holds no run outputs (issue 25): output directories (*-out, *.partial-* staging
+# The repository holds no run outputs, and no two files share a name (issue 25): output directories (*-out, *.partial-* staging
 # sets), particle files (.vtu, .pvtu, .pvd) and summary.json belong under /tmp, never in git.
 # The golden expectations (tests/golden/expected) are normalized extracts, not run outputs.
 # Usage: tree_clean.sh REPO
@@ -16,4 +16,13 @@ if [ -n "$bad" ]; then
   printf '%s\n' "$bad" | head -20
   exit 1
 fi
-echo "ok: no run outputs in the repository"
+# every file a newcomer looks for by name has a name of its own: sources, headers, scripts,
+# examples and docs (the per-case data of tests/golden/expected and tests/bad_input, and CMake's
+# fixed CMakeLists.txt, are exempt)
+dups=$(printf '%s\n' "$files" | grep -v '^tests/golden/expected/\|^tests/bad_input/.*\.yaml$\|^tests/bad_input/.*/\|CMakeLists.txt$' | xargs -n1 basename | sort | uniq -d)
+if [ -n "$dups" ]; then
+  echo "tree_clean: file names used twice (a newcomer finds a concept by its file name; rename one):"
+  for d in $dups; do printf '%s\n' "$files" | grep "/$d\$\|^$d\$" | sed 's/^/  /'; done
+  exit 1
+fi
+echo "ok: no run outputs in the repository; every source, script, example and doc has a name of its own"

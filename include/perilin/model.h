@@ -100,7 +100,7 @@ PETSC_EXTERN PetscReal      PeriProfileOne(PeriModel, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriLatticeDestroy(PeriLattice *);
 
 /* A built-in model type. Each model file (models/) ends with its descriptor(s) PeriModel_<id>,
- * whose create function stays static; models/list.h names them and src/model/registry.c registers
+ * whose create function stays static; models/model_list.h names them and src/model_api/model_registry.c registers
  * them. */
 /* What a model type promises about the energy of a homogeneous strain at a particle whose family
  * and its neighbours' families lie inside the body, on a uniform grid: that it equals the energy

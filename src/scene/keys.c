@@ -1,7 +1,7 @@
 /* The declarations applied by the typed getters (include/perilin/scene.h): the declaration of a
  * key read in a section, its range parsed and enforced, its default parsed for the key's type.
  * PeriSchemaCheck refuses at start-up a range this file cannot read. */
-#include "perilin/private/scene.h"
+#include "perilin/private/scene_file.h"
 #include <ctype.h>
 #include <errno.h>
 

@@ -6,7 +6,7 @@
  *   PeriOptionsCheckUnused, after the analysis and before any output: every other option that no
  *     rank read (PETSc's options-left machinery), which only the run itself can tell.
  * -options_unused_ok makes both warnings, for options meant for other tools (docs/scene.md). */
-#include "perilin/private/scene.h"
+#include "perilin/private/scene_file.h"
 #include <petscksp.h>
 #include "perilin/private/sys.h"
 #include <ctype.h>

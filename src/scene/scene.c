@@ -1,7 +1,7 @@
 /* Scene files: YAML -> a tree of nodes with line numbers, every scalar overridable from the
  * PETSc options database by its path joined with '_' (-material_nu 0.1). Readers validate
  * as they go and report errors as "file:line: key 'a.b' ..." (PeriInputCheck). */
-#include "perilin/private/scene.h"
+#include "perilin/private/scene_file.h"
 #include <yaml.h>
 #include <ctype.h>
 #include <errno.h>

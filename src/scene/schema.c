@@ -1,7 +1,7 @@
 /* The declared scene keys (PeriSchema) as the scene layer uses them: the keys allowed in a section,
  * perilin -help, and the key tables of docs/scene.md. The schemas come from the core modules and
  * the plug-ins through scene->owners (or the owners passed in): this layer never asks for them. */
-#include "perilin/private/scene.h"
+#include "perilin/private/scene_file.h"
 #include <stdarg.h>
 #include <ctype.h>
 #include <errno.h>

@@ -1,7 +1,7 @@
 /* Suggestions for misspelt names (bottom of src/scene/): "did you mean X?" from the names within a
  * few typos, for unknown scene keys as for unknown options, and the comma-separated lists the
  * messages show. */
-#include "perilin/private/scene.h"
+#include "perilin/private/scene_file.h"
 #include <ctype.h>
 #include <strings.h>
 

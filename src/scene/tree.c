@@ -2,7 +2,7 @@
  * (file, line, key, option) for messages, the keys allowed in a mapping, and a key's declaration in
  * a schema. Below the getters (scene.c), the declarations (keys.c) and the schema tables
  * (schema.c). */
-#include "perilin/private/scene.h"
+#include "perilin/private/scene_file.h"
 
 /* The option that sets a key: "-material_nu" for path "material.nu". */
 void PeriSceneOptionName(const char path[], char opt[], size_t len)

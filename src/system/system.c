@@ -2,7 +2,7 @@
  * Its set-up reads every scene section but analysis and output. */
 #include "perilin/private/system.h"
 #include "perilin/private/sys.h"
-#include "perilin/private/model.h"
+#include "perilin/private/model_registry.h"
 
 /* The sections read below: model (the core's keys; each model type declares its own), horizon,
  * corrections, solver. */

@@ -7,7 +7,7 @@
                                            (files that still compare equal are kept byte for byte,
                                            so the git diff of an update shows only real changes)
 
-Normalized files (see run.sh for why these are guards against unintended change, not physics tests):
+Normalized files (see golden.sh for why these are guards against unintended change, not physics tests):
   summary.json   perilin's summary minus the volatile keys (VOLATILE below), with the values of the
                  keys that vary by build and invocation (VARIES: build.perilin, which `git describe`
                  changes at every commit, the PETSc and SLEPc versions, the command line with its

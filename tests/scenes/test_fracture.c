@@ -8,7 +8,7 @@
  * - 8.5: torsion of an edge-cracked bar (a/b = 0.25, 0.5, 0.75): on the crack faces the stress
  *   is along the crack (mean |tau_yz| below 10 % of the uncracked peak and of mean |tau_xz|), the
  *   largest stress sits at the tip, and J falls as the crack deepens.
- * usage: test_fracture edge_crack.yaml cracked_bar.yaml micropolar_shear.yaml torsion/edge_crack.yaml */
+ * usage: test_fracture edge_crack.yaml cracked_bar.yaml micropolar_shear.yaml torsion/torsion_edge_crack.yaml */
 #include "testing.h"
 #include <slepcsys.h>
 

@@ -58,7 +58,7 @@ typedef struct {
 /* An analysis type (src/analysis/<name>.c): what it does with the system, and what it adds to
  * the output. Each analysis file ends with its descriptor PeriAnalysis_<Id>, written with
  * designated initializers (an op it does not need is left out, and a new op edits no analysis);
- * src/analysis/list.h names them (one line each) and src/analysis/registry.c registers them. The
+ * src/analysis/analysis_list.h names them (one line each) and src/analysis/analysis_registry.c registers them. The
  * problem calls the ops in PETSc's life cycle and has no branch per analysis:
  *   setfromscene  reads and checks every analysis.* key, before any particle exists (the scene and
  *                 the options only; no system yet); allocates the analysis' data

@@ -3,7 +3,7 @@
 
 #include "perilin.h"
 #include "perilin/private/analysis.h"
-#include "perilin/private/scene.h"
+#include "perilin/private/scene_file.h"
 #include "perilin/private/sys.h"
 
 struct _p_PeriProblem {

@@ -5,7 +5,7 @@
 
 #include <petscksp.h>
 #include "perilin/private/disc.h"
-#include "perilin/private/model.h"
+#include "perilin/private/model_registry.h"
 #include "perilin/private/output.h"
 #include "perilin/private/sys.h"
 #include "perilin/private/mass.h"
@@ -123,7 +123,7 @@ PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriMo
 PETSC_EXTERN PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem, PetscBool);
 
-/* summary.json sections (src/system/summary.c) */
+/* summary.json sections (src/system/system_summary.c) */
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryModel(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryCost(PeriSystem, PeriJSON);

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Characterization guards ("goldens", ARCHITECTURE.md section 11, step 0).
 #
-# usage: run.sh PERILIN REPO_DIR [--update]
+# usage: golden.sh PERILIN REPO_DIR [--update]
 #
 # Runs eight one-rank scenes, each into a fresh output directory, and compares what perilin writes
 # with the expectations committed in tests/golden/expected/<name>/, plus `perilin -help` with
@@ -29,8 +29,8 @@
 # that still compare equal are left untouched, so `git diff tests/golden/expected` shows exactly
 # what changed. Review that diff before committing it.
 set -u
-exe=${1:?usage: run.sh PERILIN REPO_DIR [--update]}
-repo=${2:?usage: run.sh PERILIN REPO_DIR [--update]}
+exe=${1:?usage: golden.sh PERILIN REPO_DIR [--update]}
+repo=${2:?usage: golden.sh PERILIN REPO_DIR [--update]}
 update=""
 [ "${3:-}" = "--update" ] && update="--update"
 here=$(cd "$(dirname "$0")" && pwd)

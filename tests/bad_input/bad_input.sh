@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Runs the invalid scenes of one category: run.sh PERILIN DIR CATEGORY runs DIR/CATEGORY/*.yaml.
+# Runs the invalid scenes of one category: bad_input.sh PERILIN DIR CATEGORY runs DIR/CATEGORY/*.yaml.
 # Each scene is invalid: perilin must exit with a non-zero status below 128 (or the one of its
 # "# exit:" line), print "perilin: error:" exactly once with a message matching its "# expect:"
 # line, and leave no output behind. Header lines at the top of a case (all optional but expect):

@@ -1,14 +1,14 @@
-/* Registers the built-in models of models/list.h. Only PeriInitializePackage calls this;
- * src/model/model.c holds the list it fills and never calls back here. */
-#include "perilin/private/model.h"
+/* Registers the built-in models of models/model_list.h. Only PeriInitializePackage calls this;
+ * src/model_api/model.c holds the list it fills and never calls back here. */
+#include "perilin/private/model_registry.h"
 
 #define PERI_MODEL(id) extern const PeriModelType PeriModel_##id;
-#include "../../models/list.h"
+#include "../../models/model_list.h"
 #undef PERI_MODEL
 
 static const PeriModelType *const builtin[] = {
 #define PERI_MODEL(id) &PeriModel_##id,
-#include "../../models/list.h"
+#include "../../models/model_list.h"
 #undef PERI_MODEL
 };
 
@@ -43,7 +43,7 @@ PetscErrorCode PeriModelTypeGet(const char name[], const PeriModelType **type)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The built-in types, in the order of models/list.h: their schemas for validation and -help. A
+/* The built-in types, in the order of models/model_list.h: their schemas for validation and -help. A
  * model registered at run time (PeriModelRegister) has no descriptor here, hence no keys of its own. */
 PetscErrorCode PeriModelGetTypes(PetscInt *n, const PeriModelType *const **types)
 {

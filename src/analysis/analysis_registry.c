@@ -1,15 +1,15 @@
 /* The analysis registry: analysis.type to its PeriAnalysisType. The built-in analyses of
- * src/analysis/list.h live in a static table, so the registry needs no heap and no finalizer;
+ * src/analysis/analysis_list.h live in a static table, so the registry needs no heap and no finalizer;
  * PeriProblemRun finds the scene's. */
 #include "perilin/private/analysis.h"
 
 #define PERI_ANALYSIS(id) extern const PeriAnalysisType PeriAnalysis_##id;
-#include "list.h"
+#include "analysis_list.h"
 #undef PERI_ANALYSIS
 
 static const PeriAnalysisType *const builtin[] = {
 #define PERI_ANALYSIS(id) &PeriAnalysis_##id,
-#include "list.h"
+#include "analysis_list.h"
 #undef PERI_ANALYSIS
 };
 
@@ -30,7 +30,7 @@ PetscErrorCode PeriAnalysisFind(const char name[], const PeriAnalysisType **type
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The built-in types, in the order of src/analysis/list.h: their schemas for validation and -help. */
+/* The built-in types, in the order of src/analysis/analysis_list.h: their schemas for validation and -help. */
 PetscErrorCode PeriAnalysisGetTypes(PetscInt *n, const PeriAnalysisType *const **types)
 {
   PetscFunctionBeginUser;
@@ -39,7 +39,7 @@ PetscErrorCode PeriAnalysisGetTypes(PetscInt *n, const PeriAnalysisType *const *
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The names, comma-separated, in the order of src/analysis/list.h. */
+/* The names, comma-separated, in the order of src/analysis/analysis_list.h. */
 PetscErrorCode PeriAnalysisListTypes(char buf[], size_t len)
 {
   PetscFunctionBeginUser;

@@ -1,13 +1,13 @@
 /* The model interface: registry by name (PetscFunctionList), material constants from the scene,
  * and the pieces several bond models share. Assembly and analyses call models only through
  * PeriModelOps. */
-#include "perilin/private/model.h"
+#include "perilin/private/model_registry.h"
 
 static PetscFunctionList PeriModelList = NULL;
 
 const char *const PeriCalibrationKinds[] = {"continuum", "lattice", NULL};
 
-/* Run by PetscFinalize: frees the list, as PETSc's own packages do (src/model/registry.c forgets on
+/* Run by PetscFinalize: frees the list, as PETSc's own packages do (src/model_api/model_registry.c forgets on
  * its own that it filled it). */
 static PetscErrorCode PeriModelFinalizePackage(void)
 {

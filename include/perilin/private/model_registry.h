@@ -1,4 +1,4 @@
-/* The model registry and life cycle (src/model/): create a model by name, list the types. */
+/* The model registry and life cycle (src/model_api/): create a model by name, list the types. */
 #pragma once
 
 #include <perilin/model.h>
