@@ -170,3 +170,14 @@ PetscErrorCode PeriModelComponentIndex(PeriModel m, const char name[], PetscInt 
     if (!strcmp(m->components[k], name)) *c = k;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriModelMeasureIndex - the index of the model's bond measure of the given kind (its place in
+  what ops.bond_measures writes), or -1 when the model has none. Not collective.
+@*/
+PetscInt PeriModelMeasureIndex(PeriModel m, PeriMeasureKind kind)
+{
+  for (PetscInt k = 0; k < m->nmeasures; k++)
+    if (m->measure_kinds && m->measure_kinds[k] == kind) return k;
+  return -1;
+}
