@@ -18,6 +18,9 @@ static const char *const measures[]         = {"shear_angle"};
 static const char *const corrections_bond[] = {"none", "volume", "energy", NULL};
 static const char *const corrections_os[]   = {"none", "energy", NULL};
 
+/* what each measure is (the failure criteria find theirs by kind) */
+static const PeriMeasureKind measure_kinds[] = {PERI_MEASURE_SHEAR_ANGLE};
+
 typedef struct {
   PetscReal   c;             /* per unit shear modulus: 6/(pi l delta^3) (bond-based), 2/(pi l delta^3) (b, state-based) */
   PetscInt    n;             /* particles */
@@ -291,6 +294,7 @@ static PetscErrorCode Create(PeriModel m)
   m->axis[0]             = 2; /* uz, out of the cross-section's plane */
   m->nmeasures           = 1;
   m->measure_names       = measures;
+  m->measure_kinds       = measure_kinds;
   m->ops.nu_range        = NuRange;
   m->ops.bond_measures   = BondMeasures;
   m->ops.rigid_modes     = RigidModes;

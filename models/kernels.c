@@ -94,6 +94,8 @@ void PeriBondBasedNuRange(PeriModel m, PetscReal *lo, PetscReal *hi)
   *lo = *hi = (m->dim == 2 && !m->plane_strain) ? 1.0 / 3.0 : 0.25;
 }
 
+static const PeriMeasureKind central_kinds[] = {PERI_MEASURE_STRETCH};
+
 /* The common part of central-force (bond-based) models: the dim displacements as DOFs, the
  * stretch as measure, the one bond-based Poisson ratio, translations and rotations as rigid modes. */
 void PeriModelSetCentralForce(PeriModel m)
@@ -105,6 +107,7 @@ void PeriModelSetCentralForce(PeriModel m)
   for (PetscInt d = 0; d < m->dim; d++) m->axis[d] = d;
   m->nmeasures         = 1;
   m->measure_names     = measures;
+  m->measure_kinds     = central_kinds;
   m->ops.nu_range      = PeriBondBasedNuRange;
   m->ops.bond_measures = PeriBondStretch;
   m->ops.rigid_modes   = PeriTranslationalRigidModes;

@@ -24,6 +24,9 @@ typedef struct {
 static const char *const components[] = {"ux", "uy", "theta"};
 static const char *const measures[]   = {"stretch", "sliding", "relative_rotation"};
 
+/* what each measure is (the failure criteria find theirs by kind) */
+static const PeriMeasureKind measure_kinds[] = {PERI_MEASURE_STRETCH, PERI_MEASURE_SLIDING, PERI_MEASURE_RELATIVE_ROTATION};
+
 static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
 {
   MPPD     *mp = (MPPD *)m->data;
@@ -164,6 +167,7 @@ static PetscErrorCode Create(PeriModel m, PetscBool gerstle)
   m->components          = components;
   m->nmeasures           = 3;
   m->measure_names       = measures;
+  m->measure_kinds       = measure_kinds;
   m->rotational[2]       = PETSC_TRUE; /* theta, about z */
   m->axis[0]             = 0;
   m->axis[1]             = 1;

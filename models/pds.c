@@ -14,6 +14,9 @@ typedef struct {
 static const char *const components[] = {"ux", "uy"};
 static const char *const measures[]   = {"stretch", "sliding"};
 
+/* what each measure is (the failure criteria find theirs by kind) */
+static const PeriMeasureKind measure_kinds[] = {PERI_MEASURE_STRETCH, PERI_MEASURE_SLIDING};
+
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {
   PDS *pds = (PDS *)m->data;
@@ -89,6 +92,7 @@ static PetscErrorCode PeriModelCreate_PDS(PeriModel m)
   m->axis[1]             = 1;
   m->nmeasures           = 2;
   m->measure_names       = measures;
+  m->measure_kinds       = measure_kinds;
   m->ops.nu_range        = PeriShearBondNuRange;
   m->ops.calibrate       = Calibrate;
   m->ops.bond_stiffness  = BondStiffness;

@@ -6,7 +6,7 @@
 set -euo pipefail
 cd "${1:?usage: tree_clean.sh REPO}"
 if git rev-parse --is-inside-work-tree > /dev/null 2>&1; then
-  files=$(git ls-files)
+  files=$(git ls-files | sort -u) # unmerged paths are listed once per stage
 else
   files=$(find . -path ./build -prune -o -type f -print | sed 's|^\./||')
 fi

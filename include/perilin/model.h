@@ -25,6 +25,15 @@ struct PeriCalibrationData_s {
 
 typedef struct _p_PeriModel *PeriModel;
 
+/* What a bond measure is (PeriModel.measure_kinds): the failure criteria find the measures they
+ * read by kind (PeriModelMeasureIndex), never by name; the names are for output. */
+typedef enum {
+  PERI_MEASURE_STRETCH,           /* (|xi + eta| - |xi|)/|xi|, linearized: e . (u_j - u_i)/|xi| */
+  PERI_MEASURE_SLIDING,           /* the shear angle of the bond's axis, gamma (Diana & Casolo) */
+  PERI_MEASURE_RELATIVE_ROTATION, /* theta_j - theta_i (micropolar models) */
+  PERI_MEASURE_SHEAR_ANGLE        /* antiplane: r = (u_j - u_i)/|xi| (Oterkus & Madenci eq. 5) */
+} PeriMeasureKind;
+
 /* model.calibration: the micromoduli from the continuous horizon (the papers'), or with every
  * particle's discrete family made to reproduce the continuum's moments (models/lattice.c) */
 typedef enum {
@@ -76,6 +85,9 @@ struct _p_PeriModel {
   PeriMaterial        material;
   PetscReal           delta;
   void               *data;
+  /* what each of the nmeasures bond measures is, in the order of measure_names: the failure
+     criteria find theirs by kind (PeriModelMeasureIndex) */
+  const PeriMeasureKind *measure_kinds;
 };
 
 PETSC_EXTERN PetscReal      PeriModelIsotropicEnergy(PeriModel);
@@ -93,6 +105,7 @@ PETSC_EXTERN PetscErrorCode PeriModelComponentIndex(PeriModel, const char[], Pet
 PETSC_EXTERN PetscInt       PeriModelTranslation(PeriModel, PetscInt);
 PETSC_EXTERN PetscBool      PeriModelOutOfPlane(PeriModel);
 PETSC_EXTERN PetscBool      PeriModelInPlane(PeriModel);
+PETSC_EXTERN PetscInt       PeriModelMeasureIndex(PeriModel, PeriMeasureKind);
 PETSC_EXTERN PetscErrorCode PeriLatticeCreate(PeriModel, const PeriCalibrationData *, PetscInt, PetscReal (*)(PeriModel, PetscReal), PeriLattice *);
 PETSC_EXTERN PetscReal      PeriLatticeFactor(PeriLattice, const PeriBondGeometry *);
 PETSC_EXTERN PetscReal      PeriProfileLength(PeriModel, PetscReal);

@@ -72,27 +72,21 @@ static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal uni
 
 /* sys->bond_state.failure with only criterion c of the scene's (0 stretch: tension and compression, 1
  * sliding, 2 frictional sliding with the stretch limits as its cut-offs, as Diana & Casolo pair
- * them: without them a bond in compression never fails), the other limits cleared. */
-static PetscErrorCode OnlyCriterion(PeriAnalysis an, const PeriFailure *all, PetscInt c)
+ * them: without them a bond in compression never fails), brittle, without G. */
+static PetscErrorCode OnlyCriterion(PeriAnalysis an, PetscInt c)
 {
-  PeriFailure *F = &an->sys->bond_state.failure;
-  PeriNode     node;
+  static const char *const select[3][4] = {{"tension", "compression", NULL}, {"sliding", NULL}, {"frictional", "tension", "compression", NULL}};
+  PeriFailure             *F            = &an->sys->bond_state.failure;
+  PeriNode                 node;
 
   PetscFunctionBeginUser;
-  *F   = *all;
-  F->G = F->sliding = F->friction_angle = F->cohesion = F->shear_angle = F->ultimate = F->ultimate_compressive = 0;
-  if (c == 1) F->stretch = F->compressive = 0;
-  if (c == 1) F->sliding = all->sliding;
-  if (c == 2) {
-    F->friction_angle = all->friction_angle;
-    F->cohesion       = all->cohesion;
-  }
+  PetscCall(PeriFailureSelect(F, select[c], PETSC_FALSE));
   PetscCall(PeriSceneGetMap(an->sys->scene, an->sys->scene->root, "failure", PETSC_FALSE, &node));
-  PeriInputCheck((c != 0 || F->stretch > 0) && (c != 1 || F->sliding > 0) && (c != 2 || (F->friction_angle > 0 && F->cohesion > 0)), an->sys->scene, node, c == 0 ? "stretch" : c == 1 ? "sliding"
-                                                                                                                                                                                       : "friction_angle",
+  PeriInputCheck(PeriFailureIsActive(F, select[c][0]) && (c != 2 || PeriFailureValue(F, "cohesion") > 0), an->sys->scene, node, c == 0 ? "stretch" : c == 1 ? "sliding"
+                                                                                                                                                            : "friction_angle",
                  "the anisotropy analysis's criterion %s needs its limit here (%s)", criteria[c], c == 0 ? "failure.critical_stretch" : c == 1 ? "failure.sliding"
                                                                                                                                                : "failure.friction_angle and failure.cohesion");
-  PeriInputCheck(c == 0 || F->isliding >= 0, an->sys->scene, node, NULL, "model %s has no sliding measure: criterion %s needs a shear-bond model (pds, mppd, gerstle)", an->sys->model->type, criteria[c]);
+  PeriInputCheck(c == 0 || PeriModelMeasureIndex(an->sys->model, PERI_MEASURE_SLIDING) >= 0, an->sys->scene, node, NULL, "model %s has no sliding measure: criterion %s needs a shear-bond model (pds, mppd, gerstle)", an->sys->model->type, criteria[c]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -137,14 +131,14 @@ static PetscErrorCode Run_Anisotropy(PeriAnalysis an)
 {
   Anisotropy       *A;
   const PeriFailure all  = an->sys->bond_state.failure;
-  const PetscReal   unit = all.stretch > 0 ? all.stretch : 1;
+  const PetscReal   unit = PeriFailureValue(&all, "critical_stretch") > 0 ? PeriFailureValue(&all, "critical_stretch") : 1;
 
   PetscFunctionBeginUser;
   PetscCheck(an->sys->disc.particles.dim == 2, an->comm, PETSC_ERR_USER_INPUT, "%s: the anisotropy analysis studies the 2D square lattice: dim must be 2", an->sys->scene->file);
   A = AN(an);
   PetscCall(PetscMalloc1(A->ncrit * A->npaths * A->nm, &A->emax));
   for (PetscInt c = 0; c < A->ncrit; c++) {
-    PetscCall(OnlyCriterion(an, &all, A->crit[c]));
+    PetscCall(OnlyCriterion(an, A->crit[c]));
     for (PetscInt p = 0; p < A->npaths; p++)
       for (PetscInt k = 0; k < A->nm; k++) A->emax[(c * A->npaths + p) * A->nm + k] = MaxError(an, &A->paths[2 * p], unit, A->m[k]);
   }

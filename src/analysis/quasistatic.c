@@ -253,8 +253,6 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an)
 
 static PetscErrorCode PrintCriteria(PeriAnalysis an, const Settings *st)
 {
-  const PeriFailure *F = &an->sys->bond_state.failure;
-
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   if (st->events)
@@ -262,12 +260,7 @@ static PetscErrorCode PrintCriteria(PeriAnalysis an, const Settings *st)
   else
     PetscCall(PetscPrintf(an->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
   PetscCall(PetscPrintf(an->comm, "perilin: failure:"));
-  if (F->stretch > 0) PetscCall(PetscPrintf(an->comm, " s > s_c = %g%s", (double)F->stretch, F->ultimate > 0 ? " (softening to the ultimate stretch, eq. 45)" : ""));
-  if (F->G > 0) PetscCall(PetscPrintf(an->comm, " %s critical value of each bond from G = %g by model %s", F->ishear >= 0 ? "shear-angle" : "stretch", (double)F->G, an->sys->model->type));
-  if (F->compressive > 0) PetscCall(PetscPrintf(an->comm, " -s > %g", (double)F->compressive));
-  if (F->sliding > 0) PetscCall(PetscPrintf(an->comm, " |gamma| > %g", (double)F->sliding));
-  if (F->friction_angle > 0) PetscCall(PetscPrintf(an->comm, " |gamma| > %g - s tan(%g deg)", (double)F->cohesion, (double)F->friction_angle));
-  if (F->shear_angle > 0) PetscCall(PetscPrintf(an->comm, " |r| > r_c = %g", (double)F->shear_angle));
+  PetscCall(PeriFailureView(&an->sys->bond_state.failure, an->sys->model, an->comm));
   PetscCall(PetscPrintf(an->comm, " (formulas: docs/failure.md)\n"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -189,3 +189,14 @@ PetscBool PeriModelInPlane(PeriModel m)
     if (PeriModelTranslation(m, d) < 0) return PETSC_FALSE;
   return PETSC_TRUE;
 }
+
+/*@C
+  PeriModelMeasureIndex - the index of the model's bond measure of the given kind (its place in
+  what ops.bond_measures writes), or -1 when the model has none. Not collective.
+@*/
+PetscInt PeriModelMeasureIndex(PeriModel m, PeriMeasureKind kind)
+{
+  for (PetscInt k = 0; k < m->nmeasures; k++)
+    if (m->measure_kinds && m->measure_kinds[k] == kind) return k;
+  return -1;
+}

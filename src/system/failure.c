@@ -6,33 +6,72 @@
 
 const char *const PeriFailureCauses[] = {"crack", "tension", "compression", "sliding", "shear_angle", NULL};
 
-/* failure.* (read in this order into PeriFailure) and cracks.<k>. */
-static const PeriKey failure_keys[] = {
-    {"critical_stretch", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "critical tensile stretch s_c (models with a stretch: pmb, npmb, cpmb, pds, mppd, gerstle); not with G"},
-    {"G", PERI_KEY_REAL, NULL, "(0, inf)", "[energy/length^2]", NULL, "energy release rate: each bond's critical stretch or shear angle from its model"},
-    {"compressive_stretch", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "critical compressive stretch: a bond breaks when s < -value"},
-    {"sliding", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "pds/mppd/gerstle: critical sliding gamma_0"},
-    {"friction_angle", PERI_KEY_REAL, NULL, "(0, 90)", "[degrees]", NULL, "pds/mppd/gerstle: frictional sliding gamma_l = cohesion - s tan(angle); with cohesion"},
-    {"cohesion", PERI_KEY_REAL, NULL, NULL, NULL, NULL, "pds/mppd/gerstle: the sliding limit without stretch; with friction_angle"},
-    {"shear_angle", PERI_KEY_REAL, NULL, "(0, inf)", NULL, NULL, "antiplane: critical shear angle r_c; not with G"},
-    {"ultimate_stretch", PERI_KEY_REAL, NULL, "(critical_stretch, inf)", NULL, NULL, "softening (eq. 45): the stiffness falls linearly from critical_stretch to 0 here"},
-    {"ultimate_compressive_stretch", PERI_KEY_REAL, NULL, "(compressive_stretch, inf)", NULL, NULL, "softening in compression (eq. 46)"},
-    {NULL},
+/* The criteria of criterion_list.h: each defines its failure.* keys, its checks and its index. */
+#define PERI_CRITERION(id) extern const PeriCriterionType PeriCriterion_##id;
+#include "criterion_list.h"
+#undef PERI_CRITERION
+static const PeriCriterionType *const criteria[] = {
+#define PERI_CRITERION(id) &PeriCriterion_##id,
+#include "criterion_list.h"
+#undef PERI_CRITERION
 };
+
 static const PeriKey crack_keys[] = {
     {"from", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "a pre-existing crack, a 2D segment: its first end [x, y]; bonds crossing it are removed before the first step"},
     {"to", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "its other end"},
     {NULL},
 };
+/* failure: is the union of the criteria's keys, in the order of the list, their softening keys
+ * last; then cracks.<k>. */
 const PeriSchema PeriFailureSchema[] = {
-    {"failure", failure_keys},
+#define PERI_CRITERION(id) {"failure", PeriCriterion_##id.keys},
+#include "criterion_list.h"
+#undef PERI_CRITERION
+#define PERI_CRITERION(id) {"failure", PeriCriterion_##id.softening_keys},
+#include "criterion_list.h"
+#undef PERI_CRITERION
     {"cracks.<k>", crack_keys},
     {NULL},
 };
 
+/* The k-th key of a criterion: its keys, then its softening keys; NULL past the last. */
+static const PeriKey *CriterionKey(const PeriCriterionType *t, PetscInt k)
+{
+  PetscInt n = 0;
+
+  while (n < PERI_CRITERION_MAX_KEYS && t->keys[n].name) n++;
+  if (k < 0) return NULL;
+  if (k < n) return &t->keys[k];
+  if (k == n && t->softening_keys[0].name) return &t->softening_keys[0];
+  return NULL;
+}
+
+/* Reads every criterion's keys into its values (those with a declared range must be positive) and
+ * checks that the scene switches on at least one criterion. */
+static PetscErrorCode ReadKeys(PeriScene s, PeriNode node, PeriFailure *F)
+{
+  char      list[256] = "";
+  PetscBool any       = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    PeriCriterion *c = &F->criterion[i];
+    for (PetscInt k = 0; CriterionKey(c->type, k); k++) {
+      const PeriKey *key = CriterionKey(c->type, k);
+      PetscCall(PeriSceneGetReal(s, node, key->name, PETSC_FALSE, &c->value[k], &c->given[k]));
+      PeriInputCheck(!c->given[k] || !key->range || c->value[k] > 0, s, node, key->name, "must be positive, got %g", (double)c->value[k]);
+    }
+    any = (PetscBool)(any || c->given[0]);
+    PeriListAppend(list, sizeof(list), c->type->given_as ? c->type->given_as : c->type->keys[0].name);
+  }
+  PeriInputCheck(any, s, node, NULL, "give at least one criterion: %s", list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriFailureSetUp - reads failure: and checks each criterion against the model's measures.
-  Not collective.
+  PeriFailureSetUp - reads failure: and has each criterion the scene gives keys of check them
+  against the model's measures (found by kind); the scene's first key of a criterion switches it
+  on. Not collective.
 @*/
 PetscErrorCode PeriFailureSetUp(PeriSystem sys)
 {
@@ -40,41 +79,115 @@ PetscErrorCode PeriFailureSetUp(PeriSystem sys)
   PeriFailure *F = &sys->bond_state.failure;
   PeriModel    m = sys->model;
   PeriNode     node;
-  PetscBool    has[9];
-  PetscReal   *val[9] = {&F->stretch, &F->G, &F->compressive, &F->sliding, &F->friction_angle, &F->cohesion, &F->shear_angle, &F->ultimate, &F->ultimate_compressive};
 
   PetscFunctionBeginUser;
-  F->istretch = F->isliding = F->ishear = -1;
-  for (PetscInt k = 0; k < m->nmeasures; k++) {
-    if (!strcmp(m->measure_names[k], "stretch")) F->istretch = k;
-    if (!strcmp(m->measure_names[k], "sliding")) F->isliding = k;
-    if (!strcmp(m->measure_names[k], "shear_angle")) F->ishear = k;
+  F->ncriteria = (PetscInt)PETSC_STATIC_ARRAY_LENGTH(criteria);
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    PeriCriterion *c = &F->criterion[i];
+    PetscCall(PetscMemzero(c, sizeof(*c)));
+    c->type       = criteria[i];
+    c->measure[0] = c->measure[1] = -1;
+    for (PetscInt k = 0; k < c->type->nmeasures; k++) c->measure[k] = PeriModelMeasureIndex(m, c->type->measures[k]);
   }
   PetscCall(PeriSceneGetMap(s, s->root, "failure", PETSC_FALSE, &node));
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneCheckSection(s, node, "failure"));
-  for (PetscInt k = 0; failure_keys[k].name; k++) {
-    PetscCall(PeriSceneGetReal(s, node, failure_keys[k].name, PETSC_FALSE, val[k], &has[k]));
-    PeriInputCheck(!has[k] || *val[k] > 0 || k == 5, s, node, failure_keys[k].name, "must be positive, got %g", (double)*val[k]);
+  PetscCall(ReadKeys(s, node, F));
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    PeriCriterion *c   = &F->criterion[i];
+    PetscBool      any = PETSC_FALSE;
+    for (PetscInt k = 0; CriterionKey(c->type, k); k++) any = (PetscBool)(any || c->given[k]);
+    if (!any) continue;
+    PetscCall(c->type->ops.setfromscene(c, s, node, m));
+    c->active    = c->given[0];
+    F->softening = (PetscBool)(F->softening || c->softens);
   }
-  PeriInputCheck(!has[5] || F->cohesion >= 0, s, node, "cohesion", "must not be negative, got %g", (double)F->cohesion);
-  PeriInputCheck(has[0] || has[1] || has[2] || has[3] || has[4] || has[6], s, node, NULL, "give at least one criterion: %s", "critical_stretch, G, compressive_stretch, sliding, friction_angle with cohesion, shear_angle");
-  PeriInputCheck(!(has[0] && has[1]), s, node, "G", "give critical_stretch or G, not both");
-  PeriInputCheck(!(has[6] && has[1]), s, node, "G", "give shear_angle or G, not both");
-  PeriInputCheck(!(has[0] || has[2]) || F->istretch >= 0, s, node, has[0] ? "critical_stretch" : "compressive_stretch", "model %s has no stretch measure", m->type);
-  PeriInputCheck(!(has[3] || has[4] || has[5]) || F->isliding >= 0, s, node, has[3] ? "sliding" : "friction_angle", "model %s has no sliding measure (pds, mppd, gerstle have)", m->type);
-  PeriInputCheck(!has[6] || F->ishear >= 0, s, node, "shear_angle", "model %s has no shear angle (antiplane models have)", m->type);
-  PeriInputCheck(!has[1] || m->ops.critical_from_G, s, node, "G", "model %s cannot convert an energy release rate into a critical measure; give it directly", m->type);
-  PeriInputCheck(has[4] == has[5], s, node, has[4] ? "cohesion" : "friction_angle", "frictional sliding needs both friction_angle (degrees) and cohesion");
-  PeriInputCheck(!has[4] || F->friction_angle < 90, s, node, "friction_angle", "must lie in (0, 90) degrees, got %g", (double)F->friction_angle);
-  PeriInputCheck(!has[7] || (has[0] && F->ultimate > F->stretch), s, node, "ultimate_stretch", "softening needs critical_stretch (where it starts) below ultimate_stretch (where the bond is gone)");
-  PeriInputCheck(!has[8] || (has[2] && F->ultimate_compressive > F->compressive), s, node, "ultimate_compressive_stretch", "softening needs compressive_stretch below ultimate_compressive_stretch");
   PetscCall(PetscCalloc1(sys->disc.bonds.nbonds, &sys->disc.bonds.cause));
-  if (has[7] || has[8]) {
+  if (F->softening) {
     PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &sys->disc.bonds.intact));
     for (PetscInt k = 0; k < sys->disc.bonds.nbonds; k++) sys->disc.bonds.intact[k] = 1;
   }
   F->active = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The criterion that declares key, and the key's place in its values; NULL when none does. */
+static PeriCriterion *FindKey(const PeriFailure *F, const char key[], PetscInt *k)
+{
+  for (PetscInt i = 0; i < F->ncriteria; i++)
+    for (*k = 0; CriterionKey(F->criterion[i].type, *k); (*k)++)
+      if (!strcmp(CriterionKey(F->criterion[i].type, *k)->name, key)) return (PeriCriterion *)&F->criterion[i];
+  return NULL;
+}
+
+/*@C
+  PeriFailureValue - the value of the failure key (failure.<key>), 0 when the scene does not give
+  it. Not collective.
+@*/
+PetscReal PeriFailureValue(const PeriFailure *F, const char key[])
+{
+  PetscInt             k;
+  const PeriCriterion *c = FindKey(F, key, &k);
+
+  return c ? c->value[k] : 0;
+}
+
+/*@C
+  PeriFailureSetValue - for white-box tests: as if the scene gave failure.<key>: value (0: not
+  given), without the checks of PeriFailureSetUp; the criterion's first key switches it on or
+  off. Not collective.
+@*/
+PetscErrorCode PeriFailureSetValue(PeriFailure *F, const char key[], PetscReal value)
+{
+  PetscInt       k;
+  PeriCriterion *c = FindKey(F, key, &k);
+
+  PetscFunctionBeginUser;
+  PetscCheck(c, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "no failure criterion declares the key '%s'", key);
+  c->value[k] = value;
+  c->given[k] = (PetscBool)(value != 0);
+  c->active   = c->given[0];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriFailureSelect - keeps only the named criteria (NULL-ended list) of those the scene switched
+  on; with softening false the bonds break at the critical values and do not soften. The anisotropy
+  analysis studies one criterion at a time this way. Not collective.
+@*/
+PetscErrorCode PeriFailureSelect(PeriFailure *F, const char *const names[], PetscBool softening)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    PeriCriterion *c     = &F->criterion[i];
+    PetscBool      named = PETSC_FALSE;
+    for (PetscInt k = 0; names[k]; k++) named = (PetscBool)(named || !strcmp(names[k], c->type->name));
+    c->active = (PetscBool)(named && c->given[0]);
+    if (!softening) c->softens = PETSC_FALSE;
+  }
+  if (!softening) F->softening = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriFailureIsActive - whether the criterion of that name is active. Not collective.
+@*/
+PetscBool PeriFailureIsActive(const PeriFailure *F, const char name[])
+{
+  for (PetscInt i = 0; i < F->ncriteria; i++)
+    if (!strcmp(F->criterion[i].type->name, name)) return F->criterion[i].active;
+  return PETSC_FALSE;
+}
+
+/*@C
+  PeriFailureView - each active criterion's description (its formula and limits), in the order of
+  the list, on one line without its end. Collective on comm.
+@*/
+PetscErrorCode PeriFailureView(const PeriFailure *F, PeriModel m, MPI_Comm comm)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < F->ncriteria; i++)
+    if (F->criterion[i].active) PetscCall(F->criterion[i].type->ops.view(&F->criterion[i], m, comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -161,50 +274,26 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
 }
 
 /*@C
-  PeriBondFailureIndex - how far the bond is past the scene's criteria: the largest of s/s_c
-  (tension), -s/s_cc (compression), |gamma|/gamma_0, |gamma|/(a - s tan beta) (friction) and
-  |r|/r_c; the bond breaks when it reaches 1. meas[] are the model's measures; cause (may be NULL)
-  gets the criterion that gave the index. Not collective.
+  PeriBondFailureIndex - how far the bond is past the scene's criteria: the largest of the active
+  criteria's indices (s/s_c, -s/s_cc, |gamma|/gamma_0, |gamma|/(a - s tan beta), |r|/r_c: each
+  criterion's file); the bond breaks when it reaches 1. meas[] are the model's measures; cause (may
+  be NULL) gets the cause of the first criterion that gave the index. Not collective.
 @*/
 PetscReal PeriBondFailureIndex(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause)
 {
   const PeriFailure *F   = &sys->bond_state.failure;
-  PetscReal          idx = 0, crit = 0;
-  PeriFailureCause   c = PERI_CAUSE_CRACK;
+  PetscReal          idx = 0;
+  PeriFailureCause   c   = PERI_CAUSE_CRACK;
 
-  if (F->G > 0) crit = sys->model->ops.critical_from_G(sys->model, g, F->G);
-  if (F->istretch >= 0) {
-    /* with softening the bond is gone at the ultimate stretch; before, PeriBondSoftening weakens it */
-    PetscReal s = meas[F->istretch], sc = F->ultimate > 0 ? F->ultimate : F->stretch > 0 ? F->stretch
-                                                                                         : crit;
-    PetscReal scc = F->ultimate_compressive > 0 ? F->ultimate_compressive : F->compressive;
-    if (s > 0 && sc > 0 && s / sc > idx) {
-      idx = s / sc;
-      c   = PERI_CAUSE_TENSION;
-    }
-    if (s < 0 && scc > 0 && -s / scc > idx) {
-      idx = -s / scc;
-      c   = PERI_CAUSE_COMPRESSION;
-    }
-  }
-  if (F->isliding >= 0) {
-    PetscReal gam = PetscAbsReal(meas[F->isliding]), v = 0;
-    if (F->sliding > 0) v = gam / F->sliding;
-    if (F->friction_angle > 0) {
-      /* Diana & Casolo's frictional sliding: the limit grows with compression, vanishes in tension */
-      PetscReal s = F->istretch >= 0 ? meas[F->istretch] : 0, lim = F->cohesion - s * PetscTanReal(F->friction_angle * PETSC_PI / 180);
-      v = PetscMax(v, lim > 0 ? gam / lim : (gam > 0 ? PETSC_MAX_REAL : 0));
-    }
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    const PeriCriterion *crit = &F->criterion[i];
+    PeriFailureCause     ci;
+    PetscReal            v;
+    if (!crit->active) continue;
+    v = crit->type->ops.index(crit, sys->model, g, meas, &ci);
     if (v > idx) {
       idx = v;
-      c   = PERI_CAUSE_SLIDING;
-    }
-  }
-  if (F->ishear >= 0) {
-    PetscReal rc = F->shear_angle > 0 ? F->shear_angle : crit;
-    if (rc > 0 && PetscAbsReal(meas[F->ishear]) / rc > idx) {
-      idx = PetscAbsReal(meas[F->ishear]) / rc;
-      c   = PERI_CAUSE_SHEAR_ANGLE;
+      c   = ci;
     }
   }
   if (cause) *cause = c;
@@ -246,17 +335,18 @@ PetscReal PeriBondCriticalLoad(PeriSystem sys, const PeriBondGeometry *g, const 
 }
 
 /*@C
-  PeriBondSoftening - the share of its stiffness a bond keeps at stretch s (Diana & Casolo eqs.
-  45-46): 1 below the critical stretch, falling linearly to 0 at the ultimate stretch, in tension
-  and (when given) in compression. Not collective.
+  PeriBondSoftening - the share of its stiffness a bond keeps (Diana & Casolo eqs. 45-46): the
+  smallest of the softening criteria's shares, 1 when none softens it. Not collective.
 @*/
 PetscReal PeriBondSoftening(PeriSystem sys, const PetscReal meas[])
 {
-  const PeriFailure *F = &sys->bond_state.failure;
-  PetscReal          s = F->istretch >= 0 ? meas[F->istretch] : 0, mu = 1;
+  const PeriFailure *F  = &sys->bond_state.failure;
+  PetscReal          mu = 1;
 
-  if (F->ultimate > 0 && s > F->stretch) mu = PetscMax(0, (F->ultimate - s) / (F->ultimate - F->stretch));
-  if (F->ultimate_compressive > 0 && -s > F->compressive) mu = PetscMax(0, (F->ultimate_compressive + s) / (F->ultimate_compressive - F->compressive));
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    const PeriCriterion *c = &F->criterion[i];
+    if (c->active && c->softens) mu = PetscMin(mu, c->type->ops.softening(c, meas));
+  }
   return mu;
 }
 
@@ -445,16 +535,18 @@ PetscErrorCode PeriPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, Pets
 PetscErrorCode PeriFailureAddFields(PeriSystem sys, PeriFieldList fl)
 {
   const PeriFailure *F      = &sys->bond_state.failure;
-  const PetscBool    used[] = {(PetscBool)(sys->bond_state.failure.precracked_bonds > 0), (PetscBool)(F->stretch > 0 || (F->G > 0 && F->istretch >= 0)), (PetscBool)(F->compressive > 0), (PetscBool)(F->sliding > 0 || F->friction_angle > 0), (PetscBool)(F->ishear >= 0)};
+  PetscInt           causes = F->precracked_bonds > 0 ? 1 << PERI_CAUSE_CRACK : 0;
   const PetscInt     map0   = 0;
 
   PetscFunctionBeginUser;
   if (!sys->bond_state.damage) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt i = 0; i < F->ncriteria; i++)
+    if (F->criterion[i].active) causes |= F->criterion[i].causes;
   PetscCall(PeriFieldListAddReal(fl, "damage", 1, sys->bond_state.damage, PERI_NCAUSES + 1, &map0));
   for (PetscInt c = 0; c < PERI_NCAUSES; c++) {
     char           name[32];
     const PetscInt map = 1 + c;
-    if (!used[c]) continue;
+    if (!(causes & (1 << c))) continue;
     PetscCall(PetscSNPrintf(name, sizeof(name), "damage_%s", PeriFailureCauses[c]));
     PetscCall(PeriFieldListAddReal(fl, name, 1, sys->bond_state.damage, PERI_NCAUSES + 1, &map));
   }

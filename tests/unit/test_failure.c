@@ -34,9 +34,9 @@ int main(int argc, char **argv)
   }
   PeriTestClose("pre-cracked bonds > 0", (PetscReal)(p->sys->bond_state.failure.precracked_bonds > 0), 1, 0);
   /* G: pmb, plane stress: s_c = sqrt(4 pi G / (9 E delta)) */
-  p->sys->bond_state.failure.stretch = 0;
-  p->sys->bond_state.failure.G       = 100;
-  meas[0]                            = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->sys->disc.delta));
+  PetscCall(PeriFailureSetValue(&p->sys->bond_state.failure, "critical_stretch", 0));
+  PetscCall(PeriFailureSetValue(&p->sys->bond_state.failure, "G", 100));
+  meas[0] = PetscSqrtReal(4 * PETSC_PI * 100 / (9 * 1e9 * p->sys->disc.delta));
   PeriTestClose("pmb plane stress: s at s_c from G gives index 1", PeriBondFailureIndex(p->sys, &g, meas, NULL), 1, 1e-12);
   PetscCall(PeriProblemDestroy(&p));
 
@@ -48,11 +48,11 @@ int main(int argc, char **argv)
   meas[0] = 0;
   meas[1] = -0.008;
   PeriTestClose("pds sliding index |gamma|/gamma_0", PeriBondFailureIndex(p->sys, &g, meas, NULL), 0.8, 1e-14);
-  p->sys->bond_state.failure.sliding        = 0;
-  p->sys->bond_state.failure.friction_angle = 30;
-  p->sys->bond_state.failure.cohesion       = 0.005;
-  meas[0]                                   = -0.004; /* compression raises the limit to a - s tan(beta) */
-  meas[1]                                   = 0.006;
+  PetscCall(PeriFailureSetValue(&p->sys->bond_state.failure, "sliding", 0));
+  PetscCall(PeriFailureSetValue(&p->sys->bond_state.failure, "friction_angle", 30));
+  PetscCall(PeriFailureSetValue(&p->sys->bond_state.failure, "cohesion", 0.005));
+  meas[0] = -0.004; /* compression raises the limit to a - s tan(beta) */
+  meas[1] = 0.006;
   PeriTestClose("frictional sliding index", PeriBondFailureIndex(p->sys, &g, meas, NULL), 0.006 / (0.005 + 0.004 * PetscTanReal(PETSC_PI / 6)), 1e-14);
   meas[0] = 0.01; /* tension beyond a / tan(beta): no sliding strength left */
   PeriTestClose("frictional sliding in tension breaks", (PetscReal)(PeriBondFailureIndex(p->sys, &g, meas, NULL) >= 1), 1, 0);

@@ -7,6 +7,7 @@
 #include <petscvec.h>
 #include "perilin/private/disc.h"
 #include "perilin/private/fields.h"
+#include "perilin/private/model_registry.h"
 
 typedef struct _p_PeriSystem *PeriSystem;
 
@@ -21,13 +22,57 @@ typedef enum {
 } PeriFailureCause;
 PETSC_EXTERN const char *const PeriFailureCauses[];
 
-/* Bond failure criteria (failure:, src/system/failure.c); 0 = criterion not given. */
+/* A failure criterion of failure: (docs/design.md, "How to add a failure criterion"): one file
+ * src/system/criterion_<name>.c that defines its descriptor PeriCriterion_<Id>, and one line
+ * PERI_CRITERION(<Id>) in src/system/criterion_list.h. src/system/failure.c reads the keys and
+ * asks every criterion the scene switches on; a bond's failure index is the largest of theirs. */
+#define PERI_CRITERION_MAX_KEYS 3
+#define PERI_MAX_CRITERIA       8
+
+typedef struct _PeriCriterionType PeriCriterionType;
+
+/* One criterion of the scene: its type, the values of its keys and what it found in the model. */
 typedef struct {
-  PetscBool active;
-  PetscReal stretch, G, compressive, sliding, friction_angle, cohesion, shear_angle;
-  PetscReal ultimate, ultimate_compressive; /* softening: the stretch where the stiffness is gone (0: brittle) */
-  PetscInt  istretch, isliding, ishear;     /* the model's measures, -1 when absent */
-  PetscInt  precracked_bonds;               /* bonds the scene's cracks removed */
+  const PeriCriterionType *type;
+  PetscBool                active;                             /* the scene switches it on (its first key), or the anisotropy analysis selected it */
+  PetscBool                given[PERI_CRITERION_MAX_KEYS + 1]; /* which of type->keys, then softening_keys, the scene gives */
+  PetscReal                value[PERI_CRITERION_MAX_KEYS + 1]; /* their values, in that order; 0 when not given */
+  PetscInt                 measure[2];                         /* the model's measures of the kinds type->measures, -1 when absent */
+  PetscBool                softens;                            /* set by setfromscene: bonds past the limit keep a falling share of stiffness */
+  PetscInt                 causes;                             /* set by setfromscene: the PeriFailureCauses it gives, bit (1 << cause) each */
+} PeriCriterion;
+
+struct _PeriCriterionType {
+  const char *name;     /* its name ("tension"); the anisotropy analysis selects criteria by it */
+  const char *given_as; /* its entry in "give at least one criterion: ..."; NULL: its first key */
+  /* its failure.* keys, numbers, ended by {NULL}; value[k] is keys[k]'s. The first switches the
+     criterion on; the others refine it. Those with a range must be positive (failure.c checks). */
+  PeriKey         keys[PERI_CRITERION_MAX_KEYS + 1];
+  PeriKey         softening_keys[2]; /* its key of softening, listed after every criterion's keys; value[] continues with it */
+  PeriMeasureKind measures[2];       /* the kinds of measure[] that failure.c looks up (nmeasures of them) */
+  PetscInt        nmeasures;
+  struct {
+    /* Checks its keys against each other and the model (c->measure[] are set): the scene's
+       messages; sets c->causes and c->softens. Called when the scene gives any of its keys. */
+    PetscErrorCode (*setfromscene)(PeriCriterion *c, PeriScene s, PeriNode failure, PeriModel m);
+    /* The bond's failure index (it breaks at 1), 0 when the criterion does not apply; *cause its
+       PeriFailureCause. meas[] are the model's measures of the bond. */
+    PetscReal (*index)(const PeriCriterion *c, PeriModel m, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause);
+    /* The share of its stiffness the bond keeps (1: untouched); NULL: brittle. */
+    PetscReal (*softening)(const PeriCriterion *c, const PetscReal meas[]);
+    /* Its part of the run log's "failure:" line, starting with a blank. */
+    PetscErrorCode (*view)(const PeriCriterion *c, PeriModel m, MPI_Comm comm);
+  } ops;
+};
+
+/* Bond failure criteria (failure:, src/system/failure.c): every registered criterion, those the
+ * scene switches on active. */
+typedef struct {
+  PetscBool     active;    /* the scene has failure: */
+  PetscBool     softening; /* a criterion softens bonds: bonds.intact is kept */
+  PetscInt      ncriteria;
+  PeriCriterion criterion[PERI_MAX_CRITERIA]; /* in the order of src/system/criterion_list.h */
+  PetscInt      precracked_bonds;             /* bonds the scene's cracks removed */
 } PeriFailure;
 
 /* The bond state's part of the system. */
@@ -50,6 +95,11 @@ PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
 PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriSystem, const PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriFailureView(const PeriFailure *, PeriModel, MPI_Comm);
+PETSC_EXTERN PetscErrorCode PeriFailureSelect(PeriFailure *, const char *const[], PetscBool);
+PETSC_EXTERN PetscBool      PeriFailureIsActive(const PeriFailure *, const char[]);
+PETSC_EXTERN PetscReal      PeriFailureValue(const PeriFailure *, const char[]);
+PETSC_EXTERN PetscErrorCode PeriFailureSetValue(PeriFailure *, const char[], PetscReal);
 PETSC_EXTERN PetscErrorCode PeriDamage(PeriSystem, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriFamilySync(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriPieces(PeriSystem, PetscInt *, PetscInt **, PetscReal **, PetscInt *, PetscBool *);
