@@ -48,8 +48,11 @@ static PetscBool ParseNumber(const char s[], size_t n, PetscReal *x)
   return (PetscBool)(!*end && errno != ERANGE && !PetscIsInfOrNanReal(*x));
 }
 
-/* The n characters at s as a bound naming a key of sec, maybe scaled: "load_factor_step/2^20". */
-static PetscBool ParseSymbol(const PeriSchema *sec, const char s[], size_t n)
+/* The n characters at s as a bound naming a key of sec's section, maybe scaled:
+ * "load_factor_step/2^20". The key may be declared in any entry of the owner's schema for that
+ * section (the failure criteria declare failure.* in one entry each); with schema NULL (a getter,
+ * after PeriSchemaCheck verified every declaration at start-up) any key name is taken. */
+static PetscBool ParseSymbol(const PeriSchema *schema, const PeriSchema *sec, const char s[], size_t n)
 {
   char   buf[128];
   size_t id = 0;
@@ -59,22 +62,26 @@ static PetscBool ParseSymbol(const PeriSchema *sec, const char s[], size_t n)
   if (!id || isdigit((unsigned char)buf[0])) return PETSC_FALSE;
   for (const char *c = buf + id; *c; c++)
     if (!strchr("0123456789.+-*/^ ", *c)) return PETSC_FALSE;
-  for (const PeriKey *k = sec->keys; k->name; k++)
-    if (strlen(k->name) == id && !strncmp(k->name, buf, id)) return PETSC_TRUE;
+  if (!schema) return PETSC_TRUE;
+  for (const PeriSchema *e = schema; e->section; e++) {
+    if (strcmp(e->section, sec->section)) continue;
+    for (const PeriKey *k = e->keys; k->name; k++)
+      if (strlen(k->name) == id && !strncmp(k->name, buf, id)) return PETSC_TRUE;
+  }
   return PETSC_FALSE;
 }
 
 /* One end of an interval: a number, or a key of sec (then no bound to the getter: none). */
-static PetscBool ParseEnd(const PeriSchema *sec, const char s[], size_t n, PetscReal none, PetscReal *x, PetscBool *open)
+static PetscBool ParseEnd(const PeriSchema *schema, const PeriSchema *sec, const char s[], size_t n, PetscReal none, PetscReal *x, PetscBool *open)
 {
   if (ParseNumber(s, n, x)) return PETSC_TRUE;
   *x    = none;
   *open = PETSC_FALSE;
-  return ParseSymbol(sec, s, n);
+  return ParseSymbol(schema, sec, s, n);
 }
 
 /* The range of key (declared in sec); *ok false when it is not one of the forms. No range: all. */
-static void ParseRange(const PeriSchema *sec, const PeriKey *key, Range *r, PetscBool *ok)
+static void ParseRange(const PeriSchema *schema, const PeriSchema *sec, const PeriKey *key, Range *r, PetscBool *ok)
 {
   const char *s = key->range, *comma;
   size_t      n = s ? strlen(s) : 0;
@@ -96,7 +103,7 @@ static void ParseRange(const PeriSchema *sec, const PeriKey *key, Range *r, Pets
   if (!strchr("[(", s[0]) || !strchr("])", s[n - 1]) || !comma || strchr(comma + 1, ',')) return;
   r->lo_open = (PetscBool)(s[0] == '(');
   r->hi_open = (PetscBool)(s[n - 1] == ')');
-  *ok        = (PetscBool)(ParseEnd(sec, s + 1, (size_t)(comma - s - 1), PETSC_NINFINITY, &r->lo, &r->lo_open) && ParseEnd(sec, comma + 1, (size_t)(s + n - 2 - comma), PETSC_INFINITY, &r->hi, &r->hi_open));
+  *ok        = (PetscBool)(ParseEnd(schema, sec, s + 1, (size_t)(comma - s - 1), PETSC_NINFINITY, &r->lo, &r->lo_open) && ParseEnd(schema, sec, comma + 1, (size_t)(s + n - 2 - comma), PETSC_INFINITY, &r->hi, &r->hi_open));
 }
 
 static PetscBool RangeHolds(const Range *r, PetscReal x)
@@ -190,7 +197,7 @@ PetscErrorCode PeriSchemaCheck(PetscInt nowners, const PeriSchemaOwner owners[])
         if (!key->range) continue;
         PeriSchemaPath(sec, key, path, sizeof(path));
         PetscCheck(key->type == PERI_KEY_REAL || key->type == PERI_KEY_INT || key->type == PERI_KEY_REALS, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s %s declares the range '%s' on key '%s', which is not numeric", owners[o].kind, owners[o].name, key->range, path);
-        ParseRange(sec, key, &r, &ok);
+        ParseRange(owners[o].schema, sec, key, &r, &ok);
         PetscCheck(ok, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s %s declares for key '%s' the range '%s', which the scene layer cannot read: write [a, b], (a, inf), (0, 1] or {2, 3}, an end a number, a fraction a/b, inf, or a key of the same section", owners[o].kind, owners[o].name, path, key->range);
         has = PeriKeyDefaultReal(key, &x);
         if (PeriKeyDefaultInt(key, &i)) x = (PetscReal)i, has = PETSC_TRUE;
@@ -283,7 +290,7 @@ PetscErrorCode PeriSceneCheckRange(PeriScene scene, PeriNode node, const PeriSch
 
   PetscFunctionBeginUser;
   if (!decl || !decl->range) PetscFunctionReturn(PETSC_SUCCESS);
-  ParseRange(sec, decl, &r, &ok);
+  ParseRange(NULL, sec, decl, &r, &ok);
   PetscCheck(ok, PETSC_COMM_SELF, PETSC_ERR_PLIB, "key '%s' declares the range '%s', which the scene layer cannot read", node->path, decl->range);
   PeriInputCheck(RangeHolds(&r, x), scene, node, NULL, "must %s %s%s%s, got %s (%s)", r.set ? "be one of" : "lie in", decl->range, decl->units ? " " : "", decl->units ? decl->units : "", value, decl->help);
   PetscFunctionReturn(PETSC_SUCCESS);
