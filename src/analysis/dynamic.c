@@ -1,0 +1,781 @@
+/* Transient dynamics, M a + K u = f(t), on PETSc's TS with the system's stiffness, mass and bond
+ * state (issue 26, first part; docs/dynamics.md). Explicit: velocity Verlet (TSBASICSYMPLECTIC,
+ * type 2) on the lumped mass, one product with K per step, the step checked against the stability
+ * limit 2/omega_max, omega_max^2 bounded from above by Gershgorin's theorem on M^-1 K. Implicit:
+ * generalized-alpha for second-order systems (TSALPHA2; spectral radius 1 by default, which is
+ * Newmark's average acceleration, beta = 1/4, gamma = 1/2), each step a linear solve with the
+ * static solver's KSP/PC. Any -ts_* option applies after these defaults. Bonds break after each
+ * step by the scene's failure criteria (all bonds past them, irreversibly), and the energy they
+ * held is counted as dissipated; the energy balance (kinetic + strain + dissipated - work of the
+ * loads) must close to analysis.energy_tolerance, or the run fails. */
+#include "perilin/private/analysis.h"
+#include <petscts.h>
+
+static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
+static const char *const dyn_amplitudes[]  = {"step", "ramp", "sine", NULL};
+
+#define DYN_HISTORY_COLUMNS 8 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position */
+
+typedef struct {
+  /* analysis.* */
+  PetscBool implicit;
+  PetscReal t_end, dt, energy_tol, rho_inf;
+  PetscBool pulse;                      /* analysis.pulse given */
+  PetscReal pulse_A, pulse_x0, pulse_w; /* u = A exp(-((x - x0)/w)^2) along the pulse axis */
+  PetscInt  pulse_axis, shape;          /* axis; amplitude shape of the loads in time */
+  PetscReal rise, period;               /* ramp: rise time; sine: period */
+  /* the run */
+  PetscBool  started;
+  PetscReal  omega2_max, dt_limit; /* Gershgorin's bound of M^-1 K, and 2/omega_max */
+  PetscInt   nsteps, broken, snes_its, ksp_its;
+  PetscReal  kinetic, strain, dissipated, work, E0, scale, drift; /* drift: the largest |balance - E0| / scale */
+  PetscReal  t_prev, amp_prev, pulse_pos;
+  PetscInt   nhist, cap, nsnap;
+  PetscReal *hist, *snap_time; /* rank 0 keeps them; every rank counts */
+  Vec        minv, uprev, tmp; /* 1/m per DOF (0 on held DOFs), the last step's u, work */
+  Mat        J;                /* implicit: K + shift M with the held rows and columns eliminated */
+  IS         isq, isp;         /* explicit: positions and velocities in the state [q; p] */
+  TS         ts;
+} Dynamic;
+
+static inline Dynamic *DYN(PeriAnalysis an)
+{
+  return (Dynamic *)an->data;
+}
+
+/* The loads' amplitude at time t: step (1 from t = 0), ramp (linear to 1 at the rise time), sine. */
+static PetscReal Amplitude(const Dynamic *d, PetscReal t)
+{
+  if (d->shape == 1) return d->rise > 0 ? PetscMin(1, t / d->rise) : 1;
+  if (d->shape == 2) return PetscSinReal(2 * PETSC_PI * t / d->period);
+  return 1;
+}
+
+/* analysis.* before any particle exists. */
+static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNode a)
+{
+  Dynamic *d;
+  PeriNode p, amp;
+  PetscInt kind    = 0;
+  char     axis[8] = "x";
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&d));
+  an->data = d;
+  PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
+  PetscCall(PeriSceneGetChoice(s, a, "integrator", dyn_integrators, &kind, NULL));
+  d->implicit = (PetscBool)(kind == 1);
+  PetscCall(PeriSceneGetReal(s, a, "t_end", PETSC_TRUE, &d->t_end, NULL));
+  PetscCall(PeriSceneGetReal(s, a, "dt", (PetscBool)d->implicit, &d->dt, NULL));
+  PeriInputCheck(d->dt <= d->t_end, s, a, "dt", "must not exceed t_end = %g, got %g", (double)d->t_end, (double)d->dt);
+  d->energy_tol = 0.01;
+  PetscCall(PeriSceneGetReal(s, a, "energy_tolerance", PETSC_FALSE, &d->energy_tol, NULL));
+  d->rho_inf = 1;
+  PetscCall(PeriSceneGetReal(s, a, "rho_infinity", PETSC_FALSE, &d->rho_inf, NULL));
+  PetscCall(PeriSceneGetMap(s, a, "pulse", PETSC_FALSE, &p));
+  if (p) {
+    d->pulse = PETSC_TRUE;
+    PetscCall(PeriSceneGetReal(s, p, "amplitude", PETSC_TRUE, &d->pulse_A, NULL));
+    PetscCall(PeriSceneGetReal(s, p, "center", PETSC_TRUE, &d->pulse_x0, NULL));
+    PetscCall(PeriSceneGetReal(s, p, "width", PETSC_TRUE, &d->pulse_w, NULL));
+    PetscCall(PeriSceneGetString(s, p, "axis", PETSC_FALSE, axis, sizeof(axis), NULL));
+    PeriInputCheck(!strcmp(axis, "x") || !strcmp(axis, "y") || !strcmp(axis, "z"), s, p, "axis", "must be x, y or z, got '%s'", axis);
+    d->pulse_axis = axis[0] - 'x';
+  }
+  PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
+  if (amp) {
+    PetscCall(PeriSceneGetChoice(s, amp, "shape", dyn_amplitudes, &d->shape, NULL));
+    PetscCall(PeriSceneGetReal(s, amp, "rise_time", d->shape == 1 ? PETSC_TRUE : PETSC_FALSE, &d->rise, NULL));
+    PetscCall(PeriSceneGetReal(s, amp, "period", d->shape == 2 ? PETSC_TRUE : PETSC_FALSE, &d->period, NULL));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What needs the system: a density (the mass service checks it), bc and loads only. */
+static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
+{
+  PeriScene s = an->sys->scene;
+  Dynamic  *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(!an->sys->conditions.layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a dynamic analysis takes bc only");
+  PeriInputCheck(!d->pulse || d->pulse_axis < an->sys->disc.particles.dim, s, s->root, "analysis.pulse.axis", "the body is %" PetscInt_FMT "D", an->sys->disc.particles.dim);
+  PeriInputCheck(!d->pulse || PeriModelTranslation(an->sys->model, d->pulse_axis) >= 0, s, s->root, "analysis.pulse.axis", "model %s does not translate along this axis", an->sys->model->type);
+  PetscCall(PeriMassSetUp(an->sys));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* omega_max^2 of M^-1 K from above (Gershgorin: every eigenvalue of M^-1 K lies within
+ * max_i sum_j |K_ij| / m_i), and the explicit step's limit 2/omega_max. Collective. */
+static PetscErrorCode StabilityBound(PeriAnalysis an)
+{
+  Dynamic           *d = DYN(an);
+  Mat                K = an->sys->stiffness.K;
+  Vec                m;
+  const PetscScalar *ma;
+  PetscInt           rstart, rend;
+  PetscReal          worst = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriMassGetDiagonal(an->sys, &m));
+  PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
+  PetscCall(VecGetArrayRead(m, &ma));
+  for (PetscInt r = rstart; r < rend; r++) {
+    const PetscScalar *v;
+    PetscInt           nc;
+    PetscReal          sum = 0;
+    PetscCall(MatGetRow(K, r, &nc, NULL, &v));
+    for (PetscInt k = 0; k < nc; k++) sum += PetscAbsScalar(v[k]);
+    PetscCall(MatRestoreRow(K, r, &nc, NULL, &v));
+    worst = PetscMax(worst, sum / PetscRealPart(ma[r - rstart]));
+  }
+  PetscCall(VecRestoreArrayRead(m, &ma));
+  PetscCallMPI(MPI_Allreduce(&worst, &d->omega2_max, 1, MPIU_REAL, MPI_MAX, an->comm));
+  d->dt_limit = d->omega2_max > 0 ? 2 / PetscSqrtReal(d->omega2_max) : PETSC_MAX_REAL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The explicit step: analysis.dt, or 0.8 of the limit; a dt above the limit is an input error. */
+static PetscErrorCode ChooseStep(PeriAnalysis an)
+{
+  Dynamic  *d = DYN(an);
+  PeriScene s = an->sys->scene;
+  PeriNode  a;
+
+  PetscFunctionBeginUser;
+  if (d->implicit) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetNode(s->root, "analysis", &a));
+  if (d->dt <= 0) d->dt = 0.8 * d->dt_limit;
+  PeriInputCheck(d->dt <= d->dt_limit, s, a, "dt", "%g is above the explicit stability limit 2/omega_max = %g (omega_max^2 <= %g by Gershgorin's bound on M^-1 K): use dt <= %g, or integrator: implicit", (double)d->dt, (double)d->dt_limit, (double)d->omega2_max, (double)d->dt_limit);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The initial displacements: the pulse, and the prescribed values on the held DOFs. */
+static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
+{
+  Dynamic       *d   = DYN(an);
+  PeriSystem     sys = an->sys;
+  const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
+  PetscScalar   *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(u, 0));
+  if (d->pulse) {
+    const PetscInt c = PeriModelTranslation(sys->model, d->pulse_axis);
+    PetscCall(VecGetArray(u, &a));
+    for (PetscInt i = 0; i < nloc; i++) {
+      const PetscReal x = sys->disc.particles.x[3 * i + d->pulse_axis];
+      a[i * bs + c]     = d->pulse_A * PetscExpReal(-PetscSqr((x - d->pulse_x0) / d->pulse_w));
+    }
+    PetscCall(VecRestoreArray(u, &a));
+  }
+  PetscCall(VecSetValues(u, sys->conditions.nconstrained, sys->conditions.constrained, sys->conditions.constrained_value, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(u));
+  PetscCall(VecAssemblyEnd(u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* 1/m per DOF, 0 on the held DOFs: a = minv (f - K u) leaves them where they are. */
+static PetscErrorCode InverseMass(PeriAnalysis an)
+{
+  Dynamic *d = DYN(an);
+  Vec      m;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriMassGetDiagonal(an->sys, &m));
+  PetscCall(VecDuplicate(m, &d->minv));
+  PetscCall(VecCopy(m, d->minv));
+  PetscCall(VecReciprocal(d->minv));
+  for (PetscInt k = 0; k < an->sys->conditions.nconstrained; k++) PetscCall(VecSetValue(d->minv, an->sys->conditions.constrained[k], 0, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(d->minv));
+  PetscCall(VecAssemblyEnd(d->minv));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Explicit, position split: dq/dt = p (p: the velocities). */
+static PetscErrorCode RHSPosition(TS ts, PetscReal t, Vec p, Vec dq, void *ctx)
+{
+  PetscFunctionBeginUser;
+  (void)ts;
+  (void)t;
+  (void)ctx;
+  PetscCall(VecCopy(p, dq));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Explicit, momentum split: dp/dt = M^-1 (a(t) f - K q), 0 on the held DOFs. */
+static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
+{
+  PeriAnalysis an = (PeriAnalysis)ctx;
+
+  PetscFunctionBeginUser;
+  (void)ts;
+  PetscCall(MatMult(an->sys->stiffness.K, q, dp));
+  PetscCall(VecAXPBY(dp, Amplitude(DYN(an), t), -1, an->sys->fields.f));
+  PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Explicit, the whole right-hand side [p; M^-1 (f - K q)], for any explicit TS (-ts_type rk). */
+static PetscErrorCode RHSWhole(TS ts, PetscReal t, Vec U, Vec F, void *ctx)
+{
+  Dynamic *d = DYN((PeriAnalysis)ctx);
+  Vec      q, p, fq, fp;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetSubVector(U, d->isq, &q));
+  PetscCall(VecGetSubVector(U, d->isp, &p));
+  PetscCall(VecGetSubVector(F, d->isq, &fq));
+  PetscCall(VecGetSubVector(F, d->isp, &fp));
+  PetscCall(RHSPosition(ts, t, p, fq, ctx));
+  PetscCall(RHSMomentum(ts, t, q, fp, ctx));
+  PetscCall(VecRestoreSubVector(F, d->isp, &fp));
+  PetscCall(VecRestoreSubVector(F, d->isq, &fq));
+  PetscCall(VecRestoreSubVector(U, d->isp, &p));
+  PetscCall(VecRestoreSubVector(U, d->isq, &q));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit: F = M A + K U - a(t) f, and U - g on the held DOFs. */
+static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F, void *ctx)
+{
+  PeriAnalysis an  = (PeriAnalysis)ctx;
+  PeriSystem   sys = an->sys;
+  Vec          m;
+
+  PetscFunctionBeginUser;
+  (void)ts;
+  (void)V;
+  PetscCall(PeriMassGetDiagonal(sys, &m));
+  PetscCall(MatMult(sys->stiffness.K, U, F));
+  PetscCall(VecPointwiseMult(DYN(an)->tmp, m, A));
+  PetscCall(VecAXPY(F, 1, DYN(an)->tmp));
+  PetscCall(VecAXPY(F, -Amplitude(DYN(an), t), sys->fields.f));
+  if (sys->conditions.nconstrained) {
+    const PetscScalar *u;
+    PetscScalar       *f;
+    PetscInt           r0;
+    PetscCall(VecGetOwnershipRange(F, &r0, NULL));
+    PetscCall(VecGetArrayRead(U, &u));
+    PetscCall(VecGetArray(F, &f));
+    for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) f[sys->conditions.constrained[k] - r0] = u[sys->conditions.constrained[k] - r0] - sys->conditions.constrained_value[k];
+    PetscCall(VecRestoreArray(F, &f));
+    PetscCall(VecRestoreArrayRead(U, &u));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit: J = K + shiftA M, the held rows and columns replaced by the identity. */
+static PetscErrorCode I2Jacobian(TS ts, PetscReal t, Vec U, Vec V, Vec A, PetscReal shiftV, PetscReal shiftA, Mat J, Mat P, void *ctx)
+{
+  PeriAnalysis an  = (PeriAnalysis)ctx;
+  PeriSystem   sys = an->sys;
+  Vec          m;
+
+  PetscFunctionBeginUser;
+  (void)ts, (void)t, (void)U, (void)V, (void)A, (void)shiftV, (void)J;
+  PetscCall(PeriMassGetDiagonal(sys, &m));
+  PetscCall(MatCopy(sys->stiffness.K, P, SAME_NONZERO_PATTERN));
+  PetscCall(VecCopy(m, DYN(an)->tmp));
+  PetscCall(VecScale(DYN(an)->tmp, shiftA));
+  PetscCall(MatDiagonalSet(P, DYN(an)->tmp, ADD_VALUES));
+  PetscCall(MatZeroRowsColumns(P, sys->conditions.nconstrained, sys->conditions.constrained, 1.0, NULL, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The displacements and velocities of the state (views: restore with RestoreState). */
+static PetscErrorCode GetState(PeriAnalysis an, Vec U, Vec *q, Vec *p)
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  if (d->implicit) {
+    *q = U;
+    PetscCall(TS2GetSolution(d->ts, NULL, p));
+  } else {
+    PetscCall(VecGetSubVector(U, d->isq, q));
+    PetscCall(VecGetSubVector(U, d->isp, p));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode RestoreState(PeriAnalysis an, Vec U, Vec *q, Vec *p)
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  if (!d->implicit) {
+    PetscCall(VecRestoreSubVector(U, d->isp, p));
+    PetscCall(VecRestoreSubVector(U, d->isq, q));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* 1/2 q^T K q with the present bonds. */
+static PetscErrorCode StrainEnergy(PeriAnalysis an, Vec q, PetscReal *E)
+{
+  PetscScalar e;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatMult(an->sys->stiffness.K, q, DYN(an)->tmp));
+  PetscCall(VecDot(q, DYN(an)->tmp, &e));
+  *E = 0.5 * PetscRealPart(e);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After each step: the bonds past the criteria break; the energy they held is dissipated. */
+static PetscErrorCode PostStep(TS ts)
+{
+  PeriAnalysis an;
+  Dynamic     *d;
+  Vec          U, q, p;
+  PetscInt     nb;
+  PetscReal    before, after;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetApplicationContext(ts, &an));
+  d = DYN(an);
+  if (!an->sys->bond_state.failure.active) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(TSGetSolution(ts, &U));
+  PetscCall(GetState(an, U, &q, &p));
+  PetscCall(VecCopy(q, an->sys->fields.u));
+  PetscCall(StrainEnergy(an, q, &before));
+  PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, &nb));
+  if (nb) {
+    PetscCall(StrainEnergy(an, q, &after));
+    d->dissipated += before - after;
+    d->broken += nb;
+  }
+  if (d->implicit) {
+    SNES snes;
+    KSP  ksp;
+    /* K changed: the next step sets up a new preconditioner, later steps keep it */
+    PetscCall(TSGetSNES(ts, &snes));
+    PetscCall(SNESGetKSP(snes, &ksp));
+    PetscCall(KSPSetReusePreconditioner(ksp, nb ? PETSC_FALSE : PETSC_TRUE));
+  }
+  PetscCall(RestoreState(an, U, &q, &p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* particles_NNNN.vtu of the present state, through the problem's snapshot callback. */
+static PetscErrorCode WriteSnapshot(PeriAnalysis an, Vec q, PetscReal t)
+{
+  Dynamic *d = DYN(an);
+  char     name[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(VecCopy(q, an->sys->fields.u));
+  PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  if (an->sys->bond_state.failure.active) PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
+  if (!an->vtk || !an->every || !an->snapshot) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscRealloc(sizeof(PetscReal) * (d->nsnap + 1), &d->snap_time));
+  d->snap_time[d->nsnap] = t;
+  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT, d->nsnap++));
+  PetscCall(an->snapshot(an->snapshotctx, name));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Appends a row of history.csv. */
+static PetscErrorCode RecordHistory(Dynamic *d, PetscReal t, PetscReal balance)
+{
+  const PetscReal row[DYN_HISTORY_COLUMNS] = {t, d->kinetic, d->strain, d->dissipated, d->work, balance, (PetscReal)d->broken, d->pulse_pos};
+
+  PetscFunctionBeginUser;
+  if (d->nhist == d->cap) {
+    d->cap = PetscMax(256, 2 * d->cap);
+    PetscCall(PetscRealloc(sizeof(PetscReal) * DYN_HISTORY_COLUMNS * d->cap, &d->hist));
+  }
+  PetscCall(PetscArraycpy(&d->hist[DYN_HISTORY_COLUMNS * d->nhist++], row, DYN_HISTORY_COLUMNS));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The energies of the state and the loads' work since the last step (trapezoidal in time). */
+static PetscErrorCode Energies(PeriAnalysis an, Vec q, Vec p, PetscReal t)
+{
+  Dynamic    *d = DYN(an);
+  Vec         m;
+  PetscScalar e, w;
+  PetscReal   amp = Amplitude(d, t);
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriMassGetDiagonal(an->sys, &m));
+  PetscCall(VecPointwiseMult(d->tmp, p, p));
+  PetscCall(VecDot(d->tmp, m, &e));
+  d->kinetic = 0.5 * PetscRealPart(e);
+  PetscCall(StrainEnergy(an, q, &d->strain));
+  PetscCall(VecWAXPY(d->tmp, -1, d->uprev, q));
+  PetscCall(VecDot(d->tmp, an->sys->fields.f, &w));
+  d->work += 0.5 * (amp + d->amp_prev) * PetscRealPart(w);
+  PetscCall(VecCopy(q, d->uprev));
+  d->amp_prev = amp;
+  d->t_prev   = t;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Where the pulse is: the centroid along its axis of u^2 over the particles displaced by more than
+ * half the largest displacement (a symmetric pulse's centre, to a fraction of the spacing). */
+static PetscErrorCode PulsePosition(PeriAnalysis an, Vec q)
+{
+  Dynamic           *d   = DYN(an);
+  PeriSystem         sys = an->sys;
+  const PetscInt     bs = sys->model->dofs, c = PeriModelTranslation(sys->model, d->pulse_axis), nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
+  const PetscScalar *u;
+  PetscReal          umax = 0, sum[2] = {0, 0};
+
+  PetscFunctionBeginUser;
+  if (!d->pulse) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecGetArrayRead(q, &u));
+  for (PetscInt i = 0; i < nloc; i++) umax = PetscMax(umax, PetscAbsScalar(u[i * bs + c]));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &umax, 1, MPIU_REAL, MPI_MAX, an->comm));
+  for (PetscInt i = 0; i < nloc; i++) {
+    const PetscReal v = PetscAbsScalar(u[i * bs + c]);
+    if (v <= 0.5 * umax) continue;
+    sum[0] += v * v * sys->disc.particles.x[3 * i + d->pulse_axis];
+    sum[1] += v * v;
+  }
+  PetscCall(VecRestoreArrayRead(q, &u));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPIU_REAL, MPI_SUM, an->comm));
+  d->pulse_pos = sum[1] > 0 ? sum[0] / sum[1] : 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After each step (and at t = 0): energies, the balance, history, snapshots, signals. */
+static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ctx)
+{
+  PeriAnalysis an = (PeriAnalysis)ctx;
+  Dynamic     *d  = DYN(an);
+  Vec          q, p;
+  PetscReal    balance;
+
+  PetscFunctionBeginUser;
+  PetscCall(GetState(an, U, &q, &p));
+  PetscCall(Energies(an, q, p, t));
+  PetscCall(PulsePosition(an, q));
+  balance = d->kinetic + d->strain + d->dissipated - d->work;
+  if (step == 0) d->E0 = balance;
+  d->scale = PetscMax(d->scale, PetscMax(d->kinetic + d->strain, PetscAbsReal(d->work)));
+  if (d->scale > 0) d->drift = PetscMax(d->drift, PetscAbsReal(balance - d->E0) / d->scale);
+  d->nsteps = step;
+  PetscCall(RecordHistory(d, t, balance));
+  if (an->every && step % an->every == 0) PetscCall(WriteSnapshot(an, q, t));
+  PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", t = %g of %g, %" PetscInt_FMT " bonds broken", step, (double)t, (double)d->t_end, d->broken));
+  PetscCall(RestoreState(an, U, &q, &p));
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
+  if (an->sys->run.interrupted) PetscCall(TSSetConvergedReason(ts, TS_CONVERGED_USER));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Explicit: the state [q; p] of the owned DOFs, split for TSBASICSYMPLECTIC. */
+static PetscErrorCode CreateExplicit(PeriAnalysis an, Vec *U)
+{
+  Dynamic *d = DYN(an);
+  Vec      q;
+  PetscInt n, r0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(an->sys->fields.u, &n));
+  PetscCall(VecCreateMPI(an->comm, 2 * n, PETSC_DETERMINE, U));
+  PetscCall(VecGetOwnershipRange(*U, &r0, NULL));
+  PetscCall(ISCreateStride(an->comm, n, r0, 1, &d->isq));
+  PetscCall(ISCreateStride(an->comm, n, r0 + n, 1, &d->isp));
+  PetscCall(VecGetSubVector(*U, d->isq, &q));
+  PetscCall(InitialDisplacement(an, q));
+  PetscCall(VecRestoreSubVector(*U, d->isq, &q));
+  PetscCall(TSSetType(d->ts, TSBASICSYMPLECTIC));
+  PetscCall(TSBasicSymplecticSetType(d->ts, TSBASICSYMPLECTICVELVERLET));
+  PetscCall(TSSetRHSFunction(d->ts, NULL, RHSWhole, an));
+  PetscCall(TSRHSSplitSetIS(d->ts, "position", d->isq));
+  PetscCall(TSRHSSplitSetIS(d->ts, "momentum", d->isp));
+  PetscCall(TSRHSSplitSetRHSFunction(d->ts, "position", NULL, RHSPosition, an));
+  PetscCall(TSRHSSplitSetRHSFunction(d->ts, "momentum", NULL, RHSMomentum, an));
+  PetscCall(TSSetSolution(d->ts, *U));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit: u and v apart (TS2), generalized-alpha with the static solver's KSP/PC defaults. */
+static PetscErrorCode CreateImplicit(PeriAnalysis an, Vec *U, Vec *V)
+{
+  Dynamic *d = DYN(an);
+  SNES     snes;
+  KSP      ksp;
+  PC       pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecDuplicate(an->sys->fields.u, U));
+  PetscCall(VecDuplicate(an->sys->fields.u, V));
+  PetscCall(InitialDisplacement(an, *U));
+  PetscCall(VecSet(*V, 0));
+  PetscCall(MatDuplicate(an->sys->stiffness.K, MAT_COPY_VALUES, &d->J));
+  PetscCall(PeriSetNearNullSpace(an->sys, d->J, NULL));
+  PetscCall(TSSetType(d->ts, TSALPHA2));
+  PetscCall(TSAlpha2SetRadius(d->ts, d->rho_inf));
+  PetscCall(TSSetI2Function(d->ts, NULL, I2Function, an));
+  PetscCall(TSSetI2Jacobian(d->ts, d->J, d->J, I2Jacobian, an));
+  PetscCall(TS2SetSolution(d->ts, *U, *V));
+  PetscCall(TSGetSNES(d->ts, &snes));
+  /* Newton, not KSPONLY: each step's residual must fall by 1e-8 (a true-residual check) */
+  PetscCall(SNESSetType(snes, SNESNEWTONLS));
+  PetscCall(SNESSetTolerances(snes, PETSC_DEFAULT, 1e-8, PETSC_DEFAULT, 10, PETSC_DEFAULT));
+  PetscCall(SNESGetKSP(snes, &ksp));
+  /* J follows K and the step's shift; its preconditioner is kept until bonds break (PostStep) */
+  PetscCall(KSPSetReusePreconditioner(ksp, PETSC_TRUE));
+  PetscCall(KSPSetType(ksp, KSPCG));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCGAMG));
+  PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The TS of the run, set from the options after perilin's defaults. */
+static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
+{
+  Dynamic  *d = DYN(an);
+  PeriNode  a;
+  PetscBool given;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSCreate(an->comm, &d->ts));
+  PetscCall(TSSetApplicationContext(d->ts, an));
+  PetscCall(TSSetProblemType(d->ts, TS_NONLINEAR)); /* so that SNES checks each step's residual */
+  if (d->implicit)
+    PetscCall(CreateImplicit(an, U, V));
+  else
+    PetscCall(CreateExplicit(an, U));
+  PetscCall(TSSetTime(d->ts, 0));
+  PetscCall(TSSetTimeStep(d->ts, d->dt));
+  /* a fixed step (no TSAdapt clips the last one): as many steps as reach t_end, and the time
+     limit half a step beyond, so that round-off in the sum of the steps adds no step */
+  PetscCall(TSSetMaxTime(d->ts, d->t_end + 0.5 * d->dt));
+  PetscCall(TSSetExactFinalTime(d->ts, TS_EXACTFINALTIME_STEPOVER));
+  PetscCall(TSMonitorSet(d->ts, Monitor, an, NULL));
+  PetscCall(TSSetPostStep(d->ts, PostStep));
+  PetscCall(TSSetFromOptions(d->ts));
+  PetscCall(TSGetTimeStep(d->ts, &d->dt));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
+  if (!given) PetscCall(TSSetMaxSteps(d->ts, (PetscInt)PetscCeilReal(d->t_end / d->dt - 1e-9)));
+  PetscCall(PeriSceneGetNode(an->sys->scene->root, "analysis", &a));
+  /* -ts_dt too is held to the limit */
+  PeriInputCheck(d->implicit || d->dt <= d->dt_limit, an->sys->scene, a, "dt", "-ts_dt %g is above the explicit stability limit 2/omega_max = %g: use dt <= %g, or integrator: implicit", (double)d->dt, (double)d->dt_limit, (double)d->dt_limit);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What summary.json's solver section reports: the TS, and for the implicit one its KSP/PC. */
+static PetscErrorCode RecordSolver(PeriAnalysis an)
+{
+  Dynamic *d = DYN(an);
+  TSType   type;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetType(d->ts, &type));
+  PetscCall(PetscStrncpy(an->sys->fields.solve.ksp_type, type, sizeof(an->sys->fields.solve.ksp_type)));
+  PetscCall(PetscStrncpy(an->sys->fields.solve.pc_type, d->implicit ? "gamg" : "none", sizeof(an->sys->fields.solve.pc_type)));
+  if (d->implicit) {
+    SNES   snes;
+    KSP    ksp;
+    PC     pc;
+    PCType pt;
+    PetscCall(TSGetSNES(d->ts, &snes));
+    PetscCall(SNESGetKSP(snes, &ksp));
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PCGetType(pc, &pt));
+    PetscCall(PetscStrncpy(an->sys->fields.solve.pc_type, pt, sizeof(an->sys->fields.solve.pc_type)));
+    PetscCall(TSGetSNESIterations(d->ts, &d->snes_its));
+    PetscCall(TSGetKSPIterations(d->ts, &d->ksp_its));
+  }
+  PetscCall(PetscStrncpy(an->sys->fields.solve.converged_reason, an->sys->run.interrupted ? "INTERRUPTED" : "TS_CONVERGED_TIME", sizeof(an->sys->fields.solve.converged_reason)));
+  an->sys->fields.solve.iterations = d->nsteps;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  Run_Dynamic - integrates from rest (with the initial pulse and the held values) to t_end. The
+  output describes the last completed step. Options: every -ts_* option, and for the implicit
+  integrator the -snes_*, -ksp_* and -pc_* options. Collective.
+@*/
+static PetscErrorCode Run_Dynamic(PeriAnalysis an)
+{
+  Dynamic       *d = DYN(an);
+  Vec            U = NULL, V = NULL, q, p;
+  PetscLogDouble t0, t1;
+  PetscReal      t;
+
+  PetscFunctionBeginUser;
+  d->started = PETSC_TRUE;
+  PetscCall(PeriStaticDefaultMatType(an->sys->stiffness.mat_type, sizeof(an->sys->stiffness.mat_type)));
+  if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(PetscTime(&t0));
+  PetscCall(StabilityBound(an));
+  PetscCall(ChooseStep(an));
+  PetscCall(InverseMass(an));
+  if (!an->sys->fields.u) PetscCall(PeriSystemCreateVec(an->sys, &an->sys->fields.u));
+  PetscCall(VecDuplicate(an->sys->fields.u, &d->tmp));
+  PetscCall(VecDuplicate(an->sys->fields.u, &d->uprev));
+  PetscCall(SetUpTS(an, &U, &V));
+  PetscCall(GetState(an, U, &q, &p));
+  PetscCall(VecCopy(q, d->uprev));
+  PetscCall(RestoreState(an, U, &q, &p));
+  d->amp_prev = Amplitude(d, 0);
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscCall(TSSolve(d->ts, NULL));
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscCall(TSGetTime(d->ts, &t));
+  PetscCall(PetscTime(&t1));
+  an->sys->run.log.solve_s = t1 - t0;
+  PetscCall(RecordSolver(an));
+  PetscCall(GetState(an, U, &q, &p));
+  PetscCall(VecCopy(q, an->sys->fields.u));
+  PetscCall(RestoreState(an, U, &q, &p));
+  PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  if (an->sys->bond_state.failure.active) PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
+  PetscCall(VecDestroy(&U));
+  PetscCall(VecDestroy(&V));
+  PetscCheck(an->sys->run.interrupted || d->drift <= d->energy_tol, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the energy balance (kinetic + strain + dissipated - work of the loads) drifted by %.3g of the energy scale, above analysis.energy_tolerance %g: the run is not consistent; use a smaller dt (now %g, limit %g) or the implicit integrator", an->sys->scene->file, (double)d->drift, (double)d->energy_tol, (double)d->dt, (double)d->dt_limit);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* history.csv: one row per step. Rank 0 writes (temporary name, then rename). */
+static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
+{
+  Dynamic *d = DYN(an);
+  char     path[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
+  FILE    *fp;
+  int      bad = 0;
+
+  PetscFunctionBeginUser;
+  if (an->rank) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/history.csv", dir));
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s\n", d->pulse ? ",pulse_position" : "") < 0;
+  for (PetscInt k = 0; k < d->nhist; k++) {
+    const PetscReal *r = &d->hist[DYN_HISTORY_COLUMNS * k];
+    bad |= fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%" PetscInt_FMT, (double)r[0], (double)r[1], (double)r[2], (double)r[3], (double)r[4], (double)r[5], (PetscInt)r[6]) < 0;
+    if (d->pulse) bad |= fprintf(fp, ",%.10g", (double)r[7]) < 0;
+    bad |= fprintf(fp, "\n") < 0;
+  }
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* history.csv, and with snapshots particles.pvd over the physical time. */
+static PetscErrorCode Files_Dynamic(PeriAnalysis an, const char dir[])
+{
+  Dynamic *d = DYN(an);
+  char     path[PETSC_MAX_PATH_LEN], base[32], **files;
+
+  PetscFunctionBeginUser;
+  if (!d->started) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(WriteHistory(an, dir));
+  if (!d->nsnap || an->rank) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc1(d->nsnap, &files));
+  for (PetscInt k = 0; k < d->nsnap; k++) {
+    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, k));
+    PetscCall(PetscMalloc1(40, &files[k]));
+    PetscCall(PeriParticlesFileName(an->comm, base, files[k], 40));
+  }
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.pvd", dir));
+  PetscCall(PeriWritePVD(path, d->nsnap, d->snap_time, (const char *const *)files));
+  for (PetscInt k = 0; k < d->nsnap; k++) PetscCall(PetscFree(files[k]));
+  PetscCall(PetscFree(files));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* summary.json's "dynamic" object. */
+static PetscErrorCode Summary_Dynamic(PeriAnalysis an, PeriJSON j)
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  if (!d->started) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriJSONBeginObject(j, "dynamic"));
+  PetscCall(PeriJSONString(j, "integrator", d->implicit ? "implicit" : "explicit"));
+  PetscCall(PeriJSONReal(j, "dt", d->dt));
+  PetscCall(PeriJSONReal(j, "dt_limit", d->dt_limit));
+  PetscCall(PeriJSONReal(j, "omega2_max_bound", d->omega2_max));
+  PetscCall(PeriJSONInt(j, "steps", d->nsteps));
+  PetscCall(PeriJSONReal(j, "time", d->t_prev));
+  PetscCall(PeriJSONReal(j, "kinetic_energy", d->kinetic));
+  PetscCall(PeriJSONReal(j, "strain_energy", d->strain));
+  PetscCall(PeriJSONReal(j, "dissipated_energy", d->dissipated));
+  PetscCall(PeriJSONReal(j, "work_of_loads", d->work));
+  PetscCall(PeriJSONReal(j, "energy_drift", d->drift));
+  PetscCall(PeriJSONReal(j, "energy_tolerance", d->energy_tol));
+  PetscCall(PeriJSONInt(j, "broken_bonds", d->broken));
+  if (d->implicit) PetscCall(PeriJSONInt(j, "ksp_iterations", d->ksp_its));
+  PetscCall(PeriJSONEndObject(j));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Report_Dynamic(PeriAnalysis an)
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(an->comm, "perilin: %s dynamics to t = %g in %" PetscInt_FMT " steps of %g (explicit limit %g), energy drift %.2g, %" PetscInt_FMT " bonds broken; results in %s/\n", d->implicit ? "implicit" : "explicit", (double)d->t_prev, d->nsteps, (double)d->dt, (double)d->dt_limit, (double)d->drift, d->broken, an->output_dir));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  PetscCall(TSDestroy(&d->ts));
+  PetscCall(MatDestroy(&d->J));
+  PetscCall(ISDestroy(&d->isq));
+  PetscCall(ISDestroy(&d->isp));
+  PetscCall(VecDestroy(&d->minv));
+  PetscCall(VecDestroy(&d->uprev));
+  PetscCall(VecDestroy(&d->tmp));
+  PetscCall(PetscFree(d->hist));
+  PetscCall(PetscFree(d->snap_time));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static const PeriKey dyn_keys[] = {
+    {"integrator", PERI_KEY_CHOICE, "explicit", NULL, NULL, dyn_integrators, "explicit: velocity Verlet on the lumped mass (TSBASICSYMPLECTIC), dt held below 2/omega_max; implicit: generalized-alpha (TSALPHA2), a linear solve per step"},
+    {"t_end", PERI_KEY_REAL, "required", "(0, inf)", "[time]", NULL, "the end time"},
+    {"dt", PERI_KEY_REAL, "0.8 of the explicit limit (explicit); required (implicit)", "(0, inf)", "[time]", NULL, "the time step (-ts_dt overrides it); an explicit dt above the stability limit is an input error"},
+    {"energy_tolerance", PERI_KEY_REAL, "0.01", "(0, inf)", NULL, NULL, "the largest drift of the energy balance (kinetic + strain + dissipated - work of the loads) over the run, relative to the largest energy: above it the run fails"},
+    {"rho_infinity", PERI_KEY_REAL, "1", "[0, 1]", NULL, NULL, "implicit: the spectral radius at infinite frequency (1: no numerical damping, Newmark's average acceleration)"},
+    {"pulse", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement u = amplitude exp(-((x - center)/width)^2) along axis (Ganzenmueller sec. 3.1.2)"},
+    {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
+    {NULL},
+};
+static const PeriKey dyn_pulse_keys[] = {
+    {"amplitude", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "the pulse's peak displacement"},
+    {"center", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "its position along axis"},
+    {"width", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "its width w"},
+    {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the pulse lies and displaces: x, y or z"},
+    {NULL},
+};
+static const PeriKey dyn_amplitude_keys[] = {
+    {"shape", PERI_KEY_CHOICE, "step", NULL, NULL, dyn_amplitudes, "step: 1 from t = 0; ramp: linear from 0 to 1 at rise_time; sine: sin(2 pi t / period)"},
+    {"rise_time", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "ramp: when the loads reach their value"},
+    {"period", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "sine: the period"},
+    {NULL},
+};
+/* output.every, which the snapshots follow (problem.c reads it with output.*) */
+static const PeriKey dyn_output_keys[] = {
+    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k time steps, indexed by particles.pvd with the time (0: only the end)"},
+    {NULL},
+};
+static const PeriSchema dyn_schema[] = {
+    {"analysis", dyn_keys},
+    {"analysis.pulse", dyn_pulse_keys},
+    {"analysis.amplitude", dyn_amplitude_keys},
+    {"output", dyn_output_keys},
+    {NULL},
+};
+static const char *const dyn_files[] = {"history.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", NULL};
+
+/* K is assembled (the Gershgorin bound reads its rows; the implicit step copies it into J). */
+const PeriAnalysisType PeriAnalysis_Dynamic = {
+    .name          = "dynamic",
+    .help          = "transient dynamics M a + K u = f(t) on PETSc TS, explicit or implicit, with bond failure",
+    .schema        = dyn_schema,
+    .option_prefix = "",
+    .files         = dyn_files,
+    .needs         = {.static_solver = PETSC_TRUE, .matrix_copies = 1},
+    .ops           = {.setfromscene = SetFromScene_Dynamic, .setup = SetUp_Dynamic, .run = Run_Dynamic, .files = Files_Dynamic, .summary = Summary_Dynamic, .report = Report_Dynamic, .destroy = Destroy_Dynamic},
+};
