@@ -28,7 +28,8 @@ typedef struct {
   PetscBool  started;
   PetscReal  omega2_max, dt_limit; /* Gershgorin's bound of M^-1 K, and 2/omega_max */
   PetscInt   nsteps, broken, snes_its, ksp_its;
-  PetscReal  kinetic, strain, dissipated, work, E0, scale, drift; /* drift: the largest |balance - E0| / scale */
+  PetscReal  worst;                                                      /* implicit: the largest relative residual a step ended with */
+  PetscReal  kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
   PetscReal  t_prev, amp_prev, pulse_pos;
   PetscInt   nhist, cap, nsnap;
   PetscReal *hist, *snap_time; /* rank 0 keeps them; every rank counts */
@@ -41,6 +42,56 @@ typedef struct {
 static inline Dynamic *DYN(PeriAnalysis an)
 {
   return (Dynamic *)an->data;
+}
+
+static const PeriKey dyn_keys[] = {
+    {"integrator", PERI_KEY_CHOICE, "explicit", NULL, NULL, dyn_integrators, "explicit: velocity Verlet on the lumped mass (TSBASICSYMPLECTIC), dt held below 2/omega_max; implicit: generalized-alpha (TSALPHA2), a linear solve per step"},
+    {"t_end", PERI_KEY_REAL, "required", "(0, inf)", "[time]", NULL, "the end time"},
+    {"dt", PERI_KEY_REAL, "0.8 of the explicit limit (explicit); required (implicit)", "(0, inf)", "[time]", NULL, "the time step (-ts_dt overrides it); an explicit dt above the stability limit is an input error"},
+    {"energy_tolerance", PERI_KEY_REAL, "0.01", "(0, inf)", NULL, NULL, "the largest drift of the energy balance (kinetic + strain + dissipated - work of the loads) over the run, relative to the largest energy: above it the run fails"},
+    {"rho_infinity", PERI_KEY_REAL, "1", "[0, 1]", NULL, NULL, "implicit: the spectral radius at infinite frequency (1: no numerical damping, Newmark's average acceleration)"},
+    {"pulse", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement u = amplitude exp(-((x - center)/width)^2) along axis (Ganzenmueller sec. 3.1.2)"},
+    {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
+    {NULL},
+};
+static const PeriKey dyn_pulse_keys[] = {
+    {"amplitude", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "the pulse's peak displacement"},
+    {"center", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "its position along axis"},
+    {"width", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "its width w"},
+    {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the pulse lies and displaces: x, y or z"},
+    {NULL},
+};
+static const PeriKey dyn_amplitude_keys[] = {
+    {"shape", PERI_KEY_CHOICE, "step", NULL, NULL, dyn_amplitudes, "step: 1 from t = 0; ramp: linear from 0 to 1 at rise_time; sine: sin(2 pi t / period)"},
+    {"rise_time", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "ramp: when the loads reach their value"},
+    {"period", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "sine: the period"},
+    {NULL},
+};
+/* output.every, which the snapshots follow (problem.c reads it with output.*) */
+static const PeriKey dyn_output_keys[] = {
+    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k time steps, indexed by particles.pvd with the time (0: only the end)"},
+    {NULL},
+};
+static const PeriSchema dyn_schema[] = {
+    {"analysis", dyn_keys},
+    {"analysis.pulse", dyn_pulse_keys},
+    {"analysis.amplitude", dyn_amplitude_keys},
+    {"output", dyn_output_keys},
+    {NULL},
+};
+/* Checks the keys of map (a sub-map of this analysis' section) against those this analysis
+ * declares there: an unknown key names the allowed ones. */
+static PetscErrorCode CheckOwnSection(PeriScene s, PeriNode map, const char section[])
+{
+  const char *names[16];
+  PetscInt    n = 0;
+
+  PetscFunctionBeginUser;
+  for (const PeriSchema *sec = dyn_schema; sec->section; sec++)
+    for (const PeriKey *key = sec->keys; !strcmp(sec->section, section) && key->name && n + 1 < (PetscInt)PETSC_STATIC_ARRAY_LENGTH(names); key++) names[n++] = key->name;
+  names[n] = NULL;
+  PetscCall(PeriSceneCheckKeys(s, map, names));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The loads' amplitude at time t: step (1 from t = 0), ramp (linear to 1 at the rise time), sine. */
@@ -68,13 +119,12 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
   PetscCall(PeriSceneGetReal(s, a, "t_end", PETSC_TRUE, &d->t_end, NULL));
   PetscCall(PeriSceneGetReal(s, a, "dt", (PetscBool)d->implicit, &d->dt, NULL));
   PeriInputCheck(d->dt <= d->t_end, s, a, "dt", "must not exceed t_end = %g, got %g", (double)d->t_end, (double)d->dt);
-  d->energy_tol = 0.01;
   PetscCall(PeriSceneGetReal(s, a, "energy_tolerance", PETSC_FALSE, &d->energy_tol, NULL));
-  d->rho_inf = 1;
   PetscCall(PeriSceneGetReal(s, a, "rho_infinity", PETSC_FALSE, &d->rho_inf, NULL));
   PetscCall(PeriSceneGetMap(s, a, "pulse", PETSC_FALSE, &p));
   if (p) {
     d->pulse = PETSC_TRUE;
+    PetscCall(CheckOwnSection(s, p, "analysis.pulse"));
     PetscCall(PeriSceneGetReal(s, p, "amplitude", PETSC_TRUE, &d->pulse_A, NULL));
     PetscCall(PeriSceneGetReal(s, p, "center", PETSC_TRUE, &d->pulse_x0, NULL));
     PetscCall(PeriSceneGetReal(s, p, "width", PETSC_TRUE, &d->pulse_w, NULL));
@@ -84,6 +134,7 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
   }
   PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
   if (amp) {
+    PetscCall(CheckOwnSection(s, amp, "analysis.amplitude"));
     PetscCall(PeriSceneGetChoice(s, amp, "shape", dyn_amplitudes, &d->shape, NULL));
     PetscCall(PeriSceneGetReal(s, amp, "rise_time", d->shape == 1 ? PETSC_TRUE : PETSC_FALSE, &d->rise, NULL));
     PetscCall(PeriSceneGetReal(s, amp, "period", d->shape == 2 ? PETSC_TRUE : PETSC_FALSE, &d->period, NULL));
@@ -323,28 +374,42 @@ static PetscErrorCode StrainEnergy(PeriAnalysis an, Vec q, PetscReal *E)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Implicit: the step's final residual over its first (the SNES history of this step). */
+static PetscErrorCode WorstResidual(Dynamic *d, SNES snes)
+{
+  PetscReal *a;
+  PetscInt   n;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetConvergenceHistory(snes, &a, NULL, &n));
+  if (n > 1 && a[0] > 0) d->worst = PetscMax(d->worst, a[n - 1] / a[0]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* After each step: the bonds past the criteria break; the energy they held is dissipated. */
 static PetscErrorCode PostStep(TS ts)
 {
   PeriAnalysis an;
   Dynamic     *d;
   Vec          U, q, p;
-  PetscInt     nb;
+  PetscInt     nb = 0;
   PetscReal    before, after;
 
   PetscFunctionBeginUser;
   PetscCall(TSGetApplicationContext(ts, &an));
   d = DYN(an);
-  if (!an->sys->bond_state.failure.active) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(TSGetSolution(ts, &U));
-  PetscCall(GetState(an, U, &q, &p));
-  PetscCall(VecCopy(q, an->sys->fields.u));
-  PetscCall(StrainEnergy(an, q, &before));
-  PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, &nb));
-  if (nb) {
-    PetscCall(StrainEnergy(an, q, &after));
-    d->dissipated += before - after;
-    d->broken += nb;
+  if (an->sys->bond_state.failure.active) {
+    PetscCall(TSGetSolution(ts, &U));
+    PetscCall(GetState(an, U, &q, &p));
+    PetscCall(VecCopy(q, an->sys->fields.u));
+    PetscCall(StrainEnergy(an, q, &before));
+    PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, &nb));
+    if (nb) {
+      PetscCall(StrainEnergy(an, q, &after));
+      d->dissipated += before - after;
+      d->broken += nb;
+    }
+    PetscCall(RestoreState(an, U, &q, &p));
   }
   if (d->implicit) {
     SNES snes;
@@ -353,8 +418,8 @@ static PetscErrorCode PostStep(TS ts)
     PetscCall(TSGetSNES(ts, &snes));
     PetscCall(SNESGetKSP(snes, &ksp));
     PetscCall(KSPSetReusePreconditioner(ksp, nb ? PETSC_FALSE : PETSC_TRUE));
+    PetscCall(WorstResidual(d, snes));
   }
-  PetscCall(RestoreState(an, U, &q, &p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -454,8 +519,10 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   PetscCall(PulsePosition(an, q));
   balance = d->kinetic + d->strain + d->dissipated - d->work;
   if (step == 0) d->E0 = balance;
-  d->scale = PetscMax(d->scale, PetscMax(d->kinetic + d->strain, PetscAbsReal(d->work)));
-  if (d->scale > 0) d->drift = PetscMax(d->drift, PetscAbsReal(balance - d->E0) / d->scale);
+  /* the largest error of the balance over the run, relative to the largest energy of the run */
+  d->scale  = PetscMax(d->scale, PetscMax(d->kinetic + d->strain + d->dissipated, PetscAbsReal(d->work)));
+  d->error  = PetscMax(d->error, PetscAbsReal(balance - d->E0));
+  d->drift  = d->scale > 0 ? d->error / d->scale : 0;
   d->nsteps = step;
   PetscCall(RecordHistory(d, t, balance));
   if (an->every && step % an->every == 0) PetscCall(WriteSnapshot(an, q, t));
@@ -517,6 +584,7 @@ static PetscErrorCode CreateImplicit(PeriAnalysis an, Vec *U, Vec *V)
   /* Newton, not KSPONLY: each step's residual must fall by 1e-8 (a true-residual check) */
   PetscCall(SNESSetType(snes, SNESNEWTONLS));
   PetscCall(SNESSetTolerances(snes, PETSC_DEFAULT, 1e-8, PETSC_DEFAULT, 10, PETSC_DEFAULT));
+  PetscCall(SNESSetConvergenceHistory(snes, NULL, NULL, 16, PETSC_TRUE));
   PetscCall(SNESGetKSP(snes, &ksp));
   /* J follows K and the step's shift; its preconditioner is kept until bonds break (PostStep) */
   PetscCall(KSPSetReusePreconditioner(ksp, PETSC_TRUE));
@@ -584,7 +652,8 @@ static PetscErrorCode RecordSolver(PeriAnalysis an)
     PetscCall(TSGetKSPIterations(d->ts, &d->ksp_its));
   }
   PetscCall(PetscStrncpy(an->sys->fields.solve.converged_reason, an->sys->run.interrupted ? "INTERRUPTED" : "TS_CONVERGED_TIME", sizeof(an->sys->fields.solve.converged_reason)));
-  an->sys->fields.solve.iterations = d->nsteps;
+  an->sys->fields.solve.iterations    = d->nsteps;
+  an->sys->fields.solve.residual_norm = d->worst; /* explicit: no solve, 0 */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -732,41 +801,6 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static const PeriKey dyn_keys[] = {
-    {"integrator", PERI_KEY_CHOICE, "explicit", NULL, NULL, dyn_integrators, "explicit: velocity Verlet on the lumped mass (TSBASICSYMPLECTIC), dt held below 2/omega_max; implicit: generalized-alpha (TSALPHA2), a linear solve per step"},
-    {"t_end", PERI_KEY_REAL, "required", "(0, inf)", "[time]", NULL, "the end time"},
-    {"dt", PERI_KEY_REAL, "0.8 of the explicit limit (explicit); required (implicit)", "(0, inf)", "[time]", NULL, "the time step (-ts_dt overrides it); an explicit dt above the stability limit is an input error"},
-    {"energy_tolerance", PERI_KEY_REAL, "0.01", "(0, inf)", NULL, NULL, "the largest drift of the energy balance (kinetic + strain + dissipated - work of the loads) over the run, relative to the largest energy: above it the run fails"},
-    {"rho_infinity", PERI_KEY_REAL, "1", "[0, 1]", NULL, NULL, "implicit: the spectral radius at infinite frequency (1: no numerical damping, Newmark's average acceleration)"},
-    {"pulse", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement u = amplitude exp(-((x - center)/width)^2) along axis (Ganzenmueller sec. 3.1.2)"},
-    {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
-    {NULL},
-};
-static const PeriKey dyn_pulse_keys[] = {
-    {"amplitude", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "the pulse's peak displacement"},
-    {"center", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "its position along axis"},
-    {"width", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "its width w"},
-    {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the pulse lies and displaces: x, y or z"},
-    {NULL},
-};
-static const PeriKey dyn_amplitude_keys[] = {
-    {"shape", PERI_KEY_CHOICE, "step", NULL, NULL, dyn_amplitudes, "step: 1 from t = 0; ramp: linear from 0 to 1 at rise_time; sine: sin(2 pi t / period)"},
-    {"rise_time", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "ramp: when the loads reach their value"},
-    {"period", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "sine: the period"},
-    {NULL},
-};
-/* output.every, which the snapshots follow (problem.c reads it with output.*) */
-static const PeriKey dyn_output_keys[] = {
-    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k time steps, indexed by particles.pvd with the time (0: only the end)"},
-    {NULL},
-};
-static const PeriSchema dyn_schema[] = {
-    {"analysis", dyn_keys},
-    {"analysis.pulse", dyn_pulse_keys},
-    {"analysis.amplitude", dyn_amplitude_keys},
-    {"output", dyn_output_keys},
-    {NULL},
-};
 static const char *const dyn_files[] = {"history.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", NULL};
 
 /* K is assembled (the Gershgorin bound reads its rows; the implicit step copies it into J). */

@@ -92,7 +92,13 @@ static PetscErrorCode SceneWith(const PeriSchemaOwner *o, const char section[], 
   if (plugin && n == 1 && !strcmp(comps[0], o->kind)) snprintf(leaf, sizeof(leaf), "type: %s%s", o->name, value ? ", " : "");
   if (value) snprintf(leaf + strlen(leaf), sizeof(leaf) - strlen(leaf), "%s: %s", key, value);
   Mapping(comps, n, 0, leaf, text, sizeof(text));
-  if (plugin && (n != 1 || strcmp(comps[0], o->kind))) {
+  if (plugin && n > 1 && !strcmp(comps[0], o->kind)) {
+    /* a sub-section of the plug-in's own section (analysis.pulse): the type goes beside it */
+    char        more[2100];
+    const char *inner = strchr(text + 1, '{');
+    snprintf(more, sizeof(more), "%.*s{type: %s, %s", (int)(inner - text), text, o->name, inner + 1);
+    PetscCall(PetscStrncpy(text, more, sizeof(text)));
+  } else if (plugin && (n != 1 || strcmp(comps[0], o->kind))) {
     char   more[2100];
     size_t inner = strlen(text) - 2; /* text without its braces */
     snprintf(more, sizeof(more), "{%s: {type: %s}%s%.*s}", o->kind, o->name, inner ? ", " : "", (int)inner, text + 1);
@@ -127,7 +133,7 @@ static PetscErrorCode CheckDefault(PeriScene s, PeriNode map, const PeriKey *k, 
   switch (k->type) {
   case PERI_KEY_REAL:
     PetscCall(PeriSceneGetReal(s, map, name, PETSC_FALSE, &x, &found));
-    if (given) Number(k->deflt, strlen(k->deflt), &want);
+    if (given && !Number(k->deflt, strlen(k->deflt), &want)) want = SENTINEL; /* a default in words documents the reader's rule */
     PetscCheck(x == want, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%s: read %g from an empty section, the declared default is '%s'", where, (double)x, k->deflt ? k->deflt : "none");
     *napplied += x != SENTINEL;
     break;

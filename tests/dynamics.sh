@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# The dynamic analysis (issue 26), asserted against theory, the paper and independent runs:
+#  1. Ganzenmueller sec. 3.1.2 (examples/dynamics/pulse.yaml): the pulse's speed, fitted to its
+#     position over t = 50..94, against c = sqrt((K + 4G/3)/rho) = 1.3416 (nu = 1/4): npmb within
+#     1 % (the paper: < 1 %); pmb too fast by 10-17 % (the paper: +13 %).
+#  2. The same speeds from the modal analysis (longitudinal_speed = 2 L f of the free bar): within
+#     1 % of the pulse's, for both models.
+#  3. Energy: the explicit run's balance within 1e-3, the implicit (average acceleration) within
+#     1e-10; the implicit pulse at dt 0.4 where the explicit one at dt 0.1 is, within 1 %.
+#  4. An explicit dt above the stability limit is an input error naming the limit, before any step.
+#  5. Failure (tests/scenes/dynamic_crack.yaml): bonds break, the dissipated energy closes the
+#     balance (drift < 1 %), and 1, 2 and 3 ranks break the same bonds with the same energies
+#     (1e-10 relative); the implicit integrator on 1 and 2 ranks alike.
+# Usage: dynamics.sh PERILIN REPO
+set -u
+exe=${1:?usage: dynamics.sh PERILIN REPO}
+repo=${2:?usage: dynamics.sh PERILIN REPO}
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+pulse=$repo/examples/dynamics/pulse.yaml
+crack=$repo/tests/scenes/dynamic_crack.yaml
+fail=0
+run() { # name, args...: runs perilin into $tmp/name, quietly
+  local name=$1
+  shift
+  "$@" -output_dir "$tmp/$name" > "$tmp/$name.log" 2>&1 < /dev/null || { echo "FAIL: $name exited $?"; tail -3 "$tmp/$name.log"; fail=1; }
+}
+run npmb "$exe" "$pulse"
+run pmb "$exe" "$pulse" -model_type pmb
+run implicit "$exe" "$pulse" -analysis_integrator implicit -analysis_dt 0.4 -analysis_t_end 40
+run explicit40 "$exe" "$pulse" -analysis_t_end 40
+for m in npmb pmb; do
+  run modal_$m "$exe" "$repo/examples/pmb/bar_modes.yaml" -model_type $m -grid_upper 500,4,4
+done
+run crack1 "$exe" "$crack"
+for n in 2 3; do run crack$n mpiexec --oversubscribe -n $n "$exe" "$crack"; done
+run icrack1 "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012
+run icrack2 mpiexec --oversubscribe -n 2 "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012
+# 4. the refusal: exit 1, the limit named, no output
+"$exe" "$pulse" -analysis_dt 1 -output_dir "$tmp/refused" > "$tmp/refused.log" 2>&1 < /dev/null
+code=$?
+if [ $code -ne 0 ] && grep -q "above the explicit stability limit 2/omega_max = 0.85" "$tmp/refused.log" && [ ! -e "$tmp/refused" ]; then
+  echo "ok: dt 1 refused: $(grep -o 'above the explicit stability limit[^:]*' "$tmp/refused.log")"
+else
+  echo "FAIL: dt 1 (above the limit) was not refused as expected (exit $code)"; tail -2 "$tmp/refused.log"; fail=1
+fi
+[ $fail = 0 ] || exit 1
+python3 - "$tmp" << 'PY' || fail=1
+import csv, json, math, sys
+tmp = sys.argv[1]
+bad = 0
+def check(ok, what):
+    global bad
+    print(("ok: " if ok else "FAIL: ") + what)
+    bad |= not ok
+def history(name):
+    return [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open(f"{tmp}/{name}/history.csv"))]
+def speed(name):
+    pts = [(r["time"], r["pulse_position"]) for r in history(name) if 50 <= r["time"] <= 94 + 1e-9]
+    n = len(pts); sx = sum(p[0] for p in pts); sy = sum(p[1] for p in pts)
+    sxx = sum(p[0] ** 2 for p in pts); sxy = sum(p[0] * p[1] for p in pts)
+    return (n * sxy - sx * sy) / (n * sxx - sx * sx)
+def dyn(name):
+    return json.load(open(f"{tmp}/{name}/summary.json"))["dynamic"]
+c = math.sqrt((1 + 4 * 0.6 / 3) / 1)
+s_n, s_p = speed("npmb"), speed("pmb")
+check(abs(s_n / c - 1) < 0.01, f"npmb pulse speed {s_n:.4f} within 1 % of sqrt((K+4G/3)/rho) = {c:.4f} ({100*(s_n/c-1):+.2f} %; paper: < 1 %)")
+check(0.10 < s_p / c - 1 < 0.17, f"pmb pulse speed {s_p:.4f} too fast by {100*(s_p/c-1):+.1f} % (paper: +13 %)")
+for m, s in (("npmb", s_n), ("pmb", s_p)):
+    v = json.load(open(f"{tmp}/modal_{m}/summary.json"))["modal"]["longitudinal_speed"]
+    check(abs(s / v - 1) < 0.01, f"{m}: pulse speed {s:.4f} within 1 % of the modal analysis' 2 L f = {v:.4f} ({100*(s/v-1):+.2f} %)")
+check(dyn("npmb")["energy_drift"] < 1e-3, f"explicit energy drift {dyn('npmb')['energy_drift']:.2g} < 1e-3")
+check(dyn("implicit")["energy_drift"] < 1e-10, f"implicit (average acceleration) energy drift {dyn('implicit')['energy_drift']:.2g} < 1e-10")
+pi, pe = history("implicit")[-1]["pulse_position"], history("explicit40")[-1]["pulse_position"]
+check(abs(pi - pe) < 0.01 * pe, f"pulse at t = 40: implicit (dt 0.4) {pi:.3f}, explicit (dt 0.1) {pe:.3f}")
+d = [dyn(f"crack{n}") for n in (1, 2, 3)]
+check(d[0]["broken_bonds"] > 100 and d[0]["dissipated_energy"] > 0, f"the crack runs: {d[0]['broken_bonds']} bonds broken, {d[0]['dissipated_energy']:.4g} dissipated")
+check(d[0]["energy_drift"] < 0.01, f"with failure the balance closes: drift {d[0]['energy_drift']:.2g} < 0.01")
+for n in (2, 3):
+    same = d[n - 1]["broken_bonds"] == d[0]["broken_bonds"] and all(abs(d[n - 1][k] - d[0][k]) <= 1e-10 * abs(d[0][k]) for k in ("kinetic_energy", "strain_energy", "dissipated_energy"))
+    check(same, f"explicit with failure, {n} ranks = 1 rank: {d[n-1]['broken_bonds']} bonds, kinetic {d[n-1]['kinetic_energy']:.12g}")
+i1, i2 = dyn("icrack1"), dyn("icrack2")
+same = i1["broken_bonds"] == i2["broken_bonds"] > 0 and abs(i1["kinetic_energy"] / i2["kinetic_energy"] - 1) < 1e-8
+check(same, f"implicit with failure, 2 ranks = 1 rank: {i2['broken_bonds']} bonds, kinetic {i2['kinetic_energy']:.10g} vs {i1['kinetic_energy']:.10g}")
+sys.exit(bad)
+PY
+exit $fail
