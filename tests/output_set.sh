@@ -23,7 +23,9 @@ assert q["broken_bonds"] == int(rows[-1]["broken_total"]), (q["broken_bonds"], r
 assert abs(q["peak_load_factor"] - float(rows[-1]["load_factor"])) <= 1e-9 * q["peak_load_factor"]
 assert q["steps"] == len(rows)
 # the control probe in summary.json is steps.csv's last control_u
-u = s["probes"][q["control_probe"]]["u"][0]
+# (along the control component: uy, the direction of the load)
+assert q["control_component"] == "uy", q["control_component"]
+u = s["probes"][q["control_probe"]]["u"][["ux", "uy"].index(q["control_component"])]
 assert abs(u - float(rows[-1]["control_u"])) <= 1e-9 * abs(u), (u, rows[-1]["control_u"])
 if q["failed"]:
     assert q["failure_step"] == len(rows) + 1
