@@ -3,15 +3,80 @@
 
     python3 docs/tools/plot_load_displacement.py OUTDIR [-o PNG]
 
-Reads OUTDIR/steps.csv (columns control_u and reaction: the control probe's displacement along
-analysis.control_component, and the reaction of analysis.reaction_region along it) and the names
-from OUTDIR/summary.json, and writes OUTDIR/load_displacement.png (or PNG). Needs matplotlib
-(Debian: python3-matplotlib); perilin itself never calls this script."""
+Reads OUTDIR/steps.csv (control_u: the control probe's displacement along
+analysis.control_component; the force: applied_load under load control, lambda times the applied
+load along that component, or reaction under displacement control, the reaction of
+analysis.reaction_region along it) and the names from OUTDIR/summary.json (quasistatic.force_column
+says which), and writes OUTDIR/load_displacement.png (or PNG). The axes are in the scene's own
+consistent units (perilin has no unit system). Needs matplotlib (Debian: python3-matplotlib);
+perilin itself never calls this script."""
 import argparse
 import csv
 import json
 import os
 import sys
+
+ME = "plot_load_displacement.py"
+
+
+def fail(msg):
+    sys.exit("%s: %s" % (ME, msg))
+
+
+def read_run(outdir):
+    """summary.json's quasistatic object and steps.csv's rows, or a clear message."""
+    summary = os.path.join(outdir, "summary.json")
+    if not os.path.isfile(summary):
+        fail("%s has no summary.json: give the output directory of a perilin run" % outdir)
+    try:
+        s = json.load(open(summary))
+    except ValueError as e:
+        fail("%s is not valid JSON (%s)" % (summary, e))
+    qs = s.get("quasistatic")
+    if qs is None:
+        kind = s.get("analysis", {}).get("type") if isinstance(s.get("analysis"), dict) else s.get("analysis")
+        fail("%s is the output of a %s run, not a quasi-static one: it has no load steps to plot "
+             "(analysis.type: quasistatic writes steps.csv)" % (outdir, kind or "static"))
+    path = os.path.join(outdir, "steps.csv")
+    if not os.path.isfile(path):
+        fail("%s has no steps.csv: the run stopped before its first load step" % outdir)
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    if not rows:
+        fail("%s has no load step (no equilibrium was reached)" % path)
+    return qs, rows
+
+
+def force_column(qs, rows):
+    """The column of the force and its axis label."""
+    col = qs.get("force_column") or ("reaction" if "reaction" in rows[0] else
+                                     "applied_load" if "applied_load" in rows[0] else None)
+    if not col or col not in rows[0]:
+        fail("steps.csv has no force column: a displacement-controlled run without a bc region "
+             "holding the control component has no reaction (analysis.reaction_region; docs/reactions.md)")
+    comp = qs.get("control_component", "u")
+    if col == "reaction":
+        label = "reaction of region %s along %s [force, scene units]" % (qs.get("reaction_region", "?"), comp)
+    else:
+        label = "applied load along %s, lambda x %.6g [force, scene units]" % (
+            comp, qs.get("applied_load_per_load_factor", float("nan")))
+    return col, label
+
+
+def title(qs, F):
+    """What happened, from the summary's facts (not a claim the curve contradicts)."""
+    control = qs.get("control", "")
+    head = "%s control" % control if control else "load-displacement"
+    broken = qs.get("broken_bonds", 0)
+    if qs.get("failed"):
+        what = "failed at load factor %.6g (last equilibrium %.6g)" % (qs["critical_load_factor"],
+                                                                       qs.get("peak_load_factor", float("nan")))
+    elif not qs.get("complete", True):
+        what = "interrupted at load factor %.6g" % qs.get("peak_load_factor", float("nan"))
+    else:
+        what = "reached load factor %.6g" % qs.get("peak_load_factor", float("nan"))
+    peak = max(F, key=abs)
+    return "%s: %s; %d bonds broken; peak force %.4g" % (head, what, broken, peak)
 
 
 def main():
@@ -19,32 +84,29 @@ def main():
     ap.add_argument("outdir", help="a quasi-static run's output directory")
     ap.add_argument("-o", "--output", help="the image (default OUTDIR/load_displacement.png)")
     args = ap.parse_args()
+    qs, rows = read_run(args.outdir)
+    col, ylabel = force_column(qs, rows)
     try:
         import matplotlib
         matplotlib.use("Agg")  # no display needed
         import matplotlib.pyplot as plt
     except ImportError:
-        sys.exit("plot_load_displacement.py: matplotlib is not installed (Debian: apt-get install python3-matplotlib)")
-    with open(os.path.join(args.outdir, "steps.csv"), newline="") as f:
-        rows = list(csv.DictReader(f))
-    if not rows or "reaction" not in rows[0]:
-        sys.exit("plot_load_displacement.py: %s/steps.csv has no reaction column: the run has no reaction region "
-                 "(analysis.reaction_region; docs/reactions.md)" % args.outdir)
-    qs = json.load(open(os.path.join(args.outdir, "summary.json"))).get("quasistatic", {})
+        fail("matplotlib is not installed (Debian: apt-get install python3-matplotlib)")
     u = [0.0] + [float(r["control_u"]) for r in rows]  # the unloaded state first
-    F = [0.0] + [float(r["reaction"]) for r in rows]
+    F = [0.0] + [float(r[col]) for r in rows]
     comp = qs.get("control_component", "u")
-    fig, ax = plt.subplots(figsize=(6, 4.5))
+    fig, ax = plt.subplots(figsize=(6.4, 4.8))
     ax.plot(u, F, "o-", ms=3)
-    ax.set_xlabel("%s of probe %s" % (comp, qs.get("control_probe", "?")))
-    ax.set_ylabel("reaction of %s along %s" % (qs.get("reaction_region", "?"), comp))
-    ax.set_title("load-displacement (%s)" % ("failed at load factor %g" % qs["critical_load_factor"]
-                                              if qs.get("failed") else qs.get("ending", "")), fontsize=9)
+    probe = qs.get("control_probe")
+    ax.set_xlabel("%s of probe %s [length, scene units]" % (comp, probe) if probe else
+                  "%s (no probe: 0) [length, scene units]" % comp)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title(qs, F), fontsize=9)
     ax.grid(True, alpha=0.3)
     out = args.output or os.path.join(args.outdir, "load_displacement.png")
     fig.tight_layout()
-    fig.savefig(out, dpi=120)
-    print("wrote %s (%d steps)" % (out, len(rows)))
+    fig.savefig(out, dpi=100)
+    print("wrote %s (%d steps, force: %s)" % (out, len(rows), col))
 
 
 if __name__ == "__main__":

@@ -25,14 +25,23 @@ typedef struct {
   PetscInt   max_iterations;
   PeriProbe *control;
   PetscInt   component, reaction; /* the control probe's component; the reaction region (index of disc.regions) or -1 */
+  PetscBool  displacement;        /* displacement control: a bc item or layer prescribes a nonzero value */
+  PetscBool  runaway_given;       /* analysis.runaway_fraction given (else by the control type) */
+  PetscReal  load;                /* load control: the applied load along the component at load factor 1 */
+  char       chosen[96];          /* why the component is what it is, for the run log */
   /* the names the scene gives, resolved against the system by SetUp_Quasistatic ("": not given) */
   char control_probe[PERI_NAME_LEN], control_component[PERI_NAME_LEN], reaction_region[PERI_NAME_LEN];
 } Settings;
 
-/* The analysis' data: its results, then its settings (QS(an) reads the results). */
+/* At most this many snapshots by default (output.every 0): the equilibria where bonds broke */
+#define PERI_AUTO_SNAPSHOTS 50
+
+/* The analysis' data: its results, its settings (QS(an) reads the results), and the steps whose
+ * snapshots particles_NNNN.vtu were written (particles.pvd's frames). */
 typedef struct {
   PeriQuasistatic q;
   Settings        st;
+  PetscInt        nsnaps, capsnaps, *snaps;
 } QSData;
 
 static inline PeriQuasistatic *QS(PeriAnalysis an)
@@ -74,20 +83,105 @@ static PetscInt DefaultReactionRegion(PeriSystem sys, PetscInt c)
   return -1;
 }
 
+/* What drives the run, per component at load factor 1: the largest |prescribed value| (bc items
+ * and displacement layers), the loads' sum, sum of magnitudes and sum of positive parts, and the
+ * force of the most loaded shear-stress layer on its face (0 without one). */
+typedef struct {
+  PetscReal value[PERI_MAX_DOF], load[3][PERI_MAX_DOF]; /* load: sum, |.| sum, positive sum */
+  PetscReal layer;
+} Drive;
+
+/* The drive of the system's conditions (sys->fields.f: the loads at load factor 1). Collective. */
+static PetscErrorCode DriveOf(PeriSystem sys, Drive *d)
+{
+  const PetscInt     bs = sys->model->dofs;
+  const PeriLayers  *L  = &sys->conditions.layers;
+  const PetscReal   *lo = sys->disc.particles.lower, *hi = sys->disc.particles.upper;
+  const PetscScalar *f;
+  PetscInt           n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(d, sizeof(*d)));
+  for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) {
+    PetscInt c  = sys->conditions.constrained[k] % bs;
+    d->value[c] = PetscMax(d->value[c], PetscAbsReal(sys->conditions.constrained_value[k]));
+  }
+  PetscCall(VecGetLocalSize(sys->fields.f, &n));
+  PetscCall(VecGetArrayRead(sys->fields.f, &f));
+  for (PetscInt k = 0; k < n; k++) {
+    PetscReal F = PetscRealPart(f[k]);
+    d->load[0][k % bs] += F;
+    d->load[1][k % bs] += PetscAbsReal(F);
+    d->load[2][k % bs] += PetscMax(F, 0);
+  }
+  PetscCall(VecRestoreArrayRead(sys->fields.f, &f));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, d->value, PERI_MAX_DOF, MPIU_REAL, MPI_MAX, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, d->load, 3 * PERI_MAX_DOF, MPIU_REAL, MPI_SUM, sys->comm));
+  /* fictitious layers: antiplane, 2D, one component (uz) */
+  for (PetscInt face = 0; face < 6; face++) {
+    PetscInt  a = face / 2;
+    PetscReal F = L->value[face] * (hi[1 - a] - lo[1 - a]) * sys->materials.thickness;
+    if (L->kind[face] == PERI_LAYER_DISPLACEMENT) d->value[0] = PetscMax(d->value[0], PetscAbsReal(L->value[face]));
+    if (L->kind[face] == PERI_LAYER_SHEAR_STRESS && a < 2 && PetscAbsReal(F) > PetscAbsReal(d->layer)) d->layer = F;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The control type and the default control component: displacement control when a nonzero value
+ * is prescribed (the component of the largest), else load control (the component of the largest
+ * load, by the sum of magnitudes: a body pulled at both ends has a zero total). */
+static PetscErrorCode ChooseComponent(const Drive *d, PetscInt dofs, Settings *st)
+{
+  PetscInt cv = 0, cf = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = 1; c < dofs; c++) {
+    if (d->value[c] > d->value[cv]) cv = c;
+    if (d->load[1][c] > d->load[1][cf]) cf = c;
+  }
+  st->displacement = (PetscBool)(d->value[cv] > 0);
+  st->component    = st->displacement ? cv : cf;
+  if (st->displacement)
+    PetscCall(PetscStrncpy(st->chosen, "the component of the largest prescribed value", sizeof(st->chosen)));
+  else if (d->load[1][cf] > 0)
+    PetscCall(PetscStrncpy(st->chosen, "the direction of the largest applied load", sizeof(st->chosen)));
+  else if (d->layer != 0)
+    PetscCall(PetscStrncpy(st->chosen, "the layers' shear stress", sizeof(st->chosen)));
+  else
+    PetscCall(PetscStrncpy(st->chosen, "the model's first component", sizeof(st->chosen)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The applied load along c at load factor 1 (load control's force): the total of the loads; for
+ * loads that balance along c (a body pulled at both ends) the total of those along +c, the force
+ * that goes through the body; without loads, a shear-stress layer's force on its face. */
+static PetscReal LoadAlong(const Drive *d, PetscInt c)
+{
+  if (d->load[1][c] == 0) return d->layer;
+  if (PetscAbsReal(d->load[0][c]) > 1e-9 * d->load[1][c]) return d->load[0][c];
+  return d->load[2][c];
+}
+
 /* analysis.control_component and analysis.reaction_region: the displacement and the force of
- * steps.csv's load-displacement columns. */
+ * steps.csv's load-displacement columns; and the control type, which sets the default
+ * runaway_fraction. */
 static PetscErrorCode ReadLoadDisplacement(PeriAnalysis an, PeriNode a, Settings *st)
 {
   PeriScene   s         = an->sys->scene;
   PeriModel   m         = an->sys->model;
   const char *name      = st->reaction_region;
   char        list[128] = "";
+  Drive       d;
 
   PetscFunctionBeginUser;
   for (PetscInt c = 0; c < m->dofs; c++) PeriListAppend(list, sizeof(list), m->components[c]);
-  st->component = 0;
+  PetscCall(DriveOf(an->sys, &d));
+  PetscCall(ChooseComponent(&d, m->dofs, st));
   if (st->control_component[0]) PetscCall(PeriModelComponentIndex(m, st->control_component, &st->component));
+  if (st->control_component[0]) PetscCall(PetscStrncpy(st->chosen, "analysis.control_component", sizeof(st->chosen)));
   PeriInputCheck(st->component >= 0, s, a, "control_component", "'%s' is not a component of model %s; its components are: %s", st->control_component, m->type, list);
+  st->load = LoadAlong(&d, st->component);
+  if (!st->runaway_given) st->runaway = st->displacement ? 1 : 0.01;
   st->reaction = DefaultReactionRegion(an->sys, st->component);
   if (!name[0]) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriReactionsFindRegion(an->sys, name, &st->reaction));
@@ -133,7 +227,7 @@ static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, Per
   st->all = policy == 0 ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(PeriSceneGetReal(s, a, "break_fraction", PETSC_FALSE, &st->fraction, &has));
   PeriInputCheck(!has || !st->all, s, a, "break_fraction", "applies to break: fraction only");
-  PetscCall(PeriSceneGetReal(s, a, "runaway_fraction", PETSC_FALSE, &st->runaway, NULL));
+  PetscCall(PeriSceneGetReal(s, a, "runaway_fraction", PETSC_FALSE, &st->runaway, &st->runaway_given)); /* else by the control type (SetUp) */
   PetscCall(PeriSceneGetInt(s, a, "max_iterations", PETSC_FALSE, &st->max_iterations, NULL));
   PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));
   PetscCall(PeriSceneGetString(s, a, "control_probe", PETSC_FALSE, st->control_probe, sizeof(st->control_probe), NULL));
@@ -241,13 +335,57 @@ static PetscErrorCode WriteState(PeriAnalysis an, const char name[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* particles_NNNN of the step just accepted, recorded as a frame of particles.pvd. */
 static PetscErrorCode WriteSnapshot(PeriAnalysis an)
 {
-  char name[64];
+  QSData *data = (QSData *)an->data;
+  char    name[64];
 
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT, QS(an)->nsteps));
   PetscCall(WriteState(an, name));
+  if (data->nsnaps == data->capsnaps) {
+    PetscInt *n;
+    data->capsnaps = PetscMax(64, 2 * data->capsnaps);
+    PetscCall(PetscMalloc1(data->capsnaps, &n));
+    if (data->nsnaps) PetscCall(PetscArraycpy(n, data->snaps, data->nsnaps));
+    PetscCall(PetscFree(data->snaps));
+    data->snaps = n;
+  }
+  data->snaps[data->nsnaps++] = QS(an)->nsteps;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether the step just accepted (s) gets a snapshot: every output.every steps, or by default
+ * (output.every 0) each step where bonds broke, the first PERI_AUTO_SNAPSHOTS of them. */
+static PetscBool SnapshotDue(PeriAnalysis an, const PeriStep *s)
+{
+  if (!an->vtk) return PETSC_FALSE;
+  if (an->every) return (PetscBool)(QS(an)->nsteps % an->every == 0);
+  return (PetscBool)(s->broken > 0 && ((QSData *)an->data)->nsnaps < PERI_AUTO_SNAPSHOTS);
+}
+
+/* The load-displacement columns and the control type's default, as chosen. */
+static PetscErrorCode PrintControl(PeriAnalysis an, const Settings *st)
+{
+  const char *comp = an->sys->model->components[st->component], *why;
+  char        force[160];
+
+  PetscFunctionBeginUser;
+  if (!st->displacement)
+    PetscCall(PetscSNPrintf(force, sizeof(force), "applied_load = lambda x %g along %s", (double)st->load, comp));
+  else if (st->reaction >= 0)
+    PetscCall(PetscSNPrintf(force, sizeof(force), "reaction = the reaction of region %s along %s", an->sys->disc.regions[st->reaction].name, comp));
+  else
+    PetscCall(PetscSNPrintf(force, sizeof(force), "none (no bc region holds %s: no reaction)", comp));
+  PetscCall(PetscPrintf(an->comm, "perilin: %s control: control_u is %s of probe %s (%s); force column %s\n", st->displacement ? "displacement" : "load", comp, st->control ? st->control->name : "(none: 0)", st->chosen, force));
+  if (st->runaway_given)
+    why = "analysis.runaway_fraction";
+  else if (st->displacement)
+    why = "the default of displacement control: the run follows the softening branch past a load drop";
+  else
+    why = "the default of load control: a crack that runs away at one load is the failure";
+  PetscCall(PetscPrintf(an->comm, "perilin: runaway_fraction %g (%s)\n", (double)st->runaway, why));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -259,6 +397,7 @@ static PetscErrorCode PrintCriteria(PeriAnalysis an, const Settings *st)
     PetscCall(PetscPrintf(an->comm, "perilin: quasistatic to lambda %g from bond break to bond break (events, %s breaking)\n", (double)st->max, st->all ? "all-violators" : "most-critical-fraction"));
   else
     PetscCall(PetscPrintf(an->comm, "perilin: quasistatic to lambda %g in steps of %g (%s, %s breaking)\n", (double)st->max, (double)st->step, st->adaptive ? "adaptive" : "fixed", st->all ? "all-violators" : "most-critical-fraction"));
+  PetscCall(PrintControl(an, st));
   PetscCall(PetscPrintf(an->comm, "perilin: failure:"));
   PetscCall(PeriFailureView(&an->sys->bond_state.failure, an->sys->model, an->comm));
   PetscCall(PetscPrintf(an->comm, " (formulas: docs/failure.md)\n"));
@@ -419,12 +558,15 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint
   q->broken_bonds     = s->broken_total;
   PetscCall(PeriCheckpointSave(an->sys, eq));
   PetscCall(Progress(an, st, s));
-  if (an->every && q->nsteps % an->every == 0 && an->vtk) PetscCall(WriteSnapshot(an));
+  if (SnapshotDue(an, s)) PetscCall(WriteSnapshot(an));
   /* many breaks: smaller steps; none: back towards the scene's step */
   if (st->adaptive) *dl = s->broken > nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : s->broken ? *dl
                                                                                                    : PetscMin(2 * *dl, st->step);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* said (log and summary) when the body failed before any bond broke in an equilibrium */
+#define PERI_INTACT_NOTE "no bond broke before the last equilibrium: particles.vtu shows the body before the crack grew (the scene's cracks only); failed_trial.vtu shows where it went"
 
 static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
 {
@@ -434,6 +576,8 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   q->complete = an->sys->run.interrupted ? PETSC_FALSE : PETSC_TRUE;
   if (an->sys->run.interrupted)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", an->sys->run.interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  else if (!q->failed && q->broken_bonds)
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g, %" PetscInt_FMT " bonds broken on the way (an equilibrium at every step)", (double)st->max, q->broken_bonds));
   else if (!q->failed)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st->max));
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
@@ -442,6 +586,7 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(an->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
   if (q->failed) PetscCall(PetscPrintf(an->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
+  if (q->failed && !q->broken_bonds) PetscCall(PetscPrintf(an->comm, "perilin: note: %s\n", PERI_INTACT_NOTE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -620,8 +765,16 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* steps.csv's reaction columns: the load-displacement force, the relative imbalance, then
- * R_<region>_<component> for every component a bc item holds on a region; step k's values, or
+/* The steps.csv column of the load-displacement curve's force: applied_load (load control), the
+ * reaction region's reaction (displacement control), or NULL (displacement control without one). */
+static const char *ForceColumn(PeriAnalysis an)
+{
+  if (!ST(an)->displacement) return "applied_load";
+  return QS(an)->reaction_region >= 0 ? "reaction" : NULL;
+}
+
+/* steps.csv's force columns: the reaction region's reaction, the applied load (load control), the
+ * relative imbalance, then R_<region>_<component> for every component a bc item holds on a region; step k's values, or
  * the header when k < 0. Returns nonzero when a write failed. */
 static int ReactionColumns(PeriAnalysis an, FILE *fp, PetscInt k)
 {
@@ -630,6 +783,7 @@ static int ReactionColumns(PeriAnalysis an, FILE *fp, PetscInt k)
   int                    bad = 0;
 
   if (q->reaction_region >= 0) bad |= (k < 0 ? fprintf(fp, ",reaction") : fprintf(fp, ",%.10g", (double)q->steps[k].reaction)) < 0;
+  if (!ST(an)->displacement) bad |= (k < 0 ? fprintf(fp, ",applied_load") : fprintf(fp, ",%.10g", (double)(q->steps[k].lambda * ST(an)->load))) < 0;
   bad |= (k < 0 ? fprintf(fp, ",relative_imbalance") : fprintf(fp, ",%.3g", (double)q->steps[k].imbalance)) < 0;
   for (PetscInt r = 0; r < R->nregions; r++)
     for (PetscInt c = 0; c < an->sys->model->dofs; c++) {
@@ -669,29 +823,30 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
 
 /*@C
   WriteSnapshotsPVD - particles.pvd: the snapshots particles_NNNN.vtu of the accepted steps
-  (output.every) with the load factor as the time, and, when the last equilibrium is not one of
-  them, particles.vtu (which describes it) as the last frame, so that the series ends where the
-  run did (on several ranks the frames are the .pvtu indexes). failed_trial.vtu is no equilibrium
-  and stays out. Rank 0 writes. Collective.
+  (output.every, or by default those where bonds broke) with the load factor as the time, and,
+  when the last equilibrium is not one of them, particles.vtu (which describes it) as the last
+  frame, so that the series ends where the run did (on several ranks the frames are the .pvtu
+  indexes). failed_trial.vtu is no equilibrium and stays out. Rank 0 writes. Collective.
 @*/
 static PetscErrorCode WriteSnapshotsPVD(PeriAnalysis an, const char path[])
 {
-  PeriQuasistatic *q = QS(an);
+  PeriQuasistatic *q    = QS(an);
+  QSData          *data = (QSData *)an->data;
   PetscReal       *times;
   char           **files;
   PetscInt         n = 0;
   char             base[32];
 
   PetscFunctionBeginUser;
-  if (an->rank || !q->started || !an->every || !an->vtk || q->nsteps < 1) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc2(q->nsteps + 1, &times, q->nsteps + 1, &files));
-  for (PetscInt k = an->every; k <= q->nsteps; k += an->every) {
-    times[n] = q->steps[k - 1].lambda;
-    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, k));
+  if (an->rank || !q->started || !an->vtk || q->nsteps < 1) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc2(data->nsnaps + 1, &times, data->nsnaps + 1, &files));
+  for (PetscInt k = 0; k < data->nsnaps; k++) {
+    times[n] = q->steps[data->snaps[k] - 1].lambda;
+    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, data->snaps[k]));
     PetscCall(PetscMalloc1(40, &files[n]));
     PetscCall(PeriParticlesFileName(an->comm, base, files[n++], 40));
   }
-  if (q->nsteps % an->every) {
+  if (!data->nsnaps || data->snaps[data->nsnaps - 1] != q->nsteps) {
     times[n] = q->steps[q->nsteps - 1].lambda;
     PetscCall(PetscMalloc1(40, &files[n]));
     PetscCall(PeriParticlesFileName(an->comm, "particles", files[n++], 40));
@@ -729,6 +884,11 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
   if (q->control[0]) PetscCall(PeriJSONString(j, "control_probe", q->control));
   PetscCall(PeriJSONString(j, "control_component", an->sys->model->components[q->control_component]));
   if (q->reaction_region >= 0) PetscCall(PeriJSONString(j, "reaction_region", an->sys->disc.regions[q->reaction_region].name));
+  PetscCall(PeriJSONString(j, "control", ST(an)->displacement ? "displacement" : "load"));
+  if (ForceColumn(an)) PetscCall(PeriJSONString(j, "force_column", ForceColumn(an)));
+  if (!ST(an)->displacement) PetscCall(PeriJSONReal(j, "applied_load_per_load_factor", ST(an)->load));
+  PetscCall(PeriJSONReal(j, "runaway_fraction", ST(an)->runaway));
+  if (q->failed && !q->broken_bonds) PetscCall(PeriJSONString(j, "note", PERI_INTACT_NOTE));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -752,6 +912,7 @@ static PetscErrorCode QSDestroy(PeriAnalysis an)
   PetscFunctionBeginUser;
   PetscCall(PetscFree2(QS(an)->steps, QS(an)->reactions));
   PetscCall(PetscFree(QS(an)->trial_damage));
+  PetscCall(PetscFree(((QSData *)an->data)->snaps));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -767,14 +928,14 @@ static const PeriKey qs_keys[] = {
     {"max_iterations", PERI_KEY_INT, "100", "[1, inf)", NULL, NULL, "equilibrium iterations per step"},
     {"reuse_preconditioner", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "keep the preconditioner while few bonds changed"},
     {"control_probe", PERI_KEY_STRING, "the first probe", NULL, NULL, NULL, "the probe whose displacement steps.csv reports (control_u)"},
-    {"control_component", PERI_KEY_STRING, "the first component (ux)", NULL, NULL, NULL, "the component of the control probe's displacement in steps.csv's control_u (ux, uy, uz, theta: the model's)"},
-    {"reaction_region", PERI_KEY_STRING, "the first bc region with a nonzero value, else the first holding the component", NULL, NULL, NULL, "the bc region whose reaction along control_component steps.csv reports (reaction): the force of the load-displacement curve"},
-    {"runaway_fraction", PERI_KEY_REAL, "0.01", "(0, 1]", NULL, NULL, "more bonds than this share breaking at one load is a runaway: adaptive increments retry with a smaller step, events declare the failure"},
+    {"control_component", PERI_KEY_STRING, "the direction of the load: of the largest prescribed value (displacement control), else of the largest load", NULL, NULL, NULL, "the component of the control probe's displacement in steps.csv's control_u and of the force (ux, uy, uz, theta: the model's)"},
+    {"reaction_region", PERI_KEY_STRING, "the first bc region with a nonzero value, else the first holding the component", NULL, NULL, NULL, "the bc region whose reaction along control_component steps.csv reports (reaction): the force of a displacement-controlled load-displacement curve (load control: applied_load)"},
+    {"runaway_fraction", PERI_KEY_REAL, "1 (displacement control), 0.01 (load control)", "(0, 1]", NULL, NULL, "more bonds than this share breaking at one load is a runaway: adaptive increments retry with a smaller step, events declare the failure; 1 follows the softening branch past a load drop"},
     {NULL},
 };
 /* output.every, which the run's snapshots follow (problem.c reads it with output.*) */
 static const PeriKey qs_output_keys[] = {
-    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k equilibrium steps (0: only the end)"},
+    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k equilibrium steps (0: at each equilibrium where bonds broke, at most 50); particles.pvd lists them and particles.vtu"},
     {NULL},
 };
 static const PeriSchema qs_schema[] = {{"analysis", qs_keys}, {"output", qs_output_keys}, {NULL}};
