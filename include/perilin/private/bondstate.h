@@ -51,6 +51,11 @@ struct _PeriCriterionType {
   PeriKey         softening_keys[2]; /* its key of softening, listed after every criterion's keys; value[] continues with it */
   PeriMeasureKind measures[2];       /* the kinds of measure[] that failure.c looks up (nmeasures of them) */
   PetscInt        nmeasures;
+  /* for a bound on one measure's magnitude, |measure[0]| <= value[0], served by the shared ops of
+     src/system/criterion_magnitude.c: the cause it gives, the models that have the measure (for
+     the message), the symbol of the run log */
+  PeriFailureCause cause;
+  const char      *holders, *symbol;
   struct {
     /* Checks its keys against each other and the model (c->measure[] are set): the scene's
        messages; sets c->causes and c->softens. Called when the scene gives any of its keys. */
@@ -64,6 +69,11 @@ struct _PeriCriterionType {
     PetscErrorCode (*view)(const PeriCriterion *c, PeriModel m, MPI_Comm comm);
   } ops;
 };
+
+/* The ops of a bound on one measure's magnitude (src/system/criterion_magnitude.c). */
+PETSC_EXTERN PetscErrorCode PeriCriterionMagnitudeSetFromScene(PeriCriterion *, PeriScene, PeriNode, PeriModel);
+PETSC_EXTERN PetscReal      PeriCriterionMagnitudeIndex(const PeriCriterion *, PeriModel, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
+PETSC_EXTERN PetscErrorCode PeriCriterionMagnitudeView(const PeriCriterion *, PeriModel, MPI_Comm);
 
 /* Bond failure criteria (failure:, src/system/failure.c): every registered criterion, those the
  * scene switches on active. */
