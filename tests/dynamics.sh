@@ -8,6 +8,10 @@
 #  3. Energy: the explicit run's balance within 1e-3, the implicit (average acceleration) within
 #     1e-10; the implicit pulse at dt 0.4 where the explicit one at dt 0.1 is, within 1 %.
 #  4. An explicit dt above the stability limit is an input error naming the limit, before any step.
+#  6. Free vibration (tests/scenes/bar_vibration.yaml, the bar started in its lowest longitudinal
+#     mode): the end oscillates at the modal analysis' f of the same bar (1e-4), and the period
+#     error converges at second order in dt, explicit and implicit (halving dt divides it by 3-5.5),
+#     the implicit one as the trapezoidal rule predicts, tan(W dt/2) = w dt/2 (within 10 %).
 #  5. Failure (tests/scenes/dynamic_crack.yaml): bonds break, the dissipated energy closes the
 #     balance (drift < 1 %), and 1, 2 and 3 ranks break the same bonds with the same energies
 #     (1e-10 relative); the implicit integrator on 1 and 2 ranks alike.
@@ -33,6 +37,10 @@ run explicit40 "$exe" "$pulse" -analysis_t_end 40
 for m in npmb pmb; do
   run modal_$m "$exe" "$repo/examples/pmb/bar_modes.yaml" -model_type $m -grid_upper 500,4,4
 done
+vib=$repo/tests/scenes/bar_vibration.yaml
+for dt in 0.05 0.4 0.8; do run vib_e$dt "$exe" "$vib" -analysis_dt $dt; done
+for dt in 4 8 16; do run vib_i$dt "$exe" "$vib" -analysis_dt $dt -analysis_integrator implicit; done
+run modal_vib "$exe" "$repo/examples/pmb/bar_modes.yaml" -grid_upper 100,4,4
 run crack1 "$exe" "$crack"
 for n in 2 3; do run crack$n mpiexec --oversubscribe -n $n "$exe" "$crack"; done
 run icrack1 "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012
@@ -80,6 +88,20 @@ check(d[0]["energy_drift"] < 0.01, f"with failure the balance closes: drift {d[0
 for n in (2, 3):
     same = d[n - 1]["broken_bonds"] == d[0]["broken_bonds"] and all(abs(d[n - 1][k] - d[0][k]) <= 1e-10 * abs(d[0][k]) for k in ("kinetic_energy", "strain_energy", "dissipated_energy"))
     check(same, f"explicit with failure, {n} ranks = 1 rank: {d[n-1]['broken_bonds']} bonds, kinetic {d[n-1]['kinetic_energy']:.12g}")
+def period(name):
+    rows = [(r["time"], r["probe_u"]) for r in history(name)]
+    z = [t0 + (t1 - t0) * u0 / (u0 - u1) for (t0, u0), (t1, u1) in zip(rows, rows[1:]) if (u0 > 0) != (u1 > 0)]
+    return 2 * (z[-1] - z[0]) / (len(z) - 1)
+T = period("vib_e0.05")
+f = [m["f_hz"] for m in json.load(open(f"{tmp}/modal_vib/summary.json"))["modal"]["modes"] if m["kind"] == "longitudinal"][0]
+check(abs(1 / T / f - 1) < 1e-4, f"free vibration: the end oscillates at {1/T:.8g}, the modal analysis' f = {f:.8g} ({1/T/f-1:+.1e})")
+e = {dt: period(f"vib_e{dt}") - T for dt in (0.4, 0.8)}
+check(3 < e[0.8] / e[0.4] < 5.5, f"explicit period error {e[0.8]:.3g} at dt 0.8, {e[0.4]:.3g} at dt 0.4: ratio {e[0.8]/e[0.4]:.2f} (second order: 4)")
+e = {dt: period(f"vib_i{dt}") - T for dt in (4, 8, 16)}
+check(3 < e[16] / e[8] < 5 and 3 < e[8] / e[4] < 5, f"implicit period error {e[16]:.3g}, {e[8]:.3g}, {e[4]:.3g} at dt 16, 8, 4: ratios {e[16]/e[8]:.2f}, {e[8]/e[4]:.2f} (second order: 4)")
+w = 2 * math.pi / T
+trap = 2 * math.pi / (2 / 16 * math.atan(w * 16 / 2)) - T
+check(abs(e[16] / trap - 1) < 0.1, f"implicit period error at dt 16: {e[16]:.4g}, the trapezoidal rule's {trap:.4g}")
 i1, i2 = dyn("icrack1"), dyn("icrack2")
 same = i1["broken_bonds"] == i2["broken_bonds"] > 0 and abs(i1["kinetic_energy"] / i2["kinetic_energy"] - 1) < 1e-8
 check(same, f"implicit with failure, 2 ranks = 1 rank: {i2['broken_bonds']} bonds, kinetic {i2['kinetic_energy']:.10g} vs {i1['kinetic_energy']:.10g}")

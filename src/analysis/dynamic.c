@@ -13,15 +13,17 @@
 
 static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
 static const char *const dyn_amplitudes[]  = {"step", "ramp", "sine", NULL};
+static const char *const dyn_profiles[]    = {"gaussian", "cosine", NULL};
 
-#define DYN_HISTORY_COLUMNS 8 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position */
+#define DYN_HISTORY_COLUMNS 9 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe */
 
 typedef struct {
   /* analysis.* */
   PetscBool implicit;
   PetscReal t_end, dt, energy_tol, rho_inf;
   PetscBool pulse;                      /* analysis.pulse given */
-  PetscReal pulse_A, pulse_x0, pulse_w; /* u = A exp(-((x - x0)/w)^2) along the pulse axis */
+  PetscReal pulse_A, pulse_x0, pulse_w; /* u = A exp(-((x - x0)/w)^2), or A cos(pi (x - x0)/w), along the pulse axis */
+  PetscInt  profile;                    /* 0 gaussian, 1 cosine */
   PetscInt  pulse_axis, shape;          /* axis; amplitude shape of the loads in time */
   PetscReal rise, period;               /* ramp: rise time; sine: period */
   /* the run */
@@ -30,7 +32,7 @@ typedef struct {
   PetscInt   nsteps, broken, snes_its, ksp_its;
   PetscReal  worst;                                                      /* implicit: the largest relative residual a step ended with */
   PetscReal  kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
-  PetscReal  t_prev, amp_prev, pulse_pos;
+  PetscReal  t_prev, amp_prev, pulse_pos, probe_u;                       /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
   PetscInt   nhist, cap, nsnap;
   PetscReal *hist, *snap_time; /* rank 0 keeps them; every rank counts */
   Vec        minv, uprev, tmp; /* 1/m per DOF (0 on held DOFs), the last step's u, work */
@@ -59,6 +61,7 @@ static const PeriKey dyn_pulse_keys[] = {
     {"center", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "its position along axis"},
     {"width", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "its width w"},
     {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the pulse lies and displaces: x, y or z"},
+    {"profile", PERI_KEY_CHOICE, "gaussian", NULL, NULL, dyn_profiles, "gaussian: amplitude exp(-((x - center)/width)^2); cosine: amplitude cos(pi (x - center)/width), a standing wave (with center 0 and width the bar's length, a free bar's lowest longitudinal mode)"},
     {NULL},
 };
 static const PeriKey dyn_amplitude_keys[] = {
@@ -131,6 +134,7 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
     PetscCall(PeriSceneGetString(s, p, "axis", PETSC_FALSE, axis, sizeof(axis), NULL));
     PeriInputCheck(!strcmp(axis, "x") || !strcmp(axis, "y") || !strcmp(axis, "z"), s, p, "axis", "must be x, y or z, got '%s'", axis);
     d->pulse_axis = axis[0] - 'x';
+    PetscCall(PeriSceneGetChoice(s, p, "profile", dyn_profiles, &d->profile, NULL));
   }
   PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
   if (amp) {
@@ -216,7 +220,7 @@ static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
     PetscCall(VecGetArray(u, &a));
     for (PetscInt i = 0; i < nloc; i++) {
       const PetscReal x = sys->disc.particles.x[3 * i + d->pulse_axis];
-      a[i * bs + c]     = d->pulse_A * PetscExpReal(-PetscSqr((x - d->pulse_x0) / d->pulse_w));
+      a[i * bs + c]     = d->pulse_A * (d->profile ? PetscCosReal(PETSC_PI * (x - d->pulse_x0) / d->pulse_w) : PetscExpReal(-PetscSqr((x - d->pulse_x0) / d->pulse_w)));
     }
     PetscCall(VecRestoreArray(u, &a));
   }
@@ -444,7 +448,7 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an, Vec q, PetscReal t)
 /* Appends a row of history.csv. */
 static PetscErrorCode RecordHistory(Dynamic *d, PetscReal t, PetscReal balance)
 {
-  const PetscReal row[DYN_HISTORY_COLUMNS] = {t, d->kinetic, d->strain, d->dissipated, d->work, balance, (PetscReal)d->broken, d->pulse_pos};
+  const PetscReal row[DYN_HISTORY_COLUMNS] = {t, d->kinetic, d->strain, d->dissipated, d->work, balance, (PetscReal)d->broken, d->pulse_pos, d->probe_u};
 
   PetscFunctionBeginUser;
   if (d->nhist == d->cap) {
@@ -505,6 +509,26 @@ static PetscErrorCode PulsePosition(PeriAnalysis an, Vec q)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The first probe's displacement along the pulse axis (x without a pulse), from its owner. */
+static PetscErrorCode ProbeDisplacement(PeriAnalysis an, Vec q)
+{
+  Dynamic         *d  = DYN(an);
+  const PeriProbe *pr = an->sys->fields.nprobes ? &an->sys->fields.probes[0] : NULL;
+  PetscReal        v  = 0;
+
+  PetscFunctionBeginUser;
+  if (!pr) PetscFunctionReturn(PETSC_SUCCESS);
+  if (pr->rank == an->rank) {
+    const PetscScalar *u;
+    const PetscInt     c = PeriModelTranslation(an->sys->model, d->pulse_axis);
+    PetscCall(VecGetArrayRead(q, &u));
+    if (c >= 0) v = PetscRealPart(u[pr->particle * an->sys->model->dofs + c]);
+    PetscCall(VecRestoreArrayRead(q, &u));
+  }
+  PetscCallMPI(MPI_Allreduce(&v, &d->probe_u, 1, MPIU_REAL, MPI_SUM, an->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* After each step (and at t = 0): energies, the balance, history, snapshots, signals. */
 static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ctx)
 {
@@ -517,6 +541,7 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   PetscCall(GetState(an, U, &q, &p));
   PetscCall(Energies(an, q, p, t));
   PetscCall(PulsePosition(an, q));
+  PetscCall(ProbeDisplacement(an, q));
   balance = d->kinetic + d->strain + d->dissipated - d->work;
   if (step == 0) d->E0 = balance;
   /* the largest error of the balance over the run, relative to the largest energy of the run */
@@ -715,11 +740,12 @@ static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
   if (an->rank) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/history.csv", dir));
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s\n", d->pulse ? ",pulse_position" : "") < 0;
+  bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s%s\n", d->pulse ? ",pulse_position" : "", an->sys->fields.nprobes ? ",probe_u" : "") < 0;
   for (PetscInt k = 0; k < d->nhist; k++) {
     const PetscReal *r = &d->hist[DYN_HISTORY_COLUMNS * k];
     bad |= fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%" PetscInt_FMT, (double)r[0], (double)r[1], (double)r[2], (double)r[3], (double)r[4], (double)r[5], (PetscInt)r[6]) < 0;
     if (d->pulse) bad |= fprintf(fp, ",%.10g", (double)r[7]) < 0;
+    if (an->sys->fields.nprobes) bad |= fprintf(fp, ",%.17g", (double)r[8]) < 0;
     bad |= fprintf(fp, "\n") < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
