@@ -12,6 +12,9 @@
 #     mode): the end oscillates at the modal analysis' f of the same bar (1e-4), and the period
 #     error converges at second order in dt, explicit and implicit (halving dt divides it by 3-5.5),
 #     the implicit one as the trapezoidal rule predicts, tan(W dt/2) = w dt/2 (within 10 %).
+#  7. An initial velocity (analysis.velocity) on a free plate: a rigid translation, u = v t, the
+#     kinetic energy M v^2 / 2, no strain, both integrators (tests/scenes/rigid_translation.yaml);
+#     the default explicit step ends exactly at t_end.
 #  5. Failure (tests/scenes/dynamic_crack.yaml): bonds break, the dissipated energy closes the
 #     balance (drift < 1 %), and 1, 2 and 3 ranks break the same bonds with the same energies
 #     (1e-10 relative); the implicit integrator on 1 and 2 ranks alike.
@@ -41,6 +44,8 @@ vib=$repo/tests/scenes/bar_vibration.yaml
 for dt in 0.05 0.4 0.8; do run vib_e$dt "$exe" "$vib" -analysis_dt $dt; done
 for dt in 4 8 16; do run vib_i$dt "$exe" "$vib" -analysis_dt $dt -analysis_integrator implicit; done
 run modal_vib "$exe" "$repo/examples/pmb/bar_modes.yaml" -grid_upper 100,4,4
+run rigid_e "$exe" "$repo/tests/scenes/rigid_translation.yaml"
+run rigid_i "$exe" "$repo/tests/scenes/rigid_translation.yaml" -analysis_integrator implicit -analysis_dt 0.002
 run crack1 "$exe" "$crack"
 for n in 2 3; do run crack$n mpiexec --oversubscribe -n $n "$exe" "$crack"; done
 run icrack1 "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012
@@ -102,6 +107,10 @@ check(3 < e[16] / e[8] < 5 and 3 < e[8] / e[4] < 5, f"implicit period error {e[1
 w = 2 * math.pi / T
 trap = 2 * math.pi / (2 / 16 * math.atan(w * 16 / 2)) - T
 check(abs(e[16] / trap - 1) < 0.1, f"implicit period error at dt 16: {e[16]:.4g}, the trapezoidal rule's {trap:.4g}")
+for name in ("rigid_e", "rigid_i"):
+    r = history(name)[-1]
+    ok = abs(r["time"] - 0.02) < 1e-12 and abs(r["probe_u"] / (3 * r["time"]) - 1) < 1e-9 and abs(r["kinetic"] / 5 - 1) < 1e-12 and r["strain"] < 1e-9
+    check(ok, f"{name}: an initial velocity 3 on a free plate translates it rigidly: u = {r['probe_u']:.12g} = 3 t at t = {r['time']:.12g}, kinetic {r['kinetic']:.12g} = M v^2/2 = 5, strain {r['strain']:.2g}")
 i1, i2 = dyn("icrack1"), dyn("icrack2")
 same = i1["broken_bonds"] == i2["broken_bonds"] > 0 and abs(i1["kinetic_energy"] / i2["kinetic_energy"] - 1) < 1e-8
 check(same, f"implicit with failure, 2 ranks = 1 rank: {i2['broken_bonds']} bonds, kinetic {i2['kinetic_energy']:.10g} vs {i1['kinetic_energy']:.10g}")

@@ -24,6 +24,8 @@ typedef struct {
   PetscBool pulse;                      /* analysis.pulse given */
   PetscReal pulse_A, pulse_x0, pulse_w; /* u = A exp(-((x - x0)/w)^2), or A cos(pi (x - x0)/w), along the pulse axis */
   PetscInt  profile;                    /* 0 gaussian, 1 cosine */
+  PetscReal velocity[3];                /* analysis.velocity.value, on the particles of region */
+  PeriNode  vnode;                      /* analysis.velocity, or NULL */
   PetscInt  pulse_axis, shape;          /* axis; amplitude shape of the loads in time */
   PetscReal rise, period;               /* ramp: rise time; sine: period */
   /* the run */
@@ -54,6 +56,7 @@ static const PeriKey dyn_keys[] = {
     {"rho_infinity", PERI_KEY_REAL, "1", "[0, 1]", NULL, NULL, "implicit: the spectral radius at infinite frequency (1: no numerical damping, Newmark's average acceleration)"},
     {"pulse", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement u = amplitude exp(-((x - center)/width)^2) along axis (Ganzenmueller sec. 3.1.2)"},
     {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
+    {"velocity", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial velocity of the particles of a region (a projectile, an impactor)"},
     {NULL},
 };
 static const PeriKey dyn_pulse_keys[] = {
@@ -70,6 +73,11 @@ static const PeriKey dyn_amplitude_keys[] = {
     {"period", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "sine: the period"},
     {NULL},
 };
+static const PeriKey dyn_velocity_keys[] = {
+    {"region", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the region whose particles move at t = 0"},
+    {"value", PERI_KEY_REALS, "required", NULL, "[length/time]", NULL, "their velocity, one number per dimension"},
+    {NULL},
+};
 /* output.every, which the snapshots follow (problem.c reads it with output.*) */
 static const PeriKey dyn_output_keys[] = {
     {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k time steps, indexed by particles.pvd with the time (0: only the end)"},
@@ -79,6 +87,7 @@ static const PeriSchema dyn_schema[] = {
     {"analysis", dyn_keys},
     {"analysis.pulse", dyn_pulse_keys},
     {"analysis.amplitude", dyn_amplitude_keys},
+    {"analysis.velocity", dyn_velocity_keys},
     {"output", dyn_output_keys},
     {NULL},
 };
@@ -135,6 +144,12 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
     PeriInputCheck(!strcmp(axis, "x") || !strcmp(axis, "y") || !strcmp(axis, "z"), s, p, "axis", "must be x, y or z, got '%s'", axis);
     d->pulse_axis = axis[0] - 'x';
     PetscCall(PeriSceneGetChoice(s, p, "profile", dyn_profiles, &d->profile, NULL));
+  }
+  PetscCall(PeriSceneGetMap(s, a, "velocity", PETSC_FALSE, &d->vnode));
+  if (d->vnode) {
+    PetscInt n;
+    PetscCall(CheckOwnSection(s, d->vnode, "analysis.velocity"));
+    PetscCall(PeriSceneGetRealArray(s, d->vnode, "value", PETSC_TRUE, 1, 3, d->velocity, &n));
   }
   PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
   if (amp) {
@@ -200,7 +215,8 @@ static PetscErrorCode ChooseStep(PeriAnalysis an)
   PetscFunctionBeginUser;
   if (d->implicit) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetNode(s->root, "analysis", &a));
-  if (d->dt <= 0) d->dt = 0.8 * d->dt_limit;
+  /* the default: 0.8 of the limit, shortened so that whole steps end at t_end */
+  if (d->dt <= 0) d->dt = d->t_end / PetscCeilReal(d->t_end / (0.8 * d->dt_limit));
   PeriInputCheck(d->dt <= d->dt_limit, s, a, "dt", "%g is above the explicit stability limit 2/omega_max = %g (omega_max^2 <= %g by Gershgorin's bound on M^-1 K): use dt <= %g, or integrator: implicit", (double)d->dt, (double)d->dt_limit, (double)d->omega2_max, (double)d->dt_limit);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -227,6 +243,34 @@ static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
   PetscCall(VecSetValues(u, sys->conditions.nconstrained, sys->conditions.constrained, sys->conditions.constrained_value, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(u));
   PetscCall(VecAssemblyEnd(u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The initial velocities: analysis.velocity on its region's particles (translations only), 0
+ * elsewhere and on the held DOFs. */
+static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
+{
+  Dynamic       *d   = DYN(an);
+  PeriSystem     sys = an->sys;
+  const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart, dim = sys->disc.particles.dim;
+  PeriRegion    *r;
+  PetscScalar   *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(v, 0));
+  if (!d->vnode) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriRegionFind(sys->scene, d->vnode, "region", sys->disc.nregions, sys->disc.regions, &r));
+  PetscCall(VecGetArray(v, &a));
+  for (PetscInt i = 0; i < nloc; i++)
+    if (PeriRegionContains(r, &sys->disc.particles.x[3 * i]))
+      for (PetscInt k = 0; k < dim; k++) {
+        const PetscInt c = PeriModelTranslation(sys->model, k);
+        if (c >= 0) a[i * bs + c] = d->velocity[k];
+      }
+  PetscCall(VecRestoreArray(v, &a));
+  for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) PetscCall(VecSetValue(v, sys->conditions.constrained[k], 0, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(v));
+  PetscCall(VecAssemblyEnd(v));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -574,6 +618,9 @@ static PetscErrorCode CreateExplicit(PeriAnalysis an, Vec *U)
   PetscCall(VecGetSubVector(*U, d->isq, &q));
   PetscCall(InitialDisplacement(an, q));
   PetscCall(VecRestoreSubVector(*U, d->isq, &q));
+  PetscCall(VecGetSubVector(*U, d->isp, &q));
+  PetscCall(InitialVelocity(an, q));
+  PetscCall(VecRestoreSubVector(*U, d->isp, &q));
   PetscCall(TSSetType(d->ts, TSBASICSYMPLECTIC));
   PetscCall(TSBasicSymplecticSetType(d->ts, TSBASICSYMPLECTICVELVERLET));
   PetscCall(TSSetRHSFunction(d->ts, NULL, RHSWhole, an));
@@ -597,7 +644,7 @@ static PetscErrorCode CreateImplicit(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(VecDuplicate(an->sys->fields.u, U));
   PetscCall(VecDuplicate(an->sys->fields.u, V));
   PetscCall(InitialDisplacement(an, *U));
-  PetscCall(VecSet(*V, 0));
+  PetscCall(InitialVelocity(an, *V));
   PetscCall(MatDuplicate(an->sys->stiffness.K, MAT_COPY_VALUES, &d->J));
   PetscCall(PeriSetNearNullSpace(an->sys, d->J, NULL));
   PetscCall(TSSetType(d->ts, TSALPHA2));
