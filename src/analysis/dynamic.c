@@ -246,6 +246,16 @@ static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* 0 on the held DOFs (their velocity, their inverse mass). */
+static PetscErrorCode ZeroHeld(PeriAnalysis an, Vec v)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < an->sys->conditions.nconstrained; k++) PetscCall(VecSetValue(v, an->sys->conditions.constrained[k], 0, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(v));
+  PetscCall(VecAssemblyEnd(v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The initial velocities: analysis.velocity on its region's particles (translations only), 0
  * elsewhere and on the held DOFs. */
 static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
@@ -268,9 +278,7 @@ static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
         if (c >= 0) a[i * bs + c] = d->velocity[k];
       }
   PetscCall(VecRestoreArray(v, &a));
-  for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) PetscCall(VecSetValue(v, sys->conditions.constrained[k], 0, INSERT_VALUES));
-  PetscCall(VecAssemblyBegin(v));
-  PetscCall(VecAssemblyEnd(v));
+  PetscCall(ZeroHeld(an, v));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -285,9 +293,7 @@ static PetscErrorCode InverseMass(PeriAnalysis an)
   PetscCall(VecDuplicate(m, &d->minv));
   PetscCall(VecCopy(m, d->minv));
   PetscCall(VecReciprocal(d->minv));
-  for (PetscInt k = 0; k < an->sys->conditions.nconstrained; k++) PetscCall(VecSetValue(d->minv, an->sys->conditions.constrained[k], 0, INSERT_VALUES));
-  PetscCall(VecAssemblyBegin(d->minv));
-  PetscCall(VecAssemblyEnd(d->minv));
+  PetscCall(ZeroHeld(an, d->minv));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
