@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # valgrind.sh PERILIN EXAMPLES_DIR: valgrind memcheck (leaks, invalid reads and writes, use of
-# uninitialized values) of one tiny case of each analysis: static, modal, quasi-static. Exits 77
+# uninitialized values) of one tiny case of each analysis: static, modal, quasi-static, dynamic
+# (explicit and implicit). Exits 77
 # (ctest SKIP_RETURN_CODE) when valgrind is absent. Each run takes 10-25 s under valgrind.
 #
 # Open MPI's noise: its own suppression file (uninitialized bytes in its buffers), and leaks
@@ -70,6 +71,8 @@ check() {
 check static 'strain energy' pmb/plate_traction.yaml -grid_spacing 0.02
 check modal 'modes \(Hz\)' lamina/modal.yaml -grid_spacing 0.05
 check quasistatic 'strain energy' antiplane/cracked_bar.yaml -grid_spacing 0.05 -analysis_min_step 0.25 -quiet
+check dynamic_explicit 'explicit dynamics' ../tests/scenes/dynamic_crack.yaml -grid_spacing 0.05 -analysis_t_end 0.004
+check dynamic_implicit 'implicit dynamics' ../tests/scenes/dynamic_crack.yaml -grid_spacing 0.05 -analysis_t_end 0.002 -analysis_integrator implicit -analysis_dt 4e-4
 
 [ "$fail" -eq 0 ] && echo "valgrind: clean" || echo "valgrind: $fail run(s) failed"
 [ "$fail" -eq 0 ]
