@@ -19,7 +19,10 @@
 #   - wall time of the whole process, and peak RSS summed over ranks (perilin/LAMMPS ratio);
 #   - the x-displacement of the site (-70a, 20a, 2a) after the run in both, and their relative
 #     difference (LAMMPS's bonds are geometrically nonlinear: ~1e-7 at this strain, ~1e-6).
-# A benchmark, not a test (not in ctest). Environment: RUNS (3), RANKS ("1 2"), DT (1e-7 s;
+# LAMMPS is Debian's `lammps` package (apt-get install lammps; not installed by .ci/install: a
+# benchmark, not a test). Since this script was written the explicit step assembles K as BAIJ by
+# default (its "default" rows are then BAIJ too), and -analysis_energy_every k drops the monitor's
+# second product on k - 1 steps of k. Environment: RUNS (3), RANKS ("1 2"), DT (1e-7 s;
 # perilin's limit here is 3.5e-7), KEEP=1 keeps the work directory.
 set -euo pipefail
 
