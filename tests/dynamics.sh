@@ -15,6 +15,8 @@
 #  7. An initial velocity (analysis.velocity) on a free plate: a rigid translation, u = v t, the
 #     kinetic energy M v^2 / 2, no strain, both integrators (tests/scenes/rigid_translation.yaml);
 #     the default explicit step ends exactly at t_end.
+#  8. Fronts (analysis.fronts): the pulse's wave front runs within 5 % of c; the crack's damage
+#     front reaches the plate's far edge.
 #  5. Failure (tests/scenes/dynamic_crack.yaml): bonds break, the dissipated energy closes the
 #     balance (drift < 1 %), and 1, 2 and 3 ranks break the same bonds with the same energies
 #     (1e-10 relative); the implicit integrator on 1 and 2 ranks alike.
@@ -87,7 +89,10 @@ check(dyn("npmb")["energy_drift"] < 1e-3, f"explicit energy drift {dyn('npmb')['
 check(dyn("implicit")["energy_drift"] < 1e-10, f"implicit (average acceleration) energy drift {dyn('implicit')['energy_drift']:.2g} < 1e-10")
 pi, pe = history("implicit")[-1]["pulse_position"], history("explicit40")[-1]["pulse_position"]
 check(abs(pi - pe) < 0.01 * pe, f"pulse at t = 40: implicit (dt 0.4) {pi:.3f}, explicit (dt 0.1) {pe:.3f}")
+wf = dyn("npmb")["wave_front_speed"]
+check(abs(wf / c - 1) < 0.05, f"wave front (speed above 1e-5) runs at {wf:.4f}, within 5 % of c = {c:.4f} (the front of a dispersing pulse leads its centre)")
 d = [dyn(f"crack{n}") for n in (1, 2, 3)]
+check(abs(d[0]["damage_front"] - 0.9875) < 1e-12, f"the damage front reaches the far edge of the plate: {d[0]['damage_front']} (the last particles' x = 0.9875)")
 check(d[0]["broken_bonds"] > 100 and d[0]["dissipated_energy"] > 0, f"the crack runs: {d[0]['broken_bonds']} bonds broken, {d[0]['dissipated_energy']:.4g} dissipated")
 check(d[0]["energy_drift"] < 0.01, f"with failure the balance closes: drift {d[0]['energy_drift']:.2g} < 0.01")
 for n in (2, 3):

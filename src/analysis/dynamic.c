@@ -15,7 +15,7 @@ static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
 static const char *const dyn_amplitudes[]  = {"step", "ramp", "sine", NULL};
 static const char *const dyn_profiles[]    = {"gaussian", "cosine", NULL};
 
-#define DYN_HISTORY_COLUMNS 9 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe */
+#define DYN_HISTORY_COLUMNS 11 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe, wave front, damage front */
 
 typedef struct {
   /* analysis.* */
@@ -35,7 +35,11 @@ typedef struct {
   PetscInt   nsteps, broken, snes_its, ksp_its;
   PetscReal  worst;                                                      /* implicit: the largest relative residual a step ended with */
   PetscReal  kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
-  PetscReal  t_prev, amp_prev, pulse_pos, probe_u;                       /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
+  PetscBool  fronts;                                                     /* analysis.fronts given */
+  PetscInt   front_axis;
+  PetscReal  front_origin, front_speed, front_damage; /* origin along the axis; the thresholds of speed and damage */
+  PetscReal  wave_front, damage_front;                /* the farthest distance from the origin along the axis of a particle past them */
+  PetscReal  t_prev, amp_prev, pulse_pos, probe_u;    /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
   PetscInt   nhist, cap, nsnap;
   PetscReal *hist, *snap_time; /* rank 0 keeps them; every rank counts */
   Vec        minv, uprev, tmp; /* 1/m per DOF (0 on held DOFs), the last step's u, work */
@@ -59,6 +63,7 @@ static const PeriKey dyn_keys[] = {
     {"pulse", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement u = amplitude exp(-((x - center)/width)^2) along axis (Ganzenmueller sec. 3.1.2)"},
     {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
     {"velocity", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial velocity of the particles of a region (a projectile, an impactor)"},
+    {"fronts", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the wave front and the damage front along an axis, in history.csv and (fitted speeds) summary.json"},
     {NULL},
 };
 static const PeriKey dyn_pulse_keys[] = {
@@ -80,6 +85,13 @@ static const PeriKey dyn_velocity_keys[] = {
     {"value", PERI_KEY_REALS, "required", NULL, "[length/time]", NULL, "their velocity, one number per dimension"},
     {NULL},
 };
+static const PeriKey dyn_fronts_keys[] = {
+    {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the fronts run: x, y or z"},
+    {"origin", PERI_KEY_REAL, "0", NULL, "[length]", NULL, "where they start along it: a front is the farthest distance from here"},
+    {"speed", PERI_KEY_REAL, "required", "(0, inf)", "[length/time]", NULL, "the wave front: particles moving faster than this"},
+    {"damage", PERI_KEY_REAL, "0.5", "(0, 1)", NULL, NULL, "the damage front: particles damaged more than this (scenes with failure)"},
+    {NULL},
+};
 /* output.every, which the snapshots follow (problem.c reads it with output.*) */
 static const PeriKey dyn_output_keys[] = {
     {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k time steps, indexed by particles.pvd with the time (0: only the end)"},
@@ -90,6 +102,7 @@ static const PeriSchema dyn_schema[] = {
     {"analysis.pulse", dyn_pulse_keys},
     {"analysis.amplitude", dyn_amplitude_keys},
     {"analysis.velocity", dyn_velocity_keys},
+    {"analysis.fronts", dyn_fronts_keys},
     {"output", dyn_output_keys},
     {NULL},
 };
@@ -114,6 +127,26 @@ static PetscReal Amplitude(const Dynamic *d, PetscReal t)
   if (d->shape == 1) return d->rise > 0 ? PetscMin(1, t / d->rise) : 1;
   if (d->shape == 2) return PetscSinReal(2 * PETSC_PI * t / d->period);
   return 1;
+}
+
+/* analysis.fronts. */
+static PetscErrorCode ReadFronts(Dynamic *d, PeriScene s, PeriNode a)
+{
+  PeriNode f;
+  char     axis[8] = "x";
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, a, "fronts", PETSC_FALSE, &f));
+  if (!f) PetscFunctionReturn(PETSC_SUCCESS);
+  d->fronts = PETSC_TRUE;
+  PetscCall(CheckOwnSection(s, f, "analysis.fronts"));
+  PetscCall(PeriSceneGetString(s, f, "axis", PETSC_FALSE, axis, sizeof(axis), NULL));
+  PeriInputCheck(!strcmp(axis, "x") || !strcmp(axis, "y") || !strcmp(axis, "z"), s, f, "axis", "must be x, y or z, got '%s'", axis);
+  d->front_axis = axis[0] - 'x';
+  PetscCall(PeriSceneGetReal(s, f, "origin", PETSC_FALSE, &d->front_origin, NULL));
+  PetscCall(PeriSceneGetReal(s, f, "speed", PETSC_TRUE, &d->front_speed, NULL));
+  PetscCall(PeriSceneGetReal(s, f, "damage", PETSC_FALSE, &d->front_damage, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* analysis.* before any particle exists. */
@@ -154,6 +187,7 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
     PetscCall(CheckOwnSection(s, d->vnode, "analysis.velocity"));
     PetscCall(PeriSceneGetRealArray(s, d->vnode, "value", PETSC_TRUE, 1, 3, d->velocity, &n));
   }
+  PetscCall(ReadFronts(d, s, a));
   PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
   if (amp) {
     PetscCall(CheckOwnSection(s, amp, "analysis.amplitude"));
@@ -501,7 +535,7 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an, Vec q, PetscReal t)
 /* Appends a row of history.csv. */
 static PetscErrorCode RecordHistory(Dynamic *d, PetscReal t, PetscReal balance)
 {
-  const PetscReal row[DYN_HISTORY_COLUMNS] = {t, d->kinetic, d->strain, d->dissipated, d->work, balance, (PetscReal)d->broken, d->pulse_pos, d->probe_u};
+  const PetscReal row[DYN_HISTORY_COLUMNS] = {t, d->kinetic, d->strain, d->dissipated, d->work, balance, (PetscReal)d->broken, d->pulse_pos, d->probe_u, d->wave_front, d->damage_front};
 
   PetscFunctionBeginUser;
   if (d->nhist == d->cap) {
@@ -572,6 +606,35 @@ static PetscErrorCode PulsePosition(PeriAnalysis an, Vec q)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The wave front (the farthest particle from the origin along the axis moving faster than the
+ * threshold) and the damage front (damaged more than its threshold), as distances. Collective. */
+static PetscErrorCode Fronts(PeriAnalysis an, Vec p)
+{
+  Dynamic           *d   = DYN(an);
+  PeriSystem         sys = an->sys;
+  const PetscInt     bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
+  const PetscScalar *v;
+  PetscReal          far[2] = {0, 0};
+
+  PetscFunctionBeginUser;
+  if (!d->fronts) PetscFunctionReturn(PETSC_SUCCESS);
+  if (sys->bond_state.failure.active) PetscCall(PeriDamage(sys, &sys->bond_state.damage));
+  PetscCall(VecGetArrayRead(p, &v));
+  for (PetscInt i = 0; i < nloc; i++) {
+    const PetscReal x      = PetscAbsReal(sys->disc.particles.x[3 * i + d->front_axis] - d->front_origin);
+    PetscReal       speed2 = 0;
+    for (PetscInt c = 0; c < bs; c++)
+      if (sys->model->axis[c] >= 0) speed2 += PetscSqr(PetscRealPart(v[i * bs + c]));
+    if (speed2 > PetscSqr(d->front_speed)) far[0] = PetscMax(far[0], x);
+    if (sys->bond_state.damage && sys->bond_state.damage[(PERI_NCAUSES + 1) * i] > d->front_damage) far[1] = PetscMax(far[1], x);
+  }
+  PetscCall(VecRestoreArrayRead(p, &v));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, far, 2, MPIU_REAL, MPI_MAX, an->comm));
+  d->wave_front   = far[0];
+  d->damage_front = far[1];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The first probe's displacement along the pulse axis (x without a pulse), from its owner. */
 static PetscErrorCode ProbeDisplacement(PeriAnalysis an, Vec q)
 {
@@ -613,6 +676,7 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   PetscCall(Energies(an, q, p));
   PetscCall(PulsePosition(an, q));
   PetscCall(ProbeDisplacement(an, q));
+  PetscCall(Fronts(an, p));
   balance = d->kinetic + d->strain + d->dissipated - d->work;
   if (step == 0) d->E0 = balance;
   /* the largest error of the balance over the run, relative to the largest energy of the run */
@@ -818,12 +882,13 @@ static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
   if (an->rank) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/history.csv", dir));
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s%s\n", d->pulse ? ",pulse_position" : "", an->sys->fields.nprobes ? ",probe_u" : "") < 0;
+  bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s%s%s\n", d->pulse ? ",pulse_position" : "", an->sys->fields.nprobes ? ",probe_u" : "", d->fronts ? ",wave_front,damage_front" : "") < 0;
   for (PetscInt k = 0; k < d->nhist; k++) {
     const PetscReal *r = &d->hist[DYN_HISTORY_COLUMNS * k];
     bad |= fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%" PetscInt_FMT, (double)r[0], (double)r[1], (double)r[2], (double)r[3], (double)r[4], (double)r[5], (PetscInt)r[6]) < 0;
     if (d->pulse) bad |= fprintf(fp, ",%.10g", (double)r[7]) < 0;
     if (an->sys->fields.nprobes) bad |= fprintf(fp, ",%.17g", (double)r[8]) < 0;
+    if (d->fronts) bad |= fprintf(fp, ",%.10g,%.10g", (double)r[9], (double)r[10]) < 0;
     bad |= fprintf(fp, "\n") < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
@@ -853,6 +918,21 @@ static PetscErrorCode Files_Dynamic(PeriAnalysis an, const char dir[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A front's speed: the least-squares slope of its distance over time, over the rows where it has
+ * left the origin and not yet stopped at its farthest (a wave reaching the end of the body), or 0. */
+static PetscReal FrontSpeed(const Dynamic *d, PetscInt col)
+{
+  PetscReal n = 0, st = 0, sx = 0, stt = 0, stx = 0, last = 0;
+
+  for (PetscInt k = 0; k < d->nhist; k++) last = PetscMax(last, d->hist[DYN_HISTORY_COLUMNS * k + col]);
+  for (PetscInt k = 0; k < d->nhist; k++) {
+    const PetscReal t = d->hist[DYN_HISTORY_COLUMNS * k], x = d->hist[DYN_HISTORY_COLUMNS * k + col];
+    if (x <= 0 || x >= last) continue;
+    n += 1, st += t, sx += x, stt += t * t, stx += t * x;
+  }
+  return n > 1 && n * stt - st * st > 0 ? (n * stx - st * sx) / (n * stt - st * st) : 0;
+}
+
 /* summary.json's "dynamic" object. */
 static PetscErrorCode Summary_Dynamic(PeriAnalysis an, PeriJSON j)
 {
@@ -875,6 +955,12 @@ static PetscErrorCode Summary_Dynamic(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONReal(j, "energy_tolerance", d->energy_tol));
   PetscCall(PeriJSONInt(j, "broken_bonds", d->broken));
   if (d->implicit) PetscCall(PeriJSONInt(j, "ksp_iterations", d->ksp_its));
+  if (d->fronts) {
+    PetscCall(PeriJSONReal(j, "wave_front", d->wave_front));
+    PetscCall(PeriJSONReal(j, "damage_front", d->damage_front));
+    PetscCall(PeriJSONReal(j, "wave_front_speed", FrontSpeed(d, 9)));
+    PetscCall(PeriJSONReal(j, "damage_front_speed", FrontSpeed(d, 10)));
+  }
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
