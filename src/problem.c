@@ -1,6 +1,5 @@
 /* PeriProblem: one run from scene to output. Each stage is one call; see include/perilin.h. */
 #include "perilin/private/problem.h"
-#include <signal.h>
 
 PetscErrorCode PeriProblemCreate(MPI_Comm comm, PeriProblem *problem)
 {
@@ -257,11 +256,19 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   else
     PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", sys->run.log.neighbors_s, sys->run.log.memory_mb));
   if (sys->run.interrupted) {
-    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", sys->run.interrupted == SIGTERM ? "SIGTERM" : "SIGINT", sys->fields.u_owned ? "the last complete state was written" : "no result was reached", p->output_dir));
+    PetscCall(PetscPrintf(p->comm, "perilin: interrupted by %s: %s; summary.json says \"complete\": false; results in %s/\n", PeriSignalName(sys->run.interrupted), sys->fields.u_owned ? "the last complete state was written" : "no result was reached", p->output_dir));
   } else if (p->analysis && p->analysis->type->ops.report) {
     PetscCall(p->analysis->type->ops.report(p->analysis));
   } else {
-    const PeriTorsion *t = &sys->conditions.torsion;
+    const PeriTorsion   *t = &sys->conditions.torsion;
+    const PeriReference *r = &sys->reference;
+    if (r->evaluated) {
+      PetscCall(PetscPrintf(p->comm, "perilin: against the exact %s field: relative error %.3g (L2), %.3g (max) over %" PetscInt_FMT " interior particles", PeriReferenceTypes[r->type], (double)r->error_l2_rel, (double)r->error_max_rel, r->interior_particles));
+      /* the effective constants this stress state defines (0: not defined) */
+      if (r->effective_E > 0) PetscCall(PetscPrintf(p->comm, "; effective E %g, nu %g", (double)r->effective_E, (double)r->effective_nu));
+      if (r->effective_G > 0) PetscCall(PetscPrintf(p->comm, "; effective G %g", (double)r->effective_G));
+      PetscCall(PetscPrintf(p->comm, "\n"));
+    }
     if (t->active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)t->torque, (double)t->J, (double)t->J_rectangle, 100 * (double)(t->J / t->J_rectangle - 1), (double)t->max_stress, (double)t->max_at[0], (double)t->max_at[1]));
     PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", sys->fields.strain_energy, p->output_dir));
   }

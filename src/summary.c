@@ -1,7 +1,6 @@
 /* summary.json: what the run was, what it cost, and its results (docs/summary.md lists the keys).
  * One call per contributor: the system's sections, then the analysis' own (ops.summary). */
 #include "perilin/private/problem.h"
-#include <signal.h>
 
 /* What made the run, to repeat it: "build" (perilin's version as built, PETSc's and SLEPc's) and
  * "command_line" (the arguments PETSc was started with, the program first). */
@@ -37,7 +36,7 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   /* false only for a run stopped by a signal: then the fields below describe the last complete
      state (quasistatic), or there are none */
   PetscCall(PeriJSONBool(j, "complete", sys->run.interrupted ? PETSC_FALSE : PETSC_TRUE));
-  if (sys->run.interrupted) PetscCall(PeriJSONString(j, "interrupted_by", sys->run.interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+  if (sys->run.interrupted) PetscCall(PeriJSONString(j, "interrupted_by", PeriSignalName(sys->run.interrupted)));
   PetscCall(PeriSystemSummaryDiscretization(sys, j));
   PetscCall(PeriLayersSummary(sys, j));
   PetscCall(PeriSystemSummaryCost(sys, j));

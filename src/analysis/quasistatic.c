@@ -6,7 +6,6 @@
  * or no equilibrium is found, the body has failed: with adaptive steps the step is halved from the
  * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
 #include "perilin/private/analysis.h"
-#include <signal.h>
 
 /* analysis.stepping, analysis.break */
 static const char *const qs_steppings[] = {"increments", "events", NULL};
@@ -575,7 +574,7 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   PetscFunctionBeginUser;
   q->complete = an->sys->run.interrupted ? PETSC_FALSE : PETSC_TRUE;
   if (an->sys->run.interrupted)
-    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", an->sys->run.interrupted == SIGTERM ? "SIGTERM" : "SIGINT"));
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", PeriSignalName(an->sys->run.interrupted)));
   else if (!q->failed && q->broken_bonds)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g, %" PetscInt_FMT " bonds broken on the way (an equilibrium at every step)", (double)st->max, q->broken_bonds));
   else if (!q->failed)

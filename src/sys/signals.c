@@ -29,8 +29,9 @@ static void OnSignal(int sig)
 }
 
 /*@C
-  PeriSignalsInstall - from now on SIGINT and SIGTERM are recorded instead of ending the process
-  (this replaces PETSc's own SIGTERM handler, which aborts). Not collective.
+  PeriSignalsInstall - from now on SIGINT, SIGTERM and SIGHUP (a closed terminal or ssh session)
+  are recorded instead of ending the process (this replaces PETSc's own SIGTERM handler, which
+  aborts). Not collective.
 @*/
 PetscErrorCode PeriSignalsInstall(void)
 {
@@ -40,8 +41,16 @@ PetscErrorCode PeriSignalsInstall(void)
   memset(&sa, 0, sizeof(sa));
   sa.sa_handler = OnSignal;
   sigemptyset(&sa.sa_mask);
-  PetscCheck(sigaction(SIGINT, &sa, NULL) == 0 && sigaction(SIGTERM, &sa, NULL) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "cannot install the SIGINT/SIGTERM handlers");
+  PetscCheck(sigaction(SIGINT, &sa, NULL) == 0 && sigaction(SIGTERM, &sa, NULL) == 0 && sigaction(SIGHUP, &sa, NULL) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "cannot install the SIGINT/SIGTERM/SIGHUP handlers");
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The name of a signal perilin records, for messages and summary.json. */
+const char *PeriSignalName(int sig)
+{
+  return sig == SIGTERM ? "SIGTERM" : sig == SIGHUP ? "SIGHUP"
+                                  : sig == SIGINT   ? "SIGINT"
+                                                    : "a signal";
 }
 
 /*@C
