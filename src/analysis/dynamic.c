@@ -242,20 +242,11 @@ static PetscErrorCode StabilityBound(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The explicit step: analysis.dt, or 0.8 of the limit; a dt above the limit is an input error. */
-static PetscErrorCode ChooseStep(PeriAnalysis an)
+/* The explicit step's default: 0.8 of the limit, shortened so that whole steps end at t_end (the
+ * limit itself is checked once the TS has read -ts_dt, SetUpTS). */
+static void ChooseStep(Dynamic *d)
 {
-  Dynamic  *d = DYN(an);
-  PeriScene s = an->sys->scene;
-  PeriNode  a;
-
-  PetscFunctionBeginUser;
-  if (d->implicit) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriSceneGetNode(s->root, "analysis", &a));
-  /* the default: 0.8 of the limit, shortened so that whole steps end at t_end */
-  if (d->dt <= 0) d->dt = d->t_end / PetscCeilReal(d->t_end / (0.8 * d->dt_limit));
-  PeriInputCheck(d->dt <= d->dt_limit, s, a, "dt", "%g is above the explicit stability limit 2/omega_max = %g (omega_max^2 <= %g by Gershgorin's bound on M^-1 K): use dt <= %g, or integrator: implicit", (double)d->dt, (double)d->dt_limit, (double)d->omega2_max, (double)d->dt_limit);
-  PetscFunctionReturn(PETSC_SUCCESS);
+  if (!d->implicit && d->dt <= 0) d->dt = d->t_end / PetscCeilReal(d->t_end / (0.8 * d->dt_limit));
 }
 
 /* The initial displacements: the pulse, and the prescribed values on the held DOFs. */
@@ -785,8 +776,8 @@ static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
   if (!given) PetscCall(TSSetMaxSteps(d->ts, (PetscInt)PetscCeilReal(d->t_end / d->dt - 1e-9)));
   PetscCall(PeriSceneGetNode(an->sys->scene->root, "analysis", &a));
-  /* -ts_dt too is held to the limit */
-  PeriInputCheck(d->implicit || d->dt <= d->dt_limit, an->sys->scene, a, "dt", "-ts_dt %g is above the explicit stability limit 2/omega_max = %g: use dt <= %g, or integrator: implicit", (double)d->dt, (double)d->dt_limit, (double)d->dt_limit);
+  /* analysis.dt or -ts_dt, held to the limit before any step */
+  PeriInputCheck(d->implicit || d->dt <= d->dt_limit, an->sys->scene, a, "dt", "%g (or -ts_dt) is above the explicit stability limit 2/omega_max = %g (omega_max^2 <= %g by Gershgorin's bound on M^-1 K): use dt <= %g, or integrator: implicit", (double)d->dt, (double)d->dt_limit, (double)d->omega2_max, (double)d->dt_limit);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -842,7 +833,7 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscTime(&t0));
   PetscCall(StabilityBound(an));
-  PetscCall(ChooseStep(an));
+  ChooseStep(d);
   PetscCall(InverseMass(an));
   if (!an->sys->fields.u) PetscCall(PeriSystemCreateVec(an->sys, &an->sys->fields.u));
   PetscCall(VecDuplicate(an->sys->fields.u, &d->tmp));
