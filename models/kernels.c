@@ -76,8 +76,8 @@ void PeriShearBondNuRange(PeriModel m, PetscReal *lo, PetscReal *hi)
  * (plane stress pmb: sqrt(4 pi G / (9 E delta))) and sqrt(10 G/(pi c delta^5)) = sqrt(5G/(9K delta)). */
 PetscReal PeriCriticalStretchSpring(PeriModel m, PetscReal c, PetscReal G)
 {
-  if (m->dim == 3) return PetscSqrtReal(10 * G / (PETSC_PI * c * PetscPowReal(m->delta, 5)));
-  return PetscSqrtReal(4 * G / (c * m->material.thickness * PetscPowReal(m->delta, 4)));
+  if (m->dim == 3) return PetscSqrtReal(10 * G / (PETSC_PI * c * PetscPowRealInt(m->delta, 5)));
+  return PetscSqrtReal(4 * G / (c * m->material.thickness * PetscPowRealInt(m->delta, 4)));
 }
 
 /* Linearized stretch s = e . (u_j - u_i) / |xi|. */

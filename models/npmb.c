@@ -50,8 +50,8 @@ static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal
 {
   const NPMB *np = (const NPMB *)m->data;
   PetscReal   c  = 0.5 * (np->c[b->i] + np->c[b->j]) * PeriLatticeFactor(np->lat, b);
-  if (m->dim == 3) return PetscSqrtReal(8 * G / (PETSC_PI * c * PetscPowReal(m->delta, 4)));
-  return PetscSqrtReal(3 * G / (c * m->material.thickness * PetscPowReal(m->delta, 3)));
+  if (m->dim == 3) return PetscSqrtReal(8 * G / (PETSC_PI * c * PetscPowRealInt(m->delta, 4)));
+  return PetscSqrtReal(3 * G / (c * m->material.thickness * PetscPowRealInt(m->delta, 3)));
 }
 
 static PetscErrorCode Destroy(PeriModel m)

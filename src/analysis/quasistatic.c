@@ -501,7 +501,7 @@ static PetscErrorCode Trial(PeriAnalysis an, const Settings *st, Loop *L, PetscR
       PetscCall(SolveAt(an, st, L, trial, total + s->broken, loose, s, end, why, len));
       if (*end != TRIAL_SETTLED) PetscFunctionReturn(PETSC_SUCCESS);
     }
-    PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, st->all, st->fraction, &nb));
+    PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, st->all, st->fraction, &nb, NULL));
     L->stale = (PetscBool)(nb > 0);
     if (!nb && !loose) {
       *end = TRIAL_SETTLED;

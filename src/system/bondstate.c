@@ -3,6 +3,15 @@
  * transient) breaks them here; the criteria themselves are in failure.c. */
 #include "perilin/private/system.h"
 
+/* The DOFs of a bond from i to j (local indices) in the local array u: i's, then j's. */
+static void BondDOFs(PetscInt bs, const PetscScalar *u, PetscInt i, PetscInt j, PetscReal ue[])
+{
+  for (PetscInt c = 0; c < bs; c++) {
+    ue[c]      = PetscRealPart(u[i * bs + c]);
+    ue[bs + c] = PetscRealPart(u[j * bs + c]);
+  }
+}
+
 /*@C
   PeriBondsBreak - evaluates every live bond of this rank against the criterion and breaks those past it (all, or
  * those within the top fraction of the worst index), subtracting their blocks from K; softening
@@ -10,14 +19,14 @@
  * softened by more than 1 %. With all, every bond past its criterion breaks; else those within
   the top fraction of [1, worst index]. Collective.
 @*/
-PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fraction, PetscInt *nbroken)
+PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fraction, PetscInt *nbroken, PetscReal *released)
 {
   PeriBonds        *b  = &sys->disc.bonds;
   PeriModel         m  = sys->model;
   const PetscInt    bs = m->dofs;
   PetscScalar      *u;
   PeriFailureCause *cause;
-  PetscReal        *index, *soft, worst = 0, threshold = 1;
+  PetscReal        *index, *soft, worst = 0, threshold = 1, energy = 0;
   PetscInt          mine = 0;
 
   PetscFunctionBeginUser;
@@ -26,20 +35,16 @@ PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fr
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PeriBondGeometry g;
-      PetscReal        ui[PERI_MAX_DOF], uj[PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
+      PetscReal        ue[2 * PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
       index[k] = 0;
       if (!b->live[k] || b->j[k] == i) continue;
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
-      for (PetscInt c = 0; c < bs; c++) {
-        ui[c] = PetscRealPart(u[i * bs + c]);
-        uj[c] = PetscRealPart(u[g.j * bs + c]);
-      }
-      m->ops.bond_measures(m, &g, ui, uj, meas);
+      BondDOFs(bs, u, i, g.j, ue);
+      m->ops.bond_measures(m, &g, ue, ue + bs, meas);
       index[k] = PeriBondFailureIndex(sys, &g, meas, &cause[k]);
       soft[k]  = b->intact ? PeriBondSoftening(sys, meas) : 1;
       worst    = PetscMax(worst, index[k]);
     }
-  PetscCall(PetscFree(u));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, sys->comm));
   /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
   if (!all && worst > 1) threshold = worst - fraction * (worst - 1);
@@ -50,7 +55,16 @@ PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fr
       if (!breaks && !(b->intact && soft[k] < b->intact[k])) continue;
       /* the bond's stiffness becomes new share / old share of itself (state-based models: K is
          reassembled from the synchronized families below) */
-      if (m->ops.bond_stiffness) PetscCall(PeriStiffnessScaleBond(sys, i, k, breaks ? 0 : soft[k] / b->intact[k]));
+      if (m->ops.bond_stiffness) {
+        PetscReal        ue[2 * PERI_MAX_DOF], e = 0;
+        PeriBondGeometry g;
+        if (released) {
+          PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+          BondDOFs(bs, u, i, g.j, ue);
+        }
+        PetscCall(PeriStiffnessScaleBond(sys, i, k, breaks ? 0 : soft[k] / b->intact[k], released ? ue : NULL, &e));
+        energy += e;
+      }
       if (breaks || soft[k] <= 0) {
         b->live[k]  = 0;
         b->cause[k] = (unsigned char)cause[k];
@@ -63,8 +77,10 @@ PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fr
       }
     }
   PetscCall(PetscFree3(index, soft, cause));
+  PetscCall(PetscFree(u));
   PetscCall(PeriStiffnessScaled(sys));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, sys->comm));
+  if (released) PetscCallMPI(MPI_Allreduce(&energy, released, 1, MPIU_REAL, MPI_SUM, sys->comm));
   if (*nbroken && !m->ops.bond_stiffness) {
     PetscCall(PeriFamilySync(sys));
     PetscCall(PeriSystemAssemble(sys));

@@ -89,20 +89,30 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
   PeriStiffnessScaleBond - scales the stiffness of bond k of owned particle i (live, not a
   self-image) by factor >= 0 in K: 0 breaks it (PeriOperatorScaleBond says what a matrix-free K's
   preconditioning matrix does). Call PeriStiffnessScaled after the last. Not collective.
+  With ue (the bond's DOFs: i's, then j's), *released is the strain energy the change takes out,
+  -(1/2) ue^T dK_e ue: summed over every change it is (1/2) u^T (K_before - K_after) u exactly,
+  without two products with K (the dynamic analysis' dissipated energy).
 @*/
-PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, PetscReal factor)
+PetscErrorCode PeriStiffnessScaleBond(PeriSystem sys, PetscInt i, PetscInt k, PetscReal factor, const PetscReal ue[], PetscReal *released)
 {
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
   PeriBondGeometry g;
   PetscInt         idx[2];
+  const PetscInt   n = 2 * sys->model->dofs;
 
   PetscFunctionBeginUser;
+  /* the matrix-free operator scales the bond's whole block; the matrix adds the change of it */
+  PetscCall(PeriBondStiffness(sys, i, k, sys->stiffness.op ? 1 : factor - 1, &g, Ke));
+  if (ue) {
+    PetscReal e = 0;
+    for (PetscInt r = 0; r < n; r++)
+      for (PetscInt c = 0; c < n; c++) e += ue[r] * Ke[r * n + c] * ue[c];
+    *released = -0.5 * (sys->stiffness.op ? factor - 1 : 1) * e;
+  }
   if (sys->stiffness.op) {
-    PetscCall(PeriBondStiffness(sys, i, k, 1, &g, Ke));
     PetscCall(PeriOperatorScaleBond(sys, i, k, factor, Ke));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(PeriBondStiffness(sys, i, k, factor - 1, &g, Ke)); /* the change of the bond's block */
   idx[0] = sys->disc.particles.global[i];
   idx[1] = sys->disc.particles.global[g.j];
   PetscCall(MatSetValuesBlocked(sys->stiffness.K, 2, idx, 2, idx, Ke, ADD_VALUES));

@@ -114,7 +114,7 @@ PETSC_EXTERN PetscErrorCode PeriDamage(PeriSystem, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriFamilySync(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriPieces(PeriSystem, PetscInt *, PetscInt **, PetscReal **, PetscInt *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriFailureAddFields(PeriSystem, PeriFieldList);
-PETSC_EXTERN PetscErrorCode PeriBondsBreak(PeriSystem, Vec, PetscBool, PetscReal, PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriBondsBreak(PeriSystem, Vec, PetscBool, PetscReal, PetscInt *, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriCheckpointCreate(PeriSystem, PeriCheckpoint *);
 PETSC_EXTERN PetscErrorCode PeriCheckpointSave(PeriSystem, PeriCheckpoint *);
 PETSC_EXTERN PetscErrorCode PeriCheckpointRestore(PeriSystem, PeriCheckpoint *, PetscBool, PetscBool);

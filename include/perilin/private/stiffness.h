@@ -50,7 +50,7 @@ PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscR
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
 PETSC_EXTERN PetscErrorCode PeriMatrixMB(Mat, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, PetscReal, Mat *);
-PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[], PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *);
 PETSC_EXTERN PetscErrorCode PeriOperatorPreconditioner(PeriSystem);
