@@ -25,6 +25,11 @@
 #     sqrt((K + 4G/3)/rho) = 10121 m/s for npmb and pmb (they give +5.1 % and -9.4 % here and
 #     converge to it as dx shrinks: docs/dynamics.md's table), the damage front behind it, the balance
 #     closes with 200,000 bonds broken (drift < 1 %), and 2 ranks break the same bonds.
+# 10. The cantilever lamina (mppd, with rotations) started at rest from its lowest mode shape, read
+#     back from the modal run's mode_01 (analysis.initial; the modal run on 2 ranks writes a .pvtu,
+#     read on 1 rank, and a .vtu read on 2): the tip oscillates at the modal f_1 (explicit: 1e-6),
+#     the implicit period error converges at second order (ratios 3-5 per halving of dt) and is the
+#     trapezoidal rule's within 10 %; a file of another body is refused naming a particle.
 # Usage: dynamics.sh PERILIN REPO
 set -u
 exe=${1:?usage: dynamics.sh PERILIN REPO}
@@ -61,6 +66,19 @@ eoi=$repo/examples/dynamics/eoi.yaml
 run eoi1 "$exe" "$eoi"
 run eoi2 mpiexec --oversubscribe -n 2 "$exe" "$eoi"
 run eoi_pmb "$exe" "$eoi" -model_type pmb
+run lmodal1 "$exe" "$repo/examples/lamina/modal.yaml" -analysis_nev 2
+run lmodal2 mpiexec --oversubscribe -n 2 "$exe" "$repo/examples/lamina/modal.yaml" -analysis_nev 2
+lam=$repo/tests/scenes/lamina_vibration.yaml
+run lvib_e mpiexec --oversubscribe -n 2 "$exe" "$lam" -analysis_initial_file "$tmp/lmodal1/mode_01.vtu" -analysis_t_end 1.3e-3 -analysis_energy_every 100
+for dt in 2.4e-5 4.8e-5 9.6e-5; do
+  run lvib_i$dt "$exe" "$lam" -analysis_initial_file "$tmp/lmodal2/mode_01.pvtu" -analysis_t_end 1.3e-3 -analysis_integrator implicit -analysis_dt $dt
+done
+"$exe" "$lam" -analysis_initial_file "$tmp/lmodal1/mode_01.vtu" -grid_spacing 0.02 -output_dir "$tmp/lvib_bad" > "$tmp/lvib_bad.log" 2>&1 < /dev/null
+if [ $? -ne 0 ] && grep -q "mode_01.vtu holds 3600 particles, the body 900" "$tmp/lvib_bad.log" && [ ! -e "$tmp/lvib_bad" ]; then
+  echo "ok: a mode file of another body is refused: $(grep -o 'mode_01.vtu holds[^:]*' "$tmp/lvib_bad.log")"
+else
+  echo "FAIL: a mode file of another body was not refused"; tail -3 "$tmp/lvib_bad.log"; fail=1
+fi
 # 4. the refusal: exit 1, the limit named, no output
 "$exe" "$pulse" -analysis_dt 1 -output_dir "$tmp/refused" > "$tmp/refused.log" 2>&1 < /dev/null
 code=$?
@@ -137,6 +155,18 @@ for name in ("eoi1", "eoi_pmb"):
     check(abs(e["wave_front_speed"] / cp - 1) < 0.10, f"{name}: EOI wave front at {e['wave_front_speed']:.0f} m/s, within 10 % of c_P = {cp:.0f} ({100*(e['wave_front_speed']/cp-1):+.1f} %; the experiment: 9367)")
     check(0 < e["damage_front"] < e["wave_front"], f"{name}: the damage front ({1e3*e['damage_front']:.2f} mm) behind the wave front ({1e3*e['wave_front']:.2f} mm) at 8.7 us")
     check(e["broken_bonds"] > 100000 and e["energy_drift"] < 0.01, f"{name}: {e['broken_bonds']} bonds broken, energy drift {e['energy_drift']:.2g} < 0.01")
+f1 = json.load(open(f"{tmp}/lmodal1/summary.json"))["modal"]["modes"][0]["f_hz"]
+def lperiod(name):
+    rows = [(r["time"], r["probe_u"]) for r in history(name)]
+    z = [t0 + (t1 - t0) * u0 / (u0 - u1) for (t0, u0), (t1, u1) in zip(rows, rows[1:]) if (u0 > 0) != (u1 > 0)]
+    return 2 * (z[-1] - z[0]) / (len(z) - 1)
+fe = 1 / lperiod("lvib_e")
+check(abs(fe / f1 - 1) < 1e-6, f"lamina from its mode_01 (explicit, 2 ranks): the tip at {fe:.9g} Hz, the modal f_1 = {f1:.9g} ({fe/f1-1:+.1e})")
+e = {dt: lperiod(f"lvib_i{dt}") * f1 - 1 for dt in ("2.4e-5", "4.8e-5", "9.6e-5")}
+r1, r2 = e["9.6e-5"] / e["4.8e-5"], e["4.8e-5"] / e["2.4e-5"]
+check(3 < r1 < 5 and 3 < r2 < 5, f"lamina implicit period error {e['9.6e-5']:.3g}, {e['4.8e-5']:.3g}, {e['2.4e-5']:.3g} at dt 9.6e-5, 4.8e-5, 2.4e-5: ratios {r1:.2f}, {r2:.2f} (second order: 4)")
+x = math.pi * f1 * 9.6e-5
+check(abs(e["9.6e-5"] / (x / math.atan(x) - 1) - 1) < 0.1, f"lamina implicit period error at dt 9.6e-5: {e['9.6e-5']:.4g}, the trapezoidal rule's {x / math.atan(x) - 1:.4g}")
 e1, e2 = dyn("eoi1"), dyn("eoi2")
 check(e1["broken_bonds"] == e2["broken_bonds"] and abs(e1["dissipated_energy"] / e2["dissipated_energy"] - 1) < 1e-10, f"EOI on 2 ranks = 1 rank: {e2['broken_bonds']} bonds, dissipated {e2['dissipated_energy']:.12g} vs {e1['dissipated_energy']:.12g}")
 sys.exit(bad)

@@ -21,8 +21,10 @@ typedef struct {
   /* analysis.* */
   PetscBool implicit;
   PetscReal t_end, dt, energy_tol, rho_inf;
-  PetscInt  energy_every;               /* the energies, the balance and a history row every k steps */
-  PetscBool pulse;                      /* analysis.pulse given */
+  PetscInt  energy_every;                                                   /* the energies, the balance and a history row every k steps */
+  PetscBool pulse;                                                          /* analysis.pulse given */
+  char      initial_file[PETSC_MAX_PATH_LEN], initial_array[PERI_NAME_LEN]; /* analysis.initial: "" when not given */
+  PetscReal initial_scale;
   PetscReal pulse_A, pulse_x0, pulse_w; /* u = A exp(-((x - x0)/w)^2), or A cos(pi (x - x0)/w), along the pulse axis */
   PetscInt  profile;                    /* 0 gaussian, 1 cosine */
   PetscReal velocity[3];                /* analysis.velocity.value, on the particles of region */
@@ -64,6 +66,13 @@ static const PeriKey dyn_keys[] = {
     {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
     {"velocity", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial velocity of the particles of a region (a projectile, an impactor)"},
     {"fronts", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the wave front and the damage front along an axis, in history.csv and (fitted speeds) summary.json"},
+    {"initial", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement read from a particles file perilin wrote of the same body (a modal run's mode_NN.vtu, an earlier state), added to the pulse"},
+    {NULL},
+};
+static const PeriKey dyn_initial_keys[] = {
+    {"file", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the .vtu or .pvtu, relative to the scene file; particles are matched by position"},
+    {"array", PERI_KEY_STRING, "displacement", NULL, NULL, NULL, "the vector array of the translations; the other DOFs from ARRAY_<component> (plain <component> for displacement: theta)"},
+    {"scale", PERI_KEY_REAL, "1", NULL, NULL, NULL, "a factor on the field (a mode shape is written with max |u| = 1)"},
     {NULL},
 };
 static const PeriKey dyn_pulse_keys[] = {
@@ -103,6 +112,7 @@ static const PeriSchema dyn_schema[] = {
     {"analysis.amplitude", dyn_amplitude_keys},
     {"analysis.velocity", dyn_velocity_keys},
     {"analysis.fronts", dyn_fronts_keys},
+    {"analysis.initial", dyn_initial_keys},
     {"output", dyn_output_keys},
     {NULL},
 };
@@ -149,6 +159,24 @@ static PetscErrorCode ReadFronts(Dynamic *d, PeriScene s, PeriNode a)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* analysis.initial: the file must exist now, before any particle does. */
+static PetscErrorCode ReadInitial(Dynamic *d, PeriScene s, PeriNode a)
+{
+  PeriNode  f;
+  PetscBool exists;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, a, "initial", PETSC_FALSE, &f));
+  if (!f) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(CheckOwnSection(s, f, "analysis.initial"));
+  PetscCall(PeriParticlesInputPath(s, f, "file", d->initial_file, sizeof(d->initial_file)));
+  PetscCall(PetscTestFile(d->initial_file, 'r', &exists));
+  PeriInputCheck(exists, s, f, "file", "cannot read %s", d->initial_file);
+  PetscCall(PeriSceneGetString(s, f, "array", PETSC_FALSE, d->initial_array, sizeof(d->initial_array), NULL));
+  PetscCall(PeriSceneGetReal(s, f, "scale", PETSC_FALSE, &d->initial_scale, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* analysis.* before any particle exists. */
 static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNode a)
 {
@@ -188,6 +216,7 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
     PetscCall(PeriSceneGetRealArray(s, d->vnode, "value", PETSC_TRUE, 1, 3, d->velocity, &n));
   }
   PetscCall(ReadFronts(d, s, a));
+  PetscCall(ReadInitial(d, s, a));
   PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
   if (amp) {
     PetscCall(CheckOwnSection(s, amp, "analysis.amplitude"));
@@ -249,7 +278,8 @@ static void ChooseStep(Dynamic *d)
   if (!d->implicit && d->dt <= 0) d->dt = d->t_end / PetscCeilReal(d->t_end / (0.8 * d->dt_limit));
 }
 
-/* The initial displacements: the pulse, and the prescribed values on the held DOFs. */
+/* The initial displacements: analysis.initial's field, the pulse added, and the prescribed values
+ * on the held DOFs. */
 static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
 {
   Dynamic       *d   = DYN(an);
@@ -259,12 +289,13 @@ static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
 
   PetscFunctionBeginUser;
   PetscCall(VecSet(u, 0));
+  if (d->initial_file[0]) PetscCall(PeriSystemReadDOFs(sys, d->initial_file, d->initial_array, d->initial_scale, u));
   if (d->pulse) {
     const PetscInt c = PeriModelTranslation(sys->model, d->pulse_axis);
     PetscCall(VecGetArray(u, &a));
     for (PetscInt i = 0; i < nloc; i++) {
       const PetscReal x = sys->disc.particles.x[3 * i + d->pulse_axis];
-      a[i * bs + c]     = d->pulse_A * (d->profile ? PetscCosReal(PETSC_PI * (x - d->pulse_x0) / d->pulse_w) : PetscExpReal(-PetscSqr((x - d->pulse_x0) / d->pulse_w)));
+      a[i * bs + c] += d->pulse_A * (d->profile ? PetscCosReal(PETSC_PI * (x - d->pulse_x0) / d->pulse_w) : PetscExpReal(-PetscSqr((x - d->pulse_x0) / d->pulse_w)));
     }
     PetscCall(VecRestoreArray(u, &a));
   }

@@ -60,6 +60,7 @@ PETSC_EXTERN PetscErrorCode PeriSystemEvaluateStress(PeriSystem, const PetscScal
 PETSC_EXTERN PetscErrorCode PeriSystemAddFields(PeriSystem, PeriFieldList);
 PETSC_EXTERN PetscErrorCode PeriSystemFieldListCreate(PeriSystem, PeriFieldList *);
 PETSC_EXTERN PetscErrorCode PeriSystemWriteParticles(PeriSystem, const PetscReal *, const char[], const char[]);
+PETSC_EXTERN PetscErrorCode PeriSystemReadDOFs(PeriSystem, const char[], const char[], PetscReal, Vec);
 PETSC_EXTERN PetscErrorCode PeriProbesSummary(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryFields(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriFieldsDestroy(PeriFields *);

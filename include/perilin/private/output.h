@@ -28,11 +28,25 @@ PETSC_EXTERN PetscErrorCode      PeriWriteVTU(PeriFieldList, const char[]);
 PETSC_EXTERN PetscErrorCode      PeriWriteParticles(MPI_Comm, PeriFieldList, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode      PeriParticlesFileName(MPI_Comm, const char[], char[], size_t);
 PETSC_EXTERN PetscErrorCode      PeriWritePVD(const char[], PetscInt, const PetscReal[], const char *const[]);
-PETSC_EXTERN PetscErrorCode      PeriOutputDirCreate(const char[]);
-PETSC_EXTERN PetscErrorCode      PeriFileCommit(const char[], const char[]);
-PETSC_EXTERN PetscErrorCode      PeriFileOpenTemporary(const char[], char[], size_t, FILE **);
-PETSC_EXTERN PetscErrorCode      PeriFileCloseCommit(FILE *, const char[], const char[], int);
-PETSC_EXTERN PetscErrorCode      PeriOutputSetOpen(MPI_Comm, char[], size_t, char[], size_t);
-PETSC_EXTERN PetscErrorCode      PeriOutputSetCommit(MPI_Comm, const char[], const char[]);
-PETSC_EXTERN void                PeriOutputSetDiscard(void);
-PETSC_EXTERN PetscErrorCode      PeriOutputSetAddNames(const char *const[]);
+/* What PeriReadParticles reads back from a .vtu or .pvtu perilin wrote: the points and the
+   Float64 point arrays (src/output/vturead.c). */
+#define PERI_VTU_MAX_ARRAYS 32
+typedef struct {
+  PetscInt   n;      /* points */
+  PetscReal *points; /* n x 3 */
+  PetscInt   narrays;
+  char       names[PERI_VTU_MAX_ARRAYS][PERI_NAME_LEN];
+  PetscInt   ncomp[PERI_VTU_MAX_ARRAYS];
+  PetscReal *data[PERI_VTU_MAX_ARRAYS]; /* n x ncomp */
+} PeriVTUData;
+PETSC_EXTERN PetscErrorCode PeriReadParticles(const char[], PeriVTUData *);
+PETSC_EXTERN PetscInt       PeriVTUDataFind(const PeriVTUData *, const char[]);
+PETSC_EXTERN PetscErrorCode PeriVTUDataDestroy(PeriVTUData *);
+PETSC_EXTERN PetscErrorCode PeriOutputDirCreate(const char[]);
+PETSC_EXTERN PetscErrorCode PeriFileCommit(const char[], const char[]);
+PETSC_EXTERN PetscErrorCode PeriFileOpenTemporary(const char[], char[], size_t, FILE **);
+PETSC_EXTERN PetscErrorCode PeriFileCloseCommit(FILE *, const char[], const char[], int);
+PETSC_EXTERN PetscErrorCode PeriOutputSetOpen(MPI_Comm, char[], size_t, char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriOutputSetCommit(MPI_Comm, const char[], const char[]);
+PETSC_EXTERN void           PeriOutputSetDiscard(void);
+PETSC_EXTERN PetscErrorCode PeriOutputSetAddNames(const char *const[]);
