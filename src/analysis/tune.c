@@ -123,7 +123,7 @@ static PetscErrorCode SetFromScene_Tune(PeriAnalysis an, PeriScene s, PeriNode a
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The built-in list: CG with GAMG, hypre's BoomerAMG and Jacobi, GMRES with block Jacobi, a
+/* The built-in list: CG with GAMG, hypre's BoomerAMG, Jacobi and block Jacobi (ILU(0) blocks: K is symmetric, so CG, not GMRES), a
  * direct Cholesky (MUMPS's on several ranks) on an assembled K, and GAMG and Jacobi on a
  * matrix-free K where the model and scene allow one. */
 static PetscErrorCode DefaultConfigurations(PeriAnalysis an)
@@ -141,7 +141,7 @@ static PetscErrorCode DefaultConfigurations(PeriAnalysis an)
 #endif
   PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type cg -pc_type jacobi%s", as));
   if (as[0]) PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type cg -pc_type jacobi -solver_operator matrix_free"));
-  PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type gmres -pc_type bjacobi%s", as));
+  PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type cg -pc_type bjacobi%s", as));
 #if !defined(PETSC_HAVE_MUMPS)
   if (an->sys->size == 1)
 #endif
