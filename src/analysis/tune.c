@@ -26,6 +26,7 @@ typedef struct {
   PetscReal          operator_s, setup_s, solve_s; /* building the operator, the PC's set-up, KSPSolve */
   PetscReal          memory_mb;                    /* heap held once solved, above the level before the operator, all ranks */
   PetscReal          residual, residual_tol;       /* true relative residual and the largest accepted */
+  PetscReal          u_max;                        /* max |u| over the DOFs: the solutions compared */
 } TuneRow;
 
 typedef struct {
@@ -230,6 +231,7 @@ static PetscErrorCode SolveOnce(PeriAnalysis an, PetscInt nhold, const PetscInt 
   heap1 = PeriHeapInUseMB() - heap0;
   PetscCallMPI(MPI_Allreduce(&heap1, &row->memory_mb, 1, MPIU_REAL, MPI_SUM, an->comm));
   PetscCall(PeriStaticConverged(sys, ksp, reason, &row->converged));
+  PetscCall(VecNorm(sys->fields.u, NORM_INFINITY, &row->u_max));
   PetscCall(KSPDestroy(&ksp));
   row->setup_s      = sys->fields.solve.setup_s;
   row->solve_s      = sys->fields.solve.ksp_solve_s;
@@ -384,12 +386,12 @@ static PetscErrorCode Files_Tune(PeriAnalysis an, const char dir[])
   if (an->rank || !T || !T->ran) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/tune.csv", dir));
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  bad |= fprintf(fp, "rank,configuration,converged,iterations,operator_s,setup_s,solve_s,total_s,memory_mb,residual,residual_tol,reason\n") < 0;
+  bad |= fprintf(fp, "rank,configuration,converged,iterations,operator_s,setup_s,solve_s,total_s,memory_mb,residual,residual_tol,u_max,reason\n") < 0;
   for (PetscInt i = 0; i < T->ran; i++) {
     const TuneRow *r = &T->rows[T->order[i]];
     bad |= fprintf(fp, "%" PetscInt_FMT ",", i + 1) < 0;
     bad |= WriteQuoted(fp, r->config);
-    bad |= fprintf(fp, ",%s,%" PetscInt_FMT ",%.6f,%.6f,%.6f,%.6f,%.3f,%.6e,%.3e,", r->converged ? "true" : "false", r->iterations, (double)r->operator_s, (double)r->setup_s, (double)r->solve_s, (double)Total(r), (double)r->memory_mb, (double)r->residual, (double)r->residual_tol) < 0;
+    bad |= fprintf(fp, ",%s,%" PetscInt_FMT ",%.6f,%.6f,%.6f,%.6f,%.3f,%.6e,%.3e,%.10e,", r->converged ? "true" : "false", r->iterations, (double)r->operator_s, (double)r->setup_s, (double)r->solve_s, (double)Total(r), (double)r->memory_mb, (double)r->residual, (double)r->residual_tol, (double)r->u_max) < 0;
     bad |= WriteQuoted(fp, r->reason);
     bad |= fputc('\n', fp) == EOF;
   }
@@ -419,6 +421,7 @@ static PetscErrorCode Summary_Tune(PeriAnalysis an, PeriJSON j)
     PetscCall(PeriJSONReal(j, "solve_s", r->solve_s));
     PetscCall(PeriJSONReal(j, "memory_mb", r->memory_mb));
     PetscCall(PeriJSONReal(j, "residual", r->residual));
+    PetscCall(PeriJSONReal(j, "u_max", r->u_max));
     PetscCall(PeriJSONEndObject(j));
   }
   PetscCall(PeriJSONEndArray(j));
