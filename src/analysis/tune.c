@@ -10,7 +10,6 @@
  * line, no configuration leaks into the next, and the program's unused-option check sees only the
  * command line's (a global option a configuration read counts as read). */
 #include "perilin/private/analysis.h"
-#include "perilin/private/sys.h"
 #include <ctype.h>
 
 #define PERI_TUNE_REASON_LEN 256
@@ -346,9 +345,11 @@ static PetscErrorCode Run_Tune(PeriAnalysis an)
   PetscFunctionBeginUser;
   PetscCall(VecDestroy(&an->sys->fields.u));
   PetscCall(PeriStaticPieces(an->sys, &nhold, &hold, &held));
-  for (T->ran = 0; T->ran < T->n && !an->sys->run.interrupted; T->ran++) {
+  /* a configuration a signal cut short is no measurement: the rows are those that finished */
+  for (T->ran = 0; T->ran < T->n; T->ran++) {
     PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_ANALYSIS, "configuration %" PetscInt_FMT "/%" PetscInt_FMT, T->ran + 1, T->n));
     PetscCall(MeasureConfiguration(an, T->ran, nhold, hold, held));
+    if (an->sys->run.interrupted) break;
   }
   PetscCall(Rank(T));
   if (!an->sys->run.interrupted) {
