@@ -293,11 +293,9 @@ static PetscErrorCode MeasureConfiguration(PeriAnalysis an, PetscInt k, PetscInt
   TuneRow   *row = &T->rows[k];
   PetscReal *t;
 
-  PetscInt n = 0;
-
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(3 * T->repeat, &t));
-  for (PetscInt r = 0; r < T->repeat; r++, n++) {
+  for (PetscInt r = 0; r < T->repeat; r++) {
     PetscCall(RunConfiguration(an, row->config, nhold, hold, held, row));
     t[r]                 = row->operator_s;
     t[T->repeat + r]     = row->setup_s;
@@ -306,9 +304,9 @@ static PetscErrorCode MeasureConfiguration(PeriAnalysis an, PetscInt k, PetscInt
     if (an->sys->run.interrupted || row->refused) break; /* refused: nothing to repeat */
   }
   if (!an->sys->run.interrupted && !row->refused) {
-    PetscCall(Median(n, t, &row->operator_s));
-    PetscCall(Median(n, t + T->repeat, &row->setup_s));
-    PetscCall(Median(n, t + 2 * T->repeat, &row->solve_s));
+    PetscCall(Median(T->repeat, t, &row->operator_s));
+    PetscCall(Median(T->repeat, t + T->repeat, &row->setup_s));
+    PetscCall(Median(T->repeat, t + 2 * T->repeat, &row->solve_s));
   }
   PetscCall(PetscFree(t));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -324,7 +322,7 @@ static PetscErrorCode Rank(Tune *T)
   PetscCall(PetscMalloc1(T->ran, &key));
   for (PetscInt k = 0; k < T->ran; k++) {
     T->order[k] = k;
-    key[k]      = T->rows[k].converged ? Total(&T->rows[k]) : PETSC_MAX_REAL / 2 + k;
+    key[k]      = T->rows[k].converged ? Total(&T->rows[k]) : 1e30 + 1e15 * k; /* after every time, in their order */
     nc += T->rows[k].converged;
   }
   PetscCall(PetscSortRealWithArrayInt(T->ran, key, T->order));
