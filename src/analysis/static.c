@@ -36,13 +36,9 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   PetscCall(PetscTime(&t0));
   PetscCall(VecDestroy(&an->sys->fields.u));
   {
-    /* pieces cut off by cracks: held in place when unloaded, an error when loaded */
-    PetscInt   nhold, npieces, *hold;
+    PetscInt   nhold, *hold;
     PetscReal *held;
-    PetscBool  lost;
-    PetscCall(PeriPieces(an->sys, &nhold, &hold, &held, &npieces, &lost));
-    PetscCheck(!lost, an->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", an->sys->scene->file, npieces);
-    if (npieces > 1) PetscCall(PetscPrintf(an->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
+    PetscCall(PeriStaticPieces(an->sys, &nhold, &hold, &held));
     /* the solve reads K only: the bonds' geometry makes room for GAMG, and comes back after it */
     PetscCall(PeriSystemReleaseBondGeometry(an->sys, &released));
     PetscCall(PeriStaticSolve(an->sys, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));

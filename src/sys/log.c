@@ -18,6 +18,22 @@ PetscReal PeriPeakMemoryMB(void)
   return (PetscReal)ru.ru_maxrss / 1024.0; /* kilobytes on Linux */
 }
 
+/* The heap this process has in use now (MB): glibc's count of allocated bytes, which unlike the
+ * resident memory falls when arrays are freed (the libraries keep freed memory resident, see
+ * PeriMallocInitialize), so that the memory of one computation among several can be told. Elsewhere
+ * PETSc's resident-memory count. Not collective. */
+PetscReal PeriHeapInUseMB(void)
+{
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 33)
+  struct mallinfo2 mi = mallinfo2();
+  return (PetscReal)(mi.uordblks + mi.hblkhd) / 1048576.0;
+#else
+  PetscLogDouble mem = 0;
+  if (PetscMemoryGetCurrentUsage(&mem)) return 0;
+  return (PetscReal)mem / 1048576.0;
+#endif
+}
+
 /*@C
   PeriMallocInitialize - gives freed arrays back to the system. Constructors of the libraries
   PETSc loads turn off glibc's mmap and heap trimming (M_MMAP_MAX 0 from Debian's libsuperlu_dist,

@@ -424,8 +424,9 @@ static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, P
  * GAMG's Chebyshev smoother fails (SmootherFallback). */
 static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, Vec b, KSPConvergedReason *reason)
 {
-  PetscBool retry, factor;
-  PC        pc;
+  PetscBool      retry, factor;
+  PC             pc;
+  PetscLogDouble t0, t1, t2;
 
   PetscFunctionBeginUser;
   if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
@@ -435,6 +436,10 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, 
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, ""));
   PetscCall(PeriBLASThreads(factor));
   PetscCall(PeriProgressUpdate(sys->run.progress, PERI_PROGRESS_PHASE, "solve"));
+  /* the PC's set-up on its own, so that its cost and the iterations' can be told apart (tune) */
+  PetscCall(PetscTime(&t0));
+  PetscCall(KSPSetUp(*ksp));
+  PetscCall(PetscTime(&t1));
   PetscCall(KSPSolve(*ksp, b, sys->fields.u));
   PetscCall(PeriBLASThreads(PETSC_FALSE));
   PetscCall(KSPGetConvergedReason(*ksp, reason));
@@ -443,6 +448,9 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, 
     PetscCall(KSPSolve(*ksp, b, sys->fields.u));
     PetscCall(KSPGetConvergedReason(*ksp, reason));
   }
+  PetscCall(PetscTime(&t2));
+  sys->fields.solve.setup_s += t1 - t0;
+  sys->fields.solve.ksp_solve_s += t2 - t1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -522,6 +530,7 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
 {
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
+  sys->fields.solve.setup_s = sys->fields.solve.ksp_solve_s = 0;
   PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));
   if (*reason == KSP_DIVERGED_ITS && DefaultJacobi(sys)) {
     PetscCall(PetscPrintf(sys->comm, "perilin: note: CG + Jacobi did not converge in %d iterations; GAMG on the short-range stiffness goes on from there\n", PERI_JACOBI_BUDGET));
@@ -532,6 +541,22 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
     PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));
   }
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriStaticPieces - the DOFs a static solve holds (PeriPieces): pieces cut off by cracks are held
+  in place when unloaded, an error when loaded. Free hold and held with PetscFree2. Collective.
+@*/
+PetscErrorCode PeriStaticPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold, PetscReal **held)
+{
+  PetscInt  npieces;
+  PetscBool lost;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriPieces(sys, nhold, hold, held, &npieces, &lost));
+  PetscCheck(!lost, sys->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", sys->scene->file, npieces);
+  if (npieces > 1) PetscCall(PetscPrintf(sys->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -4,21 +4,24 @@
  * operator.c, the checked solve in solve.c. */
 #include "perilin/private/system.h"
 
+/* Why K cannot be matrix-free for this system and analysis, or NULL when it can. */
+const char *PeriMatrixFreeWhyNot(PeriSystem sys)
+{
+  if (!sys->model->central_force) return "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
+  if (!sys->stiffness.needs.matrix_free) return "the analysis needs K's entries (matrix_free serves the static, quasi-static and tune analyses)";
+  if (sys->conditions.layers.T) return "fictitious layers eliminate K's rows through its entries";
+  return NULL;
+}
+
 /* solver.operator: matrix_free applies to central-force models solved once as assembled (the
  * static analysis), without fictitious layers; auto takes it with GAMG (the default), where
  * it wins (docs/performance.md), and assembled K elsewhere. */
 static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 {
-  const char *why = NULL;
+  const char *why = PeriMatrixFreeWhyNot(sys);
   PeriNode    node;
 
   PetscFunctionBeginUser;
-  if (!sys->model->central_force)
-    why = "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
-  else if (!sys->stiffness.needs.matrix_free)
-    why = "the analysis needs K's entries (matrix_free serves the static and quasi-static analyses)";
-  else if (sys->conditions.layers.T)
-    why = "fictitious layers eliminate K's rows through its entries";
   *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->stiffness.operator_kind == PERI_OPERATOR_AUTO));
   if (*mf && sys->stiffness.operator_kind == PERI_OPERATOR_AUTO) {
     /* the short-range stiffness serves AMG, the diagonal Jacobi; another -pc_type (a

@@ -25,13 +25,14 @@ typedef struct {
 typedef struct {
   char      ksp_type[64], pc_type[64], converged_reason[64]; /* "" until a solve ran */
   PetscInt  iterations;
-  PetscReal residual_norm;  /* true relative residual of the last solve */
-  PetscReal residual_tol;   /* the largest accepted (solver.residual_tol or its default) */
-  PetscBool symmetric;      /* the operator solved was symmetric */
-  PetscInt  free_modes;     /* rigid motions left free with balanced loads: solved orthogonal to them */
-  PetscReal load_imbalance; /* share of the load along those motions, removed */
-  PetscReal rhs_norm;       /* ||b|| of the last solve in the scene's units (the residual's scale) */
-  PetscReal load_factor;    /* the load factor it was solved at */
+  PetscReal setup_s, ksp_solve_s; /* of the last PeriStaticSolve: the KSP's (and PC's) set-up, then KSPSolve */
+  PetscReal residual_norm;        /* true relative residual of the last solve */
+  PetscReal residual_tol;         /* the largest accepted (solver.residual_tol or its default) */
+  PetscBool symmetric;            /* the operator solved was symmetric */
+  PetscInt  free_modes;           /* rigid motions left free with balanced loads: solved orthogonal to them */
+  PetscReal load_imbalance;       /* share of the load along those motions, removed */
+  PetscReal rhs_norm;             /* ||b|| of the last solve in the scene's units (the residual's scale) */
+  PetscReal load_factor;          /* the load factor it was solved at */
 } PeriSolveInfo;
 
 /* The present state and what is derived from it. */

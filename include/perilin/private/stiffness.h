@@ -44,6 +44,7 @@ typedef struct {
 } PeriStiffness;
 
 PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
+PETSC_EXTERN const char    *PeriMatrixFreeWhyNot(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriBondStiffness(PeriSystem, PetscInt, PetscInt, PetscReal, PeriBondGeometry *, PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
@@ -62,6 +63,7 @@ PETSC_EXTERN PetscErrorCode PeriOperatorScaleBond(PeriSystem, PetscInt, PetscInt
 PETSC_EXTERN PetscErrorCode PeriOperatorScaled(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriOperatorDestroy(PeriOperator *);
 PETSC_EXTERN PetscErrorCode PeriStaticSolve(PeriSystem, KSP *, PetscReal, PetscBool, PetscInt, const PetscInt[], const PetscReal[], KSPConvergedReason *);
+PETSC_EXTERN PetscErrorCode PeriStaticPieces(PeriSystem, PetscInt *, PetscInt **, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriStaticCheckConverged(PeriSystem, KSPConvergedReason);
 PETSC_EXTERN PetscErrorCode PeriStaticConverged(PeriSystem, KSP, KSPConvergedReason, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriStaticDefaultMatType(char[], size_t);
