@@ -12,25 +12,34 @@
 #include <petscts.h>
 
 static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
-static const char *const dyn_amplitudes[]  = {"step", "ramp", "sine", NULL};
 static const char *const dyn_profiles[]    = {"gaussian", "cosine", NULL};
 
+#define PERI_DYN_MAX_TERMS  16 /* load terms with amplitudes of their own, plus one */
 #define DYN_HISTORY_COLUMNS 11 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe, wave front, damage front */
 
 typedef struct {
   /* analysis.* */
-  PetscBool implicit;
-  PetscReal t_end, dt, energy_tol, rho_inf;
-  PetscInt  energy_every;                                                   /* the energies, the balance and a history row every k steps */
-  PetscBool pulse;                                                          /* analysis.pulse given */
-  char      initial_file[PETSC_MAX_PATH_LEN], initial_array[PERI_NAME_LEN]; /* analysis.initial: "" when not given */
-  PetscReal initial_scale;
-  PetscReal pulse_A, pulse_x0, pulse_w; /* u = A exp(-((x - x0)/w)^2), or A cos(pi (x - x0)/w), along the pulse axis */
-  PetscInt  profile;                    /* 0 gaussian, 1 cosine */
-  PetscReal velocity[3];                /* analysis.velocity.value, on the particles of region */
-  PeriNode  vnode;                      /* analysis.velocity, or NULL */
-  PetscInt  pulse_axis, shape;          /* axis; amplitude shape of the loads in time */
-  PetscReal rise, period;               /* ramp: rise time; sine: period */
+  PetscBool      implicit;
+  PetscReal      t_end, dt, energy_tol, rho_inf;
+  PetscInt       energy_every;                                                   /* the energies, the balance and a history row every k steps */
+  PetscBool      pulse;                                                          /* analysis.pulse given */
+  char           initial_file[PETSC_MAX_PATH_LEN], initial_array[PERI_NAME_LEN]; /* analysis.initial: "" when not given */
+  PetscReal      initial_scale;
+  PetscReal      pulse_A, pulse_x0, pulse_w; /* u = A exp(-((x - x0)/w)^2), or A cos(pi (x - x0)/w), along the pulse axis */
+  PetscInt       profile;                    /* 0 gaussian, 1 cosine */
+  PetscReal      velocity[3];                /* analysis.velocity.value, on the particles of region */
+  PeriNode       vnode;                      /* analysis.velocity, or NULL */
+  PetscInt       pulse_axis;                 /* the pulse's axis */
+  PeriAmplitude  amp;                        /* analysis.amplitude: of every load without one of its own */
+  PetscInt       nloads;                     /* loads.<k> in the scene */
+  PeriAmplitude *load_amp;                   /* loads.<k>.amplitude (shape step where absent) */
+  PetscBool     *own_amp;                    /* loads.<k> has an amplitude of its own */
+  /* the load in time, f(t) = sum of a_k(t) f_k over the terms: the loads without an amplitude of
+     their own under analysis.amplitude, then one term per load with its own */
+  PetscInt              nterms;
+  const PeriAmplitude **term_amp;
+  Vec                  *term_f, ft;
+  PetscReal            *term_prev; /* a_k at the last step, for the work */
   /* the run */
   PetscBool  started;
   PetscReal  omega2_max, dt_limit; /* Gershgorin's bound of M^-1 K, and 2/omega_max */
@@ -41,7 +50,7 @@ typedef struct {
   PetscInt   front_axis;
   PetscReal  front_origin, front_speed, front_damage; /* origin along the axis; the thresholds of speed and damage */
   PetscReal  wave_front, damage_front;                /* the farthest distance from the origin along the axis of a particle past them */
-  PetscReal  t_prev, amp_prev, pulse_pos, probe_u;    /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
+  PetscReal  t_prev, pulse_pos, probe_u;              /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
   PetscInt   nhist, cap, nsnap;
   PetscReal *hist, *snap_time; /* rank 0 keeps them; every rank counts */
   Vec        minv, uprev, tmp; /* 1/m per DOF (0 on held DOFs), the last step's u, work */
@@ -83,12 +92,6 @@ static const PeriKey dyn_pulse_keys[] = {
     {"profile", PERI_KEY_CHOICE, "gaussian", NULL, NULL, dyn_profiles, "gaussian: amplitude exp(-((x - center)/width)^2); cosine: amplitude cos(pi (x - center)/width), a standing wave (with center 0 and width the bar's length, a free bar's lowest longitudinal mode)"},
     {NULL},
 };
-static const PeriKey dyn_amplitude_keys[] = {
-    {"shape", PERI_KEY_CHOICE, "step", NULL, NULL, dyn_amplitudes, "step: 1 from t = 0; ramp: linear from 0 to 1 at rise_time; sine: sin(2 pi t / period)"},
-    {"rise_time", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "ramp: when the loads reach their value"},
-    {"period", PERI_KEY_REAL, NULL, "(0, inf)", "[time]", NULL, "sine: the period"},
-    {NULL},
-};
 static const PeriKey dyn_velocity_keys[] = {
     {"region", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the region whose particles move at t = 0"},
     {"value", PERI_KEY_REALS, "required", NULL, "[length/time]", NULL, "their velocity, one number per dimension"},
@@ -109,7 +112,7 @@ static const PeriKey dyn_output_keys[] = {
 static const PeriSchema dyn_schema[] = {
     {"analysis", dyn_keys},
     {"analysis.pulse", dyn_pulse_keys},
-    {"analysis.amplitude", dyn_amplitude_keys},
+    {"analysis.amplitude", PeriAmplitudeKeys},
     {"analysis.velocity", dyn_velocity_keys},
     {"analysis.fronts", dyn_fronts_keys},
     {"analysis.initial", dyn_initial_keys},
@@ -129,14 +132,6 @@ static PetscErrorCode CheckOwnSection(PeriScene s, PeriNode map, const char sect
   names[n] = NULL;
   PetscCall(PeriSceneCheckKeys(s, map, names));
   PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The loads' amplitude at time t: step (1 from t = 0), ramp (linear to 1 at the rise time), sine. */
-static PetscReal Amplitude(const Dynamic *d, PetscReal t)
-{
-  if (d->shape == 1) return d->rise > 0 ? PetscMin(1, t / d->rise) : 1;
-  if (d->shape == 2) return PetscSinReal(2 * PETSC_PI * t / d->period);
-  return 1;
 }
 
 /* analysis.fronts. */
@@ -174,6 +169,27 @@ static PetscErrorCode ReadInitial(Dynamic *d, PeriScene s, PeriNode a)
   PeriInputCheck(exists, s, f, "file", "cannot read %s", d->initial_file);
   PetscCall(PeriSceneGetString(s, f, "array", PETSC_FALSE, d->initial_array, sizeof(d->initial_array), NULL));
   PetscCall(PeriSceneGetReal(s, f, "scale", PETSC_FALSE, &d->initial_scale, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* loads.<k>.amplitude, before any particle exists (the loads themselves are read at set-up). */
+static PetscErrorCode ReadLoadAmplitudes(Dynamic *d, PeriScene s)
+{
+  PeriNode loads, amp;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(s->root, "loads", &loads));
+  if (!loads || loads->kind != PERI_NODE_SEQ || !loads->n) PetscFunctionReturn(PETSC_SUCCESS);
+  d->nloads = loads->n;
+  PetscCall(PetscCalloc2(d->nloads, &d->load_amp, d->nloads, &d->own_amp));
+  for (PetscInt k = 0; k < d->nloads; k++) {
+    if (loads->child[k]->kind != PERI_NODE_MAP) continue; /* the loads' reader says what is wrong */
+    PetscCall(PeriSceneGetNode(loads->child[k], "amplitude", &amp));
+    if (!amp) continue;
+    PetscCall(PeriSceneCheckSection(s, amp, "loads.<k>.amplitude"));
+    PetscCall(PeriAmplitudeFromScene(s, amp, &d->load_amp[k]));
+    d->own_amp[k] = PETSC_TRUE;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -218,12 +234,9 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
   PetscCall(ReadFronts(d, s, a));
   PetscCall(ReadInitial(d, s, a));
   PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
-  if (amp) {
-    PetscCall(CheckOwnSection(s, amp, "analysis.amplitude"));
-    PetscCall(PeriSceneGetChoice(s, amp, "shape", dyn_amplitudes, &d->shape, NULL));
-    PetscCall(PeriSceneGetReal(s, amp, "rise_time", d->shape == 1 ? PETSC_TRUE : PETSC_FALSE, &d->rise, NULL));
-    PetscCall(PeriSceneGetReal(s, amp, "period", d->shape == 2 ? PETSC_TRUE : PETSC_FALSE, &d->period, NULL));
-  }
+  if (amp) PetscCall(CheckOwnSection(s, amp, "analysis.amplitude"));
+  PetscCall(PeriAmplitudeFromScene(s, amp, &d->amp));
+  PetscCall(ReadLoadAmplitudes(d, s));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -367,6 +380,17 @@ static PetscErrorCode RHSPosition(TS ts, PetscReal t, Vec p, Vec dq, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* ft = f(t), the sum of the load terms under their amplitudes. */
+static PetscErrorCode LoadAt(PeriAnalysis an, PetscReal t)
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(d->ft, 0));
+  for (PetscInt k = 0; k < d->nterms; k++) PetscCall(VecAXPY(d->ft, PeriAmplitudeValue(d->term_amp[k], t), d->term_f[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Explicit, momentum split: dp/dt = M^-1 (a(t) f - K q), 0 on the held DOFs. */
 static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
 {
@@ -375,7 +399,8 @@ static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
   PetscFunctionBeginUser;
   (void)ts;
   PetscCall(MatMult(an->sys->stiffness.K, q, dp));
-  PetscCall(VecAXPBY(dp, Amplitude(DYN(an), t), -1, an->sys->fields.f));
+  PetscCall(LoadAt(an, t));
+  PetscCall(VecAYPX(dp, -1, DYN(an)->ft));
   PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -414,7 +439,8 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
   PetscCall(MatMult(sys->stiffness.K, U, F));
   PetscCall(VecPointwiseMult(DYN(an)->tmp, m, A));
   PetscCall(VecAXPY(F, 1, DYN(an)->tmp));
-  PetscCall(VecAXPY(F, -Amplitude(DYN(an), t), sys->fields.f));
+  PetscCall(LoadAt(an, t));
+  PetscCall(VecAXPY(F, -1, DYN(an)->ft));
   if (sys->conditions.nconstrained) {
     const PetscScalar *u;
     PetscScalar       *f;
@@ -594,16 +620,18 @@ static PetscErrorCode Energies(PeriAnalysis an, Vec q, Vec p)
 static PetscErrorCode Work(PeriAnalysis an, Vec q, PetscReal t)
 {
   Dynamic    *d = DYN(an);
-  PetscScalar w;
-  PetscReal   amp = Amplitude(d, t);
+  PetscScalar w[PERI_DYN_MAX_TERMS];
 
   PetscFunctionBeginUser;
   PetscCall(VecWAXPY(d->tmp, -1, d->uprev, q));
-  PetscCall(VecDot(d->tmp, an->sys->fields.f, &w));
-  d->work += 0.5 * (amp + d->amp_prev) * PetscRealPart(w);
+  PetscCall(VecMDot(d->tmp, d->nterms, d->term_f, w));
+  for (PetscInt k = 0; k < d->nterms; k++) {
+    const PetscReal a = PeriAmplitudeValue(d->term_amp[k], t);
+    d->work += 0.5 * (a + d->term_prev[k]) * PetscRealPart(w[k]);
+    d->term_prev[k] = a;
+  }
   PetscCall(VecCopy(q, d->uprev));
-  d->amp_prev = amp;
-  d->t_prev   = t;
+  d->t_prev = t;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -852,6 +880,32 @@ static PetscErrorCode RecordSolver(PeriAnalysis an)
   output describes the last completed step. Options: every -ts_* option, and for the implicit
   integrator the -snes_*, -ksp_* and -pc_* options. Collective.
 @*/
+/* The load terms: f_0 = every load without an amplitude of its own (the system's f less the
+ * others), under analysis.amplitude; then each load with its own. */
+static PetscErrorCode LoadTerms(PeriAnalysis an)
+{
+  Dynamic *d = DYN(an);
+  PetscInt n = 1;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < d->nloads; k++) n += d->own_amp[k];
+  PetscCheck(n <= PERI_DYN_MAX_TERMS, an->comm, PETSC_ERR_SUP, "%s: %" PetscInt_FMT " loads with an amplitude of their own; at most %d", an->sys->scene->file, n - 1, PERI_DYN_MAX_TERMS - 1);
+  PetscCall(PetscMalloc3(n, &d->term_amp, n, &d->term_f, n, &d->term_prev));
+  PetscCall(VecDuplicate(an->sys->fields.f, &d->ft));
+  PetscCall(VecDuplicate(an->sys->fields.f, &d->term_f[0]));
+  PetscCall(VecCopy(an->sys->fields.f, d->term_f[0]));
+  d->term_amp[0] = &d->amp;
+  d->nterms      = 1;
+  for (PetscInt k = 0; k < d->nloads; k++) {
+    if (!d->own_amp[k]) continue;
+    PetscCall(VecDuplicate(an->sys->fields.f, &d->term_f[d->nterms]));
+    PetscCall(PeriLoadAssemble(an->sys, k, d->term_f[d->nterms]));
+    PetscCall(VecAXPY(d->term_f[0], -1, d->term_f[d->nterms]));
+    d->term_amp[d->nterms++] = &d->load_amp[k];
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode Run_Dynamic(PeriAnalysis an)
 {
   Dynamic       *d = DYN(an);
@@ -875,11 +929,12 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   if (!an->sys->fields.u) PetscCall(PeriSystemCreateVec(an->sys, &an->sys->fields.u));
   PetscCall(VecDuplicate(an->sys->fields.u, &d->tmp));
   PetscCall(VecDuplicate(an->sys->fields.u, &d->uprev));
+  PetscCall(LoadTerms(an));
   PetscCall(SetUpTS(an, &U, &V));
   PetscCall(GetState(an, U, &q, &p));
   PetscCall(VecCopy(q, d->uprev));
   PetscCall(RestoreState(an, U, &q, &p));
-  d->amp_prev = Amplitude(d, 0);
+  for (PetscInt k = 0; k < d->nterms; k++) d->term_prev[k] = PeriAmplitudeValue(d->term_amp[k], 0);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(TSSolve(d->ts, NULL));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
@@ -1016,6 +1071,12 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscCall(VecDestroy(&d->tmp));
   PetscCall(PetscFree(d->hist));
   PetscCall(PetscFree(d->snap_time));
+  for (PetscInt k = 0; k < d->nterms; k++) PetscCall(VecDestroy(&d->term_f[k]));
+  PetscCall(PetscFree3(d->term_amp, d->term_f, d->term_prev));
+  PetscCall(VecDestroy(&d->ft));
+  for (PetscInt k = 0; k < d->nloads; k++) PetscCall(PeriAmplitudeDestroy(&d->load_amp[k]));
+  PetscCall(PetscFree2(d->load_amp, d->own_amp));
+  PetscCall(PeriAmplitudeDestroy(&d->amp));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1028,6 +1089,6 @@ const PeriAnalysisType PeriAnalysis_Dynamic = {
     .schema        = dyn_schema,
     .option_prefix = "",
     .files         = dyn_files,
-    .needs         = {.static_solver = PETSC_TRUE, .matrix_copies = 1},
+    .needs         = {.static_solver = PETSC_TRUE, .matrix_copies = 1, .transient = PETSC_TRUE},
     .ops           = {.setfromscene = SetFromScene_Dynamic, .setup = SetUp_Dynamic, .run = Run_Dynamic, .files = Files_Dynamic, .summary = Summary_Dynamic, .report = Report_Dynamic, .destroy = Destroy_Dynamic},
 };

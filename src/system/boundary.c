@@ -51,6 +51,7 @@ static const PeriKey load_keys[] = {
     {"traction", PERI_KEY_REALS, NULL, NULL, "[stress]", NULL, "traction on the face of a layer region: force = traction x face area, spread by volume"},
     {"body_force", PERI_KEY_REALS, NULL, NULL, "[force/volume]", NULL, "force per unit volume"},
     {"traction_field", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "traction varying over a layer region, t = A X + b at the particles: {A: [[..],..], b: [..]}"},
+    {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "a transient analysis: this load's amplitude in time, instead of analysis.amplitude"},
     {NULL},
 };
 const PeriSchema PeriBoundarySchema[] = {
@@ -58,6 +59,7 @@ const PeriSchema PeriBoundarySchema[] = {
     {"bc.<k>.affine", affine_keys},
     {"loads.<k>", load_keys},
     {"loads.<k>.traction_field", affine_keys},
+    {"loads.<k>.amplitude", PeriAmplitudeKeys},
     {NULL},
 };
 
@@ -197,78 +199,103 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Adds load item (loads.<k>) to the owned entries a of the load vector. Collective. */
+static PetscErrorCode AddLoad(PeriSystem sys, PeriNode item, PetscScalar *a)
+{
+  PeriScene      s  = sys->scene;
+  PeriModel      m  = sys->model;
+  const PetscInt bs = m->dofs, dim = sys->disc.particles.dim, uz = PeriModelTranslation(m, 2);
+  const PetscInt ncomp = dim == 2 && uz >= 0 ? 3 : dim; /* a 2D cross-section model's loads act along z: [0, 0, F] */
+  PetscReal      largest, A[3][3] = {{0}}, F[3] = {0, 0, 0}, scale;
+  PeriNode       force, traction, body, field, amp;
+  PeriRegion    *r;
+  PetscInt       n, comp[3] = {-1, -1, -1};
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force | traction_field: ..}");
+  PetscCall(PeriSceneCheckSection(s, item, "loads.<k>"));
+  PetscCall(PeriRegionFind(s, item, "region", sys->disc.nregions, sys->disc.regions, &r));
+  PetscCall(PeriSceneGetNode(item, "force", &force));
+  PetscCall(PeriSceneGetNode(item, "traction", &traction));
+  PetscCall(PeriSceneGetNode(item, "body_force", &body));
+  PetscCall(PeriSceneGetNode(item, "traction_field", &field));
+  PetscCall(PeriSceneGetNode(item, "amplitude", &amp));
+  PeriInputCheck(!amp || sys->stiffness.needs.transient, s, item, "amplitude", "only a transient analysis (analysis.type: dynamic) has time");
+  PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) + (field ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force, traction_field");
+  if (field)
+    PetscCall(ParseAffine(sys, field, "loads.<k>.traction_field", A, F));
+  else
+    PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
+                                                                        : "body_force",
+                                    PETSC_TRUE, dim, ncomp, F, &n));
+  PeriInputCheck(!(traction || field) || r->face_area > 0, s, item, traction ? "traction" : "traction_field", "needs a layer region (side: ..), whose face area converts traction to force, or a mesh's boundary group; region '%s' is not one", r->name);
+  /* particle i receives (A X_i + F) scale V_i */
+  scale = body ? 1.0 : (traction || field ? r->face_area : 1.0) / r->volume;
+  for (PetscInt d = 0; d < ncomp; d++) {
+    PetscCall(AxisComponent(m, d, &comp[d]));
+    PeriInputCheck(comp[d] >= 0 || (F[d] == 0 && A[d][0] == 0 && A[d][1] == 0 && A[d][2] == 0), s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
+  }
+  largest = 0;
+  for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++) {
+    const PetscReal *X = &sys->disc.particles.x[3 * i];
+    if (!PeriRegionContains(r, X)) continue;
+    for (PetscInt d = 0; d < ncomp; d++) {
+      PetscReal v = F[d];
+      for (PetscInt e = 0; e < dim; e++) v += A[d][e] * X[e];
+      if (comp[d] < 0) continue;
+      v *= scale * sys->disc.particles.volume[i];
+      a[(i - sys->disc.bonds.rstart) * bs + comp[d]] += v;
+      /* NaN must fail the check below, so it counts as infinitely large */
+      largest = PetscIsInfOrNanReal(v) ? PETSC_INFINITY : PetscMax(largest, PetscAbsReal(v));
+    }
+  }
+  /* Finite but huge values (1e308) overflow the solver's inner products, which then stops with
+     a NaN residual that blames the operator; say here that the load is at fault. */
+  PetscCallMPI(MPIU_Allreduce(MPI_IN_PLACE, &largest, 1, MPIU_REAL, MPIU_MAX, sys->comm));
+  PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(sys->disc.N * bs)), s, item, field ? "traction_field" : force  ? "force"
+                                                                                                                          : traction ? "traction"
+                                                                                                                                     : "body_force",
+                 "the load is too large for double precision: a particle force of %g overflows the solver's inner products (keep particle forces below about 1e150)", (double)largest);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriLoadsAssemble - the load vector from loads: total forces and tractions spread over a
   region's particles in proportion to their volume, and body forces. Collective.
 @*/
 PetscErrorCode PeriLoadsAssemble(PeriSystem sys, Vec f)
 {
-  PeriScene      s  = sys->scene;
-  PeriModel      m  = sys->model;
-  const PetscInt bs = m->dofs, dim = sys->disc.particles.dim;
-  PeriNode       loads;
-  PetscScalar   *a;
-  PetscInt       ncomp, uz;
-  PetscReal      largest;
+  PeriScene    s = sys->scene;
+  PeriNode     loads;
+  PetscScalar *a;
 
   PetscFunctionBeginUser;
-  /* a 2D cross-section model's loads act along z: they take 3 components, [0, 0, F] */
-  uz    = PeriModelTranslation(m, 2);
-  ncomp = dim == 2 && uz >= 0 ? 3 : dim;
   PetscCall(VecSet(f, 0));
   PetscCall(PeriTorsionLoads(sys, f));
   PetscCall(PeriSceneGetNode(s->root, "loads", &loads));
   if (!loads) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(loads->kind == PERI_NODE_SEQ, s, loads, NULL, "must be a list of loads, each {region: .., force: [..]}");
   PetscCall(VecGetArray(f, &a));
-  for (PetscInt k = 0; k < loads->n; k++) {
-    PeriNode    item = loads->child[k], force, traction, body, field;
-    PeriRegion *r;
-    PetscReal   A[3][3] = {{0}}, F[3] = {0, 0, 0}, scale;
-    PetscInt    n, comp[3]            = {-1, -1, -1};
-    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a load is a mapping {region: name, force | traction | body_force | traction_field: ..}");
-    PetscCall(PeriSceneCheckSection(s, item, "loads.<k>"));
-    PetscCall(PeriRegionFind(s, item, "region", sys->disc.nregions, sys->disc.regions, &r));
-    PetscCall(PeriSceneGetNode(item, "force", &force));
-    PetscCall(PeriSceneGetNode(item, "traction", &traction));
-    PetscCall(PeriSceneGetNode(item, "body_force", &body));
-    PetscCall(PeriSceneGetNode(item, "traction_field", &field));
-    PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) + (field ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force, traction_field");
-    if (field)
-      PetscCall(ParseAffine(sys, field, "loads.<k>.traction_field", A, F));
-    else
-      PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
-                                                                          : "body_force",
-                                      PETSC_TRUE, dim, ncomp, F, &n));
-    PeriInputCheck(!(traction || field) || r->face_area > 0, s, item, traction ? "traction" : "traction_field", "needs a layer region (side: ..), whose face area converts traction to force, or a mesh's boundary group; region '%s' is not one", r->name);
-    /* particle i receives (A X_i + F) scale V_i */
-    scale = body ? 1.0 : (traction || field ? r->face_area : 1.0) / r->volume;
-    for (PetscInt d = 0; d < ncomp; d++) {
-      PetscCall(AxisComponent(m, d, &comp[d]));
-      PeriInputCheck(comp[d] >= 0 || (F[d] == 0 && A[d][0] == 0 && A[d][1] == 0 && A[d][2] == 0), s, item, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + d));
-    }
-    largest = 0;
-    for (PetscInt i = sys->disc.bonds.rstart; i < sys->disc.bonds.rend; i++) {
-      const PetscReal *X = &sys->disc.particles.x[3 * i];
-      if (!PeriRegionContains(r, X)) continue;
-      for (PetscInt d = 0; d < ncomp; d++) {
-        PetscReal v = F[d];
-        for (PetscInt e = 0; e < dim; e++) v += A[d][e] * X[e];
-        if (comp[d] < 0) continue;
-        v *= scale * sys->disc.particles.volume[i];
-        a[(i - sys->disc.bonds.rstart) * bs + comp[d]] += v;
-        /* NaN must fail the check below, so it counts as infinitely large */
-        largest = PetscIsInfOrNanReal(v) ? PETSC_INFINITY : PetscMax(largest, PetscAbsReal(v));
-      }
-    }
-    /* Finite but huge values (1e308) overflow the solver's inner products, which then stops with
-       a NaN residual that blames the operator; say here that the load is at fault. */
-    PetscCallMPI(MPIU_Allreduce(MPI_IN_PLACE, &largest, 1, MPIU_REAL, MPIU_MAX, sys->comm));
-    PeriInputCheck(!PetscIsInfOrNanReal(largest * largest * (PetscReal)(sys->disc.N * bs)), s, item, field ? "traction_field" : force  ? "force"
-                                                                                                                            : traction ? "traction"
-                                                                                                                                       : "body_force",
-                   "the load is too large for double precision: a particle force of %g overflows the solver's inner products (keep particle forces below about 1e150)", (double)largest);
-  }
+  for (PetscInt k = 0; k < loads->n; k++) PetscCall(AddLoad(sys, loads->child[k], a));
+  PetscCall(VecRestoreArray(f, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriLoadAssemble - the load vector of loads.<k> alone (a transient analysis gives each load with
+  an amplitude of its own a vector). Collective.
+@*/
+PetscErrorCode PeriLoadAssemble(PeriSystem sys, PetscInt k, Vec f)
+{
+  PeriNode     loads;
+  PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(f, 0));
+  PetscCall(PeriSceneGetNode(sys->scene->root, "loads", &loads));
+  PetscCheck(loads && k >= 0 && k < loads->n, sys->comm, PETSC_ERR_ARG_OUTOFRANGE, "No load %" PetscInt_FMT, k);
+  PetscCall(VecGetArray(f, &a));
+  PetscCall(AddLoad(sys, loads->child[k], a));
   PetscCall(VecRestoreArray(f, &a));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

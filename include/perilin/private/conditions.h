@@ -68,8 +68,28 @@ typedef struct {
   PeriReactions reactions;
 } PeriConditions;
 
+/* A load's amplitude in time (src/system/amplitude.c): loads.<k>.amplitude and
+   analysis.amplitude of a transient analysis. */
+typedef enum {
+  PERI_AMPLITUDE_STEP,
+  PERI_AMPLITUDE_RAMP,
+  PERI_AMPLITUDE_SINE,
+  PERI_AMPLITUDE_TABLE
+} PeriAmplitudeShape;
+typedef struct {
+  PetscInt   shape;        /* PeriAmplitudeShape */
+  PetscReal  rise, period; /* ramp, sine */
+  PetscInt   n;            /* table: rows of (t, a) */
+  PetscReal *t, *a;
+} PeriAmplitude;
+PETSC_EXTERN const PeriKey  PeriAmplitudeKeys[];
+PETSC_EXTERN PetscErrorCode PeriAmplitudeFromScene(PeriScene, PeriNode, PeriAmplitude *);
+PETSC_EXTERN PetscReal      PeriAmplitudeValue(const PeriAmplitude *, PetscReal);
+PETSC_EXTERN PetscErrorCode PeriAmplitudeDestroy(PeriAmplitude *);
+
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriLoadsAssemble(PeriSystem, Vec);
+PETSC_EXTERN PetscErrorCode PeriLoadAssemble(PeriSystem, PetscInt, Vec);
 PETSC_EXTERN PetscErrorCode PeriReactionsSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemEvaluateReactions(PeriSystem, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriReactionsFindRegion(PeriSystem, const char[], PetscInt *);

@@ -28,6 +28,7 @@ typedef struct {
   PetscBool static_solver; /* solves with the static KSP, K of its default type (PeriStaticDefaultMatType); else K is AIJ */
   PetscReal matrix_copies; /* copies of K it holds beside K (the quasi-static loop solves on one: 1) */
   PetscReal factor_fill;   /* a direct factorization of K, its fill in matrices per log2(particles) (nested dissection measured 0.45), or 0 */
+  PetscBool transient;     /* runs in time: loads may carry an amplitude (loads.<k>.amplitude) */
 } PeriSystemNeeds;
 
 /* K and how it is applied and solved. */
