@@ -56,12 +56,15 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
      scene can be checked with -analysis_type setup */
   if (active && !active->schema) active = NULL;
   PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", active));
+  /* output.every: only the analyses that write series declare it, and only they read it (so that
+     scene.yaml has it only for them) */
+  if (PeriSchemaFindKey(type->schema, "output", "every")) PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
   PetscCall(PeriAnalysisCreate(p->comm, type, &p->analysis));
   PetscCall(PeriAnalysisSetFromScene(p->analysis, s));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* output.*; output.every is quasistatic's key (its schema), read here with the others for now. */
+/* output.*, then the analysis; output.every is read with the analysis, whose key it is. */
 static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
 {
   PeriScene s = p->scene;
@@ -80,7 +83,6 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneResolvePath(s, s->root, "output.dir", p->output_dir));
   PetscCall(PeriSceneGetBool(s, s->root, "output.vtk", &p->vtk, NULL));
   PetscCall(PeriSceneGetBool(s, s->root, "output.stress", &p->stress_output, NULL));
-  PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
   PetscCall(ReadAnalysis(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
