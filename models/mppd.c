@@ -30,13 +30,15 @@ static const PeriMeasureKind measure_kinds[] = {PERI_MEASURE_STRETCH, PERI_MEASU
 static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
 {
   MPPD     *mp = (MPPD *)m->data;
-  PetscBool has_k, has_f;
+  PetscBool has_k;
 
   PetscFunctionBeginUser;
   mp->k_theta = -1;
   PetscCall(PeriSceneGetReal(scene, node, "k_theta", PETSC_FALSE, &mp->k_theta, &has_k));
-  PetscCall(PeriSceneGetReal(scene, node, "k_theta_factor", PETSC_FALSE, &mp->k_theta_factor, &has_f));
-  PeriInputCheck(!(has_k && has_f), scene, node, "k_theta_factor", "give model.k_theta or model.k_theta_factor, not both");
+  if (has_k)
+    PetscCall(PeriSceneCheckAbsent(scene, node, "k_theta_factor", "give model.k_theta or model.k_theta_factor, not both"));
+  else
+    PetscCall(PeriSceneGetReal(scene, node, "k_theta_factor", PETSC_FALSE, &mp->k_theta_factor, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

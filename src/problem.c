@@ -56,12 +56,15 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
      scene can be checked with -analysis_type setup */
   if (active && !active->schema) active = NULL;
   PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", active));
+  /* output.every: only the analyses that write series declare it, and only they read it (so that
+     scene.yaml has it only for them) */
+  if (PeriSchemaFindKey(type->schema, "output", "every")) PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
   PetscCall(PeriAnalysisCreate(p->comm, type, &p->analysis));
   PetscCall(PeriAnalysisSetFromScene(p->analysis, s));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* output.*; output.every is quasistatic's key (its schema), read here with the others for now. */
+/* output.*, then the analysis; output.every is read with the analysis, whose key it is. */
 static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
 {
   PeriScene s = p->scene;
@@ -76,9 +79,10 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneCheckSection(s, o, "output"));
   /* from the root, so that an absent output: takes the declared defaults too */
   PetscCall(PeriSceneGetString(s, s->root, "output.dir", PETSC_FALSE, p->output_dir, sizeof(p->output_dir), NULL));
+  /* absolute in scene.yaml: run again from anywhere, it writes here again (unless -output_dir) */
+  PetscCall(PeriSceneResolvePath(s, s->root, "output.dir", p->output_dir));
   PetscCall(PeriSceneGetBool(s, s->root, "output.vtk", &p->vtk, NULL));
   PetscCall(PeriSceneGetBool(s, s->root, "output.stress", &p->stress_output, NULL));
-  PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
   PetscCall(ReadAnalysis(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -168,8 +172,8 @@ static PetscErrorCode WriteParticles(PeriProblem p)
 }
 
 /*@C
-  PeriProblemWriteOutput - writes the output set (summary.json, particles.vtu and the analysis'
-  files) into the staging directory and swaps it in for the output directory as a whole.
+  PeriProblemWriteOutput - writes the output set (summary.json, scene.yaml, particles.vtu and the
+  analysis' files) into the staging directory and swaps it in for the output directory as a whole.
   Collective.
 @*/
 PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
@@ -186,6 +190,8 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
     PetscCall(WriteParticles(p));
   }
   if (p->analysis && p->analysis->type->ops.files) PetscCall(p->analysis->type->ops.files(p->analysis, p->staging_dir));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/scene.yaml", p->staging_dir));
+  PetscCall(PeriWriteScene(p, path));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/summary.json", p->staging_dir));
   PetscCall(PeriWriteSummary(p, path));
   PetscCall(PeriOutputSetCommit(p->comm, p->staging_dir, p->output_dir));

@@ -66,3 +66,48 @@ PetscErrorCode PeriWriteSummary(PeriProblem p, const char path[])
   PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The command line as a shell would take it back: arguments with other characters than these
+ * single-quoted. */
+static PetscErrorCode CommandLine(char buf[], size_t len)
+{
+  int    argc = 0;
+  char **args = NULL;
+
+  PetscFunctionBeginUser;
+  buf[0] = 0;
+  PetscCall(PetscGetArgs(&argc, &args));
+  for (int k = 0; k < argc; k++) {
+    PetscBool plain = (PetscBool)(args[k][0] && strspn(args[k], "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789_./=:,+-@%") == strlen(args[k]));
+    size_t    used  = strlen(buf);
+    PetscCall(PetscSNPrintf(buf + used, len - used, "%s%s%s%s", k ? " " : "", plain ? "" : "'", args[k], plain ? "" : "'"));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriWriteScene - writes scene.yaml on rank 0 (temporary name, then rename): the resolved scene
+  (src/scene/resolved.c) after a header saying what made it. Collective.
+@*/
+PetscErrorCode PeriWriteScene(PeriProblem p, const char path[])
+{
+  char           perilin[PERI_VERSION_LEN], petsc[PERI_VERSION_LEN], slepc[PERI_VERSION_LEN], cmd[4096], header[8192], tmp[PETSC_MAX_PATH_LEN + 8];
+  FILE          *fp;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  if (p->rank) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriGetVersions(perilin, petsc, slepc, PERI_VERSION_LEN));
+  PetscCall(CommandLine(cmd, sizeof(cmd)));
+  PetscCall(PetscSNPrintf(header, sizeof(header),
+                          "The resolved scene of a perilin %s run (docs/summary.md): every key the run read, with the value it used.\n"
+                          "command line: %s\n"
+                          "Given back to perilin, this reproduces the run: perilin scene.yaml [-output_dir DIR]\n"
+                          "(without -output_dir it writes into output.dir again; PETSc options are no scene keys: give them again)\n",
+                          perilin, cmd));
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  ierr = PeriSceneWriteResolved(p->scene, header, fp);
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, ierr != 0));
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

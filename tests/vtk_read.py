@@ -29,6 +29,8 @@ RANKS = 1
 EXT = "vtu"
 # Arrays that differ between partitions by design: the owner, and particle numbers.
 NUMBERING = ("rank", "mirror_of")
+# The scene's conditions, written with every state (src/system/bc_fields.c): no part of a mode shape.
+CONDITIONS = ("fixed", "prescribed_displacement", "applied_force", "region_")
 # How far a run on several ranks may differ from the same run on one, relative to each array's
 # largest value. Static and quasi-static: every solve ends at a true relative residual of 1e-10
 # (perilin's default -ksp_rtol, src/system/solve.c) from a different ordering of the same sums, so
@@ -168,7 +170,7 @@ def by_position(g):
 def mode_group(name, k):
     """Which mode shape the array k of file name belongs to (its sign is one per mode), or None."""
     if name.startswith("mode_"):
-        return None if k in ("volume", "neighbors") + NUMBERING else name
+        return None if k in ("volume", "neighbors") + NUMBERING or k.startswith(CONDITIONS) else name
     m = re.match(r"mode_(\d+)", k)
     return m.group(0) if m else None
 

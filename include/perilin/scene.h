@@ -83,12 +83,17 @@ struct _p_PeriScene {
   PeriNode               root;
   PetscInt               nowners;
   const PeriSchemaOwner *owners; /* the core's schemas, then every plug-in's */
+  /* What the readers resolved beyond the file, by the same paths: the declared defaults the
+   * getters applied, input files made absolute (PeriSceneGetPath), the output directory. The
+   * getters never read it: only the resolved scene (scene.yaml of the output set) merges it in. */
+  PeriNode resolved;
 };
 
 PETSC_EXTERN PetscErrorCode PeriSceneWhere(PeriScene, PeriNode, const char[], char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriSceneGetNode(PeriNode, const char[], PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetMap(PeriScene, PeriNode, const char[], PetscBool, PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriSceneCheckKeys(PeriScene, PeriNode, const char *const[]);
+PETSC_EXTERN PetscErrorCode PeriSceneCheckAbsent(PeriScene, PeriNode, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneCheckSection(PeriScene, PeriNode, const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneCheckKeysSchema(PeriScene, PeriNode, const char[], const PeriSchemaOwner *);
 PETSC_EXTERN const PeriKey *PeriSchemaFindKey(const PeriSchema *, const char[], const char[]);
@@ -105,6 +110,7 @@ PETSC_EXTERN PetscErrorCode PeriSceneGetBool(PeriScene, PeriNode, const char[], 
 PETSC_EXTERN PetscErrorCode PeriSceneGetString(PeriScene, PeriNode, const char[], PetscBool, char[], size_t, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetChoice(PeriScene, PeriNode, const char[], const char *const[], PetscInt *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneGetRealArray(PeriScene, PeriNode, const char[], PetscBool, PetscInt, PetscInt, PetscReal[], PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriSceneGetPath(PeriScene, PeriNode, const char[], PetscBool, char[], size_t, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneParseReal(PeriScene, PeriNode, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriSceneParseBool(PeriScene, PeriNode, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneParseRealArray(PeriScene, PeriNode, PetscInt, PetscInt, PetscReal[], PetscInt *);

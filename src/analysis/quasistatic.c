@@ -203,7 +203,6 @@ static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, Per
   QSData   *data;
   Settings *st;
   PetscInt  policy = 0, stepping = 0;
-  PetscBool has;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&data));
@@ -224,8 +223,10 @@ static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, Per
   PetscCall(PeriSceneGetBool(s, a, "adaptive", &st->adaptive, NULL));
   PetscCall(PeriSceneGetChoice(s, a, "break", qs_policies, &policy, NULL));
   st->all = policy == 0 ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PeriSceneGetReal(s, a, "break_fraction", PETSC_FALSE, &st->fraction, &has));
-  PeriInputCheck(!has || !st->all, s, a, "break_fraction", "applies to break: fraction only");
+  if (st->all)
+    PetscCall(PeriSceneCheckAbsent(s, a, "break_fraction", "applies to break: fraction only"));
+  else
+    PetscCall(PeriSceneGetReal(s, a, "break_fraction", PETSC_FALSE, &st->fraction, NULL));
   PetscCall(PeriSceneGetReal(s, a, "runaway_fraction", PETSC_FALSE, &st->runaway, &st->runaway_given)); /* else by the control type (SetUp) */
   PetscCall(PeriSceneGetInt(s, a, "max_iterations", PETSC_FALSE, &st->max_iterations, NULL));
   PetscCall(PeriSceneGetBool(s, a, "reuse_preconditioner", &st->reuse, NULL));

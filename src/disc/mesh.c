@@ -223,7 +223,7 @@ static PetscErrorCode MeshSource(PeriScene scene, PeriNode node, char path[], si
   PetscBool has;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesInputPath(scene, node, "mesh", path, size));
+  PetscCall(PeriSceneGetPath(scene, node, "mesh", PETSC_TRUE, path, size, NULL));
   PeriInputCheck(access(path, R_OK) == 0, scene, node, "mesh", "cannot read %s: %s", path, strerror(errno));
   PetscCall(PetscStrlen(path, &len));
   *geo = len > 4 && !strcmp(path + len - 4, ".geo") ? PETSC_TRUE : PETSC_FALSE;
@@ -497,20 +497,5 @@ PetscErrorCode PeriMeshGroupsDestroy(PetscInt *ngroups, PeriMeshGroup **groups)
   for (PetscInt k = 0; k < *ngroups; k++) PetscCall(PetscFree((*groups)[k].x));
   PetscCall(PetscFree(*groups));
   *ngroups = 0;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The file named by node.key (required), relative to the scene file's directory unless absolute:
- * particles.file and particles.mesh. */
-PetscErrorCode PeriParticlesInputPath(PeriScene scene, PeriNode node, const char key[], char path[], size_t size)
-{
-  char name[PETSC_MAX_PATH_LEN];
-
-  PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetString(scene, node, key, PETSC_TRUE, name, sizeof(name), NULL));
-  if (name[0] == '/')
-    PetscCall(PetscStrncpy(path, name, size));
-  else
-    PetscCall(PetscSNPrintf(path, size, "%s/%s", scene->dir, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

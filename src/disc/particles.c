@@ -174,7 +174,7 @@ PetscErrorCode PeriCSVOpen(PeriScene scene, PeriNode node, PetscInt dim, PeriCSV
   csv->scene = scene;
   csv->node  = node;
   csv->dim   = dim;
-  PetscCall(PeriParticlesInputPath(scene, node, "file", csv->path, sizeof(csv->path)));
+  PetscCall(PeriSceneGetPath(scene, node, "file", PETSC_TRUE, csv->path, sizeof(csv->path), NULL));
   csv->fp = fopen(csv->path, "r");
   PeriInputCheck(csv->fp, scene, node, "file", "cannot open %s: %s", csv->path, strerror(errno));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -161,11 +161,11 @@ static PetscBool NameMatches(const char *name, const char *pattern)
 }
 
 /* Whether a file name is one perilin writes into an output directory: the set's own files
- * (summary.json, particles.vtu or .pvtu and the directory of its pieces, the marker, temporary
+ * (summary.json, scene.yaml, particles.vtu or .pvtu and the directory of its pieces, the marker, temporary
  * files), and the names the analyses declared. */
 static PetscBool IsOutputName(const char name[])
 {
-  static const char *const own[] = {"summary.json", "particles.vtu", "particles.pvtu", "particles", PERI_OUTPUT_MARKER, NULL};
+  static const char *const own[] = {"summary.json", "scene.yaml", "particles.vtu", "particles.pvtu", "particles", PERI_OUTPUT_MARKER, NULL};
   size_t                   n     = strlen(name);
 
   for (PetscInt k = 0; own[k]; k++)

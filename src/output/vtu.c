@@ -26,7 +26,7 @@ typedef enum {
   VTU_FLOAT64, /* gathered from PetscReal data */
   VTU_INT32,   /* converted from PetscInt data, with an overflow check */
   VTU_INT64,   /* first + i */
-  VTU_UINT8    /* a constant */
+  VTU_UINT8    /* flags (0/1) per particle and component, or a constant */
 } VTUKind;
 
 /* One DataArray and where its values come from: value (i, c) is real[i * stride + map[c]], or 0
@@ -41,6 +41,8 @@ typedef struct {
   const PetscInt  *ints;
   int64_t          first;
   uint8_t          byte;
+  const uint8_t   *bytes;  /* UInt8: bytes[i * ncomp + c], or the constant byte */
+  char            *cnames; /* the components' names, one after the other ('\0' between), or NULL */
   uint64_t         nbytes, offset;
 } VTUArray;
 
@@ -93,7 +95,10 @@ PetscErrorCode PeriFieldListDestroy(PeriFieldList *list)
 {
   PetscFunctionBeginUser;
   if (!*list) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt k = 0; k < (*list)->na; k++) PetscCall(PetscFree((*list)->a[k].name));
+  for (PetscInt k = 0; k < (*list)->na; k++) {
+    PetscCall(PetscFree((*list)->a[k].name));
+    PetscCall(PetscFree((*list)->a[k].cnames));
+  }
   PetscCall(PetscFree((*list)->a));
   PetscCall(PetscFree(*list));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -127,6 +132,46 @@ PetscErrorCode PeriFieldListAddInt(PeriFieldList fl, const char name[], const Pe
   PetscCall(FieldListPush(fl, VTU_POINT_DATA, name, VTU_INT32, 1, &a));
   a->ints = ints;
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriFieldListAddFlags - a UInt8 field of ncomp components (flags 0/1: a byte per value, not a
+  double): component c of particle i is bytes[i * ncomp + c], named components[c] in the file
+  (ParaView's component names; NULL: none).
+@*/
+PetscErrorCode PeriFieldListAddFlags(PeriFieldList fl, const char name[], PetscInt ncomp, const unsigned char *bytes, const char *const components[])
+{
+  VTUArray *a = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCheck(bytes || !fl->n, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONGSTATE, "Cannot write field %s: no data", name);
+  PetscCheck(ncomp >= 1 && ncomp <= 3, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Field %s: %" PetscInt_FMT " components (1 to 3)", name, ncomp);
+  PetscCall(FieldListPush(fl, VTU_POINT_DATA, name, VTU_UINT8, ncomp, &a));
+  a->bytes = bytes;
+  if (components) {
+    size_t len = 0, used = 0;
+    char  *names;
+    for (PetscInt c = 0; c < ncomp; c++) len += strlen(components[c]) + 1;
+    PetscCall(PetscMalloc1(len, &names));
+    for (PetscInt c = 0; c < ncomp; c++) {
+      PetscCall(PetscStrcpy(names + used, components[c]));
+      used += strlen(components[c]) + 1;
+    }
+    a->cnames = names;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The attributes ' ComponentName0="ux" ...' of a, or "". */
+static void ComponentNames(const VTUArray *a, char buf[], size_t len)
+{
+  const char *c = a->cnames;
+
+  buf[0] = 0;
+  for (PetscInt k = 0; c && k < a->ncomp; k++, c += strlen(c) + 1) {
+    size_t used = strlen(buf);
+    snprintf(buf + used, len - used, " ComponentName%" PetscInt_FMT "=\"%s\"", k, c);
+  }
 }
 
 /* An integer field of one value at every particle (Int32). */
@@ -192,7 +237,7 @@ static PetscErrorCode VTUFill(const VTUArray *a, PetscInt n, void *buf)
         ((int64_t *)buf)[k] = a->first + (int64_t)i;
         break;
       case VTU_UINT8:
-        ((uint8_t *)buf)[k] = a->byte;
+        ((uint8_t *)buf)[k] = a->bytes ? a->bytes[k] : a->byte;
         break;
       }
     }
@@ -238,8 +283,10 @@ static PetscErrorCode VTUWriteFile(FILE *fp, const char file[], PetscInt n, Pets
   for (s = VTU_POINT_DATA; s <= VTU_CELLS; s++) {
     PetscCall(VTUPrintf(fp, file, "      %s\n", opentag[s]));
     for (k = 0; k < na; k++) {
+      char names[256];
       if (a[k].section != (VTUSection)s) continue;
-      PetscCall(VTUPrintf(fp, file, "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%" PetscInt_FMT "\" format=\"appended\" offset=\"%" PRIu64 "\"/>\n", VTUTypeNames[a[k].kind], a[k].name, a[k].ncomp, a[k].offset));
+      ComponentNames(&a[k], names, sizeof(names));
+      PetscCall(VTUPrintf(fp, file, "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%" PetscInt_FMT "\"%s format=\"appended\" offset=\"%" PRIu64 "\"/>\n", VTUTypeNames[a[k].kind], a[k].name, a[k].ncomp, names, a[k].offset));
     }
     PetscCall(VTUPrintf(fp, file, "      %s\n", closetag[s]));
   }
@@ -357,9 +404,11 @@ static PetscErrorCode WritePVTU(PeriFieldList fl, const char path[], const char 
   bad |= fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PUnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" header_type=\"UInt64\">\n  <PUnstructuredGrid GhostLevel=\"0\">\n    <PPointData>\n", order) < 0;
   for (PetscInt k = 0; k < fl->na; k++) {
     const VTUArray *a = &fl->a[k];
+    char            names[256];
     if (a->section == VTU_POINTS) bad |= fprintf(fp, "    </PPointData>\n    <PPoints>\n") < 0;
     if (a->section == VTU_CELLS) break; /* the cells come from the pieces */
-    bad |= fprintf(fp, "      <PDataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%" PetscInt_FMT "\"/>\n", VTUTypeNames[a->kind], a->name, a->ncomp) < 0;
+    ComponentNames(a, names, sizeof(names));
+    bad |= fprintf(fp, "      <PDataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%" PetscInt_FMT "\"%s/>\n", VTUTypeNames[a->kind], a->name, a->ncomp, names) < 0;
   }
   bad |= fprintf(fp, "    </PPoints>\n") < 0;
   for (PetscMPIInt r = 0; r < size; r++) bad |= fprintf(fp, "    <Piece Source=\"%s/" PERI_PIECE_FMT "\"/>\n", base, r) < 0;

@@ -8,53 +8,6 @@
 #include <libgen.h>
 #include <strings.h>
 
-static PetscErrorCode NodeCreate(PeriNodeKind kind, const char key[], const char parent_path[], int line, PeriNode *node)
-{
-  PeriNode n;
-  size_t   len;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscNew(&n));
-  n->kind = kind;
-  n->line = line;
-  PetscCall(PetscStrallocpy(key, &n->key));
-  if (parent_path && parent_path[0]) {
-    len = strlen(parent_path) + strlen(key) + 2;
-    PetscCall(PetscMalloc1(len, &n->path));
-    PetscCall(PetscSNPrintf(n->path, len, "%s.%s", parent_path, key));
-  } else
-    PetscCall(PetscStrallocpy(key ? key : "", &n->path));
-  *node = n;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode NodeAppend(PeriNode parent, PeriNode child)
-{
-  PeriNode *c;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(parent->n + 1, &c));
-  for (PetscInt k = 0; k < parent->n; k++) c[k] = parent->child[k];
-  c[parent->n] = child;
-  PetscCall(PetscFree(parent->child));
-  parent->child = c;
-  parent->n++;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode NodeDestroy(PeriNode *node)
-{
-  PetscFunctionBeginUser;
-  if (!*node) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt k = 0; k < (*node)->n; k++) PetscCall(NodeDestroy(&(*node)->child[k]));
-  PetscCall(PetscFree((*node)->child));
-  PetscCall(PetscFree((*node)->key));
-  PetscCall(PetscFree((*node)->path));
-  PetscCall(PetscFree((*node)->value));
-  PetscCall(PetscFree(*node));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 typedef struct {
   yaml_parser_t parser;
   const char   *file;
@@ -109,8 +62,8 @@ static PetscErrorCode ParseNode(Reader *r, yaml_event_t *ev, const char key[], P
     yaml_event_delete(ev);
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: nested more than %d levels deep", r->file, line, PERI_SCENE_MAX_DEPTH);
   }
-  PetscCall(NodeCreate(kind, key, parent ? parent->path : "", line, node));
-  if (parent) PetscCall(NodeAppend(parent, *node));
+  PetscCall(PeriNodeCreate(kind, key, parent ? parent->path : "", line, node));
+  if (parent) PetscCall(PeriNodeAppend(parent, *node));
   if (kind == PERI_NODE_SCALAR) PetscCall(PetscStrallocpy((const char *)ev->data.scalar.value, &(*node)->value));
   yaml_event_delete(ev);
   if (kind == PERI_NODE_SEQ) {
@@ -203,15 +156,15 @@ static PetscErrorCode ApplyOptions(PeriNode node)
     set = PETSC_FALSE;
     if (OptionQueryable(opt)) PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
     if (set) {
-      for (PetscInt k = 0; k < node->n; k++) PetscCall(NodeDestroy(&node->child[k]));
+      for (PetscInt k = 0; k < node->n; k++) PetscCall(PeriNodeDestroy(&node->child[k]));
       node->n = 0;
       for (tok = strtok_r(val, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
         PeriNode item;
         char     idx[32];
         PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, node->n));
-        PetscCall(NodeCreate(PERI_NODE_SCALAR, idx, node->path, 0, &item));
+        PetscCall(PeriNodeCreate(PERI_NODE_SCALAR, idx, node->path, 0, &item));
         PetscCall(PetscStrallocpy(tok, &item->value));
-        PetscCall(NodeAppend(node, item));
+        PetscCall(PeriNodeAppend(node, item));
       }
       node->line = 0;
       PetscFunctionReturn(PETSC_SUCCESS);
@@ -253,17 +206,17 @@ static PetscErrorCode AddOptionKey(PeriNode root, const char path[])
     PetscCall(PetscStrncpy(leaf, dot + 1, sizeof(leaf)));
     PetscCall(PeriSceneGetNode(root, parent, &map));
     if (!map) {
-      PetscCall(NodeCreate(PERI_NODE_MAP, parent, "", 0, &map));
-      PetscCall(NodeAppend(root, map));
+      PetscCall(PeriNodeCreate(PERI_NODE_MAP, parent, "", 0, &map));
+      PetscCall(PeriNodeAppend(root, map));
     }
     if (map->kind != PERI_NODE_MAP) PetscFunctionReturn(PETSC_SUCCESS); /* the reader reports the wrong type */
   } else
     PetscCall(PetscStrncpy(leaf, path, sizeof(leaf)));
   PetscCall(PeriSceneGetNode(map, leaf, &child));
   if (child) PetscFunctionReturn(PETSC_SUCCESS); /* ApplyOptions already set it */
-  PetscCall(NodeCreate(PERI_NODE_SCALAR, leaf, map->path, 0, &child));
+  PetscCall(PeriNodeCreate(PERI_NODE_SCALAR, leaf, map->path, 0, &child));
   PetscCall(PetscStrallocpy(val, &child->value));
-  PetscCall(NodeAppend(map, child));
+  PetscCall(PeriNodeAppend(map, child));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -503,7 +456,8 @@ PetscErrorCode PeriSceneDestroy(PeriScene *scene)
 {
   PetscFunctionBeginUser;
   if (!*scene) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(NodeDestroy(&(*scene)->root));
+  PetscCall(PeriNodeDestroy(&(*scene)->root));
+  PetscCall(PeriNodeDestroy(&(*scene)->resolved));
   PetscCall(PetscFree((*scene)->owners));
   PetscCall(PetscFree(*scene));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -600,6 +554,14 @@ static PetscErrorCode GetDecl(PeriScene scene, PeriNode map, const char key[], P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A key absent from map took its declared default: the resolved scene (scene.yaml) writes it. */
+static PetscErrorCode UseDefault(PeriScene scene, PeriNode map, const char key[], const Decl *d)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneResolve(scene, map, key, d->key->type == PERI_KEY_REALS, d->key->deflt));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode GetScalar(PeriScene scene, PeriNode map, const char key[], PetscBool required, PeriKeyType type, PeriNode *node, Decl *d)
 {
   PetscFunctionBeginUser;
@@ -644,8 +606,10 @@ PetscErrorCode PeriSceneGetReal(PeriScene scene, PeriNode map, const char key[],
   if (node) {
     PetscCall(PeriSceneParseReal(scene, node, v));
     PetscCall(PeriSceneCheckRange(scene, node, d.sec, d.key, *v, node->value));
-  } else if (d.key && PeriKeyDefaultReal(d.key, &x))
+  } else if (d.key && PeriKeyDefaultReal(d.key, &x)) {
     *v = x;
+    PetscCall(UseDefault(scene, map, key, &d));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -660,7 +624,10 @@ PetscErrorCode PeriSceneGetInt(PeriScene scene, PeriNode map, const char key[], 
   PetscFunctionBeginUser;
   PetscCall(GetScalar(scene, map, key, required, PERI_KEY_INT, &node, &d));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
-  if (!node && d.key && PeriKeyDefaultInt(d.key, &i)) *v = i;
+  if (!node && d.key && PeriKeyDefaultInt(d.key, &i)) {
+    *v = i;
+    PetscCall(UseDefault(scene, map, key, &d));
+  }
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   errno = 0;
   l     = strtol(node->value, &end, 10);
@@ -702,8 +669,10 @@ PetscErrorCode PeriSceneGetBool(PeriScene scene, PeriNode map, const char key[],
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
   if (node)
     PetscCall(PeriSceneParseBool(scene, node, v));
-  else if (d.key && PeriKeyDefaultBool(d.key, &b))
+  else if (d.key && PeriKeyDefaultBool(d.key, &b)) {
     *v = b;
+    PetscCall(UseDefault(scene, map, key, &d));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -718,14 +687,16 @@ PetscErrorCode PeriSceneGetString(PeriScene scene, PeriNode map, const char key[
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
   if (node)
     PetscCall(PetscStrncpy(buf, node->value, len));
-  else if (d.key && PeriKeyDefaultString(d.key, &s))
+  else if (d.key && PeriKeyDefaultString(d.key, &s)) {
     PetscCall(PetscStrncpy(buf, s, len));
+    PetscCall(UseDefault(scene, map, key, &d));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The index of the declared default of d in the reader's choices (which may differ from the
  * declared ones: a leading "none"); *idx left alone without a default. */
-static PetscErrorCode ChoiceDefault(const Decl *d, const char *const choices[], PetscInt *idx)
+static PetscErrorCode ChoiceDefault(PeriScene scene, PeriNode map, const char key[], const Decl *d, const char *const choices[], PetscInt *idx)
 {
   const char *s;
 
@@ -734,6 +705,7 @@ static PetscErrorCode ChoiceDefault(const Decl *d, const char *const choices[], 
   for (PetscInt k = 0; choices[k]; k++)
     if (!strcmp(choices[k], s)) {
       *idx = k;
+      PetscCall(UseDefault(scene, map, key, d));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
   SETERRQ(PETSC_COMM_SELF, PETSC_ERR_PLIB, "the declared default '%s' of key '%s' is not among the choices its reader knows", s, d->key->name);
@@ -749,7 +721,7 @@ PetscErrorCode PeriSceneGetChoice(PeriScene scene, PeriNode map, const char key[
   PetscFunctionBeginUser;
   PetscCall(GetScalar(scene, map, key, PETSC_FALSE, PERI_KEY_CHOICE, &node, &d));
   if (found) *found = node ? PETSC_TRUE : PETSC_FALSE;
-  if (!node) PetscCall(ChoiceDefault(&d, choices, idx));
+  if (!node) PetscCall(ChoiceDefault(scene, map, key, &d, choices, idx));
   if (!node) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt k = 0; choices[k]; k++) {
     if (!strcmp(node->value, choices[k])) {
@@ -795,6 +767,7 @@ PetscErrorCode PeriSceneGetRealArray(PeriScene scene, PeriNode map, const char k
     PetscCheck(nx >= nmin && nx <= nmax, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the declared default %s of key '%s' does not have %" PetscInt_FMT " to %" PetscInt_FMT " entries", d.key->deflt, d.key->name, nmin, nmax);
     for (PetscInt k = 0; k < nx; k++) v[k] = x[k];
     *n = nx;
+    PetscCall(UseDefault(scene, map, key, &d));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -1,8 +1,58 @@
-/* The scene's tree as the readers walk it (src/scene/): a child by its (dotted) key, where a node is
- * (file, line, key, option) for messages, the keys allowed in a mapping, and a key's declaration in
- * a schema. Below the getters (scene.c), the declarations (keys.c) and the schema tables
- * (schema.c). */
+/* The scene's tree as the readers walk it (src/scene/): its nodes, a child by its (dotted) key,
+ * where a node is (file, line, key, option) for messages, the keys allowed in a mapping, a key's
+ * declaration in a schema, and the values the run resolved beyond the file (PeriSceneResolve, for
+ * the resolved scene of resolved.c). Below the getters (scene.c), the declarations (keys.c) and
+ * the schema tables (schema.c). */
 #include "perilin/private/scene_file.h"
+#include <errno.h>
+#include <unistd.h>
+
+PetscErrorCode PeriNodeCreate(PeriNodeKind kind, const char key[], const char parent_path[], int line, PeriNode *node)
+{
+  PeriNode n;
+  size_t   len;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&n));
+  n->kind = kind;
+  n->line = line;
+  PetscCall(PetscStrallocpy(key, &n->key));
+  if (parent_path && parent_path[0]) {
+    len = strlen(parent_path) + strlen(key) + 2;
+    PetscCall(PetscMalloc1(len, &n->path));
+    PetscCall(PetscSNPrintf(n->path, len, "%s.%s", parent_path, key));
+  } else
+    PetscCall(PetscStrallocpy(key ? key : "", &n->path));
+  *node = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriNodeAppend(PeriNode parent, PeriNode child)
+{
+  PeriNode *c;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(parent->n + 1, &c));
+  for (PetscInt k = 0; k < parent->n; k++) c[k] = parent->child[k];
+  c[parent->n] = child;
+  PetscCall(PetscFree(parent->child));
+  parent->child = c;
+  parent->n++;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriNodeDestroy(PeriNode *node)
+{
+  PetscFunctionBeginUser;
+  if (!*node) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < (*node)->n; k++) PetscCall(PeriNodeDestroy(&(*node)->child[k]));
+  PetscCall(PetscFree((*node)->child));
+  PetscCall(PetscFree((*node)->key));
+  PetscCall(PetscFree((*node)->path));
+  PetscCall(PetscFree((*node)->value));
+  PetscCall(PetscFree(*node));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 /* The option that sets a key: "-material_nu" for path "material.nu". */
 void PeriSceneOptionName(const char path[], char opt[], size_t len)
@@ -61,6 +111,21 @@ PetscErrorCode PeriSceneGetNode(PeriNode map, const char key[], PeriNode *child)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriSceneCheckAbsent - a key that does not apply (why says when it does) must be absent. Readers
+  read such a key only where it applies, so that its declared default, which the resolved scene
+  writes, is never taken for a given key. Not collective.
+@*/
+PetscErrorCode PeriSceneCheckAbsent(PeriScene scene, PeriNode map, const char key[], const char why[])
+{
+  PeriNode node;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(map, key, &node));
+  PeriInputCheck(!node, scene, map, key, "%s", why);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriSceneCheckKeys(PeriScene scene, PeriNode map, const char *const allowed[])
 {
   PetscFunctionBeginUser;
@@ -99,4 +164,97 @@ const PeriKey *PeriSchemaFindKey(const PeriSchema *schema, const char section[],
 void PeriSchemaPath(const PeriSchema *sec, const PeriKey *key, char path[], size_t len)
 {
   snprintf(path, len, "%s%s%s", sec->section, sec->section[0] ? "." : "", key->name);
+}
+
+/* The child of node named key (a list item's key is its index), created with kind when missing. */
+static PetscErrorCode Child(PeriNode node, const char key[], PeriNodeKind kind, PeriNode *child)
+{
+  PetscFunctionBeginUser;
+  *child = NULL;
+  for (PetscInt k = 0; k < node->n && !*child; k++)
+    if (!strcmp(node->child[k]->key, key)) *child = node->child[k];
+  if (*child) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriNodeCreate(kind, key, node->path, 0, child));
+  PetscCall(PeriNodeAppend(node, *child));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* node (a list) takes the items of the flow list text "[0, 0]". */
+static PetscErrorCode SetList(PeriNode node, const char text[])
+{
+  char buf[PETSC_MAX_PATH_LEN], *tok, *save;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < node->n; k++) PetscCall(PeriNodeDestroy(&node->child[k]));
+  node->n = 0;
+  PetscCall(PetscStrncpy(buf, text, sizeof(buf)));
+  for (tok = strtok_r(buf, "[], ", &save); tok; tok = strtok_r(NULL, "[], ", &save)) {
+    PeriNode item;
+    char     idx[32];
+    PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, node->n));
+    PetscCall(PeriNodeCreate(PERI_NODE_SCALAR, idx, node->path, 0, &item));
+    PetscCall(PetscStrallocpy(tok, &item->value));
+    PetscCall(PeriNodeAppend(node, item));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSceneResolve - records value as the one the run used for map.key (key may be dotted: from the
+  root, "output.dir"), a flow list of numbers when list: the resolved scene writes it instead of
+  the file's (or where the file has none). The getters never see it. Not collective.
+@*/
+PetscErrorCode PeriSceneResolve(PeriScene scene, PeriNode map, const char key[], PetscBool list, const char value[])
+{
+  char     path[512], *tok, *next, *save;
+  PeriNode node;
+
+  PetscFunctionBeginUser;
+  if (!scene->resolved) PetscCall(PeriNodeCreate(PERI_NODE_MAP, "", "", 0, &scene->resolved));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s%s%s", map ? map->path : "", map && map->path[0] ? "." : "", key));
+  node = scene->resolved;
+  for (tok = strtok_r(path, ".", &save); tok; tok = next) {
+    next = strtok_r(NULL, ".", &save);
+    PetscCall(Child(node, tok, next ? PERI_NODE_MAP : list ? PERI_NODE_SEQ
+                                                           : PERI_NODE_SCALAR,
+                    &node));
+  }
+  if (list) {
+    PetscCall(SetList(node, value));
+  } else {
+    PetscCall(PetscFree(node->value));
+    PetscCall(PetscStrallocpy(value, &node->value));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* path as an absolute path: relative paths are the working directory's. */
+static PetscErrorCode Absolute(const char path[], char abs[], size_t len)
+{
+  char cwd[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  if (path[0] == '/') {
+    PetscCall(PetscStrncpy(abs, path, len));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCheck(getcwd(cwd, sizeof(cwd)), PETSC_COMM_SELF, PETSC_ERR_SYS, "cannot get the working directory: %s", strerror(errno));
+  while (path[0] == '.' && path[1] == '/') path += 2;
+  PetscCall(PetscSNPrintf(abs, len, "%s/%s", cwd, path));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSceneResolvePath - records path (relative to the working directory, or absolute) made absolute
+  as the value of map.key in the resolved scene, which stays valid wherever it is read from. Not
+  collective.
+@*/
+PetscErrorCode PeriSceneResolvePath(PeriScene scene, PeriNode map, const char key[], const char path[])
+{
+  char abs[2 * PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(Absolute(path, abs, sizeof(abs)));
+  PetscCall(PeriSceneResolve(scene, map, key, PETSC_FALSE, abs));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -486,5 +486,6 @@ PetscErrorCode PeriConditionsDestroy(PeriConditions *C)
   PetscCall(PetscFree(C->constrained_value));
   PetscCall(PetscFree(C->constrained_region));
   PetscCall(PeriReactionsDestroy(&C->reactions));
+  PetscCall(PeriConditionFieldsDestroy(&C->fields));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -270,7 +270,8 @@ PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe 
   PeriSystemAddFields - the system's per-particle fields besides the solution, over this rank's
   particles (a list of PeriSystemFieldListCreate): volume, neighbours, rank, and where they exist
   strain energy density and antiplane shear stresses; then the features' own (damage:
-  PeriFailureAddFields; mirror images: PeriLayersAddFields). Each rank's piece: its owned particles, local 0..nowned-1.
+  PeriFailureAddFields; mirror images: PeriLayersAddFields; the conditions: fixed components,
+  prescribed values, applied forces, regions: PeriConditionsAddFields). Each rank's piece: its owned particles, local 0..nowned-1.
 @*/
 PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
 {
@@ -291,6 +292,7 @@ PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
   }
   PetscCall(PeriFailureAddFields(sys, fl));
   PetscCall(PeriLayersAddFields(sys, fl));
+  PetscCall(PeriConditionsAddFields(sys, fl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -143,8 +143,10 @@ static PetscErrorCode CreateModel(PeriSystem sys)
   PetscCall(PeriSceneGetInt(s, s->root, "dim", PETSC_TRUE, &dim, NULL));
   PetscCall(PeriSceneGetMap(s, s->root, "model", PETSC_TRUE, &m));
   PetscCall(PeriSceneGetString(s, m, "type", PETSC_TRUE, type, sizeof(type), NULL));
-  PetscCall(PeriSceneGetChoice(s, m, "plane", planes, &plane, &found));
-  PeriInputCheck(!found || dim == 2, s, m, "plane", "applies to 2D scenes only");
+  if (dim == 2)
+    PetscCall(PeriSceneGetChoice(s, m, "plane", planes, &plane, NULL));
+  else
+    PetscCall(PeriSceneCheckAbsent(s, m, "plane", "applies to 2D scenes only"));
   PetscCall(PeriModelTypeRegistered(type, &found));
   if (!found) {
     char list[256];

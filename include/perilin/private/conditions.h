@@ -57,15 +57,26 @@ typedef struct {
   PetscReal moment_allowed;            /* the largest relative moment imbalance the solve's residual explains */
 } PeriReactions;
 
+/* The conditions as particle arrays of the output (src/system/bc_fields.c), over the owned
+ * particles: kept here from one writing of the fields to the next, as the field list references
+ * them. */
+typedef struct {
+  unsigned char *fixed;      /* [n][dofs]: 1 where a DOF is constrained */
+  PetscReal     *prescribed; /* [n][dofs]: its value at load factor 1, 0 elsewhere */
+  PetscReal     *force;      /* [n][dofs]: the loads at load factor 1 (sys->fields.f) */
+  unsigned char *in_region;  /* [nregions][n]: 1 inside the region */
+} PeriConditionFields;
+
 /* Everything the scene prescribes or loads. */
 typedef struct {
-  PeriLayers    layers;
-  PeriTorsion   torsion;
-  PetscInt      nconstrained;       /* owned constrained DOFs */
-  PetscInt     *constrained;        /* their global rows, sorted */
-  PetscReal    *constrained_value;  /* their values at load factor 1 */
-  PetscInt     *constrained_region; /* the region (index of disc.regions) of the bc item that set each, or -1 */
-  PeriReactions reactions;
+  PeriLayers          layers;
+  PeriTorsion         torsion;
+  PetscInt            nconstrained;       /* owned constrained DOFs */
+  PetscInt           *constrained;        /* their global rows, sorted */
+  PetscReal          *constrained_value;  /* their values at load factor 1 */
+  PetscInt           *constrained_region; /* the region (index of disc.regions) of the bc item that set each, or -1 */
+  PeriReactions       reactions;
+  PeriConditionFields fields;
 } PeriConditions;
 
 /* A load's amplitude in time (src/system/amplitude.c): loads.<k>.amplitude and
@@ -107,3 +118,5 @@ PETSC_EXTERN PetscErrorCode PeriTorsionSummary(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriLayersSummary(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode PeriLayersAddFields(PeriSystem, PeriFieldList);
 PETSC_EXTERN PetscErrorCode PeriConditionsDestroy(PeriConditions *);
+PETSC_EXTERN PetscErrorCode PeriConditionsAddFields(PeriSystem, PeriFieldList);
+PETSC_EXTERN PetscErrorCode PeriConditionFieldsDestroy(PeriConditionFields *);

@@ -14,7 +14,6 @@ PETSC_EXTERN PetscErrorCode PeriParticlesAllocate(PeriParticles *, PetscInt);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriParticlesSlice(const PeriParticles *, PetscInt, PetscInt, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
-PETSC_EXTERN PetscErrorCode PeriParticlesInputPath(PeriScene, PeriNode, const char[], char[], size_t);
 
 /* ------------------------------------------------------------------ creation (particles.c, create.c) */
 /* Where the body comes from: exactly one of grid, particles.file, particles.mesh. */

@@ -21,6 +21,7 @@ typedef struct _p_PeriFieldList *PeriFieldList;
 PETSC_EXTERN PetscErrorCode      PeriFieldListCreate(PetscInt, const PetscReal[], PeriFieldList *);
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddReal(PeriFieldList, const char[], PetscInt, const PetscReal *, PetscInt, const PetscInt[]);
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddInt(PeriFieldList, const char[], const PetscInt *);
+PETSC_EXTERN PetscErrorCode      PeriFieldListAddFlags(PeriFieldList, const char[], PetscInt, const unsigned char *, const char *const[]);
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddIntConstant(PeriFieldList, const char[], PetscInt);
 PETSC_EXTERN PetscErrorCode      PeriFieldListAddSolution(PeriFieldList, const char[], PetscInt, const char *const[], const PetscInt[], const PetscReal *);
 PETSC_EXTERN PetscErrorCode      PeriFieldListDestroy(PeriFieldList *);

@@ -23,6 +23,7 @@ struct _p_PeriProblem {
 };
 
 PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
+PETSC_EXTERN PetscErrorCode PeriWriteScene(PeriProblem, const char[]);
 
 /* The core modules' schemas, then every built-in model's and analysis' (src/package.c), handed
  * down to the scene layer. */

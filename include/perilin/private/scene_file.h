@@ -36,3 +36,16 @@ PETSC_EXTERN PetscErrorCode PeriOptionsCheckUnused(const PeriRunSolvers *);
 PETSC_EXTERN void           PeriSceneSuggest(const char[], const char *const[], char[], size_t);
 PETSC_EXTERN void           PeriSuggest(const char[], char *const[], char[], size_t, PetscBool *);
 PETSC_EXTERN void           PeriSceneOptionName(const char[], char[], size_t);
+
+/* The tree's nodes (src/scene/tree.c), for the reader and the resolved scene. */
+PETSC_EXTERN PetscErrorCode PeriNodeCreate(PeriNodeKind, const char[], const char[], int, PeriNode *);
+PETSC_EXTERN PetscErrorCode PeriNodeAppend(PeriNode, PeriNode);
+PETSC_EXTERN PetscErrorCode PeriNodeDestroy(PeriNode *);
+
+/* The resolved scene (docs/summary.md): the value the run used for map.key (a dotted key; list: a
+ * flow list "[0, 0]" of numbers), a path made absolute (src/scene/tree.c), and the scene written
+ * back as YAML, the file's tree after the overrides with these merged in, after the comment lines
+ * of header (src/scene/resolved.c). */
+PETSC_EXTERN PetscErrorCode PeriSceneResolve(PeriScene, PeriNode, const char[], PetscBool, const char[]);
+PETSC_EXTERN PetscErrorCode PeriSceneResolvePath(PeriScene, PeriNode, const char[], const char[]);
+PETSC_EXTERN PetscErrorCode PeriSceneWriteResolved(PeriScene, const char[], FILE *);
