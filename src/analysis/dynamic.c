@@ -164,7 +164,7 @@ static PetscErrorCode ReadInitial(Dynamic *d, PeriScene s, PeriNode a)
   PetscCall(PeriSceneGetMap(s, a, "initial", PETSC_FALSE, &f));
   if (!f) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(CheckOwnSection(s, f, "analysis.initial"));
-  PetscCall(PeriParticlesInputPath(s, f, "file", d->initial_file, sizeof(d->initial_file)));
+  PetscCall(PeriSceneGetPath(s, f, "file", PETSC_TRUE, d->initial_file, sizeof(d->initial_file), NULL));
   PetscCall(PetscTestFile(d->initial_file, 'r', &exists));
   PeriInputCheck(exists, s, f, "file", "cannot read %s", d->initial_file);
   PetscCall(PeriSceneGetString(s, f, "array", PETSC_FALSE, d->initial_array, sizeof(d->initial_array), NULL));

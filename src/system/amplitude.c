@@ -53,7 +53,7 @@ static PetscErrorCode ReadTable(PeriScene s, PeriNode node, PeriAmplitude *a)
   PetscBool isrow, header = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesInputPath(s, node, "file", path, sizeof(path)));
+  PetscCall(PeriSceneGetPath(s, node, "file", PETSC_TRUE, path, sizeof(path), NULL));
   fp = fopen(path, "rb");
   PeriInputCheck(fp, s, node, "file", "cannot read %s: %s", path, strerror(errno));
   len = fseek(fp, 0, SEEK_END) ? -1 : ftell(fp);
