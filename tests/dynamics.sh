@@ -90,7 +90,7 @@ fi
 # 4. the refusal: exit 1, the limit named, no output
 "$exe" "$pulse" -analysis_dt 1 -output_dir "$tmp/refused" > "$tmp/refused.log" 2>&1 < /dev/null
 code=$?
-if [ $code -ne 0 ] && grep -q "above the explicit stability limit 2/omega_max = 0.85" "$tmp/refused.log" && [ ! -e "$tmp/refused" ]; then
+if [ $code -ne 0 ] && grep -q "above the explicit stability limit 2/omega_max = 0.81" "$tmp/refused.log" && [ ! -e "$tmp/refused" ]; then
   echo "ok: dt 1 refused: $(grep -o 'above the explicit stability limit[^:]*' "$tmp/refused.log")"
 else
   echo "FAIL: dt 1 (above the limit) was not refused as expected (exit $code)"; tail -2 "$tmp/refused.log"; fail=1

@@ -290,6 +290,60 @@ typedef struct {
   PetscReal *blocks, *row;
 } RowBuffer;
 
+/* Adds bond k of owned particle i to acc (bs*bs + bs per local particle: the signed diagonal
+ * block, then the absolute row sums of the off-diagonal blocks) at both ends. */
+static PetscErrorCode AddBondRowSums(PeriSystem sys, PetscInt i, PetscInt k, PetscReal *acc)
+{
+  const PetscInt   bs = sys->model->dofs, n = 2 * bs, w = bs * bs + bs;
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PeriBondGeometry g;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriBondStiffness(sys, i, k, 1, &g, Ke));
+  for (PetscInt e = 0; e < 2; e++) { /* e = 0: i's rows, e = 1: j's */
+    PetscReal *a = &acc[w * (e ? g.j : i)];
+    for (PetscInt r = 0; r < bs; r++)
+      for (PetscInt c = 0; c < bs; c++) {
+        a[r * bs + c] += Ke[(e * bs + r) * n + e * bs + c];
+        a[bs * bs + r] += PetscAbsReal(Ke[(e * bs + r) * n + (1 - e) * bs + c]);
+      }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriStiffnessRowSums - the absolute row sums of K (sum over c of |K_rc|, held DOFs as free ones)
+  from the live bonds' blocks, without K: the diagonal blocks summed with their signs, the
+  off-diagonal ones bond by bond (an upper bound where a pair has several periodic images). For
+  a Gershgorin bound of an assembled or a matrix-free K alike. Models with per-bond blocks only.
+  Collective.
+@*/
+PetscErrorCode PeriStiffnessRowSums(PeriSystem sys, Vec sums)
+{
+  const PeriBonds *b  = &sys->disc.bonds;
+  const PetscInt   bs = sys->model->dofs, w = bs * bs + bs;
+  PetscReal       *acc;
+  PetscScalar     *s;
+
+  PetscFunctionBeginUser;
+  PetscCheck(sys->model->ops.bond_stiffness, sys->comm, PETSC_ERR_SUP, "Model %s has no per-bond blocks", sys->model->type);
+  PetscCall(PetscCalloc1(w * sys->disc.particles.n, &acc));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      if (b->live[k] && b->j[k] != i) PetscCall(AddBondRowSums(sys, i, k, acc));
+  PetscCall(PeriDiscGhostsToOwners(&sys->disc, MPIU_REAL, w, MPI_SUM, acc));
+  PetscCall(VecGetArray(sums, &s));
+  for (PetscInt i = 0; i < sys->disc.nowned; i++)
+    for (PetscInt r = 0; r < bs; r++) {
+      PetscReal sum = acc[w * i + bs * bs + r];
+      for (PetscInt c = 0; c < bs; c++) sum += PetscAbsReal(acc[w * i + r * bs + c]);
+      s[i * bs + r] = sum;
+    }
+  PetscCall(VecRestoreArray(sums, &s));
+  PetscCall(PetscFree(acc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The block of bond k of owned particle i, times the filter's scale. */
 /*@C
   PeriBondStiffness - the (2 dofs)^2 stiffness block of bond k of particle i times scale, and the

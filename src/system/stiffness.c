@@ -8,7 +8,7 @@
 const char *PeriMatrixFreeWhyNot(PeriSystem sys)
 {
   if (!sys->model->central_force) return "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
-  if (!sys->stiffness.needs.matrix_free) return "the analysis needs K's entries (matrix_free serves the static, quasi-static and tune analyses)";
+  if (!sys->stiffness.needs.matrix_free) return "the analysis needs K's entries (matrix_free serves the static, quasi-static, tune and explicit dynamic analyses)";
   if (sys->conditions.layers.T) return "fictitious layers eliminate K's rows through its entries";
   return NULL;
 }

@@ -51,6 +51,7 @@ PETSC_EXTERN PetscErrorCode PeriBondStiffness(PeriSystem, PetscInt, PetscInt, Pe
 PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
 PETSC_EXTERN PetscErrorCode PeriMatrixMB(Mat, PetscReal *);
+PETSC_EXTERN PetscErrorCode PeriStiffnessRowSums(PeriSystem, Vec);
 PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, PetscReal, Mat *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[], PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
