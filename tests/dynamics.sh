@@ -30,6 +30,10 @@
 #     read on 1 rank, and a .vtu read on 2): the tip oscillates at the modal f_1 (explicit: 1e-6),
 #     the implicit period error converges at second order (ratios 3-5 per halving of dt) and is the
 #     trapezoidal rule's within 10 %; a file of another body is refused naming a particle.
+# 12. The implicit summary's resolved_frequency_1pct (the highest frequency within 1 % in period,
+#     from TSALPHA2's amplification matrix): equal to the trapezoidal rule's closed form,
+#     x/(2 atan(x/2)) - 1 = 0.01, at rho_infinity 1 (1e-9); at rho_infinity 0.5 the lamina run again
+#     with dt chosen so that its f_1 is that frequency has a measured period error of 1 % (+-5 %).
 # 11. Loads with amplitudes of their own (tests/scenes/timed_loads.yaml: a step force and a force
 #     under a CSV table on a free plate): the rigid translation u(t) integrated exactly by hand,
 #     reached at second order in dt by both integrators (error ratio 4 +- 0.2 per halving, below
@@ -81,6 +85,9 @@ run lvib_e mpiexec --oversubscribe -n 2 "$exe" "$lam" -analysis_initial_file "$t
 for dt in 2.4e-5 4.8e-5 9.6e-5; do
   run lvib_i$dt "$exe" "$lam" -analysis_initial_file "$tmp/lmodal2/mode_01.pvtu" -analysis_t_end 1.3e-3 -analysis_integrator implicit -analysis_dt $dt
 done
+run lvib_r1 "$exe" "$lam" -analysis_initial_file "$tmp/lmodal1/mode_01.vtu" -analysis_t_end 1.3e-3 -analysis_integrator implicit -analysis_dt 4.8e-5 -analysis_rho_infinity 0.5 -analysis_energy_tolerance 0.2
+dt1=$(python3 -c "import json; s = json.load(open('$tmp/lmodal1/summary.json')); d = json.load(open('$tmp/lvib_r1/summary.json'))['dynamic']; print(repr(4.8e-5 * d['resolved_frequency_1pct'] / s['modal']['modes'][0]['f_hz']))" 2>/dev/null || echo 1e-5)
+run lvib_r2 "$exe" "$lam" -analysis_initial_file "$tmp/lmodal1/mode_01.vtu" -analysis_t_end 1.3e-3 -analysis_integrator implicit -analysis_dt "$dt1" -analysis_rho_infinity 0.5 -analysis_energy_tolerance 0.2
 "$exe" "$lam" -analysis_initial_file "$tmp/lmodal1/mode_01.vtu" -grid_spacing 0.02 -output_dir "$tmp/lvib_bad" > "$tmp/lvib_bad.log" 2>&1 < /dev/null
 if [ $? -ne 0 ] && grep -q "mode_01.vtu holds 3600 particles, the body 900" "$tmp/lvib_bad.log" && [ ! -e "$tmp/lvib_bad" ]; then
   echo "ok: a mode file of another body is refused: $(grep -o 'mode_01.vtu holds[^:]*' "$tmp/lvib_bad.log")"
@@ -175,6 +182,11 @@ r1, r2 = e["9.6e-5"] / e["4.8e-5"], e["4.8e-5"] / e["2.4e-5"]
 check(3 < r1 < 5 and 3 < r2 < 5, f"lamina implicit period error {e['9.6e-5']:.3g}, {e['4.8e-5']:.3g}, {e['2.4e-5']:.3g} at dt 9.6e-5, 4.8e-5, 2.4e-5: ratios {r1:.2f}, {r2:.2f} (second order: 4)")
 x = math.pi * f1 * 9.6e-5
 check(abs(e["9.6e-5"] / (x / math.atan(x) - 1) - 1) < 0.1, f"lamina implicit period error at dt 9.6e-5: {e['9.6e-5']:.4g}, the trapezoidal rule's {x / math.atan(x) - 1:.4g}")
+fr = dyn("lvib_i9.6e-5")["resolved_frequency_1pct"]
+x = 2 * math.pi * fr * 9.6e-5
+check(abs(x / (2 * math.atan(x / 2)) - 1 - 0.01) < 1e-9, f"resolved_frequency_1pct {fr:.6g} at dt 9.6e-5: the trapezoidal rule's period error there is {x / (2 * math.atan(x / 2)) - 1:.10f}")
+er = lperiod("lvib_r2") * f1 - 1
+check(abs(er / 0.01 - 1) < 0.05, f"rho_infinity 0.5, dt {dyn('lvib_r2')['dt']:.4g} (f_1 = {f1:.6g} Hz resolved at 1 % by the summary): measured period error {er:.5f}")
 def timed_error(name):
     r = history(name)[-1]
     t, t1 = r["time"], 0.01

@@ -946,6 +946,20 @@ static PetscErrorCode LoadTerms(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* What to try when the energy balance drifts. */
+static const char *DriftAdvice(const Dynamic *d)
+{
+  static char advice[256];
+
+  if (!d->implicit)
+    PetscSNPrintf(advice, sizeof(advice), "use a smaller dt (now %g, limit %g) or the implicit integrator", (double)d->dt, (double)d->dt_limit);
+  else if (d->rho_inf < 1)
+    PetscSNPrintf(advice, sizeof(advice), "rho_infinity %g < 1 damps the high frequencies by design and takes their energy: raise analysis.energy_tolerance, or use rho_infinity 1 (no numerical damping)", (double)d->rho_inf);
+  else
+    PetscSNPrintf(advice, sizeof(advice), "use a smaller dt (now %g)", (double)d->dt);
+  return advice;
+}
+
 static PetscErrorCode Run_Dynamic(PeriAnalysis an)
 {
   Dynamic       *d = DYN(an);
@@ -990,7 +1004,7 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   if (an->sys->bond_state.failure.active) PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
   PetscCall(VecDestroy(&U));
   PetscCall(VecDestroy(&V));
-  PetscCheck(an->sys->run.interrupted || d->drift <= d->energy_tol, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the energy balance (kinetic + strain + dissipated - work of the loads) drifted by %.3g of the energy scale, above analysis.energy_tolerance %g: the run is not consistent; use a smaller dt (now %g, limit %g) or the implicit integrator", an->sys->scene->file, (double)d->drift, (double)d->energy_tol, (double)d->dt, (double)d->dt_limit);
+  PetscCheck(an->sys->run.interrupted || d->drift <= d->energy_tol, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the energy balance (kinetic + strain + dissipated - work of the loads) drifted by %.3g of the energy scale, above analysis.energy_tolerance %g: the run is not consistent; %s", an->sys->scene->file, (double)d->drift, (double)d->energy_tol, DriftAdvice(d));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1078,7 +1092,11 @@ static PetscErrorCode Summary_Dynamic(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONReal(j, "energy_drift", d->drift));
   PetscCall(PeriJSONReal(j, "energy_tolerance", d->energy_tol));
   PetscCall(PeriJSONInt(j, "broken_bonds", d->broken));
-  if (d->implicit) PetscCall(PeriJSONInt(j, "ksp_iterations", d->ksp_its));
+  if (d->implicit) {
+    PetscCall(PeriJSONInt(j, "ksp_iterations", d->ksp_its));
+    PetscCall(PeriJSONReal(j, "rho_infinity", d->rho_inf));
+    PetscCall(PeriJSONReal(j, "resolved_frequency_1pct", PeriAlpha2ResolvedFrequency(d->rho_inf, d->dt, 0.01)));
+  }
   if (d->fronts) {
     PetscCall(PeriJSONReal(j, "wave_front", d->wave_front));
     PetscCall(PeriJSONReal(j, "damage_front", d->damage_front));
@@ -1091,10 +1109,12 @@ static PetscErrorCode Summary_Dynamic(PeriAnalysis an, PeriJSON j)
 
 static PetscErrorCode Report_Dynamic(PeriAnalysis an)
 {
-  Dynamic *d = DYN(an);
+  Dynamic *d            = DYN(an);
+  char     resolved[96] = "";
 
   PetscFunctionBeginUser;
-  PetscCall(PetscPrintf(an->comm, "perilin: %s dynamics to t = %g in %" PetscInt_FMT " steps of %g (explicit limit %g), energy drift %.2g, %" PetscInt_FMT " bonds broken; results in %s/\n", d->implicit ? "implicit" : "explicit", (double)d->t_prev, d->nsteps, (double)d->dt, (double)d->dt_limit, (double)d->drift, d->broken, an->output_dir));
+  if (d->implicit) PetscCall(PetscSNPrintf(resolved, sizeof(resolved), ", modes below %g within 1 %% in period", (double)PeriAlpha2ResolvedFrequency(d->rho_inf, d->dt, 0.01)));
+  PetscCall(PetscPrintf(an->comm, "perilin: %s dynamics to t = %g in %" PetscInt_FMT " steps of %g (explicit limit %g%s), energy drift %.2g, %" PetscInt_FMT " bonds broken; results in %s/\n", d->implicit ? "implicit" : "explicit", (double)d->t_prev, d->nsteps, (double)d->dt, (double)d->dt_limit, resolved, (double)d->drift, d->broken, an->output_dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

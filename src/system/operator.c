@@ -23,6 +23,7 @@ struct _p_PeriOperator {
   PetscReal  rmax, pscale; /* the preconditioning matrix: its longest bond and its scale */
   Vec        xm, ym;       /* ghosted work vectors: the input with held DOFs zeroed, and K of it */
   Vec        kdiag;        /* the diagonal of K */
+  PetscBool  kdiag_stale;  /* bonds changed since kdiag was computed: recomputed when asked for (an explicit time loop never asks) */
 };
 
 /* One MATSHELL over the shared bond data: y = s K_m x on free DOFs, y = hd x on held ones, where
@@ -112,6 +113,8 @@ static PetscErrorCode ShellMult(Mat A, Vec x, Vec y)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscErrorCode ComputeDiagonal(PeriOperator);
+
 static PetscErrorCode ShellGetDiagonal(Mat A, Vec d)
 {
   Shell       *sh;
@@ -119,6 +122,7 @@ static PetscErrorCode ShellGetDiagonal(Mat A, Vec d)
 
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &sh));
+  if (sh->op->kdiag_stale) PetscCall(ComputeDiagonal(sh->op));
   PetscCall(VecCopy(sh->op->kdiag, d));
   PetscCall(VecScale(d, sh->scale));
   PetscCall(VecGetArray(d, &da));
@@ -329,6 +333,7 @@ static PetscErrorCode ComputeDiagonal(PeriOperator op)
   PetscCall(VecGhostUpdateBegin(op->ym, ADD_VALUES, SCATTER_REVERSE));
   PetscCall(VecGhostUpdateEnd(op->ym, ADD_VALUES, SCATTER_REVERSE));
   PetscCall(VecCopy(op->ym, op->kdiag));
+  op->kdiag_stale = PETSC_FALSE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -459,7 +464,7 @@ PetscErrorCode PeriOperatorScaled(PeriSystem sys)
     PetscCall(MatAssemblyBegin(sys->stiffness.Kpc, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(sys->stiffness.Kpc, MAT_FINAL_ASSEMBLY));
   }
-  PetscCall(ComputeDiagonal(sys->stiffness.op));
+  sys->stiffness.op->kdiag_stale = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

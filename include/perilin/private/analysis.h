@@ -103,6 +103,9 @@ struct _p_PeriAnalysis {
   void                   *snapshotctx;
   void                   *data;
 };
+/* TSALPHA2's period error on one mode (src/analysis/period_error.c) */
+PETSC_EXTERN PetscReal      PeriAlpha2PeriodError(PetscReal, PetscReal);
+PETSC_EXTERN PetscReal      PeriAlpha2ResolvedFrequency(PetscReal, PetscReal, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCreate(MPI_Comm, const PeriAnalysisType *, PeriAnalysis *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisSetFromScene(PeriAnalysis, PeriScene);
 PETSC_EXTERN PetscErrorCode PeriAnalysisSetUp(PeriAnalysis, PeriSystem);
