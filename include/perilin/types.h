@@ -80,4 +80,5 @@ typedef struct {
   PetscReal Vi, Vj;
   PetscReal weight; /* alpha * lambda */
   PetscReal mu;     /* the bond's shear modulus across materials (Oterkus & Madenci eq. 60); 0: the material's */
+  PetscInt  bond;   /* 1 + its index in the system's bond list; 0 for other geometry (families, unit cells): keys per-bond caches */
 } PeriBondGeometry;

@@ -30,6 +30,7 @@ PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fr
   PetscInt          mine = 0;
 
   PetscFunctionBeginUser;
+  PetscCall(PeriFailureCacheBonds(sys));
   PetscCall(PeriSystemLocalDOFs(sys, U, &u));
   PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
   for (PetscInt i = b->rstart; i < b->rend; i++)
@@ -149,5 +150,6 @@ PetscErrorCode PeriBondStateDestroy(PeriBondState *B)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscFree(B->damage));
+  for (PetscInt c = 0; c < B->failure.ncriteria; c++) PetscCall(PetscFree(B->failure.criterion[c].critical));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -21,10 +21,22 @@ static PetscErrorCode SetFromScene(PeriCriterion *c, PeriScene s, PeriNode node,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The bond's critical value from G, kept per listed bond once computed (a time loop asks every
+ * step; the square root and a lattice calibration's factor cost as much as the force). */
+static PetscReal Critical(const PeriCriterion *c, PeriModel m, const PeriBondGeometry *g)
+{
+  PetscReal *v;
+
+  if (g->bond <= 0 || g->bond > c->ncritical) return m->ops.critical_from_G(m, g, c->value[0]);
+  v = &c->critical[g->bond - 1];
+  if (*v < 0) *v = m->ops.critical_from_G(m, g, c->value[0]);
+  return *v;
+}
+
 /* s/s_c(G) for s > 0 (tension), or |r|/r_c(G) */
 static PetscReal Index(const PeriCriterion *c, PeriModel m, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause)
 {
-  const PetscReal crit = m->ops.critical_from_G(m, g, c->value[0]);
+  const PetscReal crit = Critical(c, m, g);
 
   if (m->measure_kinds[0] == PERI_MEASURE_SHEAR_ANGLE) {
     *cause = PERI_CAUSE_SHEAR_ANGLE;
@@ -42,7 +54,8 @@ static PetscErrorCode View(const PeriCriterion *c, PeriModel m, MPI_Comm comm)
 }
 
 const PeriCriterionType PeriCriterion_Energy = {
-    .name = "energy",
-    .keys = {{"G", PERI_KEY_REAL, NULL, "(0, inf)", "[energy/length^2]", NULL, "energy release rate: each bond's critical stretch or shear angle from its model"}},
-    .ops  = {.setfromscene = SetFromScene, .index = Index, .view = View},
+    .name     = "energy",
+    .per_bond = PETSC_TRUE,
+    .keys     = {{"G", PERI_KEY_REAL, NULL, "(0, inf)", "[energy/length^2]", NULL, "energy release rate: each bond's critical stretch or shear angle from its model"}},
+    .ops      = {.setfromscene = SetFromScene, .index = Index, .view = View},
 };

@@ -274,6 +274,27 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
 }
 
 /*@C
+  PeriFailureCacheBonds - room for the per-bond critical values of the active criteria that keep
+  them (type->per_bond), sized to the bond list, to be filled on first use. Not collective.
+@*/
+PetscErrorCode PeriFailureCacheBonds(PeriSystem sys)
+{
+  PeriFailure   *F = &sys->bond_state.failure;
+  const PetscInt n = sys->disc.bonds.nbonds;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    PeriCriterion *c = &F->criterion[i];
+    if (!c->active || !c->type->per_bond || c->ncritical == n) continue;
+    PetscCall(PetscFree(c->critical));
+    PetscCall(PetscMalloc1(n, &c->critical));
+    for (PetscInt k = 0; k < n; k++) c->critical[k] = -1;
+    c->ncritical = n;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
   PeriBondFailureIndex - how far the bond is past the scene's criteria: the largest of the active
   criteria's indices (s/s_c, -s/s_cc, |gamma|/gamma_0, |gamma|/(a - s tan beta), |r|/r_c: each
   criterion's file); the bond breaks when it reaches 1. meas[] are the model's measures; cause (may

@@ -25,6 +25,7 @@ static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const Pets
   g->Vj     = pt->volume[g->j];
   g->weight = b->alpha[k] * b->lambda[k] * (b->intact ? b->intact[k] : 1);
   g->mu     = bond_mu ? bond_mu[k] : 0;
+  g->bond   = 0;
 }
 
 /* The kernel's view of local bond k of owned particle i. */
@@ -32,6 +33,7 @@ PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, Pe
 {
   PetscFunctionBeginUser;
   FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->materials.bond_mu, i, k, g);
+  g->bond = k + 1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -40,6 +40,8 @@ typedef struct {
   PetscInt                 measure[2];                         /* the model's measures of the kinds type->measures, -1 when absent */
   PetscBool                softens;                            /* set by setfromscene: bonds past the limit keep a falling share of stiffness */
   PetscInt                 causes;                             /* set by setfromscene: the PeriFailureCauses it gives, bit (1 << cause) each */
+  PetscReal               *critical;                           /* type->per_bond: each listed bond's critical value, computed on first use (-1: not yet) */
+  PetscInt                 ncritical;
 } PeriCriterion;
 
 struct _PeriCriterionType {
@@ -56,6 +58,9 @@ struct _PeriCriterionType {
      the message), the symbol of the run log */
   PeriFailureCause cause;
   const char      *holders, *symbol;
+  /* its critical value differs per bond but not in time (from G by the model): failure.c keeps
+     c->critical, one per bond, so that a time loop does not recompute it every step */
+  PetscBool per_bond;
   struct {
     /* Checks its keys against each other and the model (c->measure[] are set): the scene's
        messages; sets c->causes and c->softens. Called when the scene gives any of its keys. */
@@ -101,6 +106,7 @@ typedef struct {
 } PeriCheckpoint;
 
 PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriFailureCacheBonds(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
 PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
