@@ -396,8 +396,7 @@ static PetscErrorCode Calibrate(PeriSystem sys)
 @*/
 PetscErrorCode PeriSystemSetUp(PeriSystem sys)
 {
-  PeriScene            s  = sys->scene;
-  const PeriParticles *pt = &sys->disc.particles;
+  PeriScene s = sys->scene;
 
   PetscFunctionBeginUser;
   PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
@@ -405,9 +404,8 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
   PetscCall(ReadCorrections(sys));
   PetscCall(SetUpBonds(sys));
-  for (PetscInt i = 0; i < sys->disc.nowned; i++)
-    PetscCheck(sys->disc.neighbor_count[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->disc.delta, (double)pt->spacing[i]);
   PetscCall(PeriRegionsCreateFromScene(sys->comm, s, &sys->disc.particles, sys->disc.nowned, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
+  PetscCall(PeriCheckBonded(sys)); /* the regions name where */
   PetscCall(ReadShearModuli(sys));
   PetscCall(Calibrate(sys));
   PetscCall(PeriReadProbes(sys));
@@ -418,6 +416,8 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   /* the loads too, so that a bad load is reported before any solve */
   PetscCall(PeriSystemCreateVec(sys, &sys->fields.f));
   PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
+  /* after the bcs, which may hold what the bonds do not, and the loads, which tell held pieces */
+  PetscCall(PeriCheckHeld(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
