@@ -4,15 +4,16 @@
  * the elements of the energy (bonds or families) that the energy and the torsion loads share. */
 #include "perilin/private/system.h"
 
-/* Which bonds enter the matrix and how: the bonds no longer than rmax (K itself: all), their
- * blocks times scale; broken ones with broken_share of their block (0: left out). */
+/* Which bonds enter the matrix and how: those of the short range sr (K itself: NULL, all), their
+ * blocks times its factor; broken ones with broken_share of their block (0: left out). */
 typedef struct {
-  PetscReal rmax, scale, broken_share;
+  const PeriShortRange *sr;
+  PetscReal             broken_share;
 } BondFilter;
 
-static inline PetscBool Kept(const PeriBonds *b, PetscInt k, const BondFilter *f)
+static inline PetscBool Kept(const PeriBonds *b, PetscInt i, PetscInt k, const BondFilter *f)
 {
-  return (PetscBool)((b->live[k] || f->broken_share > 0) && b->length[k] <= f->rmax);
+  return (PetscBool)((b->live[k] || f->broken_share > 0) && PeriShortRangeHolds(f->sr, b, i, k));
 }
 
 /* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
@@ -20,7 +21,7 @@ static PetscInt RowPartners(const PeriBonds *b, const BondFilter *f, PetscInt i,
 {
   PetscInt n = 0, m = 0;
   for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-    if (Kept(b, k, f) && b->j[k] != i) buf[n++] = b->j[k];
+    if (Kept(b, i, k, f) && b->j[k] != i) buf[n++] = b->j[k];
   PetscSortInt(n, buf);
   for (PetscInt k = 0; k < n; k++)
     if (!m || buf[k] != buf[m - 1]) buf[m++] = buf[k];
@@ -249,7 +250,7 @@ static PetscErrorCode CreateBondStiffness(PeriSystem sys, const BondFilter *f, M
 static PetscBool IsIncoming(const PeriBonds *b, const BondFilter *f, PetscInt r, PetscInt k)
 {
   PetscInt j = b->j[k];
-  return (PetscBool)(Kept(b, k, f) && j != r && j >= b->rstart && j < b->rend);
+  return (PetscBool)(Kept(b, r, k, f) && j != r && j >= b->rstart && j < b->rend);
 }
 
 /* The incoming bonds of every owned particle j as a CSR (ptr, bond, row): bond k stored at owned
@@ -364,8 +365,10 @@ PetscErrorCode PeriBondStiffness(PeriSystem sys, PetscInt i, PetscInt k, PetscRe
 /* The block of bond k under the filter: scaled, broken bonds by their share. */
 static PetscErrorCode BondBlock(PeriSystem sys, const BondFilter *f, PetscInt i, PetscInt k, PeriBondGeometry *g, PetscReal Ke[])
 {
+  const PetscReal scale = PeriShortRangeFactor(f->sr, &sys->disc.bonds, i, k);
+
   PetscFunctionBeginUser;
-  PetscCall(PeriBondStiffness(sys, i, k, sys->disc.bonds.live[k] ? f->scale : f->scale * f->broken_share, g, Ke));
+  PetscCall(PeriBondStiffness(sys, i, k, sys->disc.bonds.live[k] ? scale : scale * f->broken_share, g, Ke));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -387,7 +390,7 @@ static PetscErrorCode GatherBondRow(PeriSystem sys, const BondFilter *f, const I
   for (PetscInt k = b->offset[i - rstart]; k < b->offset[i - rstart + 1]; k++) {
     PetscInt j = b->j[k];
     /* a self-image bond moves both ends alike: its blocks cancel */
-    if (!Kept(b, k, f) || j == i) continue;
+    if (!Kept(b, i, k, f) || j == i) continue;
     PetscCall(BondBlock(sys, f, i, k, &g, Ke));
     RowAdd(bs, i, &Ke[0], nb, w->slot, w->col, w->blocks, &w->ncol);
     RowAdd(bs, j, &Ke[bs], nb, w->slot, w->col, w->blocks, &w->ncol);
@@ -464,7 +467,7 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, const BondFilter *f, Mat *K)
 @*/
 PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 {
-  const BondFilter all = {PETSC_MAX_REAL, 1, 0};
+  const BondFilter all = {NULL, 0};
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
@@ -479,13 +482,13 @@ PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 }
 
 /*@C
-  PeriAssembleShortRange - assembles scale times the sum of the blocks of the bonds no longer than
-  rmax, broken ones with broken_share of theirs (bond-based models), as PeriAssembleStiffness does
-  K. Collective.
+  PeriAssembleShortRange - assembles the blocks of the bonds of the short range sr, each times its
+  factor (PeriShortRangeFactor), broken ones with broken_share of theirs (bond-based models), as
+  PeriAssembleStiffness does K. Collective.
 @*/
-PetscErrorCode PeriAssembleShortRange(PeriSystem sys, PetscReal rmax, PetscReal scale, PetscReal broken_share, Mat *P)
+PetscErrorCode PeriAssembleShortRange(PeriSystem sys, const PeriShortRange *sr, PetscReal broken_share, Mat *P)
 {
-  const BondFilter shorter = {rmax, scale, broken_share};
+  const BondFilter shorter = {sr, broken_share};
 
   PetscFunctionBeginUser;
   PetscCheck(!sys->model->ops.family_stiffness, sys->comm, PETSC_ERR_SUP, "a short-range stiffness needs a bond-based model");

@@ -2,7 +2,7 @@
  * bond by bond from one vector per bond, w = sqrt(k) e (k the bond's spring constant, e its unit
  * vector: the bond's block is k e e^T), 28 bytes per bond where the assembled K holds two dim x dim
  * blocks per bond in each of two rows (about 150 bytes in 3D). AMG then works on an assembled
- * short-range stiffness (the bonds no longer than solver.pc_radius times the nearest-neighbour
+ * short-range stiffness (the bonds no longer than solver.pc_radius times their ends' nearest-neighbour
  * distance, scaled to the full family's stiffness): a few shells instead of the whole horizon. */
 #include "perilin/private/system.h"
 
@@ -12,18 +12,17 @@
 #endif
 
 struct _p_PeriOperator {
-  PetscInt   refct; /* the system's reference and one per shell: a reused preconditioner may keep a shell after the system rebuilt its operator */
-  PetscInt   nloc, bs, nghost;
-  PetscInt  *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
-  PetscInt  *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
-  PetscReal *w;   /* bs per bond: sqrt(k) e */
-  PetscReal *len; /* per bond: |xi|, for the preconditioner's choice of bonds; freed after it */
-  PetscInt  *ghost;
-  PetscInt  *slot;         /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
-  PetscReal  rmax, pscale; /* the preconditioning matrix: its longest bond and its scale */
-  Vec        xm, ym;       /* ghosted work vectors: the input with held DOFs zeroed, and K of it */
-  Vec        kdiag;        /* the diagonal of K */
-  PetscBool  kdiag_stale;  /* bonds changed since kdiag was computed: recomputed when asked for (an explicit time loop never asks) */
+  PetscInt       refct; /* the system's reference and one per shell: a reused preconditioner may keep a shell after the system rebuilt its operator */
+  PetscInt       nloc, bs, nghost;
+  PetscInt      *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
+  PetscInt      *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
+  PetscReal     *w;   /* bs per bond: sqrt(k) e */
+  PetscInt      *ghost;
+  PetscInt      *slot;        /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
+  PeriShortRange short_range; /* the preconditioning matrix's bonds and their scales */
+  Vec            xm, ym;      /* ghosted work vectors: the input with held DOFs zeroed, and K of it */
+  Vec            kdiag;       /* the diagonal of K */
+  PetscBool      kdiag_stale; /* bonds changed since kdiag was computed: recomputed when asked for (an explicit time loop never asks) */
 };
 
 /* One MATSHELL over the shared bond data: y = s K_m x on free DOFs, y = hd x on held ones, where
@@ -263,7 +262,14 @@ static PetscErrorCode SpringConstant(PeriModel m, const PeriBondGeometry *g, con
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The live bonds of the owned particles as (jl, w, len), ghosts numbered after the owned ones. */
+/* Whether stored bond k of particle i is one of the operator's: live, and not a self-image (whose
+ * block cancels). */
+static inline PetscBool OperatorBond(const PeriBonds *b, PetscInt i, PetscInt k)
+{
+  return (PetscBool)(b->live[k] && b->j[k] != i);
+}
+
+/* The live bonds of the owned particles as (jl, w), ghosts numbered after the owned ones. */
 static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
 {
   const PeriBonds *b = &sys->disc.bonds;
@@ -275,7 +281,6 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(op->nloc + 1, &op->ptr));
   PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->bs, &op->w));
-  PetscCall(PetscMalloc1(b->nbonds, &op->len));
   PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
   if (sys->bond_state.failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
   op->nghost = 0;
@@ -284,13 +289,12 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PetscReal kb;
       if (op->slot) op->slot[k] = -1;
-      if (!b->live[k] || b->j[k] == i) continue;
+      if (!OperatorBond(b, i, k)) continue;
       if (op->slot) op->slot[k] = nb;
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
       PetscCall(SpringConstant(m, &g, Ke, &kb));
       for (PetscInt d = 0; d < op->bs; d++) op->w[nb * op->bs + d] = PetscSqrtReal(kb) * g.xi[d] / g.length;
-      op->len[nb] = g.length;
       if (g.j < sys->disc.nowned)
         op->jl[nb] = g.j;
       else { /* for now -1 - its global index: numbered below, as the ghosted vectors number them */
@@ -348,26 +352,66 @@ static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The preconditioning matrix's bonds and scale: those no longer than radius times the shortest
- * bond, their springs scaled so that a uniform expansion (sum of k |xi|^2 over the bonds) stores
- * the full family's energy. */
-static PetscErrorCode ChooseShortRange(PeriSystem sys, PeriOperator op, PetscReal radius)
+/* Per particle of the local view, sum of k |xi|^2 over its bonds (full) and over those of the short
+ * range (part): the energies a uniform expansion stores in them, up to a common factor. Collective. */
+static PetscErrorCode ExpansionEnergies(PeriSystem sys, PeriOperator op, PetscReal full[], PetscReal part[])
 {
-  PetscReal hmin = PETSC_MAX_REAL, sum[2] = {0, 0};
+  const PeriDisc  *disc = &sys->disc;
+  const PeriBonds *b    = &disc->bonds;
+  PetscInt         t    = 0; /* the operator's bond: CollectBonds keeps the OperatorBond ones in order */
 
   PetscFunctionBeginUser;
-  for (PetscInt b = 0; b < op->ptr[op->nloc]; b++) hmin = PetscMin(hmin, op->len[b]);
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmin, 1, MPIU_REAL, MPI_MIN, sys->comm));
-  op->rmax = radius * hmin * (1 + 1e-10);
-  for (PetscInt b = 0; b < op->ptr[op->nloc]; b++) {
-    PetscReal e = 0;
-    for (PetscInt d = 0; d < op->bs; d++) e += PetscSqr(op->w[op->bs * b + d] * op->len[b]);
-    sum[0] += e;
-    if (op->len[b] <= op->rmax) sum[1] += e;
-  }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, sum, 2, MPIU_REAL, MPI_SUM, sys->comm));
-  PetscCheck(sum[1] > 0 || PetscIsInfOrNanReal(sum[1]), sys->comm, PETSC_ERR_USER_INPUT, "solver.pc_radius %g keeps no bond: it must be at least 1 (the nearest neighbours)", (double)radius);
-  op->pscale = sum[0] / sum[1];
+  PetscCall(PetscArrayzero(full, disc->particles.n));
+  PetscCall(PetscArrayzero(part, disc->particles.n));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscReal e = 0;
+      if (!OperatorBond(b, i, k)) continue;
+      for (PetscInt d = 0; d < op->bs; d++) e += PetscSqr(op->w[op->bs * t + d] * b->length[k]);
+      t++;
+      full[i] += e;
+      full[b->j[k]] += e;
+      if (!PeriShortRangeHolds(&op->short_range, b, i, k)) continue;
+      part[i] += e;
+      part[b->j[k]] += e;
+    }
+  PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_SUM, full));
+  PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_SUM, part));
+  PetscCall(PeriDiscOwnersToGhosts(disc, MPIU_REAL, 1, full));
+  PetscCall(PeriDiscOwnersToGhosts(disc, MPIU_REAL, 1, part));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The preconditioning matrix's bonds and scales (PeriShortRange) from the operator's bonds: each
+ * particle's reach is radius times its shortest bond, and its scale what its family stores under a
+ * uniform expansion (sum of k |xi|^2 over its bonds) over what its short bonds store. A reach from
+ * the whole body's shortest bond instead left the coarse particles of a graded mesh without any
+ * bond, and the matrix singular. Collective. */
+static PetscErrorCode ChooseShortRange(PeriSystem sys, PeriOperator op, PetscReal radius)
+{
+  const PeriDisc  *disc = &sys->disc;
+  const PeriBonds *b    = &disc->bonds;
+  const PetscInt   n    = disc->particles.n;
+  PeriShortRange  *sr   = &op->short_range;
+  PetscReal       *full, *part;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc2(n, &sr->reach, n, &sr->scale));
+  PetscCall(PetscMalloc2(n, &full, n, &part));
+  for (PetscInt i = 0; i < n; i++) sr->reach[i] = PETSC_MAX_REAL;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      if (!OperatorBond(b, i, k)) continue;
+      sr->reach[i]       = PetscMin(sr->reach[i], b->length[k]);
+      sr->reach[b->j[k]] = PetscMin(sr->reach[b->j[k]], b->length[k]);
+    }
+  PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_MIN, sr->reach));
+  PetscCall(PeriDiscOwnersToGhosts(disc, MPIU_REAL, 1, sr->reach));
+  for (PetscInt i = 0; i < n; i++) sr->reach[i] *= radius * (1 + 1e-10);
+  PetscCall(ExpansionEnergies(sys, op, full, part));
+  /* a particle without bonds has no row to precondition: any scale */
+  for (PetscInt i = 0; i < n; i++) sr->scale[i] = part[i] > 0 ? full[i] / part[i] : 1;
+  PetscCall(PetscFree2(full, part));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -399,7 +443,6 @@ PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator
   PetscCall(CollectBonds(sys, *op));
   PetscCall(SetUpGhosts(sys, *op));
   PetscCall(ChooseShortRange(sys, *op, radius));
-  PetscCall(PetscFree((*op)->len)); /* only the choice of the short bonds needed it */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -413,7 +456,7 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
   PetscFunctionBeginUser;
   if (sys->stiffness.Kpc) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
-  PetscCall(PeriAssembleShortRange(sys, sys->stiffness.op->rmax, sys->stiffness.op->pscale, PERI_BROKEN_SHARE, &sys->stiffness.Kpc));
+  PetscCall(PeriAssembleShortRange(sys, &sys->stiffness.op->short_range, PERI_BROKEN_SHARE, &sys->stiffness.Kpc));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   if (!sys->run.log.pc_matrix_counted) { /* summary.json's matrix_mb counts it with the operator */
     PetscReal mb;
@@ -450,8 +493,8 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
   for (PetscInt d = 0; d < op->bs; d++) op->w[op->bs * t + d] *= PetscSqrtReal(factor);
-  if (!sys->stiffness.Kpc || factor > 0 || sys->disc.bonds.length[k] > op->rmax) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * op->pscale * Ke[a];
+  if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc.bonds, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc.bonds, i, k) * Ke[a];
   PetscCall(MatSetValuesBlocked(sys->stiffness.Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -478,7 +521,7 @@ PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
   }
   PetscCall(PetscFree((*op)->ptr));
   PetscCall(PetscFree2((*op)->jl, (*op)->w));
-  PetscCall(PetscFree((*op)->len));
+  PetscCall(PetscFree2((*op)->short_range.reach, (*op)->short_range.scale));
   PetscCall(PetscFree((*op)->ghost));
   PetscCall(PetscFree((*op)->slot));
   PetscCall(VecDestroy(&(*op)->xm));

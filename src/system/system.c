@@ -26,7 +26,7 @@ static const PeriKey corrections_keys[] = {
 const char *const    PeriOperatorKinds[] = {"auto", "assembled", "matrix_free", NULL};
 static const PeriKey solver_keys[]       = {
           {"operator", PERI_KEY_CHOICE, "auto", NULL, NULL, PeriOperatorKinds, "how K is applied: assembled, or matrix_free (central-force models in a static analysis: K u bond by bond, AMG on a short-range stiffness); auto: matrix_free where it applies and the preconditioner is GAMG (the default)"},
-          {"pc_radius", PERI_KEY_REAL, "1.75", "[1, inf)", NULL, NULL, "matrix_free: the bonds no longer than pc_radius times the shortest bond make the preconditioning matrix"},
+          {"pc_radius", PERI_KEY_REAL, "1.75", "[1, inf)", NULL, NULL, "matrix_free: the bonds no longer than pc_radius times the shortest bond of either end make the preconditioning matrix"},
           {"residual_tol", PERI_KEY_REAL, "0", "[0, 1)", NULL, NULL, "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; 0: min(max(100 rtol, 1e-6), 1e-3)"},
           {NULL},
 };
@@ -398,8 +398,7 @@ static PetscErrorCode Calibrate(PeriSystem sys)
 @*/
 PetscErrorCode PeriSystemSetUp(PeriSystem sys)
 {
-  PeriScene            s  = sys->scene;
-  const PeriParticles *pt = &sys->disc.particles;
+  PeriScene s = sys->scene;
 
   PetscFunctionBeginUser;
   PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
@@ -407,9 +406,8 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
   PetscCall(ReadCorrections(sys));
   PetscCall(SetUpBonds(sys));
-  for (PetscInt i = 0; i < sys->disc.nowned; i++)
-    PetscCheck(sys->disc.neighbor_count[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s: particle at (%g, %g, %g) has no bonds: it would move freely (horizon %g, spacing %g)", s->file, (double)pt->x[3 * i], (double)pt->x[3 * i + 1], (double)pt->x[3 * i + 2], (double)sys->disc.delta, (double)pt->spacing[i]);
   PetscCall(PeriRegionsCreateFromScene(sys->comm, s, &sys->disc.particles, sys->disc.nowned, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
+  PetscCall(PeriCheckBonded(sys)); /* the regions name where */
   PetscCall(ReadShearModuli(sys));
   PetscCall(Calibrate(sys));
   PetscCall(PeriReadProbes(sys));
@@ -420,6 +418,8 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   /* the loads too, so that a bad load is reported before any solve */
   PetscCall(PeriSystemCreateVec(sys, &sys->fields.f));
   PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
+  /* after the bcs, which may hold what the bonds do not, and the loads, which tell held pieces */
+  PetscCall(PeriCheckHeld(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -21,6 +21,29 @@ typedef enum {
 PETSC_EXTERN const char *const  PeriOperatorKinds[];
 typedef struct _p_PeriOperator *PeriOperator;
 
+/* The bonds of the short-range stiffness that preconditions a matrix-free K, chosen per particle
+ * of the local view so that a graded body keeps every particle in it: a bond enters when it is no
+ * longer than the larger reach of its ends (pc_radius times that end's shortest bond), its block
+ * scaled by the mean of its ends' scales (what the particle's whole family stores under a uniform
+ * expansion over what its short bonds store). */
+typedef struct {
+  PetscReal *reach, *scale;
+} PeriShortRange;
+
+/* Whether bond k of particle i is in the short-range stiffness sr (NULL: every bond). */
+static inline PetscBool PeriShortRangeHolds(const PeriShortRange *sr, const PeriBonds *b, PetscInt i, PetscInt k)
+{
+  return (PetscBool)(!sr || b->length[k] <= PetscMax(sr->reach[i], sr->reach[b->j[k]]));
+}
+
+/* The factor of bond k of particle i in the short-range stiffness sr, 0 when it is not in it
+ * (sr NULL: every bond, factor 1). */
+static inline PetscReal PeriShortRangeFactor(const PeriShortRange *sr, const PeriBonds *b, PetscInt i, PetscInt k)
+{
+  if (!sr) return 1;
+  return PeriShortRangeHolds(sr, b, i, k) ? 0.5 * (sr->scale[i] + sr->scale[b->j[k]]) : 0;
+}
+
 /* What an analysis asks of the stiffness, declared in its type (PeriAnalysisType.needs): the memory
  * estimate and K's defaults read it, so that no file of the system names an analysis. */
 typedef struct {
@@ -52,7 +75,7 @@ PETSC_EXTERN PetscErrorCode PeriRigidModes(PeriSystem, PetscInt *, Vec[], PetscR
 PETSC_EXTERN PetscErrorCode PeriSetNearNullSpace(PeriSystem, Mat, IS);
 PETSC_EXTERN PetscErrorCode PeriMatrixMB(Mat, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessRowSums(PeriSystem, Vec);
-PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, PetscReal, PetscReal, PetscReal, Mat *);
+PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, const PeriShortRange *, PetscReal, Mat *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[], PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *);

@@ -91,6 +91,10 @@ PETSC_EXTERN PetscErrorCode PeriSystemBondGeometry(PeriSystem, PetscInt, PetscIn
 PETSC_EXTERN PetscErrorCode PeriSystemFamilyGeometry(PeriSystem, PetscInt, PetscInt *, PeriBondGeometry[]);
 PETSC_EXTERN PetscInt       PeriSystemMaxFamily(PeriSystem);
 
+/* particles their bonds cannot hold, refused before a solve (src/system/holding.c) */
+PETSC_EXTERN PetscErrorCode PeriCheckBonded(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriCheckHeld(PeriSystem);
+
 /* assembly (src/system/assembly.c) */
 /* One element of the energy, as PeriElementsForEach visits it: a live bond of a bond-based model,
  * or the family of an owned particle of a state-based model. */
