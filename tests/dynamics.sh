@@ -20,6 +20,7 @@
 #  5. Failure (tests/scenes/dynamic_crack.yaml): bonds break, the dissipated energy closes the
 #     balance (drift < 1 %), and 1, 2 and 3 ranks break the same bonds with the same energies
 #     (1e-10 relative); the implicit integrator on 1, 2 and 3 ranks alike.
+# 13. (below) a failed implicit step is an error naming the reasons, with no output.
 #  9. The edge-on impact (examples/dynamics/eoi.yaml, Diehl & Schweitzer) at its coarsest dx
 #     (2.5 mm): the wave front runs within 10 % of the bond-based P-wave speed
 #     sqrt((K + 4G/3)/rho) = 10121 m/s for npmb and pmb (they give +5.1 % and -9.4 % here and
@@ -93,6 +94,15 @@ if [ $? -ne 0 ] && grep -q "mode_01.vtu holds 3600 particles, the body 900" "$tm
   echo "ok: a mode file of another body is refused: $(grep -o 'mode_01.vtu holds[^:]*' "$tmp/lvib_bad.log")"
 else
   echo "FAIL: a mode file of another body was not refused"; tail -3 "$tmp/lvib_bad.log"; fail=1
+fi
+# 13. a failed implicit step (the EOI at dt 1.74e-6: GAMG turns indefinite on the step's matrix
+#     after 135,000 bonds broke) fails the run with the solver's reasons and what to try, no output
+"$exe" "$eoi" -analysis_integrator implicit -analysis_dt 1.74e-6 -output_dir "$tmp/ifail" > "$tmp/ifail.log" 2>&1 < /dev/null
+code=$?
+if [ $code -ne 0 ] && grep -q "the implicit step after t = .* failed: DIVERGED_LINEAR_SOLVE, its linear solve DIVERGED_INDEFINITE_PC (PC gamg.*try -pc_type jacobi" "$tmp/ifail.log" && [ ! -e "$tmp/ifail" ]; then
+  echo "ok: a failed implicit step is refused: $(grep -o 'the implicit step after[^(]*' "$tmp/ifail.log")"
+else
+  echo "FAIL: a failed implicit step was not refused as expected (exit $code)"; tail -2 "$tmp/ifail.log"; fail=1
 fi
 # 4. the refusal: exit 1, the limit named, no output
 "$exe" "$pulse" -analysis_dt 1 -output_dir "$tmp/refused" > "$tmp/refused.log" 2>&1 < /dev/null

@@ -859,6 +859,7 @@ static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(TSSetExactFinalTime(d->ts, TS_EXACTFINALTIME_STEPOVER));
   PetscCall(TSMonitorSet(d->ts, Monitor, an, NULL));
   PetscCall(TSSetPostStep(d->ts, PostStep));
+  PetscCall(TSSetErrorIfStepFails(d->ts, PETSC_FALSE)); /* a failed step is perilin's message (CheckSteps) */
   PetscCall(TSSetFromOptions(d->ts));
   PetscCall(TSGetTimeStep(d->ts, &d->dt));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
@@ -946,6 +947,33 @@ static PetscErrorCode LoadTerms(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A step the TS could not complete fails the run, naming the solver's reason and what to try. */
+static PetscErrorCode CheckSteps(PeriAnalysis an)
+{
+  Dynamic            *d = DYN(an);
+  TSConvergedReason   reason;
+  SNES                snes;
+  KSP                 ksp;
+  PC                  pc;
+  SNESConvergedReason sr;
+  KSPConvergedReason  kr;
+  PCType              pctype;
+  PetscReal           t;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetConvergedReason(d->ts, &reason));
+  if (reason >= 0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(TSGetTime(d->ts, &t));
+  PetscCheck(d->implicit, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the time step after t = %g failed (%s)", an->sys->scene->file, (double)t, TSConvergedReasons[reason]);
+  PetscCall(TSGetSNES(d->ts, &snes));
+  PetscCall(SNESGetConvergedReason(snes, &sr));
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(KSPGetConvergedReason(ksp, &kr));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCGetType(pc, &pctype));
+  SETERRQ(an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the implicit step after t = %g failed: %s, its linear solve %s (PC %s, after %" PetscInt_FMT " bonds broke): the run is no result; try -pc_type jacobi (slower, always valid for the step's symmetric positive definite matrix K + M/(beta dt^2)), a smaller dt, or the explicit integrator", an->sys->scene->file, (double)t, SNESConvergedReasons[sr], KSPConvergedReasons[kr], pctype ? pctype : "none", d->broken);
+}
+
 /* What to try when the energy balance drifts. */
 static const char *DriftAdvice(const Dynamic *d)
 {
@@ -993,6 +1021,7 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(TSSolve(d->ts, NULL));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
+  PetscCall(CheckSteps(an));
   PetscCall(TSGetTime(d->ts, &t));
   PetscCall(PetscTime(&t1));
   an->sys->run.log.solve_s = t1 - t0;
