@@ -150,22 +150,13 @@ static PetscErrorCode ApplyOptions(PeriNode node)
 {
   PetscFunctionBeginUser;
   if (node->kind == PERI_NODE_SEQ && node->n > 0 && node->child[0]->kind == PERI_NODE_SCALAR) {
-    char      opt[512], val[PETSC_MAX_PATH_LEN], *tok, *save;
+    char      opt[512], val[PETSC_MAX_PATH_LEN];
     PetscBool set;
     PeriSceneOptionName(node->path, opt, sizeof(opt));
     set = PETSC_FALSE;
     if (OptionQueryable(opt)) PetscCall(PetscOptionsGetString(NULL, NULL, opt, val, sizeof(val), &set));
     if (set) {
-      for (PetscInt k = 0; k < node->n; k++) PetscCall(PeriNodeDestroy(&node->child[k]));
-      node->n = 0;
-      for (tok = strtok_r(val, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
-        PeriNode item;
-        char     idx[32];
-        PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, node->n));
-        PetscCall(PeriNodeCreate(PERI_NODE_SCALAR, idx, node->path, 0, &item));
-        PetscCall(PetscStrallocpy(tok, &item->value));
-        PetscCall(PeriNodeAppend(node, item));
-      }
+      PetscCall(PeriNodeSetItems(node, val, ","));
       node->line = 0;
       PetscFunctionReturn(PETSC_SUCCESS);
     }

@@ -179,8 +179,11 @@ static PetscErrorCode Child(PeriNode node, const char key[], PeriNodeKind kind, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* node (a list) takes the items of the flow list text "[0, 0]". */
-static PetscErrorCode SetList(PeriNode node, const char text[])
+/*@C
+  PeriNodeSetItems - node (a list) drops its items and takes those of text split at any of delims
+  (a flow list "[0, 0]" with "[], ", an option's "0,0" with ",").
+@*/
+PetscErrorCode PeriNodeSetItems(PeriNode node, const char text[], const char delims[])
 {
   char buf[PETSC_MAX_PATH_LEN], *tok, *save;
 
@@ -188,7 +191,7 @@ static PetscErrorCode SetList(PeriNode node, const char text[])
   for (PetscInt k = 0; k < node->n; k++) PetscCall(PeriNodeDestroy(&node->child[k]));
   node->n = 0;
   PetscCall(PetscStrncpy(buf, text, sizeof(buf)));
-  for (tok = strtok_r(buf, "[], ", &save); tok; tok = strtok_r(NULL, "[], ", &save)) {
+  for (tok = strtok_r(buf, delims, &save); tok; tok = strtok_r(NULL, delims, &save)) {
     PeriNode item;
     char     idx[32];
     PetscCall(PetscSNPrintf(idx, sizeof(idx), "%" PetscInt_FMT, node->n));
@@ -220,7 +223,7 @@ PetscErrorCode PeriSceneResolve(PeriScene scene, PeriNode map, const char key[],
                     &node));
   }
   if (list) {
-    PetscCall(SetList(node, value));
+    PetscCall(PeriNodeSetItems(node, value, "[], "));
   } else {
     PetscCall(PetscFree(node->value));
     PetscCall(PetscStrallocpy(value, &node->value));

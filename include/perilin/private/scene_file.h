@@ -40,6 +40,7 @@ PETSC_EXTERN void           PeriSceneOptionName(const char[], char[], size_t);
 /* The tree's nodes (src/scene/tree.c), for the reader and the resolved scene. */
 PETSC_EXTERN PetscErrorCode PeriNodeCreate(PeriNodeKind, const char[], const char[], int, PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriNodeAppend(PeriNode, PeriNode);
+PETSC_EXTERN PetscErrorCode PeriNodeSetItems(PeriNode, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriNodeDestroy(PeriNode *);
 
 /* The resolved scene (docs/summary.md): the value the run used for map.key (a dotted key; list: a
