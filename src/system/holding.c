@@ -87,26 +87,32 @@ PetscErrorCode PeriCheckBonded(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether the block A (bs x bs) is positive definite on the DOFs free[]: Cholesky of A scaled to
- * a unit diagonal, so that the test does not depend on units (a rotation's stiffness beside a
- * displacement's). */
+/* Whether the block A (bs x bs) is nonsingular on the DOFs free[]: LDL^T of A scaled to a unit
+ * diagonal (so that the test does not depend on units, a rotation's stiffness beside a
+ * displacement's), a pivot near 0 being a motion without energy. A negative pivot is no such
+ * motion: the negative shear springs of nu > 1/3 make the block indefinite, and the solver, not
+ * this check, answers for that (docs/models: CG stops with a reason, a direct solver solves). */
 static PetscBool Holds(PetscInt bs, const PetscReal A[], const PetscBool free[])
 {
   PetscInt  f[PERI_MAX_DOF], n = 0;
-  PetscReal L[PERI_MAX_DOF][PERI_MAX_DOF];
+  PetscReal L[PERI_MAX_DOF][PERI_MAX_DOF], d[PERI_MAX_DOF], sc[PERI_MAX_DOF];
 
   for (PetscInt a = 0; a < bs; a++)
     if (free[a]) {
-      if (!(A[a * bs + a] > 0)) return PETSC_FALSE;
+      if (!(PetscAbsReal(A[a * bs + a]) > 0)) return PETSC_FALSE;
+      sc[n]  = 1 / PetscSqrtReal(PetscAbsReal(A[a * bs + a]));
       f[n++] = a;
     }
-  for (PetscInt k = 0; k < n; k++)
-    for (PetscInt r = k; r < n; r++) {
-      PetscReal s = A[f[r] * bs + f[k]] / PetscSqrtReal(A[f[r] * bs + f[r]] * A[f[k] * bs + f[k]]);
-      for (PetscInt l = 0; l < k; l++) s -= L[r][l] * L[k][l];
-      if (r == k && s <= PERI_HOLD_PIVOT) return PETSC_FALSE;
-      L[r][k] = r == k ? PetscSqrtReal(s) : s / L[k][k];
+  for (PetscInt k = 0; k < n; k++) {
+    d[k] = A[f[k] * bs + f[k]] * sc[k] * sc[k];
+    for (PetscInt l = 0; l < k; l++) d[k] -= L[k][l] * L[k][l] * d[l];
+    if (PetscAbsReal(d[k]) <= PERI_HOLD_PIVOT) return PETSC_FALSE;
+    for (PetscInt r = k + 1; r < n; r++) {
+      PetscReal v = A[f[r] * bs + f[k]] * sc[r] * sc[k];
+      for (PetscInt l = 0; l < k; l++) v -= L[r][l] * L[k][l] * d[l];
+      L[r][k] = v / d[k];
     }
+  }
   return PETSC_TRUE;
 }
 
