@@ -15,6 +15,7 @@
 #  7. An initial velocity (analysis.velocity) on a free plate: a rigid translation, u = v t, the
 #     kinetic energy M v^2 / 2, no strain, both integrators (tests/scenes/rigid_translation.yaml);
 #     the default explicit step ends exactly at t_end.
+#     An initial displacement on the region all (analysis.displacement): a rigid offset that stays.
 #  8. Fronts (analysis.fronts): the pulse's wave front runs within 5 % of c; the crack's damage
 #     front reaches the plate's far edge.
 #  5. Failure (tests/scenes/dynamic_crack.yaml): bonds break, the dissipated energy closes the
@@ -66,6 +67,8 @@ for dt in 0.05 0.4 0.8; do run vib_e$dt "$exe" "$vib" -analysis_dt $dt; done
 for dt in 4 8 16; do run vib_i$dt "$exe" "$vib" -analysis_dt $dt -analysis_integrator implicit; done
 run modal_vib "$exe" "$repo/examples/pmb/bar_modes.yaml" -grid_upper 100,4,4
 run rigid_e "$exe" "$repo/tests/scenes/rigid_translation.yaml"
+sed 's/velocity: {region: all, value: \[3, -1\]}/displacement: {region: all, value: [0.01, -0.02]}/' "$repo/tests/scenes/rigid_translation.yaml" > "$tmp/rigid_offset.yaml"
+run rigid_o "$exe" "$tmp/rigid_offset.yaml"
 run rigid_i "$exe" "$repo/tests/scenes/rigid_translation.yaml" -analysis_integrator implicit -analysis_dt 0.002
 run crack1 "$exe" "$crack"
 for n in 2 3; do run crack$n mpiexec --oversubscribe -n $n "$exe" "$crack"; done
@@ -168,6 +171,8 @@ for name in ("rigid_e", "rigid_i"):
     r = history(name)[-1]
     ok = abs(r["time"] - 0.02) < 1e-12 and abs(r["probe_u"] / (3 * r["time"]) - 1) < 1e-9 and abs(r["kinetic"] / 5 - 1) < 1e-12 and r["strain"] < 1e-9
     check(ok, f"{name}: an initial velocity 3 on a free plate translates it rigidly: u = {r['probe_u']:.12g} = 3 t at t = {r['time']:.12g}, kinetic {r['kinetic']:.12g} = M v^2/2 = 5, strain {r['strain']:.2g}")
+r = history("rigid_o")
+check(all(abs(x["probe_u"] - 0.01) < 1e-15 and x["kinetic"] < 1e-20 and x["strain"] < 1e-15 for x in r), f"analysis.displacement on the region all: a rigid offset, u = 0.01 at every step, no motion, no strain ({len(r)} rows)")
 i1 = dyn("icrack1")
 for n in (2, 3):
     i2 = dyn(f"icrack{n}")

@@ -29,6 +29,8 @@ typedef struct {
   PetscInt       profile;                    /* 0 gaussian, 1 cosine */
   PetscReal      velocity[3];                /* analysis.velocity.value, on the particles of region */
   PeriNode       vnode;                      /* analysis.velocity, or NULL */
+  PeriNode       unode;                      /* analysis.displacement, or NULL */
+  PetscReal      displacement[3];            /* analysis.displacement.value, on the particles of region */
   PetscInt       pulse_axis;                 /* the pulse's axis */
   PeriAmplitude  amp;                        /* analysis.amplitude: of every load without one of its own */
   PetscInt       nloads;                     /* loads.<k> in the scene */
@@ -74,6 +76,7 @@ static const PeriKey dyn_keys[] = {
     {"pulse", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement u = amplitude exp(-((x - center)/width)^2) along axis (Ganzenmueller sec. 3.1.2)"},
     {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
     {"velocity", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial velocity of the particles of a region (a projectile, an impactor)"},
+    {"displacement", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement of the particles of a region, at rest, added to the pulse and analysis.initial"},
     {"fronts", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the wave front and the damage front along an axis, in history.csv and (fitted speeds) summary.json"},
     {"initial", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement read from a particles file perilin wrote of the same body (a modal run's mode_NN.vtu, an earlier state), added to the pulse"},
     {NULL},
@@ -97,6 +100,11 @@ static const PeriKey dyn_velocity_keys[] = {
     {"value", PERI_KEY_REALS, "required", NULL, "[length/time]", NULL, "their velocity, one number per dimension"},
     {NULL},
 };
+static const PeriKey dyn_displacement_keys[] = {
+    {"region", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the region whose particles start displaced"},
+    {"value", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "their displacement, one number per dimension"},
+    {NULL},
+};
 static const PeriKey dyn_fronts_keys[] = {
     {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the fronts run: x, y or z"},
     {"origin", PERI_KEY_REAL, "0", NULL, "[length]", NULL, "where they start along it: a front is the farthest distance from here"},
@@ -114,6 +122,7 @@ static const PeriSchema dyn_schema[] = {
     {"analysis.pulse", dyn_pulse_keys},
     {"analysis.amplitude", PeriAmplitudeKeys},
     {"analysis.velocity", dyn_velocity_keys},
+    {"analysis.displacement", dyn_displacement_keys},
     {"analysis.fronts", dyn_fronts_keys},
     {"analysis.initial", dyn_initial_keys},
     {"output", dyn_output_keys},
@@ -151,6 +160,21 @@ static PetscErrorCode ReadFronts(Dynamic *d, PeriScene s, PeriNode a)
   PetscCall(PeriSceneGetReal(s, f, "origin", PETSC_FALSE, &d->front_origin, NULL));
   PetscCall(PeriSceneGetReal(s, f, "speed", PETSC_TRUE, &d->front_speed, NULL));
   PetscCall(PeriSceneGetReal(s, f, "damage", PETSC_FALSE, &d->front_damage, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* analysis.<key>: {region, value} (velocity, displacement), the region found at set-up. */
+static PetscErrorCode ReadRegionValue(PeriScene s, PeriNode a, const char key[], PeriNode *node, PetscReal value[3])
+{
+  char     section[64];
+  PetscInt n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, a, key, PETSC_FALSE, node));
+  if (!*node) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(section, sizeof(section), "analysis.%s", key));
+  PetscCall(CheckOwnSection(s, *node, section));
+  PetscCall(PeriSceneGetRealArray(s, *node, "value", PETSC_TRUE, 1, 3, value, &n));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -225,12 +249,8 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
     d->pulse_axis = axis[0] - 'x';
     PetscCall(PeriSceneGetChoice(s, p, "profile", dyn_profiles, &d->profile, NULL));
   }
-  PetscCall(PeriSceneGetMap(s, a, "velocity", PETSC_FALSE, &d->vnode));
-  if (d->vnode) {
-    PetscInt n;
-    PetscCall(CheckOwnSection(s, d->vnode, "analysis.velocity"));
-    PetscCall(PeriSceneGetRealArray(s, d->vnode, "value", PETSC_TRUE, 1, 3, d->velocity, &n));
-  }
+  PetscCall(ReadRegionValue(s, a, "velocity", &d->vnode, d->velocity));
+  PetscCall(ReadRegionValue(s, a, "displacement", &d->unode, d->displacement));
   PetscCall(ReadFronts(d, s, a));
   PetscCall(ReadInitial(d, s, a));
   PetscCall(PeriSceneGetMap(s, a, "amplitude", PETSC_FALSE, &amp));
@@ -314,8 +334,31 @@ static void ChooseStep(Dynamic *d)
   if (!d->implicit && d->dt <= 0) d->dt = d->t_end / PetscCeilReal(d->t_end / (0.8 * d->dt_limit));
 }
 
-/* The initial displacements: analysis.initial's field, the pulse added, and the prescribed values
- * on the held DOFs. */
+/* Adds value (one number per dimension) to the translations of the particles of node.region
+ * (node: analysis.velocity or analysis.displacement; nothing when NULL). */
+static PetscErrorCode AddRegionValue(PeriAnalysis an, PeriNode node, const PetscReal value[], Vec v)
+{
+  PeriSystem     sys = an->sys;
+  const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart, dim = sys->disc.particles.dim;
+  PeriRegion    *r;
+  PetscScalar   *a;
+
+  PetscFunctionBeginUser;
+  if (!node) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriRegionFind(sys->scene, node, "region", sys->disc.nregions, sys->disc.regions, &r));
+  PetscCall(VecGetArray(v, &a));
+  for (PetscInt i = 0; i < nloc; i++)
+    if (PeriRegionContains(r, &sys->disc.particles.x[3 * i]))
+      for (PetscInt k = 0; k < dim; k++) {
+        const PetscInt c = PeriModelTranslation(sys->model, k);
+        if (c >= 0) a[i * bs + c] += value[k];
+      }
+  PetscCall(VecRestoreArray(v, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The initial displacements: analysis.initial's field, the pulse and analysis.displacement added,
+ * and the prescribed values on the held DOFs. */
 static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
 {
   Dynamic       *d   = DYN(an);
@@ -335,6 +378,7 @@ static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
     }
     PetscCall(VecRestoreArray(u, &a));
   }
+  PetscCall(AddRegionValue(an, d->unode, d->displacement, u));
   PetscCall(VecSetValues(u, sys->conditions.nconstrained, sys->conditions.constrained, sys->conditions.constrained_value, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(u));
   PetscCall(VecAssemblyEnd(u));
@@ -355,24 +399,9 @@ static PetscErrorCode ZeroHeld(PeriAnalysis an, Vec v)
  * elsewhere and on the held DOFs. */
 static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
 {
-  Dynamic       *d   = DYN(an);
-  PeriSystem     sys = an->sys;
-  const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart, dim = sys->disc.particles.dim;
-  PeriRegion    *r;
-  PetscScalar   *a;
-
   PetscFunctionBeginUser;
   PetscCall(VecSet(v, 0));
-  if (!d->vnode) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriRegionFind(sys->scene, d->vnode, "region", sys->disc.nregions, sys->disc.regions, &r));
-  PetscCall(VecGetArray(v, &a));
-  for (PetscInt i = 0; i < nloc; i++)
-    if (PeriRegionContains(r, &sys->disc.particles.x[3 * i]))
-      for (PetscInt k = 0; k < dim; k++) {
-        const PetscInt c = PeriModelTranslation(sys->model, k);
-        if (c >= 0) a[i * bs + c] = d->velocity[k];
-      }
-  PetscCall(VecRestoreArray(v, &a));
+  PetscCall(AddRegionValue(an, DYN(an)->vnode, DYN(an)->velocity, v));
   PetscCall(ZeroHeld(an, v));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
