@@ -107,6 +107,20 @@ if [ $code -ne 0 ] && grep -q "the implicit step after t = .* failed: DIVERGED_L
 else
   echo "FAIL: a failed implicit step was not refused as expected (exit $code)"; tail -2 "$tmp/ifail.log"; fail=1
 fi
+# 14. SIGINT mid-run (the EOI at dx 1.25 mm, 82 steps): the run stops after the step under way,
+#     exit 130, summary.json "complete": false with the steps done, history.csv ending there
+timeout --preserve-status -s INT 4 "$exe" "$eoi" -grid_spacing 1.25e-3 -output_dir "$tmp/sigint" > "$tmp/sigint.log" 2>&1 < /dev/null
+code=$?
+if [ $code -eq 130 ] && python3 - "$tmp/sigint" << 'PY'
+import csv, json, sys
+s = json.load(open(sys.argv[1] + "/summary.json"))
+rows = list(csv.DictReader(open(sys.argv[1] + "/history.csv")))
+d = s["dynamic"]
+ok = s["complete"] is False and 0 < d["steps"] < 82 and len(rows) == d["steps"] + 1 and abs(float(rows[-1]["time"]) / d["time"] - 1) < 1e-9
+print(("ok" if ok else "FAIL") + f": SIGINT stopped the explicit run after step {d['steps']} of 82 at t = {d['time']:.4g}, {len(rows)} history rows, complete {s['complete']}")
+sys.exit(not ok)
+PY
+then :; else echo "FAIL: SIGINT did not stop the dynamic run as expected (exit $code)"; tail -2 "$tmp/sigint.log"; fail=1; fi
 # 4. the refusal: exit 1, the limit named, no output
 "$exe" "$pulse" -analysis_dt 1 -output_dir "$tmp/refused" > "$tmp/refused.log" 2>&1 < /dev/null
 code=$?

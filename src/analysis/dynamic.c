@@ -608,6 +608,9 @@ static PetscErrorCode PostStep(TS ts)
     d->broken += nb;
     PetscCall(RestoreState(an, U, &q, &p));
   }
+  /* a signal ends the run after this step (TSStep resets the reason, so a monitor could not) */
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
+  if (an->sys->run.interrupted) PetscCall(TSSetConvergedReason(ts, TS_CONVERGED_USER));
   if (d->implicit) {
     SNES snes;
     KSP  ksp;
@@ -795,8 +798,6 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   if (an->every && step % an->every == 0) PetscCall(WriteSnapshot(an, q, t));
   PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", t = %g of %g, %" PetscInt_FMT " bonds broken", step, (double)t, (double)d->t_end, d->broken));
   PetscCall(RestoreState(an, U, &q, &p));
-  PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
-  if (an->sys->run.interrupted) PetscCall(TSSetConvergedReason(ts, TS_CONVERGED_USER));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
