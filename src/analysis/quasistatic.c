@@ -309,6 +309,8 @@ static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscInt c
 
 static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriStep *s)
 {
+  char soft[48] = "";
+
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   /* the bar where the status line would be drawn: a terminal of the user's (src/sys/progress.c) */
@@ -319,7 +321,8 @@ static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriSt
     bar[40] = 0;
     PetscCall(PetscPrintf(an->comm, "\r[%s] ", bar));
   }
-  PetscCall(PetscPrintf(an->comm, "step %4" PetscInt_FMT "  lambda %-12.6g u %-12.5g broken %6" PetscInt_FMT " (total %8" PetscInt_FMT ")  equilibrium its %3" PetscInt_FMT "  ksp its %5" PetscInt_FMT "  %.2f s\n", QS(an)->nsteps, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds));
+  if (an->sys->bond_state.failure.softening) PetscCall(PetscSNPrintf(soft, sizeof(soft), "  softened %8" PetscInt_FMT, s->softened));
+  PetscCall(PetscPrintf(an->comm, "step %4" PetscInt_FMT "  lambda %-12.6g u %-12.5g broken %6" PetscInt_FMT " (total %8" PetscInt_FMT ")%s  equilibrium its %3" PetscInt_FMT "  ksp its %5" PetscInt_FMT "  %.2f s\n", QS(an)->nsteps, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, soft, s->iterations, s->ksp_iterations, (double)s->seconds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -356,13 +359,17 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether the step just accepted (s) gets a snapshot: every output.every steps, or by default
- * (output.every 0) each step where bonds broke, the first PERI_AUTO_SNAPSHOTS of them. */
+/* Whether the step just accepted (s, the last recorded) gets a snapshot: every output.every
+ * steps, or by default (output.every 0) each step where bonds broke or more softened, the first
+ * PERI_AUTO_SNAPSHOTS of them. */
 static PetscBool SnapshotDue(PeriAnalysis an, const PeriStep *s)
 {
+  const PeriQuasistatic *q    = QS(an);
+  const PetscInt         prev = q->nsteps > 1 ? q->steps[q->nsteps - 2].softened : 0;
+
   if (!an->vtk) return PETSC_FALSE;
-  if (an->every) return (PetscBool)(QS(an)->nsteps % an->every == 0);
-  return (PetscBool)(s->broken > 0 && ((QSData *)an->data)->nsnaps < PERI_AUTO_SNAPSHOTS);
+  if (an->every) return (PetscBool)(q->nsteps % an->every == 0);
+  return (PetscBool)((s->broken > 0 || s->softened != prev) && ((QSData *)an->data)->nsnaps < PERI_AUTO_SNAPSHOTS);
 }
 
 /* The load-displacement columns and the control type's default, as chosen. */
@@ -545,9 +552,13 @@ static PetscErrorCode Failed(PeriAnalysis an, PeriCheckpoint *eq, PetscReal tria
 /* An accepted step: recorded, reported, saved, and the next step size chosen. */
 static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint *eq, PeriStep *s, PetscReal *dl, PetscInt nbonds)
 {
-  PeriQuasistatic *q = QS(an);
+  PeriQuasistatic *q       = QS(an);
+  const PetscInt   changes = s->broken; /* bonds broken or softened by more than 1 %, in every round */
 
   PetscFunctionBeginUser;
+  /* what the step reports: bonds counted once, dead ones apart from softened ones */
+  PetscCall(PeriBondsCount(an->sys, &s->broken_total, &s->softened));
+  s->broken = s->broken_total - q->broken_bonds;
   PetscCall(ControlValue(an, st->control, st->component, &s->control_u));
   /* the reactions of this equilibrium (and the check that they balance the loads) */
   PetscCall(PeriSystemEvaluateReactions(an->sys, s->lambda));
@@ -560,8 +571,8 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint
   PetscCall(Progress(an, st, s));
   if (SnapshotDue(an, s)) PetscCall(WriteSnapshot(an));
   /* many breaks: smaller steps; none: back towards the scene's step */
-  if (st->adaptive) *dl = s->broken > nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : s->broken ? *dl
-                                                                                                   : PetscMin(2 * *dl, st->step);
+  if (st->adaptive) *dl = changes > nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : changes ? *dl
+                                                                                               : PetscMin(2 * *dl, st->step);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -570,21 +581,23 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint
 
 static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
 {
-  PeriQuasistatic *q = QS(an);
+  PeriQuasistatic *q        = QS(an);
+  char             soft[48] = "";
 
   PetscFunctionBeginUser;
   q->complete = an->sys->run.interrupted ? PETSC_FALSE : PETSC_TRUE;
   if (an->sys->run.interrupted)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "interrupted (%s): the results at the last equilibrium", PeriSignalName(an->sys->run.interrupted)));
-  else if (!q->failed && q->broken_bonds)
-    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g, %" PetscInt_FMT " bonds broken on the way (an equilibrium at every step)", (double)st->max, q->broken_bonds));
+  else if (!q->failed && (q->broken_bonds || (q->nsteps && q->steps[q->nsteps - 1].softened)))
+    PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g, %" PetscInt_FMT " bonds broken and %" PetscInt_FMT " softened on the way (an equilibrium at every step)", (double)st->max, q->broken_bonds, q->nsteps ? q->steps[q->nsteps - 1].softened : 0));
   else if (!q->failed)
     PetscCall(PetscSNPrintf(q->ending, sizeof(q->ending), "reached lambda = %g without failure", (double)st->max));
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
   PetscCall(PeriSystemEvaluateReactions(an->sys, q->peak_load_factor));
   PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscPrintf(an->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, q->solves, q->pc_setups));
+  if (an->sys->bond_state.failure.softening && q->nsteps) PetscCall(PetscSNPrintf(soft, sizeof(soft), " (%" PetscInt_FMT " softened)", q->steps[q->nsteps - 1].softened));
+  PetscCall(PetscPrintf(an->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken%s, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, soft, q->solves, q->pc_setups));
   if (q->failed) PetscCall(PetscPrintf(an->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
   if (q->failed && !q->broken_bonds) PetscCall(PetscPrintf(an->comm, "perilin: note: %s\n", PERI_INTACT_NOTE));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -808,12 +821,12 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
   PetscFunctionBeginUser;
   if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,equilibrium_iterations,ksp_iterations,seconds") < 0;
+  bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,softened,equilibrium_iterations,ksp_iterations,seconds") < 0;
   bad |= ReactionColumns(an, fp, -1);
   bad |= fprintf(fp, "\n") < 0;
   for (PetscInt k = 0; k < QS(an)->nsteps; k++) {
     const PeriStep *s = &QS(an)->steps[k];
-    bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
+    bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->softened, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
     bad |= ReactionColumns(an, fp, k);
     bad |= fprintf(fp, "\n") < 0;
   }
@@ -875,6 +888,7 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
     PetscCall(PeriJSONInt(j, "failed_trial_broken_bonds", q->failed_trial_broken));
   }
   PetscCall(PeriJSONInt(j, "broken_bonds", q->broken_bonds));
+  if (q->nsteps) PetscCall(PeriJSONInt(j, "softened_bonds", q->steps[q->nsteps - 1].softened));
   PetscCall(PeriJSONInt(j, "precracked_bonds", an->sys->bond_state.failure.precracked_bonds));
   PetscCall(PeriJSONBool(j, "failed", q->failed));
   PetscCall(PeriJSONBool(j, "complete", q->complete));

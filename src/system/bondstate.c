@@ -146,6 +146,32 @@ PetscErrorCode PeriCheckpointDestroy(PeriCheckpoint *e)
 }
 
 /* Frees what the bond state holds. */
+/*@C
+  PeriBondsCount - the bonds the run has broken (dead, less those the scene's cracks removed) and
+  those softened (alive with less than their whole stiffness), over all ranks: what a step reports,
+  where summing PeriBondsBreak's counts would count a bond that softens in several rounds each
+  time. Collective.
+@*/
+PetscErrorCode PeriBondsCount(PeriSystem sys, PetscInt *broken, PetscInt *softened)
+{
+  const PeriBonds *b    = &sys->disc.bonds;
+  PetscInt         n[2] = {0, 0};
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      if (b->j[k] == i) continue;
+      if (!b->live[k])
+        n[0]++;
+      else if (b->intact && b->intact[k] < 1)
+        n[1]++;
+    }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, n, 2, MPIU_INT, MPI_SUM, sys->comm));
+  *broken   = n[0] - sys->bond_state.failure.precracked_bonds;
+  *softened = n[1];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriBondStateDestroy(PeriBondState *B)
 {
   PetscFunctionBeginUser;

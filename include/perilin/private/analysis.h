@@ -34,8 +34,9 @@ typedef struct {
 /* One load step of the quasi-static analysis. */
 typedef struct {
   PetscReal lambda, control_u, seconds;
-  PetscInt  broken, broken_total, iterations, ksp_iterations;
-  PetscReal reaction, imbalance; /* the reaction region's force along the control component; the relative imbalance */
+  PetscInt  broken, broken_total, iterations, ksp_iterations; /* broken: at this step (dead bonds), not counting softening */
+  PetscInt  softened;                                         /* bonds softened (alive, less than their whole stiffness) at this equilibrium */
+  PetscReal reaction, imbalance;                              /* the reaction region's force along the control component; the relative imbalance */
 } PeriStep;
 
 typedef struct {

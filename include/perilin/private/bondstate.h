@@ -107,6 +107,7 @@ typedef struct {
 
 PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriFailureCacheBonds(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriBondsCount(PeriSystem, PetscInt *, PetscInt *);
 PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
 PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
