@@ -40,7 +40,7 @@ typedef struct {
      their own under analysis.amplitude, then one term per load with its own */
   PetscInt              nterms;
   const PeriAmplitude **term_amp;
-  Vec                  *term_f, ft;
+  Vec                  *term_f;
   PetscReal            *term_prev; /* a_k at the last step, for the work */
   /* the run */
   PetscBool  started;
@@ -432,14 +432,16 @@ static PetscErrorCode RHSPosition(TS ts, PetscReal t, Vec p, Vec dq, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* ft = f(t), the sum of the load terms under their amplitudes. */
-static PetscErrorCode LoadAt(PeriAnalysis an, PetscReal t)
+/* y = alpha y + sign f(t), f(t) the sum of the load terms under their amplitudes. */
+static PetscErrorCode LoadAt(PeriAnalysis an, PetscReal t, PetscReal sign, PetscReal alpha, Vec y)
 {
-  Dynamic *d = DYN(an);
+  Dynamic    *d = DYN(an);
+  PetscScalar a[PERI_DYN_MAX_TERMS];
 
   PetscFunctionBeginUser;
-  PetscCall(VecSet(d->ft, 0));
-  for (PetscInt k = 0; k < d->nterms; k++) PetscCall(VecAXPY(d->ft, PeriAmplitudeValue(d->term_amp[k], t), d->term_f[k]));
+  for (PetscInt k = 0; k < d->nterms; k++) a[k] = sign * PeriAmplitudeValue(d->term_amp[k], t);
+  PetscCall(VecAXPBY(y, a[0], alpha, d->term_f[0])); /* one pass over y when every load shares one amplitude */
+  if (d->nterms > 1) PetscCall(VecMAXPY(y, d->nterms - 1, a + 1, d->term_f + 1));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -451,8 +453,7 @@ static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
   PetscFunctionBeginUser;
   (void)ts;
   PetscCall(MatMult(an->sys->stiffness.K, q, dp));
-  PetscCall(LoadAt(an, t));
-  PetscCall(VecAYPX(dp, -1, DYN(an)->ft));
+  PetscCall(LoadAt(an, t, 1, -1, dp));
   PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -491,8 +492,7 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
   PetscCall(MatMult(sys->stiffness.K, U, F));
   PetscCall(VecPointwiseMult(DYN(an)->tmp, m, A));
   PetscCall(VecAXPY(F, 1, DYN(an)->tmp));
-  PetscCall(LoadAt(an, t));
-  PetscCall(VecAXPY(F, -1, DYN(an)->ft));
+  PetscCall(LoadAt(an, t, -1, 1, F));
   if (sys->conditions.nconstrained) {
     const PetscScalar *u;
     PetscScalar       *f;
@@ -962,7 +962,6 @@ static PetscErrorCode LoadTerms(PeriAnalysis an)
   for (PetscInt k = 0; k < d->nloads; k++) n += d->own_amp[k];
   PetscCheck(n <= PERI_DYN_MAX_TERMS, an->comm, PETSC_ERR_SUP, "%s: %" PetscInt_FMT " loads with an amplitude of their own; at most %d", an->sys->scene->file, n - 1, PERI_DYN_MAX_TERMS - 1);
   PetscCall(PetscMalloc3(n, &d->term_amp, n, &d->term_f, n, &d->term_prev));
-  PetscCall(VecDuplicate(an->sys->fields.f, &d->ft));
   PetscCall(VecDuplicate(an->sys->fields.f, &d->term_f[0]));
   PetscCall(VecCopy(an->sys->fields.f, d->term_f[0]));
   d->term_amp[0] = &d->amp;
@@ -1193,7 +1192,6 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscCall(PetscFree(d->snap_time));
   for (PetscInt k = 0; k < d->nterms; k++) PetscCall(VecDestroy(&d->term_f[k]));
   PetscCall(PetscFree3(d->term_amp, d->term_f, d->term_prev));
-  PetscCall(VecDestroy(&d->ft));
   for (PetscInt k = 0; k < d->nloads; k++) PetscCall(PeriAmplitudeDestroy(&d->load_amp[k]));
   PetscCall(PetscFree2(d->load_amp, d->own_amp));
   PetscCall(PeriAmplitudeDestroy(&d->amp));
