@@ -14,12 +14,24 @@ PetscReal PeriModelIsotropicEnergy(PeriModel m)
   return mt->E / (1 - mt->nu);
 }
 
-/* integral of |xi|^p over the continuous horizon (per unit thickness times t in 2D) */
-PetscReal PeriModelHorizonMoment(PeriModel m, PetscInt p)
+/* integral of |xi|^p over the continuous horizon of radius d (per unit thickness times t in 2D) */
+PetscReal PeriModelHorizonMomentAt(PeriModel m, PetscInt p, PetscReal d)
 {
-  PetscReal d = m->delta;
   if (m->dim == 3) return 4 * PETSC_PI * PetscPowReal(d, p + 3) / (p + 3);
   return 2 * PETSC_PI * m->material.thickness * PetscPowReal(d, p + 2) / (p + 2);
+}
+
+/* ... of the model's horizon */
+PetscReal PeriModelHorizonMoment(PeriModel m, PetscInt p)
+{
+  return PeriModelHorizonMomentAt(m, p, m->delta);
+}
+
+/* The horizon a bond's constants refer to: the model's, or with per-particle horizons the mean of
+ * its two ends' (the constants c_ij are the mean of the ends' c_i, Diehl & Schweitzer). */
+PetscReal PeriModelBondHorizon(PeriModel m, const PeriBondGeometry *b)
+{
+  return m->horizon ? 0.5 * (m->horizon[b->i] + m->horizon[b->j]) : m->delta;
 }
 
 /* k [e e^T, -e e^T; -e e^T, e e^T] on the translational DOFs (the first dim of the dofs),
@@ -73,11 +85,13 @@ void PeriShearBondNuRange(PeriModel m, PetscReal *lo, PetscReal *hi)
 /* Critical stretch of a spring with pair energy c s^2 |xi| V_i V_j / 2 for the energy release rate G:
  * the energy of all bonds across a unit crack area at stretch s is G = c s^2 t delta^4 / 4 in 2D
  * and pi c s^2 delta^5 / 10 in 3D (Silling & Askari; Ha & Bobaru), so s_c = sqrt(4G/(c t delta^4))
- * (plane stress pmb: sqrt(4 pi G / (9 E delta))) and sqrt(10 G/(pi c delta^5)) = sqrt(5G/(9K delta)). */
-PetscReal PeriCriticalStretchSpring(PeriModel m, PetscReal c, PetscReal G)
+ * (plane stress pmb: sqrt(4 pi G / (9 E delta))) and sqrt(10 G/(pi c delta^5)) = sqrt(5G/(9K delta)),
+ * delta the bond's (PeriModelBondHorizon). */
+PetscReal PeriCriticalStretchSpring(PeriModel m, const PeriBondGeometry *b, PetscReal c, PetscReal G)
 {
-  if (m->dim == 3) return PetscSqrtReal(10 * G / (PETSC_PI * c * PetscPowRealInt(m->delta, 5)));
-  return PetscSqrtReal(4 * G / (c * m->material.thickness * PetscPowRealInt(m->delta, 4)));
+  const PetscReal d = PeriModelBondHorizon(m, b);
+  if (m->dim == 3) return PetscSqrtReal(10 * G / (PETSC_PI * c * PetscPowRealInt(d, 5)));
+  return PetscSqrtReal(4 * G / (c * m->material.thickness * PetscPowRealInt(d, 4)));
 }
 
 /* Linearized stretch s = e . (u_j - u_i) / |xi|. */

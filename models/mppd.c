@@ -114,7 +114,7 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
   const MPPD *mp = (const MPPD *)m->data;
-  return PeriCriticalStretchSpring(m, mp->c * PeriLatticeFactor(mp->normal, b), G);
+  return PeriCriticalStretchSpring(m, b, mp->c * PeriLatticeFactor(mp->normal, b), G);
 }
 
 static PetscErrorCode Destroy(PeriModel m)

@@ -45,13 +45,13 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
  * (A_seg the circular segment beyond the crack line), G = (c s^2/2) int_0^delta V_cap(z) dz =
  * pi c s^2 delta^4 / 8 in 3D. Ganzenmueller's eq. 21 (and Diehl's eq. 16) count each bond from both
  * sides, G = (2/3) c s^2 t delta^3, which makes s_c and the critical loads too small by sqrt(2)
- * (docs/failure.md). c is the bond's c_ij. */
+ * (docs/failure.md). c is the bond's c_ij, delta the bond's (PeriModelBondHorizon). */
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
   const NPMB *np = (const NPMB *)m->data;
-  PetscReal   c  = 0.5 * (np->c[b->i] + np->c[b->j]) * PeriLatticeFactor(np->lat, b);
-  if (m->dim == 3) return PetscSqrtReal(8 * G / (PETSC_PI * c * PetscPowRealInt(m->delta, 4)));
-  return PetscSqrtReal(3 * G / (c * m->material.thickness * PetscPowRealInt(m->delta, 3)));
+  PetscReal   c = 0.5 * (np->c[b->i] + np->c[b->j]) * PeriLatticeFactor(np->lat, b), d = PeriModelBondHorizon(m, b);
+  if (m->dim == 3) return PetscSqrtReal(8 * G / (PETSC_PI * c * PetscPowRealInt(d, 4)));
+  return PetscSqrtReal(3 * G / (c * m->material.thickness * PetscPowRealInt(d, 3)));
 }
 
 static PetscErrorCode Destroy(PeriModel m)
@@ -77,6 +77,7 @@ static PetscErrorCode PeriModelCreate_NPMB(PeriModel m)
   m->ops.destroy               = Destroy;
   m->ops.critical_from_G       = CriticalFromG;
   m->takes_lattice             = PETSC_TRUE;
+  m->takes_own_horizon         = PETSC_TRUE; /* c_i from the particle's own family: no horizon in it */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -56,7 +56,7 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
   const PDS *pds = (const PDS *)m->data;
-  return PeriCriticalStretchSpring(m, pds->c * PeriLatticeFactor(pds->lat, b), G);
+  return PeriCriticalStretchSpring(m, b, pds->c * PeriLatticeFactor(pds->lat, b), G);
 }
 
 static PetscErrorCode Destroy(PeriModel m)

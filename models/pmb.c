@@ -6,9 +6,14 @@
 
 typedef struct {
   PetscReal   c;
+  PetscReal  *ci;  /* per-particle horizons without the lattice: c_i of each particle's own horizon, else NULL */
   PeriLattice lat; /* model.calibration: lattice, else NULL */
 } PMB;
 
+/* With per-particle horizons each particle has the c of its own horizon and a bond the mean of its
+ * ends' (Diehl & Schweitzer's c_ij); the lattice calibration instead normalizes every family to the
+ * moments of the one horizon delta, so c of delta times its factor is 4 W0 over the family's own sum
+ * whatever the particle's horizon. */
 static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
 {
   PMB *pmb = (PMB *)m->data;
@@ -16,26 +21,35 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
   PetscFunctionBeginUser;
   pmb->c = 4 * PeriModelIsotropicEnergy(m) / PeriModelHorizonMoment(m, 1);
   PetscCall(PeriLatticeCreate(m, data, 4, PeriProfileLength, &pmb->lat));
+  PetscCall(PetscFree(pmb->ci));
+  if (m->horizon && !pmb->lat) {
+    PetscCall(PetscMalloc1(data->n, &pmb->ci));
+    for (PetscInt i = 0; i < data->n; i++) pmb->ci[i] = 4 * PeriModelIsotropicEnergy(m) / PeriModelHorizonMomentAt(m, 1, m->horizon[i]);
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscReal BondConstant(const PMB *pmb, const PeriBondGeometry *b)
+{
+  return (pmb->ci ? 0.5 * (pmb->ci[b->i] + pmb->ci[b->j]) : pmb->c) * PeriLatticeFactor(pmb->lat, b);
 }
 
 /* pair energy V_i V_j w = (c V_i V_j / |xi|) (e . (u_j - u_i))^2 / 2 */
 static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[])
 {
-  const PMB *pmb = (const PMB *)m->data;
-  PeriCentralBondBlock(m, b, pmb->c * PeriLatticeFactor(pmb->lat, b) * b->Vi * b->Vj * b->weight / b->length, Ke);
+  PeriCentralBondBlock(m, b, BondConstant((const PMB *)m->data, b) * b->Vi * b->Vj * b->weight / b->length, Ke);
 }
 
 static PetscReal CriticalFromG(PeriModel m, const PeriBondGeometry *b, PetscReal G)
 {
-  const PMB *pmb = (const PMB *)m->data;
-  return PeriCriticalStretchSpring(m, pmb->c * PeriLatticeFactor(pmb->lat, b), G);
+  return PeriCriticalStretchSpring(m, b, BondConstant((const PMB *)m->data, b), G);
 }
 
 static PetscErrorCode Destroy(PeriModel m)
 {
   PetscFunctionBeginUser;
   PetscCall(PeriLatticeDestroy(&((PMB *)m->data)->lat));
+  PetscCall(PetscFree(((PMB *)m->data)->ci));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -52,6 +66,7 @@ static PetscErrorCode PeriModelCreate_PMB(PeriModel m)
   m->ops.critical_from_G = CriticalFromG;
   m->ops.destroy         = Destroy;
   m->takes_lattice       = PETSC_TRUE;
+  m->takes_own_horizon   = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

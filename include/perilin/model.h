@@ -83,7 +83,9 @@ struct _p_PeriModel {
   PeriCalibrationKind calibration;              /* set before calibrate */
   char                warning[256];             /* set by calibration; printed once by the problem */
   PeriMaterial        material;
-  PetscReal           delta;
+  PetscReal           delta;             /* the horizon; with per-particle horizons, the largest */
+  const PetscReal    *horizon;           /* horizon.spacing: own: each particle's of the local view (b->i, b->j index it); else NULL */
+  PetscBool           takes_own_horizon; /* the model calibrates per particle, so it takes per-particle horizons */
   void               *data;
   /* what each of the nmeasures bond measures is, in the order of measure_names: the failure
      criteria find theirs by kind (PeriModelMeasureIndex) */
@@ -92,11 +94,13 @@ struct _p_PeriModel {
 
 PETSC_EXTERN PetscReal      PeriModelIsotropicEnergy(PeriModel);
 PETSC_EXTERN PetscReal      PeriModelHorizonMoment(PeriModel, PetscInt);
+PETSC_EXTERN PetscReal      PeriModelHorizonMomentAt(PeriModel, PetscInt, PetscReal);
+PETSC_EXTERN PetscReal      PeriModelBondHorizon(PeriModel, const PeriBondGeometry *);
 PETSC_EXTERN void           PeriCentralBondBlock(PeriModel, const PeriBondGeometry *, PetscReal, PetscReal[]);
 PETSC_EXTERN void           PeriAddSpring(PetscInt, const PetscReal[], PetscReal, PetscReal[]);
 PETSC_EXTERN void           PeriPlaneMicromoduli(PeriModel, PetscReal *, PetscReal *);
 PETSC_EXTERN void           PeriShearBondNuRange(PeriModel, PetscReal *, PetscReal *);
-PETSC_EXTERN PetscReal      PeriCriticalStretchSpring(PeriModel, PetscReal, PetscReal);
+PETSC_EXTERN PetscReal      PeriCriticalStretchSpring(PeriModel, const PeriBondGeometry *, PetscReal, PetscReal);
 PETSC_EXTERN void           PeriBondStretch(PeriModel, const PeriBondGeometry *, const PetscReal[], const PetscReal[], PetscReal[]);
 PETSC_EXTERN void           PeriBondBasedNuRange(PeriModel, PetscReal *, PetscReal *);
 PETSC_EXTERN void           PeriModelSetCentralForce(PeriModel);

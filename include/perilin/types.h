@@ -37,6 +37,12 @@ typedef struct {
 
 #define PeriParticleIsFictitious(pt, k) ((pt)->image && (pt)->image[k] >= 0)
 
+/* The global index of particle k of p (p may be a rank's local view). */
+static inline PetscInt PeriParticleGlobal(const PeriParticles *p, PetscInt k)
+{
+  return p->global ? p->global[k] : k;
+}
+
 /* ------------------------------------------------------------------ bonds (src/neighbors.c, src/corrections.c) */
 typedef enum {
   PERI_PARTIAL_VOLUME_NONE,

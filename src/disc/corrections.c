@@ -34,21 +34,33 @@ PetscErrorCode PeriNeighborhoodVolumes(const PeriDisc *d, PetscReal family[], Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The volume of a full continuous horizon of radius delta: pi delta^2 t in 2D, 4/3 pi delta^3 in 3D. */
+static PetscReal HorizonVolume(const PeriParticles *p, PetscReal delta)
+{
+  return p->dim == 2 ? PETSC_PI * delta * delta * p->thickness : 4.0 / 3.0 * PETSC_PI * delta * delta * delta;
+}
+
 /*@C
   PeriSurfaceCorrectionApply - sets each bond's lambda. The volume method: lambda = 2 V0 /
-  (V(H_i) + V(H_j)), V0 the volume of a full continuous horizon (pi delta^2 t in 2D, 4/3 pi
-  delta^3 in 3D) and V(H) the discrete volume of the body inside the horizon, the particle's own
-  cell included. Not collective.
+  (V(H_i) + V(H_j)), V0 the volume of a full continuous horizon and V(H) the discrete volume of
+  the body inside the horizon, the particle's own cell included. With per-particle horizons
+  (horizon, else NULL) each end is measured against its own full horizon: lambda = 2 / (V(H_i) /
+  V0_i + V(H_j) / V0_j), the same where the two agree. Not collective.
 @*/
-PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection sc, const PeriParticles *p, PetscReal delta, const PetscReal family[], PeriBonds *b)
+PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection sc, const PeriParticles *p, PetscReal delta, const PetscReal horizon[], const PetscReal family[], PeriBonds *b)
 {
-  PetscReal V0 = p->dim == 2 ? PETSC_PI * delta * delta * p->thickness : 4.0 / 3.0 * PETSC_PI * delta * delta * delta;
+  PetscReal V0 = HorizonVolume(p, delta);
 
   PetscFunctionBeginUser;
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscInt j   = b->j[k];
-      b->lambda[k] = sc == PERI_SURFACE_VOLUME ? 2 * V0 / (family[i] + p->volume[i] + family[j] + p->volume[j]) : 1.0;
+      PetscInt j = b->j[k];
+      if (sc != PERI_SURFACE_VOLUME)
+        b->lambda[k] = 1.0;
+      else if (horizon)
+        b->lambda[k] = 2 / ((family[i] + p->volume[i]) / HorizonVolume(p, horizon[i]) + (family[j] + p->volume[j]) / HorizonVolume(p, horizon[j]));
+      else
+        b->lambda[k] = 2 * V0 / (family[i] + p->volume[i] + family[j] + p->volume[j]);
     }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

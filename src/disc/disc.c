@@ -11,6 +11,7 @@ PetscErrorCode PeriDiscDestroy(PeriDisc *disc)
   PetscCall(PeriParticlesDestroy(&disc->particles));
   PetscCall(PeriHaloDestroy(&disc->halo));
   PetscCall(PetscFree(disc->range));
+  PetscCall(PetscFree(disc->horizon));
   PetscCall(PetscFree(disc->regions));
   PetscCall(PetscFree2(disc->family_volume, disc->neighbor_count));
   disc->nregions = 0;

@@ -104,7 +104,7 @@ static PetscErrorCode CellListDestroy(CellList *cl)
 }
 
 /* Growable bond storage. */
-static PetscErrorCode BondsReserve(PeriBonds *b, PetscInt need, PetscInt *cap)
+PetscErrorCode PeriBondsReserve(PeriBonds *b, PetscInt need, PetscInt *cap)
 {
   PetscFunctionBeginUser;
   if (need <= *cap) PetscFunctionReturn(PETSC_SUCCESS);
@@ -147,12 +147,6 @@ static PetscBool ShiftPositive(const PetscInt w[3])
   return PETSC_FALSE;
 }
 
-/* The global index of particle k of p (p may be a rank's local view). */
-static inline PetscInt Global(const PeriParticles *p, PetscInt k)
-{
-  return p->global ? p->global[k] : k;
-}
-
 /* The cell at offset o from cell ci, wrapped across periodic axes (wrap: the images crossed per
  * axis), or -1 beyond a non-periodic face. */
 static PetscInt NeighborCell(const PeriParticles *p, const CellList *cl, const PetscInt ci[], const PetscInt o[], PetscInt wrap[])
@@ -169,8 +163,29 @@ static PetscInt NeighborCell(const PeriParticles *p, const CellList *cl, const P
   return CellIndex(cl, c);
 }
 
-/* Appends the bonds of particle i (those with j >= i when half) to b. Errors on coincident
- * particles. */
+/*@C
+  PeriBondsAdd - appends the bond of i to j (x = X_j - X_i, image shift included) for horizon delta
+  when its partial-volume factor is positive. Errors on coincident particles. Not collective.
+@*/
+PetscErrorCode PeriBondsAdd(const PeriParticles *p, PetscInt i, PetscInt j, const PetscReal x[], PetscReal delta, PeriPartialVolume pv, PeriBonds *b, PetscInt *cap)
+{
+  PetscReal len = PetscSqrtReal(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]), h = 0.5 * (p->spacing[i] + p->spacing[j]), alpha;
+
+  PetscFunctionBeginUser;
+  PetscCheck(len > 1e-8 * h, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "particles %" PetscInt_FMT " and %" PetscInt_FMT " coincide at (%g, %g, %g)%s (distance %g, spacing %g)", p->source_line[i] ? p->source_line[i] : i, p->source_line[j] ? p->source_line[j] : j, (double)p->x[3 * i], (double)p->x[3 * i + 1], (double)p->x[3 * i + 2], p->source_line[i] ? " (the numbers are lines of particles.file)" : "", (double)len, (double)h);
+  alpha = PeriPartialVolumeFactor(pv, len, delta, h);
+  if (alpha <= 0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriBondsReserve(b, b->nbonds + 1, cap));
+  b->j[b->nbonds] = j;
+  for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
+  b->length[b->nbonds] = len;
+  b->alpha[b->nbonds]  = alpha;
+  b->live[b->nbonds]   = 1;
+  b->nbonds++;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Appends the bonds of particle i (those with j >= i when half) to b. */
 static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, PetscReal delta, PeriPartialVolume pv, PetscReal r, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
 {
   const PetscReal *xi = &p->x[3 * i];
@@ -185,9 +200,9 @@ static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, 
         if (cell < 0) continue;
         for (PetscInt s = cl->start[cell]; s < cl->start[cell + 1]; s++) {
           PetscInt  j = cl->item[s], self = (j == i);
-          PetscReal x[3], len2            = 0, len, h, alpha;
+          PetscReal x[3], len2            = 0;
           /* the row of the smaller global index holds the pair, whichever rank that is */
-          if (half && (Global(p, j) < Global(p, i) || (self && !ShiftPositive(wrap)))) continue;
+          if (half && (PeriParticleGlobal(p, j) < PeriParticleGlobal(p, i) || (self && !ShiftPositive(wrap)))) continue;
           if (self && !wrap[0] && !wrap[1] && !wrap[2]) continue;
           if (!half && self) continue;
           for (PetscInt d = 0; d < 3; d++) {
@@ -195,18 +210,7 @@ static PetscErrorCode ParticleBonds(const PeriParticles *p, const CellList *cl, 
             len2 += x[d] * x[d];
           }
           if (len2 > r * r) continue;
-          len = PetscSqrtReal(len2);
-          h   = 0.5 * (p->spacing[i] + p->spacing[j]);
-          PetscCheck(len > 1e-8 * h, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "particles %" PetscInt_FMT " and %" PetscInt_FMT " coincide at (%g, %g, %g)%s (distance %g, spacing %g)", p->source_line[i] ? p->source_line[i] : i, p->source_line[j] ? p->source_line[j] : j, (double)xi[0], (double)xi[1], (double)xi[2], p->source_line[i] ? " (the numbers are lines of particles.file)" : "", (double)len, (double)h);
-          alpha = PeriPartialVolumeFactor(pv, len, delta, h);
-          if (alpha <= 0) continue;
-          PetscCall(BondsReserve(b, b->nbonds + 1, cap));
-          b->j[b->nbonds] = j;
-          for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
-          b->length[b->nbonds] = len;
-          b->alpha[b->nbonds]  = alpha;
-          b->live[b->nbonds]   = 1;
-          b->nbonds++;
+          PetscCall(PeriBondsAdd(p, i, j, x, delta, pv, b, cap));
         }
       }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -219,9 +223,11 @@ static PetscErrorCode ParticlesBox(const PeriParticles *, PetscReal, PetscReal[]
   each pair is stored once, in the row of its smaller global index; otherwise every neighbour is
   listed (the graph for partitioning). p may be the whole body or a rank's local view (owned
   particles, then ghosts): the bonds' rows and j are indices into p (p->global maps them to global
-  indices). Not collective. Errors on coincident particles.
+  indices). With horizon (each particle's own, horizon.spacing: own) a pair is bonded within the
+  larger of its two horizons and the cells are those of PeriNeighborSearchLevels; delta is then the
+  largest. Not collective. Errors on coincident particles.
 @*/
-PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
+PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, const PetscReal horizon[], PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
 {
   CellList       cl;
   PetscReal      hmax = 0, r;
@@ -230,6 +236,10 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(b, sizeof(*b)));
+  if (horizon) {
+    PetscCall(PeriNeighborSearchLevels(p, horizon, pv, rstart, rend, half, b));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   for (PetscInt k = 0; k < p->n; k++) hmax = PetscMax(hmax, p->spacing[k]);
   r = PeriSearchRadius(pv, delta, hmax);
   if (p->global) { /* a rank's local view: cells over its particles only */
@@ -242,7 +252,7 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, PeriP
     /* reserve what a full horizon holds, so the arrays are rarely copied while they grow */
     PetscReal vmean = 0, ball = p->dim == 2 ? PETSC_PI * r * r * p->thickness : 4.0 / 3.0 * PETSC_PI * r * r * r;
     for (PetscInt k = 0; k < p->n; k++) vmean += p->volume[k] / p->n;
-    PetscCall(BondsReserve(b, (PetscInt)(1.05 * (rend - rstart) * ball / vmean / (half ? 2 : 1)) + 16, &cap));
+    PetscCall(PeriBondsReserve(b, (PetscInt)(1.05 * (rend - rstart) * ball / vmean / (half ? 2 : 1)) + 16, &cap));
   }
   b->rstart = rstart;
   b->rend   = rend;
@@ -370,7 +380,7 @@ PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *p, PeriBonds *b, Pe
   of the search (ParticleBonds with no image shift), so every value is the same to the bit; the
   arrays are sized to the bonds exactly. Not collective.
 @*/
-PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta, PeriPartialVolume pv, PeriBonds *b)
+PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta, const PetscReal horizon[], PeriPartialVolume pv, PeriBonds *b)
 {
   PetscFunctionBeginUser;
   if (!b->lambda) {
@@ -391,7 +401,7 @@ PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta,
         len2 += x * x;
       }
       b->length[k] = PetscSqrtReal(len2);
-      b->alpha[k]  = PeriPartialVolumeFactor(pv, b->length[k], delta, 0.5 * (p->spacing[i] + p->spacing[j]));
+      b->alpha[k]  = PeriPartialVolumeFactor(pv, b->length[k], horizon ? PetscMax(horizon[i], horizon[j]) : delta, 0.5 * (p->spacing[i] + p->spacing[j]));
     }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

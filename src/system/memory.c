@@ -281,6 +281,6 @@ PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released
 PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem sys, PetscBool released)
 {
   PetscFunctionBeginUser;
-  if (released) PetscCall(PeriBondsRestoreGeometry(&sys->disc.particles, sys->disc.delta, sys->disc.partial_volume, &sys->disc.bonds));
+  if (released) PetscCall(PeriBondsRestoreGeometry(&sys->disc.particles, sys->disc.delta, sys->disc.horizon, sys->disc.partial_volume, &sys->disc.bonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -13,10 +13,12 @@ static const PeriKey     model_keys[] = {
         {"calibration", PERI_KEY_CHOICE, NULL, NULL, NULL, PeriCalibrationKinds, "lattice: each particle's discrete family reproduces the continuum's moments, so every homogeneous strain has the target energy, at surfaces too (docs/models/lattice.md; the default of pds, mppd, gerstle); continuum: micromoduli from the continuous horizon (the papers'; the default of the others)"},
         {NULL},
 };
-static const PeriKey horizon_keys[] = {
-    {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the mean spacing: delta = m dx (may be fractional); m or delta is required"},
-    {"delta", PERI_KEY_REAL, NULL, NULL, "[length]", NULL, "the horizon radius, instead of m"},
-    {NULL},
+static const char *const spacings[]     = {"mean", "own", NULL};
+static const PeriKey     horizon_keys[] = {
+        {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the spacing: delta = m dx (may be fractional); m or delta is required"},
+        {"delta", PERI_KEY_REAL, NULL, NULL, "[length]", NULL, "the horizon radius, instead of m"},
+        {"spacing", PERI_KEY_CHOICE, "mean", NULL, NULL, spacings, "the spacing m multiplies: mean (one horizon for the body) or own (each particle's own spacing: a horizon per particle, for graded and stochastic meshes; a pair is bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md)"},
+        {NULL},
 };
 static const PeriKey corrections_keys[] = {
     {"partial_volume", PERI_KEY_CHOICE, "linear_continued", NULL, NULL, PeriPartialVolumes, "partial volumes of the particles the horizon cuts: none, linear (alpha ramp cut at delta), linear_continued (the ramp continued to delta + dx/2)"},
@@ -38,6 +40,24 @@ const PeriSchema PeriSystemSchema[] = {
     {NULL},
 };
 
+/* horizon.spacing: own: each particle's horizon is m times its own spacing, for the models that
+ * calibrate per particle and bodies without periodic axes; delta becomes the largest. */
+static PetscErrorCode ReadOwnHorizon(PeriSystem sys, PeriNode h, PetscBool hasm, PetscReal m, PetscReal hmax)
+{
+  PeriScene s   = sys->scene;
+  PetscInt  own = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetChoice(s, h, "spacing", spacings, &own, NULL));
+  if (!own) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(hasm, s, h, "spacing", "own needs horizon.m (the multiple of each particle's spacing), not horizon.delta");
+  PeriInputCheck(sys->model->takes_own_horizon, s, h, "spacing", "model %s calibrates its springs on one horizon for the whole body; per-particle horizons are derived for pmb and npmb (docs/mesh.md, \"Per-particle horizons\"): use one of them or horizon.spacing: mean", sys->model->type);
+  for (PetscInt d = 0; d < 3; d++) PeriInputCheck(!sys->disc.particles.periodic[d], s, h, "spacing", "own is not implemented on periodic axes (grid.periodic); a periodic grid has one spacing, so horizon.spacing: mean gives the same horizon");
+  sys->disc.horizon_m = m;
+  sys->disc.delta     = m * hmax;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode ReadHorizon(PeriSystem sys)
 {
   PeriScene s = sys->scene;
@@ -55,14 +75,15 @@ static PetscErrorCode ReadHorizon(PeriSystem sys)
   if (hasm) {
     sys->disc.delta = m * sys->disc.particles.mean_spacing;
   }
+  for (PetscInt k = 0; k < sys->disc.particles.n; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm)); /* the ranks' blocks */
+  PetscCall(ReadOwnHorizon(sys, h, hasm, m, hmax));
   {
     /* beyond the body's diagonal every particle bonds with every other: N^2 bonds, no locality */
     PetscReal diag2 = 0;
     for (PetscInt d = 0; d < sys->disc.particles.dim; d++) diag2 += PetscSqr(sys->disc.particles.upper[d] - sys->disc.particles.lower[d]);
     PeriInputCheck(sys->disc.delta <= PetscSqrtReal(diag2), s, h, hasm ? "m" : "delta", "the horizon %g exceeds the body's size (its diagonal %g): every particle would bond with every other; a horizon is a few spacings (m = 3 is usual)", (double)sys->disc.delta, (double)PetscSqrtReal(diag2));
   }
-  for (PetscInt k = 0; k < sys->disc.particles.n; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm)); /* the ranks' blocks */
   PeriInputCheck(sys->disc.delta >= hmax * (1 - 1e-10), s, h, hasm ? "m" : "delta", "the horizon %g is smaller than the particle spacing %g: particles would have no bonds", (double)sys->disc.delta, (double)hmax);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -312,6 +333,11 @@ static PetscErrorCode SetLocalView(PeriSystem sys)
   for (PetscInt k = 0; k < owned.n; k++) hmax = PetscMax(hmax, owned.spacing[k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
   PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax)));
+  if (sys->disc.horizon_m > 0) { /* the ghosts' too: a pair's horizon is the larger of its two */
+    PetscCall(PetscMalloc1(sys->disc.particles.n, &sys->disc.horizon));
+    for (PetscInt k = 0; k < sys->disc.particles.n; k++) sys->disc.horizon[k] = sys->disc.horizon_m * sys->disc.particles.spacing[k];
+    sys->model->horizon = sys->disc.horizon;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -322,9 +348,9 @@ static PetscErrorCode SearchBonds(PeriSystem sys)
   PeriDisc *d = &sys->disc;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->partial_volume, 0, d->nowned, PETSC_TRUE, &d->bonds));
+  PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_TRUE, &d->bonds));
   /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
-  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->partial_volume, 0, d->nowned, PETSC_FALSE, &d->family));
+  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_FALSE, &d->family));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -348,7 +374,7 @@ static PetscErrorCode SetUpBonds(PeriSystem sys)
   /* a crack is geometry: the family volumes, the surface correction and the calibration see it */
   PetscCall(PeriCracksApply(sys));
   PetscCall(PeriNeighborhoodVolumes(d, d->family_volume, d->neighbor_count));
-  PetscCall(PeriSurfaceCorrectionApply(d->surface, &d->particles, d->delta, d->family_volume, &d->bonds));
+  PetscCall(PeriSurfaceCorrectionApply(d->surface, &d->particles, d->delta, d->horizon, d->family_volume, &d->bonds));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Neighbors, 0, 0, 0, 0));
   PetscCall(PetscTime(&t1));
   sys->run.log.neighbors_s = t1 - t0;

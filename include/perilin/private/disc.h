@@ -92,13 +92,16 @@ PETSC_EXTERN PetscErrorCode PeriRegionFind(PeriScene, PeriNode, const char[], Pe
 PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscReal[]);
 PETSC_EXTERN PetscReal      PeriRegionTolerance(const PeriParticles *);
 
-PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriBondsAdd(const PeriParticles *, PetscInt, PetscInt, const PetscReal[], PetscReal, PeriPartialVolume, PeriBonds *, PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriBondsReserve(PeriBonds *, PetscInt, PetscInt *);
 PETSC_EXTERN PetscErrorCode PeriBondsDestroy(PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *, PeriBonds *, PetscBool *);
-PETSC_EXTERN PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *, PetscReal, PeriPartialVolume, PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PeriBonds *);
 PETSC_EXTERN PetscReal      PeriPartialVolumeFactor(PeriPartialVolume, PetscReal, PetscReal, PetscReal);
 PETSC_EXTERN PetscReal      PeriSearchRadius(PeriPartialVolume, PetscReal, PetscReal);
-PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection, const PeriParticles *, PetscReal, const PetscReal[], const PetscReal[], PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriPartition(MPI_Comm, const PeriParticles *, PetscReal, PetscInt **, PetscInt **);
 PETSC_EXTERN PetscErrorCode PeriPartitionBlocks(MPI_Comm, const PeriParticles *, PetscReal, PetscMPIInt **);
 
@@ -162,7 +165,9 @@ typedef struct {
   PeriHalo              halo;      /* the ghosts and the SF that refreshes them */
   PetscInt              nregions;
   PeriRegion           *regions;
-  PetscReal             delta;
+  PetscReal             delta;     /* the horizon: the body's one, or the largest of horizon[] */
+  PetscReal             horizon_m; /* horizon.spacing: own: delta_i = m h_i; 0: one delta */
+  PetscReal            *horizon;   /* horizon.spacing: own: each local particle's delta_i; else NULL */
   PeriPartialVolume     partial_volume;
   PeriSurfaceCorrection surface;
   PeriBonds             bonds;          /* once per pair, in the row of the smaller global index (owned rows, local j) */

@@ -1,0 +1,199 @@
+/* Neighbour search for per-particle horizons (horizon.spacing: own), O(N log N) at any ratio of
+ * the largest horizon to the smallest.
+ *
+ * A pair is bonded within the larger of its two horizons. One cell list sized by the largest reach
+ * puts a whole coarse horizon's worth of fine particles in every cell; sized by the smallest, a
+ * coarse particle visits (ratio)^dim cells. So the particles are sorted into levels by their reach
+ * rho (their horizon plus what the partial volume adds): level L holds rho in [2^L, 2^(L+1)) times
+ * the smallest, and its cells are half of C_L = 2^(L+1) rho_min wide. A particle of level L finds
+ *  - the particles of levels <= L in the cumulative cells of its own level: their pair's radius is
+ *    its own reach, below C_L, so two cells either way hold them;
+ *  - the particles of each coarser level L' in that level's own cells: the pair's radius is theirs,
+ *    below C_L'.
+ * Each level's cells are sparse: the occupied ones sorted by key and found by bisection, so memory
+ * stays O(N levels) however large the box is in fine cells. */
+#include "perilin/private/disc.h"
+
+#define LEVELS_REACH 2 /* cells of C_L / 2: two cells either way cover C_L */
+#define LEVELS_MAX   40
+
+typedef struct {
+  PetscReal  size, lower[3];
+  PetscInt   ncell[3];
+  PetscInt   nkeys;
+  PetscReal *key;   /* sorted keys of the occupied cells (integers held exactly in a double) */
+  PetscInt  *start; /* nkeys + 1 */
+  PetscInt  *item;  /* the particles, by cell */
+} SparseCells;
+
+static PetscReal CellKey(const SparseCells *sc, const PetscInt c[3])
+{
+  return (PetscReal)c[0] + (PetscReal)sc->ncell[0] * ((PetscReal)c[1] + (PetscReal)sc->ncell[1] * (PetscReal)c[2]);
+}
+
+static void CellCoords(const SparseCells *sc, PetscInt dim, const PetscReal x[], PetscInt c[3])
+{
+  for (PetscInt d = 0; d < 3; d++) c[d] = d < dim ? PetscMin((PetscInt)PetscFloorReal((x[d] - sc->lower[d]) / sc->size), sc->ncell[d] - 1) : 0;
+}
+
+/* The sparse cells of size over the m particles list[] of p, lower..upper their box. */
+static PetscErrorCode SparseCellsCreate(const PeriParticles *p, const PetscReal lower[], const PetscReal upper[], PetscReal size, PetscInt m, const PetscInt list[], SparseCells *sc)
+{
+  PetscReal *key, total = 1;
+
+  PetscFunctionBeginUser;
+  sc->size = size;
+  for (PetscInt d = 0; d < 3; d++) {
+    sc->lower[d] = lower[d];
+    sc->ncell[d] = d < p->dim ? (PetscInt)PetscFloorReal((upper[d] - lower[d]) / size) + 1 : 1;
+    total *= sc->ncell[d];
+  }
+  PetscCheck(total < 4e15, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "the body spans %g cells of its smallest horizon: too many to number exactly; is a particle's spacing or a coordinate wrong?", (double)total);
+  PetscCall(PetscMalloc3(m, &key, m, &sc->item, m + 1, &sc->start));
+  for (PetscInt s = 0; s < m; s++) {
+    PetscInt c[3];
+    CellCoords(sc, p->dim, &p->x[3 * list[s]], c);
+    key[s]      = CellKey(sc, c);
+    sc->item[s] = list[s];
+  }
+  PetscCall(PetscSortRealWithArrayInt(m, key, sc->item));
+  sc->nkeys = 0;
+  for (PetscInt s = 0; s < m; s++)
+    if (!s || key[s] != key[s - 1]) {
+      key[sc->nkeys]         = key[s];
+      sc->start[sc->nkeys++] = s;
+    }
+  sc->start[sc->nkeys] = m;
+  sc->key              = key; /* the first nkeys entries are the unique keys */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode SparseCellsDestroy(SparseCells *sc)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree3(sc->key, sc->item, sc->start));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Appends the bonds of i with the particles of sc within LEVELS_REACH cells (with j of a larger
+ * global index when half). */
+static PetscErrorCode CellsBonds(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, const SparseCells *sc, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
+{
+  PetscInt ci[3], o[3], r[3];
+
+  PetscFunctionBeginUser;
+  CellCoords(sc, p->dim, &p->x[3 * i], ci);
+  for (PetscInt d = 0; d < 3; d++) r[d] = d < p->dim ? LEVELS_REACH : 0;
+  for (o[2] = -r[2]; o[2] <= r[2]; o[2]++)
+    for (o[1] = -r[1]; o[1] <= r[1]; o[1]++)
+      for (o[0] = -r[0]; o[0] <= r[0]; o[0]++) {
+        PetscInt c[3], loc, inside = 1;
+        for (PetscInt d = 0; d < 3; d++) {
+          c[d] = ci[d] + o[d];
+          inside &= c[d] >= 0 && c[d] < sc->ncell[d];
+        }
+        if (!inside) continue;
+        PetscCall(PetscFindReal(CellKey(sc, c), sc->nkeys, sc->key, 0.25, &loc));
+        if (loc < 0) continue;
+        for (PetscInt s = sc->start[loc]; s < sc->start[loc + 1]; s++) {
+          const PetscInt j = sc->item[s];
+          PetscReal      x[3];
+          if (j == i || (half && PeriParticleGlobal(p, j) < PeriParticleGlobal(p, i))) continue;
+          for (PetscInt d = 0; d < 3; d++) x[d] = p->x[3 * j + d] - p->x[3 * i + d];
+          PetscCall(PeriBondsAdd(p, i, j, x, PetscMax(horizon[i], horizon[j]), pv, b, cap));
+        }
+      }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Each particle's level by its reach, the number of levels and the smallest reach. */
+static PetscErrorCode Levels(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscInt level[], PetscInt *nl, PetscReal *rmin)
+{
+  PetscFunctionBeginUser;
+  *rmin = PETSC_MAX_REAL;
+  *nl   = 1;
+  for (PetscInt k = 0; k < p->n; k++) *rmin = PetscMin(*rmin, PeriSearchRadius(pv, horizon[k], p->spacing[k]));
+  for (PetscInt k = 0; k < p->n; k++) {
+    level[k] = (PetscInt)PetscFloorReal(PetscLog2Real(PeriSearchRadius(pv, horizon[k], p->spacing[k]) / *rmin));
+    level[k] = PetscMax(level[k], 0);
+    PetscCheck(level[k] < LEVELS_MAX, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "the horizons range over a factor above 2^%d: is a particle's volume wrong?", LEVELS_MAX);
+    *nl = PetscMax(*nl, level[k] + 1);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The box of the local view. */
+static void Box(const PeriParticles *p, PetscReal lo[], PetscReal hi[])
+{
+  for (PetscInt d = 0; d < 3; d++) {
+    lo[d] = PETSC_MAX_REAL;
+    hi[d] = PETSC_MIN_REAL;
+    for (PetscInt k = 0; k < p->n; k++) {
+      lo[d] = PetscMin(lo[d], p->x[3 * k + d]);
+      hi[d] = PetscMax(hi[d], p->x[3 * k + d]);
+    }
+  }
+}
+
+/* The cells of every level: cum[L] over the particles of levels <= L, own[L] over those of L. */
+static PetscErrorCode LevelCells(const PeriParticles *p, const PetscInt level[], PetscInt nl, PetscReal rmin, SparseCells cum[], SparseCells own[])
+{
+  PetscInt *list;
+  PetscReal lo[3], hi[3];
+
+  PetscFunctionBeginUser;
+  Box(p, lo, hi);
+  PetscCall(PetscMalloc1(p->n, &list));
+  for (PetscInt L = 0; L < nl; L++) {
+    PetscReal size = PetscPowRealInt(2.0, L + 1) * rmin / LEVELS_REACH;
+    PetscInt  m    = 0;
+    for (PetscInt k = 0; k < p->n; k++)
+      if (level[k] <= L) list[m++] = k;
+    PetscCall(SparseCellsCreate(p, lo, hi, size, m, list, &cum[L]));
+    m = 0;
+    for (PetscInt k = 0; k < p->n; k++)
+      if (level[k] == L) list[m++] = k;
+    PetscCall(SparseCellsCreate(p, lo, hi, size, m, list, &own[L]));
+  }
+  PetscCall(PetscFree(list));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriNeighborSearchLevels - PeriNeighborSearch for per-particle horizons (horizon[k] of each
+  particle of p): a pair is bonded when its partial-volume factor for the larger of the two
+  horizons is positive. Bodies without periodic axes. Not collective.
+@*/
+PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
+{
+  SparseCells    cum[LEVELS_MAX], own[LEVELS_MAX];
+  PetscInt      *level, nl, cap = 0;
+  PetscReal      rmin;
+  PetscErrorCode ierr = PETSC_SUCCESS;
+
+  PetscFunctionBeginUser;
+  PetscCheck(!p->periodic[0] && !p->periodic[1] && !p->periodic[2], PETSC_COMM_SELF, PETSC_ERR_SUP, "per-particle horizons on periodic axes are not implemented");
+  PetscCall(PetscMemzero(b, sizeof(*b)));
+  PetscCall(PetscMalloc1(p->n, &level));
+  PetscCall(Levels(p, horizon, pv, level, &nl, &rmin));
+  PetscCall(LevelCells(p, level, nl, rmin, cum, own));
+  b->rstart = rstart;
+  b->rend   = rend;
+  PetscCall(PetscMalloc1(rend - rstart + 1, &b->offset));
+  b->offset[0] = 0;
+  /* coincident particles are an input error: the cells are freed before it is passed on */
+  for (PetscInt i = rstart; i < rend && !ierr; i++) {
+    ierr = CellsBonds(p, horizon, pv, &cum[level[i]], i, half, b, &cap);
+    for (PetscInt L = level[i] + 1; L < nl && !ierr; L++) ierr = CellsBonds(p, horizon, pv, &own[L], i, half, b, &cap);
+    b->offset[i - rstart + 1] = b->nbonds;
+  }
+  for (PetscInt L = 0; L < nl; L++) {
+    PetscCall(SparseCellsDestroy(&cum[L]));
+    PetscCall(SparseCellsDestroy(&own[L]));
+  }
+  PetscCall(PetscFree(level));
+  PetscCall(ierr);
+  PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
+  for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
