@@ -112,16 +112,28 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The analysis' snapshot callback: the system's present state as BASE.vtu (BASE.pvtu on several
- * ranks) in the output set, which is opened here if the run has not opened it yet (a test drives
- * the library without it). */
-static PetscErrorCode WriteSnapshot(void *ctx, const char base[])
+/* The analysis' output-directory callback: the staging directory of the output set, opened here
+ * if the run has not opened it yet (a test drives the library without it). */
+static PetscErrorCode OutputDir(void *ctx, const char **dir)
 {
   PeriProblem p = (PeriProblem)ctx;
 
   PetscFunctionBeginUser;
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
-  PetscCall(PeriSystemWriteParticles(p->sys, p->sys->fields.u_owned, p->staging_dir, base));
+  *dir = p->staging_dir;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The analysis' snapshot callback: the system's present state as BASE.vtu (BASE.pvtu on several
+ * ranks) in the output set. */
+static PetscErrorCode WriteSnapshot(void *ctx, const char base[])
+{
+  PeriProblem p   = (PeriProblem)ctx;
+  const char *dir = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(OutputDir(ctx, &dir));
+  PetscCall(PeriSystemWriteParticles(p->sys, p->sys->fields.u_owned, dir, base));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -138,7 +150,10 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   p->analysis->every       = p->output_every;
   p->analysis->output_dir  = p->output_dir;
   p->analysis->snapshot    = WriteSnapshot;
+  p->analysis->outputdir   = OutputDir;
   p->analysis->snapshotctx = p;
+  /* the scene as every run of it has read it by now: what ties a checkpoint to its scene */
+  if (p->analysis->type->checkpoints) PetscCall(PeriSceneFingerprint(p->scene, &p->analysis->fingerprint));
   /* a signal during the set-up: no analysis, only the summary saying so */
   PetscCall(PeriSignalReceived(p->comm, &p->sys->run.interrupted));
   PetscCall(PetscLogStagePush(PERI_STAGE_Solve));
