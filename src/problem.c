@@ -30,6 +30,28 @@ PetscErrorCode PeriProblemLoad(PeriProblem p, const char file[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* -restart and -peri_checkpoint_every: the analysis reads them when its type writes checkpoints;
+ * another refuses -restart, naming the types that do. */
+static PetscErrorCode ReadCheckpointOptions(PeriProblem p)
+{
+  const PeriAnalysisType *const *types;
+  PetscInt                       ntypes;
+  PetscBool                      given;
+  char                           list[128] = "";
+
+  PetscFunctionBeginUser;
+  if (p->analysis->type->checkpoints) {
+    PetscCall(PeriAnalysisCheckpointSetFromOptions(p->analysis));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-restart", &given));
+  PetscCall(PeriAnalysisGetTypes(&ntypes, &types));
+  for (PetscInt k = 0; k < ntypes; k++)
+    if (types[k]->checkpoints) PeriListAppend(list, sizeof(list), types[k]->name);
+  PetscCheck(!given, p->comm, PETSC_ERR_USER_INPUT, "-restart continues a run from its checkpoint, and analysis.type %s writes none (those that do: %s): run it from the start", p->analysis_type, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* analysis.type, checked against the registered types; analysis.* against that analysis' schema
  * (p->scene->owners holds every plug-in's), then read by the analysis itself: every analysis key
  * is checked before any particle exists. */
@@ -61,6 +83,7 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
   if (PeriSchemaFindKey(type->schema, "output", "every")) PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
   PetscCall(PeriAnalysisCreate(p->comm, type, &p->analysis));
   PetscCall(PeriAnalysisSetFromScene(p->analysis, s));
+  PetscCall(ReadCheckpointOptions(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

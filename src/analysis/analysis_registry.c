@@ -77,7 +77,6 @@ PetscErrorCode PeriAnalysisSetFromScene(PeriAnalysis an, PeriScene s)
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_FALSE, &a));
   if (an->type->ops.setfromscene) PetscCall(an->type->ops.setfromscene(an, s, a));
-  PetscCall(PeriAnalysisCheckpointSetFromOptions(an));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -49,27 +49,17 @@ static PetscErrorCode OpenViewer(MPI_Comm comm, const char path[], PetscFileMode
 
 /*@C
   PeriAnalysisCheckpointSetFromOptions - -restart DIR and -peri_checkpoint_every N (default 1; 0
-  writes none), before any particle exists: -restart is refused for a type without checkpoints and
-  for a DIR without a checkpoint, at no cost. Collective.
+  writes none) of an analysis whose type has checkpoints (the problem refuses -restart for the
+  others), before any particle exists: a DIR without a checkpoint is refused at no cost. Collective.
 @*/
 PetscErrorCode PeriAnalysisCheckpointSetFromOptions(PeriAnalysis an)
 {
-  const PeriAnalysisType *const *types;
-  PetscInt                       ntypes;
-  PetscBool                      given, found;
-  char                           list[128] = "", path[PETSC_MAX_PATH_LEN + 32];
+  PetscBool given, found;
+  char      path[PETSC_MAX_PATH_LEN + 32];
 
   PetscFunctionBeginUser;
   an->checkpoint_every = 1;
   PetscCall(PetscOptionsGetString(NULL, NULL, "-restart", an->restart, sizeof(an->restart), &given));
-  if (!an->type->checkpoints) {
-    PetscCall(PeriAnalysisGetTypes(&ntypes, &types));
-    for (PetscInt k = 0; k < ntypes; k++)
-      if (types[k]->checkpoints) PeriListAppend(list, sizeof(list), types[k]->name);
-    PetscCheck(!given, an->comm, PETSC_ERR_USER_INPUT, "-restart continues a run from its checkpoint, and analysis.type %s writes none (those that do: %s): run it from the start", an->type->name, list);
-    an->checkpoint_every = 0;
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_checkpoint_every", &an->checkpoint_every, NULL));
   PetscCheck(an->checkpoint_every >= 0, an->comm, PETSC_ERR_USER_INPUT, "-peri_checkpoint_every %" PetscInt_FMT ": give a number of equilibria >= 1, or 0 for no checkpoints", an->checkpoint_every);
   if (!given) PetscFunctionReturn(PETSC_SUCCESS);
