@@ -30,6 +30,28 @@ PetscErrorCode PeriProblemLoad(PeriProblem p, const char file[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* -restart and -peri_checkpoint_every: the analysis reads them when its type writes checkpoints;
+ * another refuses -restart, naming the types that do. */
+static PetscErrorCode ReadCheckpointOptions(PeriProblem p)
+{
+  const PeriAnalysisType *const *types;
+  PetscInt                       ntypes;
+  PetscBool                      given;
+  char                           list[128] = "";
+
+  PetscFunctionBeginUser;
+  if (p->analysis->type->checkpoints) {
+    PetscCall(PeriAnalysisCheckpointSetFromOptions(p->analysis));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-restart", &given));
+  PetscCall(PeriAnalysisGetTypes(&ntypes, &types));
+  for (PetscInt k = 0; k < ntypes; k++)
+    if (types[k]->checkpoints) PeriListAppend(list, sizeof(list), types[k]->name);
+  PetscCheck(!given, p->comm, PETSC_ERR_USER_INPUT, "-restart continues a run from its checkpoint, and analysis.type %s writes none (those that do: %s): run it from the start", p->analysis_type, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* analysis.type, checked against the registered types; analysis.* against that analysis' schema
  * (p->scene->owners holds every plug-in's), then read by the analysis itself: every analysis key
  * is checked before any particle exists. */
@@ -61,6 +83,7 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
   if (PeriSchemaFindKey(type->schema, "output", "every")) PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
   PetscCall(PeriAnalysisCreate(p->comm, type, &p->analysis));
   PetscCall(PeriAnalysisSetFromScene(p->analysis, s));
+  PetscCall(ReadCheckpointOptions(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -112,16 +135,28 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The analysis' snapshot callback: the system's present state as BASE.vtu (BASE.pvtu on several
- * ranks) in the output set, which is opened here if the run has not opened it yet (a test drives
- * the library without it). */
-static PetscErrorCode WriteSnapshot(void *ctx, const char base[])
+/* The analysis' output-directory callback: the staging directory of the output set, opened here
+ * if the run has not opened it yet (a test drives the library without it). */
+static PetscErrorCode OutputDir(void *ctx, const char **dir)
 {
   PeriProblem p = (PeriProblem)ctx;
 
   PetscFunctionBeginUser;
   if (!p->staging_dir[0]) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
-  PetscCall(PeriSystemWriteParticles(p->sys, p->sys->fields.u_owned, p->staging_dir, base));
+  *dir = p->staging_dir;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The analysis' snapshot callback: the system's present state as BASE.vtu (BASE.pvtu on several
+ * ranks) in the output set. */
+static PetscErrorCode WriteSnapshot(void *ctx, const char base[])
+{
+  PeriProblem p   = (PeriProblem)ctx;
+  const char *dir = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(OutputDir(ctx, &dir));
+  PetscCall(PeriSystemWriteParticles(p->sys, p->sys->fields.u_owned, dir, base));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -138,7 +173,10 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   p->analysis->every       = p->output_every;
   p->analysis->output_dir  = p->output_dir;
   p->analysis->snapshot    = WriteSnapshot;
+  p->analysis->outputdir   = OutputDir;
   p->analysis->snapshotctx = p;
+  /* the scene as every run of it has read it by now: what ties a checkpoint to its scene */
+  if (p->analysis->type->checkpoints) PetscCall(PeriSceneFingerprint(p->scene, &p->analysis->fingerprint));
   /* a signal during the set-up: no analysis, only the summary saying so */
   PetscCall(PeriSignalReceived(p->comm, &p->sys->run.interrupted));
   PetscCall(PetscLogStagePush(PERI_STAGE_Solve));

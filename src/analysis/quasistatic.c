@@ -6,6 +6,7 @@
  * or no equilibrium is found, the body has failed: with adaptive steps the step is halved from the
  * last equilibrium until it is below min_step, so the critical lambda is bracketed. */
 #include "perilin/private/analysis.h"
+#include <signal.h>
 
 /* analysis.stepping, analysis.break */
 static const char *const qs_steppings[] = {"increments", "events", NULL};
@@ -41,6 +42,7 @@ typedef struct {
   PeriQuasistatic q;
   Settings        st;
   PetscInt        nsnaps, capsnaps, *snaps;
+  PetscInt        stop_after; /* -peri_stop_after_step: stop after this step as a SIGINT would (0: never) */
 } QSData;
 
 static inline PeriQuasistatic *QS(PeriAnalysis an)
@@ -235,6 +237,7 @@ static PetscErrorCode SetFromScene_Quasistatic(PeriAnalysis an, PeriScene s, Per
   PetscCall(PeriSceneGetString(s, a, "reaction_region", PETSC_FALSE, st->reaction_region, sizeof(st->reaction_region), NULL));
   st->quiet = PETSC_FALSE;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-quiet", &st->quiet, NULL));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_stop_after_step", &data->stop_after, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -570,9 +573,160 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint
   PetscCall(PeriCheckpointSave(an->sys, eq));
   PetscCall(Progress(an, st, s));
   if (SnapshotDue(an, s)) PetscCall(WriteSnapshot(an));
+  /* a run stopped here for a test takes the path of an interrupted one: the next poll ends it */
+  if (q->nsteps == ((QSData *)an->data)->stop_after) PeriSignalSimulate(SIGINT);
   /* many breaks: smaller steps; none: back towards the scene's step */
   if (st->adaptive) *dl = changes > nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : changes ? *dl
                                                                                                : PetscMin(2 * *dl, st->step);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The numbers of one step in a checkpoint: PeriStep as reals and integers (a viewer has no struct). */
+#define PERI_STEP_REALS 5
+#define PERI_STEP_INTS  5
+
+static void StepPack(const PeriStep *s, PetscReal r[], PetscInt n[])
+{
+  r[0] = s->lambda, r[1] = s->control_u, r[2] = s->seconds, r[3] = s->reaction, r[4] = s->imbalance;
+  n[0] = s->broken, n[1] = s->broken_total, n[2] = s->iterations, n[3] = s->ksp_iterations, n[4] = s->softened;
+}
+
+static void StepUnpack(const PetscReal r[], const PetscInt n[], PeriStep *s)
+{
+  s->lambda = r[0], s->control_u = r[1], s->seconds = r[2], s->reaction = r[3], s->imbalance = r[4];
+  s->broken = n[0], s->broken_total = n[1], s->iterations = n[2], s->ksp_iterations = n[3], s->softened = n[4];
+}
+
+/* Room for n steps (and their reactions) and n snapshots, on reading a checkpoint. */
+static PetscErrorCode StepsAllocate(PeriAnalysis an, PetscInt n, PetscInt nsnaps)
+{
+  PeriQuasistatic *q    = QS(an);
+  QSData          *data = (QSData *)an->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree2(q->steps, q->reactions));
+  PetscCall(PetscFree(data->snaps));
+  q->cap = PetscMax(64, n);
+  PetscCall(PetscMalloc2(q->cap, &q->steps, q->cap * an->sys->conditions.reactions.nregions * PERI_MAX_DOF, &q->reactions));
+  data->capsnaps = PetscMax(64, nsnaps);
+  PetscCall(PetscMalloc1(data->capsnaps, &data->snaps));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The loop's state at an equilibrium, besides the bonds and u (PeriCheckpointView): the load factor
+ * and the next step, the counters, the steps so far (steps.csv's rows and their reactions) and the
+ * snapshots written (particles.pvd's frames). write: into v, else from v. Collective. */
+static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lambda, PetscReal *dl, PetscBool write)
+{
+  PeriQuasistatic *q    = QS(an);
+  QSData          *data = (QSData *)an->data;
+  const PetscInt   w    = an->sys->conditions.reactions.nregions * PERI_MAX_DOF;
+  PetscReal        r[2] = {*lambda, *dl}, *sr;
+  PetscInt         n[5] = {q->nsteps, q->pc_setups, q->solves, data->nsnaps, w}, *si;
+
+  PetscFunctionBeginUser;
+  if (write) {
+    PetscCall(PetscViewerBinaryWrite(v, r, 2, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, n, 5, PETSC_INT));
+  } else {
+    PetscCall(PetscViewerBinaryRead(v, r, 2, NULL, PETSC_REAL));
+    PetscCall(PetscViewerBinaryRead(v, n, 5, NULL, PETSC_INT));
+    PetscCheck(n[4] == w && n[0] > 0, an->comm, PETSC_ERR_FILE_UNEXPECTED, "-restart: the checkpoint's steps do not fit this scene's reaction regions");
+    PetscCall(StepsAllocate(an, n[0], n[3]));
+    *lambda = r[0], *dl = r[1];
+    q->nsteps = n[0], q->pc_setups = n[1], q->solves = n[2], data->nsnaps = n[3];
+  }
+  PetscCall(PetscMalloc2(q->nsteps * PERI_STEP_REALS, &sr, q->nsteps * PERI_STEP_INTS, &si));
+  for (PetscInt k = 0; write && k < q->nsteps; k++) StepPack(&q->steps[k], &sr[k * PERI_STEP_REALS], &si[k * PERI_STEP_INTS]);
+  if (write) {
+    PetscCall(PetscViewerBinaryWrite(v, sr, q->nsteps * PERI_STEP_REALS, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, si, q->nsteps * PERI_STEP_INTS, PETSC_INT));
+    PetscCall(PetscViewerBinaryWrite(v, q->reactions, q->nsteps * w, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, data->snaps, data->nsnaps, PETSC_INT));
+  } else {
+    PetscCall(PetscViewerBinaryRead(v, sr, q->nsteps * PERI_STEP_REALS, NULL, PETSC_REAL));
+    PetscCall(PetscViewerBinaryRead(v, si, q->nsteps * PERI_STEP_INTS, NULL, PETSC_INT));
+    PetscCall(PetscViewerBinaryRead(v, q->reactions, q->nsteps * w, NULL, PETSC_REAL));
+    PetscCall(PetscViewerBinaryRead(v, data->snaps, data->nsnaps, NULL, PETSC_INT));
+  }
+  for (PetscInt k = 0; !write && k < q->nsteps; k++) StepUnpack(&sr[k * PERI_STEP_REALS], &si[k * PERI_STEP_INTS], &q->steps[k]);
+  PetscCall(PetscFree2(sr, si));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After an accepted equilibrium (eq, just saved) from which the loop goes on at lambda with the
+ * step dl: its checkpoint, every -peri_checkpoint_every steps (checkpoint.c). Collective. */
+static PetscErrorCode WriteCheckpoint(PeriAnalysis an, const PeriCheckpoint *eq, PetscReal lambda, PetscReal dl)
+{
+  PeriQuasistatic *q = QS(an);
+  PetscViewer      v;
+  char             tmp[PETSC_MAX_PATH_LEN + 32];
+  PetscLogDouble   t0, t1;
+
+  PetscFunctionBeginUser;
+  if (!an->checkpoint_every || q->nsteps % an->checkpoint_every) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscTime(&t0));
+  PetscCall(PeriAnalysisCheckpointBegin(an, &v, tmp, sizeof(tmp)));
+  PetscCall(StateBinary(an, v, &lambda, &dl, PETSC_TRUE));
+  PetscCall(PeriCheckpointView(an->sys, eq, v));
+  PetscCall(PeriAnalysisCheckpointEnd(an, &v, tmp));
+  PetscCall(PetscTime(&t1));
+  q->checkpoints++;
+  q->checkpoint_s += t1 - t0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The snapshots of the checkpoint's run (particles.pvd's frames so far), taken from -restart's
+ * directory into this run's output set; one that is gone leaves the series. Collective. */
+static PetscErrorCode AdoptSnapshots(PeriAnalysis an)
+{
+  QSData     *data = (QSData *)an->data;
+  const char *dir;
+  PetscInt    n = 0;
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(an->comm, &size));
+  PetscCall(an->outputdir(an->snapshotctx, &dir));
+  for (PetscInt k = 0; k < data->nsnaps; k++) {
+    char      base[32], file[40];
+    PetscBool found, pieces = PETSC_TRUE;
+    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, data->snaps[k]));
+    PetscCall(PeriParticlesFileName(an->comm, base, file, sizeof(file)));
+    PetscCall(PeriOutputSetAdopt(an->comm, an->restart, dir, file, &found));
+    if (found && size > 1) PetscCall(PeriOutputSetAdopt(an->comm, an->restart, dir, base, &pieces)); /* base/piece_RRRR.vtu */
+    if (found && pieces) data->snaps[n++] = data->snaps[k];
+  }
+  if (n < data->nsnaps) PetscCall(PetscPrintf(an->comm, "perilin: note: %" PetscInt_FMT " of the %" PetscInt_FMT " snapshots of %s are gone: particles.pvd lists the others\n", data->nsnaps - n, data->nsnaps, an->restart));
+  data->nsnaps = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -restart: the loop's state, the bonds and u of the checkpoint, K assembled for those bonds, and a
+ * KSP that starts from u, as the interrupted run's next solve did. Its preconditioner is built
+ * anew (the interrupted run's came from an earlier K): the next solves agree with the interrupted
+ * run's to the solver's tolerance, not bit for bit. Collective. */
+static PetscErrorCode Restart(PeriAnalysis an, Loop *L, PeriCheckpoint *eq, PetscReal *lambda, PetscReal *dl)
+{
+  PeriQuasistatic *q = QS(an);
+  PetscViewer      v;
+  char             file[PETSC_MAX_PATH_LEN + 32];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriAnalysisRestartBegin(an, &v, file, sizeof(file)));
+  PetscCall(StateBinary(an, v, lambda, dl, PETSC_FALSE));
+  PetscCall(PeriCheckpointLoad(an->sys, eq, v, file));
+  PetscCall(PetscViewerDestroy(&v));
+  PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_TRUE, PETSC_TRUE));
+  PetscCall(AdoptSnapshots(an));
+  q->peak_load_factor = q->steps[q->nsteps - 1].lambda;
+  q->broken_bonds     = q->steps[q->nsteps - 1].broken_total;
+  q->restart_step     = q->nsteps;
+  L->stale            = PETSC_TRUE;
+  L->since_setup      = L->nbonds; /* a new preconditioner at the first solve, counted */
+  PetscCall(PeriStaticKSPCreate(an->sys, an->sys->fields.solve.symmetric, &L->ksp));
+  PetscCall(KSPSetInitialGuessNonzero(L->ksp, PETSC_TRUE));
+  if (!ST(an)->quiet) PetscCall(PetscPrintf(an->comm, "perilin: restarted from %s: step %" PetscInt_FMT " at load factor %g, %" PetscInt_FMT " bonds broken\n", file, q->nsteps, (double)*lambda, q->broken_bonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -670,8 +824,13 @@ static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Pe
 
   PetscFunctionBeginUser;
   /* the intact body solved once, at the largest load factor: its response at any other is a
-     multiple (no bond breaks in this solve) */
-  PetscCall(SolveAt(an, st, L, lambda, 0, PETSC_FALSE, &s0, &end, why, sizeof(why)));
+     multiple (no bond breaks in this solve); or the equilibrium of a checkpoint */
+  if (an->restart[0]) {
+    PetscReal dl;
+    PetscCall(Restart(an, L, eq, &lambda, &dl));
+    end = TRIAL_SETTLED;
+  } else
+    PetscCall(SolveAt(an, st, L, lambda, 0, PETSC_FALSE, &s0, &end, why, sizeof(why)));
   while (end == TRIAL_SETTLED) {
     PetscReal      next, trial;
     PeriStep       s = {0};
@@ -696,6 +855,8 @@ static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Pe
     {
       PetscReal dl = 0;
       PetscCall(Accept(an, st, eq, &s, &dl, L->nbonds));
+      /* the state at the top of this loop: a restart goes on from here */
+      PetscCall(WriteCheckpoint(an, eq, lambda, dl));
     }
   }
   if (end == TRIAL_INTERRUPTED) PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_FALSE, PETSC_TRUE));
@@ -710,6 +871,7 @@ static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L
   PetscReal lambda = 0, dl = st->step;
 
   PetscFunctionBeginUser;
+  if (an->restart[0]) PetscCall(Restart(an, L, eq, &lambda, &dl));
   while (lambda < st->max * (1 - 1e-12)) {
     PetscReal      trial = PetscMin(lambda + dl, st->max);
     PeriStep       s     = {0};
@@ -740,6 +902,7 @@ static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L
     s.broken_total = QS(an)->broken_bonds + s.broken;
     s.seconds      = t - tstep;
     PetscCall(Accept(an, st, eq, &s, &dl, L->nbonds));
+    PetscCall(WriteCheckpoint(an, eq, lambda, dl));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -902,6 +1065,10 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
   if (ForceColumn(an)) PetscCall(PeriJSONString(j, "force_column", ForceColumn(an)));
   if (!ST(an)->displacement) PetscCall(PeriJSONReal(j, "applied_load_per_load_factor", ST(an)->load));
   PetscCall(PeriJSONReal(j, "runaway_fraction", ST(an)->runaway));
+  PetscCall(PeriJSONInt(j, "checkpoints", q->checkpoints));
+  PetscCall(PeriJSONReal(j, "checkpoint_s", q->checkpoint_s));
+  if (q->restart_step) PetscCall(PeriJSONString(j, "restarted_from", an->restart));
+  if (q->restart_step) PetscCall(PeriJSONInt(j, "restart_step", q->restart_step));
   if (q->failed && !q->broken_bonds) PetscCall(PeriJSONString(j, "note", PERI_INTACT_NOTE));
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -954,7 +1121,7 @@ static const PeriKey qs_output_keys[] = {
 };
 static const PeriSchema qs_schema[] = {{"analysis", qs_keys}, {"output", qs_output_keys}, {NULL}};
 
-static const char *const qs_files[] = {"steps.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", "failed_trial.vtu", "failed_trial.pvtu", "failed_trial", NULL};
+static const char *const qs_files[] = {"steps.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", "failed_trial.vtu", "failed_trial.pvtu", "failed_trial", "checkpoint", NULL};
 
 /* K is applied and changed bond by bond (matrix-free where the model allows), and the loop solves
  * on a copy of it. */
@@ -965,5 +1132,6 @@ const PeriAnalysisType PeriAnalysis_Quasistatic = {
     .option_prefix = "",
     .files         = qs_files,
     .needs         = {.matrix_free = PETSC_TRUE, .static_solver = PETSC_TRUE, .matrix_copies = 1},
+    .checkpoints   = PETSC_TRUE,
     .ops           = {.setfromscene = SetFromScene_Quasistatic, .setup = SetUp_Quasistatic, .run = PeriAnalysisRun_Quasistatic, .files = QSFiles, .summary = QSSummary, .destroy = QSDestroy},
 };

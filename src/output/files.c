@@ -325,3 +325,83 @@ void PeriOutputSetDiscard(void)
   (void)RemoveTree(peri_staging);
   peri_staging[0] = 0;
 }
+
+/* dst as a hard link to src (the same file system: no copy), else a copy. Not collective. */
+static PetscErrorCode LinkOrCopy(const char src[], const char dst[])
+{
+  char   buf[65536];
+  size_t n;
+  FILE  *in, *out;
+  int    bad = 0;
+
+  PetscFunctionBeginUser;
+  if (link(src, dst) == 0) PetscFunctionReturn(PETSC_SUCCESS);
+  in = fopen(src, "rb");
+  PetscCheck(in, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot read %s: %s", src, strerror(errno));
+  out = fopen(dst, "wb");
+  if (!out) fclose(in);
+  PetscCheck(out, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write %s: %s", dst, strerror(errno));
+  while ((n = fread(buf, 1, sizeof(buf), in)) > 0) bad |= fwrite(buf, 1, n, out) != n;
+  bad |= ferror(in) != 0;
+  fclose(in);
+  bad |= fclose(out) != 0;
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "copying %s to %s failed", src, dst);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Rank 0's part of PeriOutputSetAdopt: from/name, a file or a directory of files, into to/name. */
+static PetscErrorCode Adopt(const char from[], const char to[], const char name[], PetscBool *found)
+{
+  char           src[PETSC_MAX_PATH_LEN], dst[PETSC_MAX_PATH_LEN];
+  struct stat    st;
+  DIR           *d;
+  struct dirent *e;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(src, sizeof(src), "%s/%s", from, name));
+  PetscCall(PetscSNPrintf(dst, sizeof(dst), "%s/%s", to, name));
+  *found = (PetscBool)(stat(src, &st) == 0);
+  if (!*found) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!S_ISDIR(st.st_mode)) {
+    PetscCall(LinkOrCopy(src, dst));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PeriOutputDirCreate(dst));
+  d = opendir(src);
+  PetscCheck(d, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot read %s: %s", src, strerror(errno));
+  while ((e = readdir(d))) {
+    char f[PETSC_MAX_PATH_LEN], g[PETSC_MAX_PATH_LEN];
+    if (e->d_name[0] == '.') continue;
+    PetscCall(PetscSNPrintf(f, sizeof(f), "%s/%s", src, e->d_name));
+    PetscCall(PetscSNPrintf(g, sizeof(g), "%s/%s", dst, e->d_name));
+    PetscCall(LinkOrCopy(f, g));
+  }
+  closedir(d);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriOutputSetAdopt - takes the file or directory (of files) name of an earlier output set from
+  into the staging directory to, hard-linked where the file system allows, else copied: a run
+  continued from another's checkpoint keeps the snapshots that run wrote. *found: whether from had
+  it. Collective; rank 0 works.
+@*/
+PetscErrorCode PeriOutputSetAdopt(MPI_Comm comm, const char from[], const char to[], const char name[], PetscBool *found)
+{
+  PetscMPIInt    rank;
+  PetscErrorCode ierr  = PETSC_SUCCESS;
+  int            ok[2] = {0, 0};
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    ierr  = Adopt(from, to, name, found);
+    ok[0] = ierr == PETSC_SUCCESS;
+    ok[1] = ok[0] && *found;
+  }
+  PetscCallMPI(MPI_Bcast(ok, 2, MPI_INT, 0, comm));
+  PetscCall(ierr);
+  PetscCheck(ok[0], comm, PETSC_ERR_FILE_WRITE, "cannot take %s/%s into the output set", from, name);
+  *found = (PetscBool)ok[1];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

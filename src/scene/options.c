@@ -29,7 +29,7 @@ static const char *const read_later[] = {
 
 /* Common options that no object prints under -help (global ones, solver packages set up only at
  * factorization): candidates for "did you mean" only. */
-static const char *const more_names[] = {"-help", "-version", "-info", "-log_view", "-log_trace", "-log_all", "-malloc_debug", "-malloc_dump", "-malloc_view", "-malloc_test", "-memory_view", "-options_left", "-options_file", "-options_view", "-objects_dump", "-on_error_abort", "-on_error_attach_debugger", "-start_in_debugger", "-fp_trap", "-quiet", "-progress", "-options_unused_ok", "-scene_doc_update", "-scene_doc_check", "-mat_mumps_icntl_4", "-mat_mumps_icntl_7", "-mat_mumps_icntl_14", "-mat_mumps_icntl_24", "-mat_mumps_cntl_1", "-mat_mumps_cntl_3", NULL};
+static const char *const more_names[] = {"-help", "-version", "-info", "-log_view", "-log_trace", "-log_all", "-malloc_debug", "-malloc_dump", "-malloc_view", "-malloc_test", "-memory_view", "-options_left", "-options_file", "-options_view", "-objects_dump", "-on_error_abort", "-on_error_attach_debugger", "-start_in_debugger", "-fp_trap", "-quiet", "-progress", "-restart", "-options_unused_ok", "-scene_doc_update", "-scene_doc_check", "-mat_mumps_icntl_4", "-mat_mumps_icntl_7", "-mat_mumps_icntl_14", "-mat_mumps_icntl_24", "-mat_mumps_cntl_1", "-mat_mumps_cntl_3", NULL};
 
 typedef struct {
   char   **name;

@@ -144,3 +144,35 @@ PetscErrorCode PeriSceneWriteResolved(PeriScene scene, const char header[], FILE
   PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriSceneFingerprint - a 64-bit hash (FNV-1a) of the resolved scene as it stands, without its
+  output section (where and what a run writes does not change what it computes): two runs with the
+  same fingerprint read the same keys with the same values, so a checkpoint of one can continue the
+  other. Not collective; every rank computes the same.
+@*/
+PetscErrorCode PeriSceneFingerprint(PeriScene scene, PetscInt64 *hash)
+{
+  char          *text = NULL;
+  size_t         len  = 0;
+  FILE          *fp   = open_memstream(&text, &len);
+  PetscBool      skip = PETSC_FALSE;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_MEM, "cannot open a memory stream for the scene's fingerprint");
+  ierr = PeriSceneWriteResolved(scene, NULL, fp);
+  fclose(fp);
+  if (ierr) free(text);
+  PetscCall(ierr);
+  *hash = (PetscInt64)0xcbf29ce484222325ULL;
+  /* line by line: the top-level section output: and its indented lines are left out */
+  for (const char *line = text; line && *line;) {
+    size_t n = strcspn(line, "\n");
+    if (line[0] != ' ' && line[0] != '-') skip = (PetscBool)!strncmp(line, "output:", 7);
+    for (size_t k = 0; k < n && !skip; k++) *hash = (PetscInt64)(((unsigned long long)*hash ^ (unsigned char)line[k]) * 0x100000001b3ULL);
+    line += n + (line[n] == '\n');
+  }
+  free(text);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

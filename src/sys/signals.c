@@ -71,3 +71,13 @@ int PeriSignalPending(void)
 {
   return (int)peri_signal;
 }
+
+/*@C
+  PeriSignalSimulate - records sig as if it had arrived (-peri_stop_after_step: a run stopped at a
+  chosen point takes the very path of an interrupted one). Not collective: every rank that should
+  stop calls it.
+@*/
+void PeriSignalSimulate(int sig)
+{
+  if (!peri_signal) peri_signal = sig;
+}

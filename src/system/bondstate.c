@@ -136,6 +136,85 @@ PetscErrorCode PeriCheckpointRestore(PeriSystem sys, PeriCheckpoint *e, PetscBoo
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The solve that reached a checkpoint, as PETSc binary data: its names as bytes, then its numbers
+ * (a viewer has no struct type). write: into v, else from v. Collective. */
+static PetscErrorCode SolveInfoBinary(PetscViewer v, PeriSolveInfo *s, PetscBool write)
+{
+  PetscInt  n[3] = {s->iterations, s->symmetric, s->free_modes};
+  PetscReal r[7] = {s->setup_s, s->ksp_solve_s, s->residual_norm, s->residual_tol, s->load_imbalance, s->rhs_norm, s->load_factor};
+
+  PetscFunctionBeginUser;
+  if (write) {
+    PetscCall(PetscViewerBinaryWrite(v, s->ksp_type, sizeof(s->ksp_type), PETSC_CHAR));
+    PetscCall(PetscViewerBinaryWrite(v, s->pc_type, sizeof(s->pc_type), PETSC_CHAR));
+    PetscCall(PetscViewerBinaryWrite(v, s->converged_reason, sizeof(s->converged_reason), PETSC_CHAR));
+    PetscCall(PetscViewerBinaryWrite(v, n, 3, PETSC_INT));
+    PetscCall(PetscViewerBinaryWrite(v, r, 7, PETSC_REAL));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscViewerBinaryRead(v, s->ksp_type, sizeof(s->ksp_type), NULL, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryRead(v, s->pc_type, sizeof(s->pc_type), NULL, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryRead(v, s->converged_reason, sizeof(s->converged_reason), NULL, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryRead(v, n, 3, NULL, PETSC_INT));
+  PetscCall(PetscViewerBinaryRead(v, r, 7, NULL, PETSC_REAL));
+  s->iterations     = n[0];
+  s->symmetric      = (PetscBool)n[1];
+  s->free_modes     = n[2];
+  s->setup_s        = r[0];
+  s->ksp_solve_s    = r[1];
+  s->residual_norm  = r[2];
+  s->residual_tol   = r[3];
+  s->load_imbalance = r[4];
+  s->rhs_norm       = r[5];
+  s->load_factor    = r[6];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriCheckpointView - writes the equilibrium e (just saved from sys) into a checkpoint file: every
+  rank's bond count and flags in rank order (live, the cause of each dead bond, which the in-memory
+  checkpoint does not need since a dead bond's cause never changes, and with softening the shares),
+  the solve that reached it, and the displacements (VecView). PeriCheckpointLoad reads it back on
+  the same ranks and partition. Collective.
+@*/
+PetscErrorCode PeriCheckpointView(PeriSystem sys, const PeriCheckpoint *e, PetscViewer v)
+{
+  const PeriBonds *b = &sys->disc.bonds;
+  PeriSolveInfo    s = e->solve;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerBinaryWriteAll(v, &b->nbonds, 1, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_INT));
+  PetscCall(PetscViewerBinaryWriteAll(v, e->live, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryWriteAll(v, b->cause, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  if (e->intact) PetscCall(PetscViewerBinaryWriteAll(v, e->intact, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_REAL));
+  PetscCall(SolveInfoBinary(v, &s, PETSC_TRUE));
+  PetscCall(VecView(e->u, v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriCheckpointLoad - reads what PeriCheckpointView wrote into e (created by PeriCheckpointCreate)
+  and the causes into sys; PeriCheckpointRestore then makes it the system's state. The bond counts
+  of every rank must be this run's: the same scene on the same number of ranks. Collective.
+@*/
+PetscErrorCode PeriCheckpointLoad(PeriSystem sys, PeriCheckpoint *e, PetscViewer v, const char file[])
+{
+  PeriBonds *b = &sys->disc.bonds;
+  PetscInt   n, bad;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerBinaryReadAll(v, &n, 1, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_INT));
+  bad = n != b->nbonds;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, sys->comm));
+  PetscCheck(!bad, sys->comm, PETSC_ERR_USER_INPUT, "%s: its bonds are not shared out between the ranks as in this run (was it written by another perilin or with another -peri_partition?): restart with the options of the run that wrote it", file);
+  PetscCall(PetscViewerBinaryReadAll(v, e->live, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryReadAll(v, b->cause, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  if (e->intact) PetscCall(PetscViewerBinaryReadAll(v, e->intact, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_REAL));
+  PetscCall(SolveInfoBinary(v, &e->solve, PETSC_FALSE));
+  PetscCall(VecLoad(e->u, v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriCheckpointDestroy(PeriCheckpoint *e)
 {
   PetscFunctionBeginUser;

@@ -271,9 +271,13 @@ static PetscErrorCode ProgressMonitor(KSP ksp, PetscInt it, PetscReal rnorm, voi
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* CG (GMRES for an unsymmetric operator) + GAMG (or the default Jacobi, PERI_JACOBI_BUDGET
- * iterations), rtol 1e-10, then the options. */
-static PetscErrorCode StaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *ksp)
+/*@C
+  PeriStaticKSPCreate - the KSP of static solves: CG (GMRES for an unsymmetric operator) + GAMG (or
+  the default Jacobi, PERI_JACOBI_BUDGET iterations), rtol 1e-10, then the options. PeriStaticSolve
+  creates it on first use; a caller creates it ahead to set it up first (a restart's initial
+  guess). Collective.
+@*/
+PetscErrorCode PeriStaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *ksp)
 {
   PC        pc;
   PetscBool cg, set;
@@ -429,7 +433,7 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, 
   PetscLogDouble t0, t1, t2;
 
   PetscFunctionBeginUser;
-  if (!*ksp) PetscCall(StaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
+  if (!*ksp) PetscCall(PeriStaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
   PetscCall(KSPSetOperators(*ksp, A, P));
   /* a factorization uses the BLAS threads (src/sys/threads.c) */
   PetscCall(KSPGetPC(*ksp, &pc));
@@ -536,7 +540,7 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
     PetscCall(PetscPrintf(sys->comm, "perilin: note: CG + Jacobi did not converge in %d iterations; GAMG on the short-range stiffness goes on from there\n", PERI_JACOBI_BUDGET));
     PetscCall(PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default)));
     PetscCall(KSPDestroy(ksp));
-    PetscCall(StaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
+    PetscCall(PeriStaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
     PetscCall(KSPSetInitialGuessNonzero(*ksp, PETSC_TRUE));
     PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));
   }

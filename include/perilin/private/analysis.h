@@ -7,6 +7,9 @@ typedef struct _p_PeriAnalysis *PeriAnalysis;
 /* Writes the system's present state as NAME (a .vtu) into the output set: installed by the
  * problem, which owns the set, so that an analysis can write a series while it runs. */
 typedef PetscErrorCode (*PeriSnapshotFn)(void *ctx, const char base[]); /* base.vtu, or base.pvtu on several ranks */
+/* The output set's directory, opened if the run has not opened it yet (installed with the snapshot
+ * callback, same ctx): where an analysis writes its checkpoints. */
+typedef PetscErrorCode (*PeriOutputDirFn)(void *ctx, const char **dir);
 
 #define PERI_MAX_VTU_MODES 12
 
@@ -54,6 +57,8 @@ typedef struct {
   char       stepping[16];                       /* increments | events */
   PetscInt   control_component, reaction_region; /* the model's component; index of disc.regions, or -1 */
   PetscReal *reactions;                          /* per step, every region's reaction: nregions x PERI_MAX_DOF */
+  PetscInt   checkpoints, restart_step;          /* checkpoints written; the step -restart continued from (0: none) */
+  PetscReal  checkpoint_s;                       /* the time spent writing them */
 } PeriQuasistatic;
 
 /* An analysis type (src/analysis/<name>.c): what it does with the system, and what it adds to
@@ -87,6 +92,7 @@ typedef struct {
   const char        *option_prefix; /* of its linear solvers' options ("st_" for an eigensolver's), NULL: none */
   const char *const *files;         /* the names of its files in the output set, NULL-terminated ('#': digits), or NULL */
   PeriSystemNeeds    needs;         /* what it asks of the system: K's kind and memory */
+  PetscBool          checkpoints;   /* it writes checkpoints at its equilibria and continues from one (-restart; src/analysis/checkpoint.c) */
   PeriAnalysisOps    ops;
 } PeriAnalysisType;
 /* One analysis of one problem: its type, the system it works on (borrowed, from PeriAnalysisSetUp
@@ -101,8 +107,13 @@ struct _p_PeriAnalysis {
   PetscInt                every;      /* output.every: snapshots every k steps (0: none) */
   const char             *output_dir; /* for messages only */
   PeriSnapshotFn          snapshot;   /* writes the present state into the output set */
+  PeriOutputDirFn         outputdir;  /* the output set's directory (ctx: snapshotctx) */
   void                   *snapshotctx;
-  void                   *data;
+  /* a type with checkpoints (src/analysis/checkpoint.c): -restart DIR, -peri_checkpoint_every N */
+  char       restart[PETSC_MAX_PATH_LEN]; /* continue from DIR/checkpoint ("": from the start) */
+  PetscInt   checkpoint_every;            /* a checkpoint every this many equilibria (0: none) */
+  PetscInt64 fingerprint;                 /* of the scene as the run began (PeriSceneFingerprint) */
+  void      *data;
 };
 /* TSALPHA2's period error on one mode (src/analysis/period_error.c) */
 PETSC_EXTERN PetscReal      PeriAlpha2PeriodError(PetscReal, PetscReal);
@@ -112,6 +123,10 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisSetFromScene(PeriAnalysis, PeriScene);
 PETSC_EXTERN PetscErrorCode PeriAnalysisSetUp(PeriAnalysis, PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun(PeriAnalysis);
 PETSC_EXTERN PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *);
+PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointSetFromOptions(PeriAnalysis);
+PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointBegin(PeriAnalysis, PetscViewer *, char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointEnd(PeriAnalysis, PetscViewer *, const char[]);
+PETSC_EXTERN PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis, PetscViewer *, char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisFind(const char[], const PeriAnalysisType **);
 PETSC_EXTERN PetscErrorCode PeriAnalysisListTypes(char[], size_t);

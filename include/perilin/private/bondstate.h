@@ -125,5 +125,7 @@ PETSC_EXTERN PetscErrorCode PeriBondsBreak(PeriSystem, Vec, PetscBool, PetscReal
 PETSC_EXTERN PetscErrorCode PeriCheckpointCreate(PeriSystem, PeriCheckpoint *);
 PETSC_EXTERN PetscErrorCode PeriCheckpointSave(PeriSystem, PeriCheckpoint *);
 PETSC_EXTERN PetscErrorCode PeriCheckpointRestore(PeriSystem, PeriCheckpoint *, PetscBool, PetscBool);
+PETSC_EXTERN PetscErrorCode PeriCheckpointView(PeriSystem, const PeriCheckpoint *, PetscViewer);
+PETSC_EXTERN PetscErrorCode PeriCheckpointLoad(PeriSystem, PeriCheckpoint *, PetscViewer, const char[]);
 PETSC_EXTERN PetscErrorCode PeriCheckpointDestroy(PeriCheckpoint *);
 PETSC_EXTERN PetscErrorCode PeriBondStateDestroy(PeriBondState *);

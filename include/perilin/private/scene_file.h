@@ -50,3 +50,4 @@ PETSC_EXTERN PetscErrorCode PeriNodeDestroy(PeriNode *);
 PETSC_EXTERN PetscErrorCode PeriSceneResolve(PeriScene, PeriNode, const char[], PetscBool, const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneResolvePath(PeriScene, PeriNode, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriSceneWriteResolved(PeriScene, const char[], FILE *);
+PETSC_EXTERN PetscErrorCode PeriSceneFingerprint(PeriScene, PetscInt64 *);

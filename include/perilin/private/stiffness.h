@@ -87,6 +87,7 @@ PETSC_EXTERN PetscErrorCode PeriOperatorMemoryMB(PeriSystem, PeriOperator, Petsc
 PETSC_EXTERN PetscErrorCode PeriOperatorScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriOperatorScaled(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriOperatorDestroy(PeriOperator *);
+PETSC_EXTERN PetscErrorCode PeriStaticKSPCreate(PeriSystem, PetscBool, KSP *);
 PETSC_EXTERN PetscErrorCode PeriStaticSolve(PeriSystem, KSP *, PetscReal, PetscBool, PetscInt, const PetscInt[], const PetscReal[], KSPConvergedReason *);
 PETSC_EXTERN PetscErrorCode PeriStaticPieces(PeriSystem, PetscInt *, PetscInt **, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriStaticCheckConverged(PeriSystem, KSPConvergedReason);

@@ -10,6 +10,7 @@ PETSC_EXTERN PetscErrorCode PeriFunctionListNames(PetscFunctionList, char[], siz
 PETSC_EXTERN PetscErrorCode PeriSignalsInstall(void);
 PETSC_EXTERN PetscErrorCode PeriSignalReceived(MPI_Comm, int *);
 PETSC_EXTERN int            PeriSignalPending(void);
+PETSC_EXTERN void           PeriSignalSimulate(int);
 PETSC_EXTERN const char    *PeriSignalName(int);
 
 /* log events */
