@@ -180,14 +180,16 @@ def anisotropy(setdir, outdir, facts):
                 if pts:
                     top = max(top, max(v for _, v in pts))
                     ax.plot([t for t, _ in pts], [v for _, v in pts], color="C%d" % k, lw=1, label="m = %s" % m)
-            ax.set_ylim(1, 1.02 * top)  # the centre is 1: lattice and continuum agree
+            # the circle of 1 (lattice and continuum agree) at a third of the radius
+            ax.set_ylim(1 - (top - 1) / 2, top + (top - 1) / 20)
+            ax.set_yticks([1, round(top, 3)])
             ax.set_thetamin(0)
             ax.set_thetamax(90)
             ax.tick_params(labelsize=6)
             ax.set_title("%s, [%s, %s]" % (c, p[0], p[1]), fontsize=8)
     handles, labels = fig.axes[0].get_legend_handles_labels() if fig.axes else ([], [])
     fig.legend(handles, labels, loc="lower center", ncol=len(ms), fontsize=8)
-    fig.suptitle("lattice failure load / continuum failure load against the orientation Theta (centre: 1)", fontsize=10)
+    fig.suptitle("lattice failure load / continuum failure load against the orientation Theta (inner tick: 1)", fontsize=10)
     fig.tight_layout(rect=(0, 0.05, 1, 0.95))
     save(fig, os.path.join(outdir, "anisotropy_polar.png"))
     # envelopes: where the continuum and the lattice (its strongest orientation) fail in (s1, s2)
