@@ -117,6 +117,7 @@ static const PeriKey analysis_keys[] = {
 static const PeriKey output_keys[] = {
     {"dir", PERI_KEY_STRING, "<scene file name without directory and last extension>-out", NULL, NULL, NULL, "output directory"},
     {"vtk", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "write particles.vtu"},
+    {"plots", PERI_KEY_BOOL, "true", NULL, NULL, NULL, "draw the run's pictures into the output set (PNG, python3-matplotlib): quasistatic load_displacement.png, modal modes.png, anisotropy anisotropy_polar.png and anisotropy_envelope.png; when they cannot be drawn, a warning and summary.json plots.error, the run's results stay"},
     {"stress", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "per-particle stress and strain (vector models): arrays stress, strain, elastic_stress in particles.vtu and sigma, epsilon, sigma_elastic in the probes (docs/stress.md); costs a pass over the bonds and 27 numbers per particle"},
     {NULL},
 };

@@ -106,6 +106,7 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
   PetscCall(PeriSceneResolvePath(s, s->root, "output.dir", p->output_dir));
   PetscCall(PeriSceneGetBool(s, s->root, "output.vtk", &p->vtk, NULL));
   PetscCall(PeriSceneGetBool(s, s->root, "output.stress", &p->stress_output, NULL));
+  PetscCall(PeriSceneGetBool(s, s->root, "output.plots", &p->plots, NULL));
   PetscCall(ReadAnalysis(p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -169,12 +170,13 @@ PetscErrorCode PeriProblemRun(PeriProblem p)
   PetscLogDouble t;
 
   PetscFunctionBeginUser;
-  p->analysis->vtk         = p->vtk;
-  p->analysis->every       = p->output_every;
-  p->analysis->output_dir  = p->output_dir;
-  p->analysis->snapshot    = WriteSnapshot;
-  p->analysis->outputdir   = OutputDir;
-  p->analysis->snapshotctx = p;
+  p->analysis->vtk           = p->vtk;
+  p->analysis->every         = p->output_every;
+  p->analysis->plots.enabled = p->plots;
+  p->analysis->output_dir    = p->output_dir;
+  p->analysis->snapshot      = WriteSnapshot;
+  p->analysis->outputdir     = OutputDir;
+  p->analysis->snapshotctx   = p;
   /* the scene as every run of it has read it by now: what ties a checkpoint to its scene */
   if (p->analysis->type->checkpoints) PetscCall(PeriSceneFingerprint(p->scene, &p->analysis->fingerprint));
   /* a signal during the set-up: no analysis, only the summary saying so */
@@ -227,6 +229,8 @@ PetscErrorCode PeriProblemWriteOutput(PeriProblem p)
   if (p->vtk && (!p->sys->run.interrupted || p->sys->fields.u_owned)) {
     PetscCall(WriteParticles(p));
   }
+  /* a signal asks to stop soon: no pictures (summary.json says why) */
+  if (p->analysis && p->sys->run.interrupted) PetscCall(PetscStrncpy(p->analysis->plots.error, "the run was interrupted", sizeof(p->analysis->plots.error)));
   if (p->analysis && p->analysis->type->ops.files) PetscCall(p->analysis->type->ops.files(p->analysis, p->staging_dir));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/scene.yaml", p->staging_dir));
   PetscCall(PeriWriteScene(p, path));

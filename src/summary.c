@@ -42,6 +42,7 @@ static PetscErrorCode WriteSummary(PeriProblem p, PeriJSON j)
   PetscCall(PeriSystemSummaryCost(sys, j));
   PetscCall(PeriSystemSummarySolver(sys, j));
   if (p->analysis && p->analysis->type->ops.summary) PetscCall(p->analysis->type->ops.summary(p->analysis, j));
+  if (p->analysis) PetscCall(PeriPlotsSummary(&p->analysis->plots, j));
   PetscCall(PeriTorsionSummary(sys, j));
   PetscCall(PeriSystemSummaryFields(sys, j));
   PetscCall(PeriReactionsSummary(sys, j));

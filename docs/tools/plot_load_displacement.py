@@ -8,8 +8,9 @@ analysis.control_component; the force: applied_load under load control, lambda t
 load along that component, or reaction under displacement control, the reaction of
 analysis.reaction_region along it) and the names from OUTDIR/summary.json (quasistatic.force_column
 says which), and writes OUTDIR/load_displacement.png (or PNG). The axes are in the scene's own
-consistent units (perilin has no unit system). Needs matplotlib (Debian: python3-matplotlib);
-perilin itself never calls this script."""
+consistent units (perilin has no unit system). Needs matplotlib (Debian: python3-matplotlib).
+A run draws the same picture itself (output.plots, src/output/draw_plots.py, whose drawing this
+script shares): this script redraws it from a finished output set, e.g. after -output_plots false."""
 import argparse
 import csv
 import json
@@ -92,20 +93,17 @@ def main():
         import matplotlib.pyplot as plt
     except ImportError:
         fail("matplotlib is not installed (Debian: apt-get install python3-matplotlib)")
+    # the picture a run draws itself (output.plots), from the script perilin runs
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "src", "output"))
+    from draw_plots import draw_load_displacement
     u = [0.0] + [float(r["control_u"]) for r in rows]  # the unloaded state first
     F = [0.0] + [float(r[col]) for r in rows]
     comp = qs.get("control_component", "u")
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
-    ax.plot(u, F, "o-", ms=3)
     probe = qs.get("control_probe")
-    ax.set_xlabel("%s of probe %s [length, scene units]" % (comp, probe) if probe else
-                  "%s (no probe: 0) [length, scene units]" % comp)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title(qs, F), fontsize=9)
-    ax.grid(True, alpha=0.3)
+    xlabel = ("%s of probe %s [length, scene units]" % (comp, probe) if probe else
+              "%s (no probe: 0) [length, scene units]" % comp)
     out = args.output or os.path.join(args.outdir, "load_displacement.png")
-    fig.tight_layout()
-    fig.savefig(out, dpi=100)
+    draw_load_displacement(plt, u, F, xlabel, ylabel, title(qs, F), out)
     print("wrote %s (%d steps, force: %s)" % (out, len(rows), col))
 
 

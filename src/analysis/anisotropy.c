@@ -14,11 +14,15 @@ typedef struct {
   PetscReal *paths; /* s1, s2 per path, in units of the criterion's limit */
   PetscReal *m;
   PetscInt   crit[3];
-  PetscReal *emax; /* [crit][path][m], in % */
+  PetscReal *emax;     /* [crit][path][m], in % */
+  PetscReal *ratio;    /* [crit][path][m][orientation]: the lattice's failure load over the continuum's */
+  PetscReal *envelope; /* [crit][m][psi][3]: the continuum's failure load along psi, the lattice's smallest and largest over the orientations */
 } Anisotropy;
 
 #define AN(an)                    ((Anisotropy *)(an)->data)
 #define PERI_CONTINUUM_DIRECTIONS 7200 /* every 0.025 degrees over a half turn: the continuum */
+#define PERI_ENVELOPE_DIRECTIONS  72   /* directions psi of the envelopes in the (s1, s2) plane: every 5 degrees */
+#define PERI_ENVELOPE_NEVER       1e6  /* a load factor above this many limits: a measure zero but for rounding (sliding under s1 = s2), so nothing fails */
 
 /* The load factor at which a bond of direction a and length len fails under H = F - I (2 x 2,
  * row-major), rotations held at 0. */
@@ -38,36 +42,84 @@ static PetscReal DirectionLoad(PeriSystem sys, PetscReal a, PetscReal len, const
   return PeriBondCriticalLoad(sys, &g, meas, m->nmeasures);
 }
 
-/* The smallest failure load factor over the lattice family of ratio m, and over the continuum. */
-static void FailureLoads(PeriSystem sys, PetscReal m, const PetscReal H[], PetscReal *lattice, PetscReal *continuum)
+/* The smallest failure load factor over the lattice family of ratio m. */
+static PetscReal LatticeLoad(PeriSystem sys, PetscReal m, const PetscReal H[])
 {
-  const PetscInt r = (PetscInt)PetscFloorReal(m);
+  const PetscInt r       = (PetscInt)PetscFloorReal(m);
+  PetscReal      lattice = PETSC_INFINITY;
 
-  *lattice = *continuum = PETSC_INFINITY;
   for (PetscInt i = -r; i <= r; i++)
     for (PetscInt j = -r; j <= r; j++)
-      if ((i || j) && i * i + j * j <= m * m * (1 + 1e-12)) *lattice = PetscMin(*lattice, DirectionLoad(sys, PetscAtan2Real(j, i), PetscSqrtReal(i * i + j * j), H));
-  for (PetscInt k = 0; k < PERI_CONTINUUM_DIRECTIONS; k++) *continuum = PetscMin(*continuum, DirectionLoad(sys, PETSC_PI * k / PERI_CONTINUUM_DIRECTIONS, 1, H));
+      if ((i || j) && i * i + j * j <= m * m * (1 + 1e-12)) lattice = PetscMin(lattice, DirectionLoad(sys, PetscAtan2Real(j, i), PetscSqrtReal(i * i + j * j), H));
+  return lattice;
+}
+
+/* The smallest failure load factor over the continuum (every direction). */
+static PetscReal ContinuumLoad(PeriSystem sys, const PetscReal H[])
+{
+  PetscReal continuum = PETSC_INFINITY;
+
+  for (PetscInt k = 0; k < PERI_CONTINUUM_DIRECTIONS; k++) continuum = PetscMin(continuum, DirectionLoad(sys, PETSC_PI * k / PERI_CONTINUUM_DIRECTIONS, 1, H));
+  return continuum;
+}
+
+/* H = Q diag(s1, s2) Q^T of orientation k of n, Q = [c sn; -sn c] (eq. 70). */
+static void Rotated(PetscInt k, PetscInt n, const PetscReal s[], PetscReal H[])
+{
+  const PetscReal th = -0.5 * PETSC_PI * k / (n - 1), c = PetscCosReal(th), sn = PetscSinReal(th);
+
+  H[0] = c * c * s[0] + sn * sn * s[1];
+  H[1] = H[2] = -c * sn * s[0] + sn * c * s[1];
+  H[3]        = sn * sn * s[0] + c * c * s[1];
 }
 
 /* e_max (%) of one path (in units of s0t, scaled by unit) and m under the criterion now in
- * sys->bond_state.failure. */
-static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal unit, PetscReal m)
+ * sys->bond_state.failure, and the ratio of the lattice's failure load to the continuum's at each
+ * orientation (inf where nothing fails along the path). */
+static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal unit, PetscReal m, PetscReal ratio[])
 {
   const PetscInt  n     = AN(an)->norient;
   const PetscReal s[2]  = {unit * path[0], unit * path[1]};
   PetscReal       worst = 0;
 
   for (PetscInt k = 0; k < n; k++) {
-    const PetscReal th = -0.5 * PETSC_PI * k / (n - 1), c = PetscCosReal(th), sn = PetscSinReal(th);
-    /* H = Q diag(s1, s2) Q^T, Q = [c sn; -sn c] (eq. 70) */
-    const PetscReal H[4] = {c * c * s[0] + sn * sn * s[1], -c * sn * s[0] + sn * c * s[1], -sn * c * s[0] + c * sn * s[1], sn * sn * s[0] + c * c * s[1]};
-    PetscReal       lat, cont;
-    FailureLoads(an->sys, m, H, &lat, &cont);
-    if (PetscIsInfReal(cont)) continue; /* nothing fails along this path */
-    worst = PetscMax(worst, lat / cont - 1);
+    PetscReal H[4], lat, cont;
+    Rotated(k, n, s, H);
+    lat      = LatticeLoad(an->sys, m, H);
+    cont     = ContinuumLoad(an->sys, H);
+    ratio[k] = PETSC_INFINITY;
+    if (cont >= PETSC_INFINITY) continue; /* nothing fails along this path (PETSC_INFINITY is finite) */
+    ratio[k] = lat / cont;
+    worst    = PetscMax(worst, lat / cont - 1);
   }
   return 100 * worst;
+}
+
+/* The failure envelope of one m in the (s1, s2) plane under the criterion now in
+ * sys->bond_state.failure: along each direction psi the load factor (in units of s0t) at which
+ * the continuum fails (isotropic: at Theta = 0), and the smallest and largest over the lattice's
+ * orientations. */
+static void Envelope(PeriAnalysis an, PetscReal unit, PetscReal m, PetscReal env[])
+{
+  const PetscInt n = AN(an)->norient;
+
+  for (PetscInt d = 0; d < PERI_ENVELOPE_DIRECTIONS; d++) {
+    const PetscReal psi = 2 * PETSC_PI * d / PERI_ENVELOPE_DIRECTIONS, s[2] = {unit * PetscCosReal(psi), unit * PetscSinReal(psi)};
+    PetscReal       H[4], *e                                                = &env[3 * d];
+    Rotated(0, n, s, H);
+    e[0] = ContinuumLoad(an->sys, H);
+    e[1] = PETSC_INFINITY;
+    e[2] = 0;
+    for (PetscInt k = 0; k < n; k++) {
+      PetscReal lat;
+      Rotated(k, n, s, H);
+      lat  = LatticeLoad(an->sys, m, H);
+      e[1] = PetscMin(e[1], lat);
+      e[2] = PetscMax(e[2], lat);
+    }
+    for (PetscInt k = 0; k < 3; k++)
+      if (e[k] > PERI_ENVELOPE_NEVER) e[k] = PETSC_INFINITY;
+  }
 }
 
 /* sys->bond_state.failure with only criterion c of the scene's (0 stretch: tension and compression, 1
@@ -136,17 +188,59 @@ static PetscErrorCode Run_Anisotropy(PeriAnalysis an)
   PetscFunctionBeginUser;
   PetscCheck(an->sys->disc.particles.dim == 2, an->comm, PETSC_ERR_USER_INPUT, "%s: the anisotropy analysis studies the 2D square lattice: dim must be 2", an->sys->scene->file);
   A = AN(an);
-  PetscCall(PetscMalloc1(A->ncrit * A->npaths * A->nm, &A->emax));
+  PetscCall(PetscMalloc3(A->ncrit * A->npaths * A->nm, &A->emax, A->ncrit * A->npaths * A->nm * A->norient, &A->ratio, A->ncrit * A->nm * PERI_ENVELOPE_DIRECTIONS * 3, &A->envelope));
   for (PetscInt c = 0; c < A->ncrit; c++) {
     PetscCall(OnlyCriterion(an, A->crit[c]));
     for (PetscInt p = 0; p < A->npaths; p++)
-      for (PetscInt k = 0; k < A->nm; k++) A->emax[(c * A->npaths + p) * A->nm + k] = MaxError(an, &A->paths[2 * p], unit, A->m[k]);
+      for (PetscInt k = 0; k < A->nm; k++) {
+        const PetscInt row = (c * A->npaths + p) * A->nm + k;
+        A->emax[row]       = MaxError(an, &A->paths[2 * p], unit, A->m[k], &A->ratio[row * A->norient]);
+      }
+    for (PetscInt k = 0; k < A->nm; k++) Envelope(an, unit, A->m[k], &A->envelope[(c * A->nm + k) * PERI_ENVELOPE_DIRECTIONS * 3]);
   }
   an->sys->bond_state.failure = all;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* anisotropy.csv: criterion,s1,s2,m,e_max_percent. Rank 0 writes (temporary name, then rename). */
+/* A load factor for the CSV files: PETSC_INFINITY (nothing fails) as inf. */
+static double CSVLoad(PetscReal v)
+{
+  return v >= PETSC_INFINITY ? (double)INFINITY : (double)v;
+}
+
+/* anisotropy_polar.csv (criterion,s1,s2,m,theta_deg,ratio) and anisotropy_envelope.csv
+ * (criterion,m,psi_deg,continuum,lattice_min,lattice_max). Rank 0 writes. */
+static PetscErrorCode WriteCurves(PeriAnalysis an, const char dir[])
+{
+  Anisotropy *A = AN(an);
+  char        path[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
+  FILE       *fp;
+  int         bad = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/anisotropy_polar.csv", dir));
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  bad |= fprintf(fp, "criterion,s1,s2,m,theta_deg,ratio\n") < 0;
+  for (PetscInt c = 0; c < A->ncrit; c++)
+    for (PetscInt p = 0; p < A->npaths; p++)
+      for (PetscInt k = 0; k < A->nm; k++)
+        for (PetscInt o = 0; o < A->norient; o++) bad |= fprintf(fp, "%s,%g,%g,%g,%.6g,%.8g\n", criteria[A->crit[c]], (double)A->paths[2 * p], (double)A->paths[2 * p + 1], (double)A->m[k], 90.0 * o / (A->norient - 1), CSVLoad(A->ratio[((c * A->npaths + p) * A->nm + k) * A->norient + o])) < 0;
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/anisotropy_envelope.csv", dir));
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  bad |= fprintf(fp, "criterion,m,psi_deg,continuum,lattice_min,lattice_max\n") < 0;
+  for (PetscInt c = 0; c < A->ncrit; c++)
+    for (PetscInt k = 0; k < A->nm; k++)
+      for (PetscInt d = 0; d < PERI_ENVELOPE_DIRECTIONS; d++) {
+        const PetscReal *e = &A->envelope[((c * A->nm + k) * PERI_ENVELOPE_DIRECTIONS + d) * 3];
+        bad |= fprintf(fp, "%s,%g,%g,%.8g,%.8g,%.8g\n", criteria[A->crit[c]], (double)A->m[k], 360.0 * d / PERI_ENVELOPE_DIRECTIONS, CSVLoad(e[0]), CSVLoad(e[1]), CSVLoad(e[2])) < 0;
+      }
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* anisotropy.csv: criterion,s1,s2,m,e_max_percent; the curves behind it, and their pictures. Rank 0
+ * writes (temporary name, then rename). */
 static PetscErrorCode Files_Anisotropy(PeriAnalysis an, const char dir[])
 {
   Anisotropy *A = AN(an);
@@ -156,6 +250,7 @@ static PetscErrorCode Files_Anisotropy(PeriAnalysis an, const char dir[])
 
   PetscFunctionBeginUser;
   if (an->rank || !A || !A->emax) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(WriteCurves(an, dir));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/anisotropy.csv", dir));
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "criterion,s1,s2,m,e_max_percent\n") < 0;
@@ -163,6 +258,7 @@ static PetscErrorCode Files_Anisotropy(PeriAnalysis an, const char dir[])
     for (PetscInt p = 0; p < A->npaths; p++)
       for (PetscInt k = 0; k < A->nm; k++) bad |= fprintf(fp, "%s,%g,%g,%g,%.4f\n", criteria[A->crit[c]], (double)A->paths[2 * p], (double)A->paths[2 * p + 1], (double)A->m[k], (double)A->emax[(c * A->npaths + p) * A->nm + k]) < 0;
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  PetscCall(PeriPlotsDraw(an->comm, dir, "anisotropy", NULL, &an->plots));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -194,7 +290,7 @@ static PetscErrorCode Destroy_Anisotropy(PeriAnalysis an)
   PetscFunctionBeginUser;
   PetscCall(PetscFree(AN(an)->paths));
   PetscCall(PetscFree(AN(an)->m));
-  PetscCall(PetscFree(AN(an)->emax));
+  PetscCall(PetscFree3(AN(an)->emax, AN(an)->ratio, AN(an)->envelope));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -206,7 +302,7 @@ static const PeriKey anisotropy_keys[] = {
     {NULL},
 };
 static const PeriSchema  anisotropy_schema[] = {{"analysis", anisotropy_keys}, {NULL}};
-static const char *const anisotropy_files[]  = {"anisotropy.csv", NULL};
+static const char *const anisotropy_files[]  = {"anisotropy.csv", "anisotropy_polar.csv", "anisotropy_envelope.csv", "anisotropy_polar.png", "anisotropy_envelope.png", NULL};
 
 /* Solves nothing: K is never built (the memory estimate sizes it as a static run's, assembled). */
 const PeriAnalysisType PeriAnalysis_Anisotropy = {

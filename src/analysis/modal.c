@@ -733,6 +733,8 @@ static PetscErrorCode ModalFiles(PeriAnalysis an, const char dir[])
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/modes.csv", dir));
   PetscCall(PeriWriteModesCSV(an, path));
   if (an->vtk) PetscCall(WriteModeShapes(an, dir));
+  /* the frequencies from modes.csv, the shapes from particles.vtu (.pvtu) when output.vtk */
+  if (Modal(an)->nmodes) PetscCall(PeriPlotsDraw(an->comm, dir, "modal", NULL, &an->plots));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -774,7 +776,7 @@ static PetscErrorCode SolversFromOptions_Modal(MPI_Comm comm, const char ksp_typ
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static const char *const modal_files[] = {"modes.csv", "modes.pvd", "mode_#.vtu", "mode_#.pvtu", "mode_#", NULL};
+static const char *const modal_files[] = {"modes.csv", "modes.pvd", "mode_#.vtu", "mode_#.pvtu", "mode_#", "modes.png", NULL};
 
 /* K is assembled AIJ and factored (its fill measured in docs/performance.md); the mass comes from
  * the system's mass service. */

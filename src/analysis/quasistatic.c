@@ -1074,7 +1074,29 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* steps.csv and the snapshot series particles.pvd. */
+/* load_displacement.png from steps.csv (output.plots), with the facts summary.json will hold. */
+static PetscErrorCode QSPlots(PeriAnalysis an, const char dir[])
+{
+  const PeriQuasistatic *q = QS(an);
+  char                   arg[8][PERI_NAME_LEN + 32];
+  const char            *args[9] = {NULL};
+
+  PetscFunctionBeginUser;
+  if (!ForceColumn(an)) PetscCall(PetscStrncpy(an->plots.error, "steps.csv has no force column (displacement control without a reaction region)", sizeof(an->plots.error)));
+  PetscCall(PetscSNPrintf(arg[0], sizeof(arg[0]), "force=%s", ForceColumn(an) ? ForceColumn(an) : ""));
+  PetscCall(PetscSNPrintf(arg[1], sizeof(arg[1]), "component=%s", an->sys->model->components[q->control_component]));
+  PetscCall(PetscSNPrintf(arg[2], sizeof(arg[2]), "probe=%s", q->control));
+  PetscCall(PetscSNPrintf(arg[3], sizeof(arg[3]), "region=%s", q->reaction_region >= 0 ? an->sys->disc.regions[q->reaction_region].name : ""));
+  PetscCall(PetscSNPrintf(arg[4], sizeof(arg[4]), "load=%.10g", (double)(ST(an)->displacement ? 0 : ST(an)->load)));
+  PetscCall(PetscSNPrintf(arg[5], sizeof(arg[5]), "peak=%.10g", (double)q->peak_load_factor));
+  PetscCall(PetscSNPrintf(arg[6], sizeof(arg[6]), "critical=%.10g", (double)(q->failed ? q->critical_load_factor : 0)));
+  PetscCall(PetscSNPrintf(arg[7], sizeof(arg[7]), "broken=%" PetscInt_FMT, q->broken_bonds));
+  for (PetscInt k = 0; k < 8; k++) args[k] = arg[k];
+  PetscCall(PeriPlotsDraw(an->comm, dir, "quasistatic", args, &an->plots));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* steps.csv, the snapshot series particles.pvd and the picture of the curve. */
 static PetscErrorCode QSFiles(PeriAnalysis an, const char dir[])
 {
   char path[PETSC_MAX_PATH_LEN];
@@ -1085,6 +1107,7 @@ static PetscErrorCode QSFiles(PeriAnalysis an, const char dir[])
   PetscCall(PeriWriteStepsCSV(an, path));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/particles.pvd", dir));
   PetscCall(WriteSnapshotsPVD(an, path));
+  if (QS(an)->nsteps) PetscCall(QSPlots(an, dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1121,7 +1144,7 @@ static const PeriKey qs_output_keys[] = {
 };
 static const PeriSchema qs_schema[] = {{"analysis", qs_keys}, {"output", qs_output_keys}, {NULL}};
 
-static const char *const qs_files[] = {"steps.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", "failed_trial.vtu", "failed_trial.pvtu", "failed_trial", "checkpoint", NULL};
+static const char *const qs_files[] = {"steps.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", "failed_trial.vtu", "failed_trial.pvtu", "failed_trial", "checkpoint", "load_displacement.png", NULL};
 
 /* K is applied and changed bond by bond (matrix-free where the model allows), and the loop solves
  * on a copy of it. */

@@ -125,6 +125,12 @@ static int RemoveTree(const char path[])
   return nftw(path, RemoveEntry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
+/* rm -rf path, for the writers' own scratch directories. Not collective. */
+int PeriOutputRemoveTree(const char path[])
+{
+  return RemoveTree(path);
+}
+
 /* The names the analyses write into an output set, as they declare them (PeriOutputSetAddNames):
  * static strings, kept by reference. */
 #define PERI_OUTPUT_MAX_NAMES 64

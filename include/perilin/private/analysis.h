@@ -105,6 +105,7 @@ struct _p_PeriAnalysis {
   PeriSystem              sys;
   PetscBool               vtk;        /* output.vtk: fields are written */
   PetscInt                every;      /* output.every: snapshots every k steps (0: none) */
+  PeriPlots               plots;      /* output.plots, and the pictures its files op drew (PeriPlotsDraw) */
   const char             *output_dir; /* for messages only */
   PeriSnapshotFn          snapshot;   /* writes the present state into the output set */
   PeriOutputDirFn         outputdir;  /* the output set's directory (ctx: snapshotctx) */

@@ -52,3 +52,13 @@ PETSC_EXTERN PetscErrorCode PeriOutputSetCommit(MPI_Comm, const char[], const ch
 PETSC_EXTERN void           PeriOutputSetDiscard(void);
 PETSC_EXTERN PetscErrorCode PeriOutputSetAddNames(const char *const[]);
 PETSC_EXTERN PetscErrorCode PeriOutputSetAdopt(MPI_Comm, const char[], const char[], const char[], PetscBool *);
+PETSC_EXTERN int            PeriOutputRemoveTree(const char[]);
+/* The pictures of one run (src/output/plots.c): asked for (output.plots), drawn, or why not. */
+typedef struct {
+  PetscBool enabled;
+  char      kind[32];   /* set when the analysis draws pictures: summary.json then has "plots" */
+  char      files[256]; /* the PNG files written, separated by spaces */
+  char      error[512]; /* why none was written */
+} PeriPlots;
+PETSC_EXTERN PetscErrorCode PeriPlotsDraw(MPI_Comm, const char[], const char[], const char *const[], PeriPlots *);
+PETSC_EXTERN PetscErrorCode PeriPlotsSummary(const PeriPlots *, PeriJSON);

@@ -19,6 +19,7 @@ struct _p_PeriProblem {
   PetscBool      write_output;                    /* set by the executable: check output.dir before computing */
   PetscBool      vtk;
   PetscBool      stress_output; /* output.stress */
+  PetscBool      plots;         /* output.plots: the analysis draws its pictures */
   PetscLogDouble t_start;
 };
 
