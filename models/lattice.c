@@ -38,6 +38,7 @@ struct _n_PeriLattice {
   PetscReal *coef;                                       /* per particle: nbasis coefficients of mu_i */
   PetscInt   kept;                                       /* particles that kept mu = 1: no polynomial of the degree makes them isotropic */
   PetscInt   damped;                                     /* particles that took part of their polynomial */
+  PeriPatch  patch;                                      /* model.calibration: patch, the global correction on top (models/patch.c); else NULL */
 };
 
 /* monomials of total degree D in dim variables, in a fixed order: exponents of the k-th */
@@ -285,6 +286,34 @@ static PetscErrorCode DampLopsided(PeriLattice lat, const PeriCalibrationData *d
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* model.calibration: patch: the lattice's factors of the rank's bonds, then their global
+ * correction (models/patch.c); warns with the smallest factor when one is below LATTICE_MIN_MU. */
+static PetscErrorCode Patch(PeriLattice lat, PeriModel m, const PeriCalibrationData *data, PetscReal (*profile)(PeriModel, PetscReal), PetscReal Scont)
+{
+  const PeriBonds *b = data->bonds;
+  PetscReal       *f0, fmin = PETSC_MAX_REAL;
+
+  PetscFunctionBeginUser;
+  PetscCheck(m->central_force && lat->degree == LATTICE_DEGREE, PETSC_COMM_SELF, PETSC_ERR_SUP, "%s: the patch calibration is for central-force models", m->type);
+  PetscCall(PetscMalloc1(b->nbonds, &f0));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PeriBondGeometry g = {.i = i, .j = b->j[k], .length = b->length[k], .Vi = data->particles->volume[i], .Vj = data->particles->volume[b->j[k]], .weight = b->alpha[k] * b->lambda[k], .bond = k + 1};
+      for (PetscInt d = 0; d < 3; d++) g.xi[d] = b->xi[3 * k + d];
+      f0[k] = PeriLatticeFactor(lat, &g);
+    }
+  PetscCall(PeriPatchCreate(m, data, profile, f0, Scont, &lat->patch));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PeriBondGeometry g = {.bond = k + 1};
+      if (b->j[k] != i && b->live[k]) fmin = PetscMin(fmin, f0[k] + PeriPatchCorrection(lat->patch, &g));
+    }
+  PetscCall(PetscFree(f0));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &fmin, 1, MPIU_REAL, MPI_MIN, data->comm));
+  if (fmin < LATTICE_MIN_MU) PetscCall(PetscSNPrintf(m->warning, sizeof(m->warning), "patch calibration: the smallest bond factor is %g (below %g): the corrections of a few irregular families are large; check the mesh's quality near them, or use model.calibration: lattice", (double)fmin, (double)LATTICE_MIN_MU));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriLatticeCreate - the lattice calibration of one spring family: for every particle the scale
   and the angular polynomial (of degree 4, or 2 for a scalar field) that make the discrete moments
@@ -299,7 +328,7 @@ PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, P
 
   PetscFunctionBeginUser;
   PetscCall(PeriLatticeDestroy(lattice));
-  if (m->calibration != PERI_CALIBRATION_LATTICE) PetscFunctionReturn(PETSC_SUCCESS);
+  if (m->calibration == PERI_CALIBRATION_CONTINUUM) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(degree == 2 || degree == LATTICE_DEGREE, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "lattice calibration: degree %" PetscInt_FMT " (2 or 4)", degree);
   PetscCall(PetscNew(&lat));
   lat->n      = data->n;
@@ -320,7 +349,9 @@ PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, P
   PetscCall(DampLopsided(lat, data));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lat->kept, 1, MPIU_INT, MPI_SUM, data->comm));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &lat->damped, 1, MPIU_INT, MPI_SUM, data->comm));
-  if (lat->kept || lat->damped)
+  if (m->calibration == PERI_CALIBRATION_PATCH)
+    PetscCall(Patch(lat, m, data, profile, Scont));
+  else if (lat->kept || lat->damped)
     PetscCall(PetscSNPrintf(m->warning, sizeof(m->warning), "lattice calibration: %" PetscInt_FMT " of %" PetscInt_FMT " particles (at corners and edges) are not made exactly isotropic: %" PetscInt_FMT " have too few bond directions (scale only, as npmb), %" PetscInt_FMT " take part of the correction so that no bond's multiplier falls below %g", lat->kept + lat->damped, data->N, lat->kept, lat->damped, (double)LATTICE_MIN_MU));
   *lattice = lat;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -334,7 +365,7 @@ PetscReal PeriLatticeFactor(PeriLattice lat, const PeriBondGeometry *b)
   if (!lat) return 1;
   for (PetscInt d = 0; d < 3; d++) e[d] = d < lat->dim ? b->xi[d] / b->length : 0;
   Powers(e, lat->degree, pw);
-  return 0.5 * (lat->scale[b->i] * Multiplier(lat, b->i, pw) + lat->scale[b->j] * Multiplier(lat, b->j, pw));
+  return 0.5 * (lat->scale[b->i] * Multiplier(lat, b->i, pw) + lat->scale[b->j] * Multiplier(lat, b->j, pw)) + PeriPatchCorrection(lat->patch, b);
 }
 
 PetscErrorCode PeriLatticeDestroy(PeriLattice *lat)
@@ -342,6 +373,7 @@ PetscErrorCode PeriLatticeDestroy(PeriLattice *lat)
   PetscFunctionBeginUser;
   if (!*lat) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscFree2((*lat)->scale, (*lat)->coef));
+  PetscCall(PeriPatchDestroy(&(*lat)->patch));
   PetscCall(PetscFree(*lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -38,7 +38,8 @@ typedef enum {
  * particle's discrete family made to reproduce the continuum's moments (models/lattice.c) */
 typedef enum {
   PERI_CALIBRATION_CONTINUUM,
-  PERI_CALIBRATION_LATTICE
+  PERI_CALIBRATION_LATTICE,
+  PERI_CALIBRATION_PATCH /* lattice, then corrected so that affine fields are exact on any cloud (models/patch.c) */
 } PeriCalibrationKind;
 PETSC_EXTERN const char *const PeriCalibrationKinds[];
 typedef struct _n_PeriLattice *PeriLattice;
@@ -115,6 +116,10 @@ PETSC_EXTERN PetscReal      PeriLatticeFactor(PeriLattice, const PeriBondGeometr
 PETSC_EXTERN PetscReal      PeriProfileLength(PeriModel, PetscReal);
 PETSC_EXTERN PetscReal      PeriProfileOne(PeriModel, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriLatticeDestroy(PeriLattice *);
+typedef struct _n_PeriPatch *PeriPatch;
+PETSC_EXTERN PetscErrorCode PeriPatchCreate(PeriModel, const PeriCalibrationData *, PetscReal (*)(PeriModel, PetscReal), const PetscReal[], PetscReal, PeriPatch *);
+PETSC_EXTERN PetscReal      PeriPatchCorrection(PeriPatch, const PeriBondGeometry *);
+PETSC_EXTERN PetscErrorCode PeriPatchDestroy(PeriPatch *);
 
 /* A built-in model type. Each model file (models/) ends with its descriptor(s) PeriModel_<id>,
  * whose create function stays static; models/model_list.h names them and src/model_api/model_registry.c registers

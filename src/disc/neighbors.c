@@ -2,38 +2,6 @@
  * axis gives several bonds to images of the same particle, as the continuum would). */
 #include "perilin/private/disc.h"
 
-const char *const PeriPartialVolumes[] = {"none", "linear", "linear_continued", NULL};
-
-/* Bonds of length within this relative slack of delta are inside the horizon: m = 3 gives
- * |xi| = 3 dx in floating point that must count whatever the rounding. */
-#define PERI_HORIZON_SLACK 1e-10
-
-/* The partial-volume factor of a bond of length r for horizon delta and spacing h: the share of
- * the neighbour's cell inside the horizon, a linear ramp that is 1/2 at delta (Diana & Casolo
- * eq. 9 with its sign corrected, see docs/theory.md). "linear" cuts the ramp at delta;
- * "linear_continued" lets it reach zero at delta + h/2. */
-PetscReal PeriPartialVolumeFactor(PeriPartialVolume pv, PetscReal r, PetscReal delta, PetscReal h)
-{
-  const PetscReal rin = delta * (1 + PERI_HORIZON_SLACK);
-  switch (pv) {
-  case PERI_PARTIAL_VOLUME_NONE:
-    return r <= rin ? 1.0 : 0.0;
-  case PERI_PARTIAL_VOLUME_LINEAR:
-    if (r > rin) return 0.0;
-    break;
-  case PERI_PARTIAL_VOLUME_LINEAR_CONTINUED:
-    if (r >= delta + h / 2) return 0.0;
-    break;
-  }
-  if (r <= delta - h / 2) return 1.0;
-  return PetscMin(1.0, (delta + h / 2 - r) / h);
-}
-
-PetscReal PeriSearchRadius(PeriPartialVolume pv, PetscReal delta, PetscReal hmax)
-{
-  return pv == PERI_PARTIAL_VOLUME_LINEAR_CONTINUED ? delta + hmax / 2 : delta * (1 + PERI_HORIZON_SLACK);
-}
-
 typedef struct {
   PetscInt  ncell[3], reach[3];
   PetscReal lower[3], size[3], length[3];
@@ -103,41 +71,6 @@ static PetscErrorCode CellListDestroy(CellList *cl)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Growable bond storage. */
-PetscErrorCode PeriBondsReserve(PeriBonds *b, PetscInt need, PetscInt *cap)
-{
-  PetscFunctionBeginUser;
-  if (need <= *cap) PetscFunctionReturn(PETSC_SUCCESS);
-  {
-    PetscInt       nc = PetscMax(2 * *cap, need + 1024);
-    PetscInt      *j;
-    PetscReal     *xi, *len, *alpha;
-    unsigned char *live;
-    PetscCall(PetscMalloc1(nc, &j));
-    PetscCall(PetscMalloc1(3 * nc, &xi));
-    PetscCall(PetscMalloc1(nc, &len));
-    PetscCall(PetscMalloc1(nc, &alpha));
-    PetscCall(PetscMalloc1(nc, &live));
-    PetscCall(PetscArraycpy(j, b->j, b->nbonds));
-    PetscCall(PetscArraycpy(xi, b->xi, 3 * b->nbonds));
-    PetscCall(PetscArraycpy(len, b->length, b->nbonds));
-    PetscCall(PetscArraycpy(alpha, b->alpha, b->nbonds));
-    PetscCall(PetscArraycpy(live, b->live, b->nbonds));
-    PetscCall(PetscFree(b->j));
-    PetscCall(PetscFree(b->xi));
-    PetscCall(PetscFree(b->length));
-    PetscCall(PetscFree(b->alpha));
-    PetscCall(PetscFree(b->live));
-    b->j      = j;
-    b->xi     = xi;
-    b->length = len;
-    b->alpha  = alpha;
-    b->live   = live;
-    *cap      = nc;
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* Is the image shift positive in lexicographic order? Of the two images of a particle's
  * self-bond (+shift, -shift) only one is stored. */
 static PetscBool ShiftPositive(const PetscInt w[3])
@@ -161,28 +94,6 @@ static PetscInt NeighborCell(const PeriParticles *p, const CellList *cl, const P
     c[d] -= wrap[d] * cl->ncell[d];
   }
   return CellIndex(cl, c);
-}
-
-/*@C
-  PeriBondsAdd - appends the bond of i to j (x = X_j - X_i, image shift included) for horizon delta
-  when its partial-volume factor is positive. Errors on coincident particles. Not collective.
-@*/
-PetscErrorCode PeriBondsAdd(const PeriParticles *p, PetscInt i, PetscInt j, const PetscReal x[], PetscReal delta, PeriPartialVolume pv, PeriBonds *b, PetscInt *cap)
-{
-  PetscReal len = PetscSqrtReal(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]), h = 0.5 * (p->spacing[i] + p->spacing[j]), alpha;
-
-  PetscFunctionBeginUser;
-  PetscCheck(len > 1e-8 * h, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "particles %" PetscInt_FMT " and %" PetscInt_FMT " coincide at (%g, %g, %g)%s (distance %g, spacing %g)", p->source_line[i] ? p->source_line[i] : i, p->source_line[j] ? p->source_line[j] : j, (double)p->x[3 * i], (double)p->x[3 * i + 1], (double)p->x[3 * i + 2], p->source_line[i] ? " (the numbers are lines of particles.file)" : "", (double)len, (double)h);
-  alpha = PeriPartialVolumeFactor(pv, len, delta, h);
-  if (alpha <= 0) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriBondsReserve(b, b->nbonds + 1, cap));
-  b->j[b->nbonds] = j;
-  for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
-  b->length[b->nbonds] = len;
-  b->alpha[b->nbonds]  = alpha;
-  b->live[b->nbonds]   = 1;
-  b->nbonds++;
-  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Appends the bonds of particle i (those with j >= i when half) to b. */
@@ -332,76 +243,5 @@ PetscErrorCode PeriParticlesNear(const PeriParticles *p, PetscReal r, PetscInt m
   PetscCall(CellListCreate(p, lo, hi, r, &cl));
   for (PetscInt k = 0; k < m; k++) near[k] = PointNear(p, &cl, r, &y[3 * k]);
   PetscCall(CellListDestroy(&cl));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-PetscErrorCode PeriBondsDestroy(PeriBonds *b)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFree(b->offset));
-  PetscCall(PetscFree(b->j));
-  PetscCall(PetscFree(b->xi));
-  PetscCall(PetscFree(b->length));
-  PetscCall(PetscFree(b->alpha));
-  PetscCall(PetscFree(b->lambda));
-  PetscCall(PetscFree(b->live));
-  PetscCall(PetscFree(b->intact));
-  PetscCall(PetscFree(b->cause));
-  b->nbonds = 0;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriBondsReleaseGeometry - frees the bond vectors, lengths and partial-volume factors (40 of the
-  53 bytes a bond holds), and the surface factors when all are 1 (8 more), while nothing reads
-  them; PeriBondsRestoreGeometry recomputes them. Only for bodies without periodic axes, whose
-  bonds never join images (*released says whether it freed them). Not collective.
-@*/
-PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *p, PeriBonds *b, PetscBool *released)
-{
-  PetscFunctionBeginUser;
-  *released = PETSC_FALSE;
-  for (PetscInt d = 0; d < 3; d++)
-    if (p->periodic[d]) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscFree(b->xi));
-  PetscCall(PetscFree(b->length));
-  PetscCall(PetscFree(b->alpha));
-  {
-    PetscInt k = 0;
-    while (k < b->nbonds && b->lambda[k] == 1) k++;
-    if (k == b->nbonds) PetscCall(PetscFree(b->lambda));
-  }
-  *released = PETSC_TRUE;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriBondsRestoreGeometry - recomputes what PeriBondsReleaseGeometry freed, with the arithmetic
-  of the search (ParticleBonds with no image shift), so every value is the same to the bit; the
-  arrays are sized to the bonds exactly. Not collective.
-@*/
-PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta, const PetscReal horizon[], PeriPartialVolume pv, PeriBonds *b)
-{
-  PetscFunctionBeginUser;
-  if (!b->lambda) {
-    PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
-    for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
-  }
-  PetscCall(PetscMalloc1(3 * b->nbonds, &b->xi));
-  PetscCall(PetscMalloc1(b->nbonds, &b->length));
-  PetscCall(PetscMalloc1(b->nbonds, &b->alpha));
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      const PetscInt j    = b->j[k];
-      PetscReal      len2 = 0;
-      for (PetscInt d = 0; d < 3; d++) {
-        /* the search's x_j + wrap L - x_i with wrap = 0 (+ 0.0 keeps the sign of a zero alike) */
-        PetscReal x      = p->x[3 * j + d] + 0.0 - p->x[3 * i + d];
-        b->xi[3 * k + d] = x;
-        len2 += x * x;
-      }
-      b->length[k] = PetscSqrtReal(len2);
-      b->alpha[k]  = PeriPartialVolumeFactor(pv, b->length[k], horizon ? PetscMax(horizon[i], horizon[j]) : delta, 0.5 * (p->spacing[i] + p->spacing[j]));
-    }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -5,7 +5,7 @@
 
 static PetscFunctionList PeriModelList = NULL;
 
-const char *const PeriCalibrationKinds[] = {"continuum", "lattice", NULL};
+const char *const PeriCalibrationKinds[] = {"continuum", "lattice", "patch", NULL};
 
 /* Run by PetscFinalize: frees the list, as PETSc's own packages do (src/model_api/model_registry.c forgets on
  * its own that it filled it). */

@@ -10,7 +10,7 @@ static const char *const planes[]     = {"stress", "strain", NULL};
 static const PeriKey     model_keys[] = {
         {"type", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the bond model (docs/models/)"},
         {"plane", PERI_KEY_CHOICE, "stress", NULL, NULL, planes, "2D only: plane stress or plane strain"},
-        {"calibration", PERI_KEY_CHOICE, NULL, NULL, NULL, PeriCalibrationKinds, "lattice: each particle's discrete family reproduces the continuum's moments, so every homogeneous strain has the target energy, at surfaces too (docs/models/lattice.md; the default of pds, mppd, gerstle); continuum: micromoduli from the continuous horizon (the papers'; the default of the others)"},
+        {"calibration", PERI_KEY_CHOICE, NULL, NULL, NULL, PeriCalibrationKinds, "lattice: each particle's discrete family reproduces the continuum's moments, so every homogeneous strain has the target energy, at surfaces too (docs/models/lattice.md; the default of pds, mppd, gerstle); patch: lattice, then every bond corrected so that on any cloud (graded, stochastic) affine fields are equilibria and dilations have the target energy at every interior particle (central-force models; docs/mesh.md, \"Patch tests\"); continuum: micromoduli from the continuous horizon (the papers'; the default of the others)"},
         {NULL},
 };
 static const char *const spacings[]     = {"mean", "own", NULL};
@@ -100,7 +100,7 @@ static PetscErrorCode ReadCorrections(PeriSystem sys)
   PetscCall(PeriSceneCheckSection(s, c, "corrections"));
   PetscCall(PeriSceneGetChoice(s, c, "partial_volume", PeriPartialVolumes, &pv, NULL));
   PetscCall(PeriSceneGetChoice(s, c, "surface", PeriSurfaceCorrections, &sc, &found));
-  PeriInputCheck(sc == PERI_SURFACE_NONE || sys->model->calibration != PERI_CALIBRATION_LATTICE, s, c, "surface", "the lattice calibration (model.calibration; the default of pds, mppd and gerstle) makes every particle's family reproduce the continuum, at surfaces too, which a surface correction would count twice: use surface: none, or model.calibration: continuum to keep this correction (the papers' calibration)");
+  PeriInputCheck(sc == PERI_SURFACE_NONE || sys->model->calibration == PERI_CALIBRATION_CONTINUUM, s, c, "surface", "the lattice calibration (model.calibration; the default of pds, mppd and gerstle) makes every particle's family reproduce the continuum, at surfaces too, which a surface correction would count twice: use surface: none, or model.calibration: continuum to keep this correction (the papers' calibration)");
   PeriInputCheck(sc == PERI_SURFACE_NONE || sys->model->allows_surface_correction, s, c, "surface", "model %s normalizes each particle's micromodulus by its own family volume, which already corrects surfaces: use surface: none", sys->model->type);
   {
     static const char *const defaults[] = {"none", "volume", NULL};
@@ -180,6 +180,7 @@ static PetscErrorCode CreateModel(PeriSystem sys)
     PetscInt kind = sys->model->calibration; /* the model's default */
     PetscCall(PeriSceneGetChoice(s, m, "calibration", PeriCalibrationKinds, &kind, NULL));
     PeriInputCheck(kind == PERI_CALIBRATION_CONTINUUM || sys->model->takes_lattice, s, m, "calibration", "model %s has no lattice calibration (pmb, npmb, cpmb, pds, mppd, gerstle and antiplane have; antiplane_os is exact for every homogeneous strain with corrections.surface: energy): use continuum", type);
+    PeriInputCheck(kind != PERI_CALIBRATION_PATCH || sys->model->central_force, s, m, "calibration", "patch corrects the springs of central-force models (pmb, npmb, cpmb); model %s has more kinds of springs: use lattice", type);
     sys->model->calibration = (PeriCalibrationKind)kind;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
