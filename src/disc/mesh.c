@@ -1,12 +1,26 @@
 /* Particles and regions from a Gmsh mesh, through Gmsh's own C API (gmshc.h): a .msh file of any
- * version Gmsh reads, or a .geo file meshed here. One particle per element of the scene's
- * dimension, at its centroid, with its exact measure; named physical groups become particle sets
- * (docs/mesh.md). Every rank reads the same file: Gmsh is not MPI-aware, and meshing on one thread
- * is deterministic, so every rank builds the same particles without a broadcast. */
+ * version Gmsh reads, or a .geo file meshed here; an Abaqus .inp or Exodus II file is converted
+ * into a temporary .msh by mesh_import.py (meshio) in a child process first, since Gmsh reads
+ * neither. One particle per element of the scene's dimension, at its centroid, with its exact
+ * measure; named physical groups become particle sets (docs/mesh.md). Rank 0 reads: Gmsh is not
+ * MPI-aware. */
 #include "perilin/private/disc.h"
 #include <gmshc.h>
 #include <unistd.h>
 #include <errno.h>
+#include <stdlib.h>
+#include <strings.h>
+
+#define PERI_MESH_TIMEOUT 600 /* seconds for meshio to convert a mesh: about 5 s per million elements */
+#ifndef PERI_MESH_PYTHON
+#  define PERI_MESH_PYTHON "python3"
+#endif
+#ifndef PERI_MESH_SCRIPT
+#  define PERI_MESH_SCRIPT ""
+#endif
+#ifndef PERI_MESH_SCRIPT_INSTALLED
+#  define PERI_MESH_SCRIPT_INSTALLED ""
+#endif
 
 static PetscBool gmsh_started = PETSC_FALSE;
 
@@ -215,9 +229,21 @@ static void ElementsFree(MeshElements *e)
   gmshFree(e->nntags);
 }
 
-/* The mesh file's path (absolute, or relative to the scene file's folder), whether it is a .geo
- * and the characteristic length a .geo needs. */
-static PetscErrorCode MeshSource(PeriScene scene, PeriNode node, char path[], size_t size, PetscBool *geo, PetscReal *lc)
+/* The format of a mesh Gmsh does not read, by its extension (any case), or NULL: Gmsh 4.8 writes
+ * Abaqus .inp but reads neither it nor Exodus II, so src/disc/mesh_import.py (meshio) converts them. */
+static const char *ImportedFormat(const char path[])
+{
+  static const char *const ext[] = {".inp", ".exo", ".e", ".ex2", ".exii", ".gen"};
+  const char              *dot   = strrchr(path, '.');
+
+  for (size_t k = 0; dot && k < sizeof(ext) / sizeof(ext[0]); k++)
+    if (!strcasecmp(dot, ext[k])) return k ? "Exodus II" : "Abaqus";
+  return NULL;
+}
+
+/* The mesh file's path (absolute, or relative to the scene file's folder), whether it is a .geo,
+ * the characteristic length a .geo needs, and the format of a file to convert first (or NULL). */
+static PetscErrorCode MeshSource(PeriScene scene, PeriNode node, char path[], size_t size, PetscBool *geo, PetscReal *lc, const char **format)
 {
   size_t    len;
   PetscBool has;
@@ -226,29 +252,68 @@ static PetscErrorCode MeshSource(PeriScene scene, PeriNode node, char path[], si
   PetscCall(PeriSceneGetPath(scene, node, "mesh", PETSC_TRUE, path, size, NULL));
   PeriInputCheck(access(path, R_OK) == 0, scene, node, "mesh", "cannot read %s: %s", path, strerror(errno));
   PetscCall(PetscStrlen(path, &len));
-  *geo = len > 4 && !strcmp(path + len - 4, ".geo") ? PETSC_TRUE : PETSC_FALSE;
-  *lc  = 0;
+  *geo    = len > 4 && !strcmp(path + len - 4, ".geo") ? PETSC_TRUE : PETSC_FALSE;
+  *format = ImportedFormat(path);
+  *lc     = 0;
   PetscCall(PeriSceneGetReal(scene, node, "size", PETSC_FALSE, lc, &has));
   PeriInputCheck(!*geo || has, scene, node, "mesh", "%s is a .geo file: give particles.size, the characteristic length Gmsh meshes it with", path);
   PeriInputCheck(*geo || !has, scene, node, "size", "applies to a .geo file only; %s is a mesh already", path);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Opens the file in Gmsh, meshing a .geo in the scene's dimension with the largest element size lc,
- * and checks that the mesh's highest element dimension is the scene's. */
-static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[], PetscBool geo, PetscReal lc, PetscInt dim)
+/* Removes the conversion's scratch directory and what it holds (the .msh and the child's log). */
+static void ImportRemove(const char dir[], const char msh[], const char log[])
 {
-  char      msg[256];
+  (void)unlink(msh);
+  (void)unlink(log);
+  (void)rmdir(dir);
+}
+
+/* Converts an Abaqus or Exodus mesh into dir/mesh.msh (dir: a new scratch directory under $TMPDIR or
+ * /tmp) with meshio in a child process. A failed conversion is an input error quoting the child's
+ * last line (meshio's message, or that meshio is missing) and leaves nothing behind. */
+static PetscErrorCode MeshImport(PeriScene scene, PeriNode node, const char path[], const char format[], char dir[], size_t dsize, char msh[], size_t msize)
+{
+  const char *script = PeriChildScript("PERILIN_MESH_SCRIPT", PERI_MESH_SCRIPT, PERI_MESH_SCRIPT_INSTALLED), *tmp = getenv("TMPDIR");
+  char        log[PETSC_MAX_PATH_LEN], reason[512]                                                                = "";
+  char       *argv[5];
+  int         failed;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(script, scene, node, "mesh", "%s is an %s mesh, converted by mesh_import.py, which is neither at %s nor at %s (set PERILIN_MESH_SCRIPT)", path, format, PERI_MESH_SCRIPT, PERI_MESH_SCRIPT_INSTALLED);
+  PetscCall(PetscSNPrintf(dir, dsize, "%s/perilin-mesh-XXXXXX", tmp && tmp[0] ? tmp : "/tmp"));
+  PetscCheck(mkdtemp(dir), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot create a scratch directory %s to convert %s: %s", dir, path, strerror(errno));
+  PetscCall(PetscSNPrintf(msh, msize, "%s/mesh.msh", dir));
+  PetscCall(PetscSNPrintf(log, sizeof(log), "%s/log", dir));
+  argv[0] = (char *)PeriChildPython(PERI_MESH_PYTHON);
+  argv[1] = (char *)script;
+  argv[2] = (char *)path;
+  argv[3] = msh;
+  argv[4] = NULL;
+  failed  = PeriChildRun(argv, log, PERI_MESH_TIMEOUT, reason, sizeof(reason));
+  if (failed) ImportRemove(dir, msh, log);
+  PeriInputCheck(!failed, scene, node, "mesh", "cannot read the %s mesh %s: %s", format, path, reason);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Opens the file (path, or the conversion of path in dir/mesh.msh, which is removed once read) in
+ * Gmsh, meshing a .geo in the scene's dimension with the largest element size lc, and checks that
+ * the mesh's highest element dimension is the scene's. */
+static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[], const char dir[], const char msh[], PetscBool geo, PetscReal lc, PetscInt dim)
+{
+  char      msg[256], log[PETSC_MAX_PATH_LEN];
   int       ierr = 0, *types;
   size_t    ntypes;
   PetscInt  top = -1, ed, ec;
-  PetscBool simplex, verbose;
+  PetscBool simplex;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetBool(scene, node, "verbose", &verbose, NULL));
-  PetscCall(GmshStart(verbose));
-  gmshOpen(path, &ierr);
+  gmshOpen(dir[0] ? msh : path, &ierr);
   if (ierr) GmshLastError(msg, sizeof(msg));
+  if (dir[0]) {
+    PetscCall(PetscSNPrintf(log, sizeof(log), "%s/log", dir));
+    ImportRemove(dir, msh, log);
+  }
   PeriInputCheck(!ierr, scene, node, "mesh", "Gmsh cannot read %s: %s", path, msg);
   if (geo) {
     gmshOptionSetNumber("Mesh.MeshSizeMax", lc, &ierr);
@@ -446,17 +511,21 @@ static PetscErrorCode MeshGroups(PeriScene scene, PeriNode node, const char path
 @*/
 PetscErrorCode PeriMeshRead(PeriScene scene, PeriNode node, PetscInt dim, PetscReal thickness, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt *ngroups, PeriMeshGroup **groups)
 {
-  char      path[PETSC_MAX_PATH_LEN];
-  PetscBool geo = PETSC_FALSE;
-  PetscReal lc  = 0;
-  MeshNodes nodes;
-  PetscInt *elem;
-  size_t    maxelem;
-  int       ierr = 0;
+  char        path[PETSC_MAX_PATH_LEN], dir[PETSC_MAX_PATH_LEN] = "", msh[PETSC_MAX_PATH_LEN] = "";
+  PetscBool   geo = PETSC_FALSE, verbose;
+  PetscReal   lc  = 0;
+  MeshNodes   nodes;
+  PetscInt   *elem;
+  size_t      maxelem;
+  int         ierr   = 0;
+  const char *format = NULL;
 
   PetscFunctionBeginUser;
-  PetscCall(MeshSource(scene, node, path, sizeof(path), &geo, &lc));
-  PetscCall(MeshOpen(scene, node, path, geo, lc, dim));
+  PetscCall(MeshSource(scene, node, path, sizeof(path), &geo, &lc, &format));
+  PetscCall(PeriSceneGetBool(scene, node, "verbose", &verbose, NULL));
+  PetscCall(GmshStart(verbose));
+  if (format) PetscCall(MeshImport(scene, node, path, format, dir, sizeof(dir), msh, sizeof(msh)));
+  PetscCall(MeshOpen(scene, node, path, dir, msh, geo, lc, dim));
   PetscCall(NodesGet(&nodes));
   PetscCall(MeshParticles(scene, node, path, &nodes, dim, thickness, n, x, vol, &elem, &maxelem));
   PetscCall(MeshGroups(scene, node, path, &nodes, dim, thickness, elem, *n, *x, ngroups, groups));

@@ -23,7 +23,7 @@ static const PeriKey grid_keys[] = {
 };
 static const PeriKey particles_keys[] = {
     {"file", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid; give file or mesh"},
-    {"mesh", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "Gmsh mesh (.msh, any version Gmsh reads) or geometry (.geo, meshed with size), relative to the scene file: one particle per element of dimension dim, named physical groups as regions (docs/mesh.md)"},
+    {"mesh", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "Gmsh mesh (.msh, any version Gmsh reads), geometry (.geo, meshed with size), Abaqus .inp or Exodus II (.exo, .e: converted with meshio), relative to the scene file: one particle per element of dimension dim, named physical groups, element and node sets and Exodus blocks as regions (docs/mesh.md)"},
     {"size", PERI_KEY_REAL, "required for a .geo", "(0, inf)", "[length]", NULL, "the largest element size Gmsh meshes a .geo with (Mesh.MeshSizeMax; smaller sizes in the .geo still refine)"},
     {"verbose", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "let Gmsh print its messages while it reads or meshes particles.mesh"},
     {NULL},

@@ -9,20 +9,13 @@
  * failed run: the physics outputs stay as they are (docs/build.md, "Pictures"). Rank 0 draws. */
 #define _GNU_SOURCE
 #include "perilin/private/output.h"
+#include "perilin/private/sys.h"
 
 #include <dirent.h>
 #include <errno.h>
-#include <fcntl.h>
-#include <signal.h>
-#include <spawn.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
-#include <time.h>
-#include <unistd.h>
-
-extern char **environ;
 
 #define PERI_PLOTS_TIMEOUT 60 /* seconds: matplotlib draws any of them in about one */
 #ifndef PERI_PLOTS_PYTHON
@@ -34,75 +27,6 @@ extern char **environ;
 #ifndef PERI_PLOTS_SCRIPT_INSTALLED
 #  define PERI_PLOTS_SCRIPT_INSTALLED ""
 #endif
-
-/* The script: $PERILIN_PLOTS_SCRIPT, else the source tree's (a build), else the installed copy. */
-static const char *Script(void)
-{
-  const char *env = getenv("PERILIN_PLOTS_SCRIPT");
-
-  if (env && env[0]) return env;
-  if (PERI_PLOTS_SCRIPT[0] && access(PERI_PLOTS_SCRIPT, R_OK) == 0) return PERI_PLOTS_SCRIPT;
-  if (PERI_PLOTS_SCRIPT_INSTALLED[0] && access(PERI_PLOTS_SCRIPT_INSTALLED, R_OK) == 0) return PERI_PLOTS_SCRIPT_INSTALLED;
-  return NULL;
-}
-
-/* The interpreter: $PERILIN_PYTHON, else the one CMake found able to import matplotlib (the first
- * python3 on PATH may be a pyenv or venv without it). */
-static const char *Python(void)
-{
-  const char *env = getenv("PERILIN_PYTHON");
-
-  return env && env[0] ? env : PERI_PLOTS_PYTHON;
-}
-
-/* The last non-empty line of the child's log, as the reason it failed. */
-static void LastLine(const char log[], char reason[], size_t len)
-{
-  char  line[512];
-  FILE *fp = fopen(log, "r");
-
-  if (!fp) return;
-  while (fgets(line, sizeof(line), fp)) {
-    line[strcspn(line, "\n")] = 0;
-    if (line[0]) snprintf(reason, len, "%s", line);
-  }
-  fclose(fp);
-}
-
-/* Runs argv with stdout and stderr into log; 0 when it exited 0 within the timeout, else reason. */
-static int RunChild(char *const argv[], const char log[], char reason[], size_t len)
-{
-  posix_spawn_file_actions_t fa;
-  pid_t                      pid;
-  int                        status = 0, err;
-  const struct timespec      tick   = {0, 20000000};
-
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 1, log, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  err = posix_spawnp(&pid, argv[0], &fa, NULL, argv, environ);
-  posix_spawn_file_actions_destroy(&fa);
-  if (err) {
-    snprintf(reason, len, "cannot run %s: %s", argv[0], strerror(err));
-    return 1;
-  }
-  for (int t = 0; t < PERI_PLOTS_TIMEOUT * 50; t++) {
-    pid_t w = waitpid(pid, &status, WNOHANG);
-    if (w == pid) {
-      if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return 0;
-      snprintf(reason, len, "%s %s", argv[1], WIFEXITED(status) ? "failed" : "was killed by a signal");
-      LastLine(log, reason, len);
-      return 1;
-    }
-    if (w < 0 && errno != EINTR) break;
-    nanosleep(&tick, NULL);
-  }
-  kill(pid, SIGKILL);
-  (void)waitpid(pid, &status, 0);
-  snprintf(reason, len, "%s took more than %d s and was stopped", argv[1], PERI_PLOTS_TIMEOUT);
-  return 1;
-}
 
 /* Moves every PNG of scratch into dir, in name order, and lists them in pl->files. */
 static PetscErrorCode CommitPictures(const char scratch[], const char dir[], PeriPlots *pl)
@@ -136,7 +60,7 @@ static PetscErrorCode Draw(const char dir[], const char kind[], const char *cons
   char        scratch[PETSC_MAX_PATH_LEN], log[PETSC_MAX_PATH_LEN + 8];
   char       *argv[32];
   PetscInt    n      = 0;
-  const char *script = Script();
+  const char *script = PeriChildScript("PERILIN_PLOTS_SCRIPT", PERI_PLOTS_SCRIPT, PERI_PLOTS_SCRIPT_INSTALLED);
 
   PetscFunctionBeginUser;
   if (!script) {
@@ -146,14 +70,14 @@ static PetscErrorCode Draw(const char dir[], const char kind[], const char *cons
   PetscCall(PetscSNPrintf(scratch, sizeof(scratch), "%s/plots.tmp", dir));
   PetscCheck(mkdir(scratch, 0755) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot create %s: %s", scratch, strerror(errno));
   PetscCall(PetscSNPrintf(log, sizeof(log), "%s/log", scratch));
-  argv[n++] = (char *)Python();
+  argv[n++] = (char *)PeriChildPython(PERI_PLOTS_PYTHON);
   argv[n++] = (char *)script;
   argv[n++] = (char *)kind;
   argv[n++] = (char *)dir;
   argv[n++] = scratch;
   for (PetscInt k = 0; args && args[k] && n < 31; k++) argv[n++] = (char *)args[k];
   argv[n] = NULL;
-  if (!RunChild(argv, log, pl->error, sizeof(pl->error))) PetscCall(CommitPictures(scratch, dir, pl));
+  if (!PeriChildRun(argv, log, PERI_PLOTS_TIMEOUT, pl->error, sizeof(pl->error))) PetscCall(CommitPictures(scratch, dir, pl));
   (void)PeriOutputRemoveTree(scratch);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

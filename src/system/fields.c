@@ -10,7 +10,7 @@ static PetscBool LexLess(const PetscReal a[], const PetscReal b[])
 
 /* probes: any names, each a point. */
 static const PeriKey probe_keys[] = {
-    {"<name>", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a point [x, y(, z)] inside the body: the displacement and energy density of the nearest particle"},
+    {"<name>", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a point [x, y(, z)] inside the body: the displacement and energy density of the nearest particle (beyond its cell but within the horizon: taken there with a note; farther: an error)"},
     {NULL},
 };
 const PeriSchema PeriProbesSchema[] = {{"probes", probe_keys}, {NULL}};
@@ -36,28 +36,62 @@ static PetscInt NearestOwned(PeriSystem sys, const PetscReal y[], PetscReal *bes
 }
 
 /* The probe's nearest particle over all ranks: each rank offers its nearest owned one (squared
- * distance, position, spacing), the best offer wins. Collective. */
-static PetscErrorCode ProbeLocate(PeriSystem sys, PeriProbe *pr, PetscReal *dist, PetscReal *spacing)
+ * distance, position, spacing, horizon), the best offer wins. Collective. */
+static PetscErrorCode ProbeLocate(PeriSystem sys, PeriProbe *pr, PetscReal *dist, PetscReal *spacing, PetscReal *delta)
 {
   const PeriParticles *pt = &sys->disc.particles;
-  PetscReal            mine[5], *all;
+  PetscReal            mine[6], *all;
   PetscInt             p = NearestOwned(sys, pr->x, &mine[0]);
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) mine[1 + d] = p >= 0 ? pt->x[3 * p + d] : 0;
   mine[4] = p >= 0 ? pt->spacing[p] : 0;
-  PetscCall(PetscMalloc1(5 * sys->size, &all));
-  PetscCallMPI(MPI_Allgather(mine, 5, MPIU_REAL, all, 5, MPIU_REAL, sys->comm));
+  mine[5] = p >= 0 && sys->disc.horizon ? sys->disc.horizon[p] : sys->disc.delta;
+  PetscCall(PetscMalloc1(6 * sys->size, &all));
+  PetscCallMPI(MPI_Allgather(mine, 6, MPIU_REAL, all, 6, MPIU_REAL, sys->comm));
   pr->rank = 0;
   for (PetscMPIInt r = 1; r < sys->size; r++) {
-    const PetscReal *o = &all[5 * r], *b = &all[5 * pr->rank];
+    const PetscReal *o = &all[6 * r], *b = &all[6 * pr->rank];
     if (o[0] < b[0] || (o[0] == b[0] && o[0] < PETSC_MAX_REAL && LexLess(&o[1], &b[1]))) pr->rank = r;
   }
   pr->particle = pr->rank == sys->rank ? p : -1;
-  for (PetscInt d = 0; d < 3; d++) pr->particle_x[d] = all[5 * pr->rank + 1 + d];
-  *dist    = PetscSqrtReal(all[5 * pr->rank]);
-  *spacing = all[5 * pr->rank + 4];
+  for (PetscInt d = 0; d < 3; d++) pr->particle_x[d] = all[6 * pr->rank + 1 + d];
+  *dist    = PetscSqrtReal(all[6 * pr->rank]);
+  *spacing = all[6 * pr->rank + 4];
+  *delta   = all[6 * pr->rank + 5];
   PetscCall(PetscFree(all));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* "(x, y)" or "(x, y, z)", for messages. */
+static PetscErrorCode PointString(PetscInt dim, const PetscReal x[], char s[], size_t len)
+{
+  PetscFunctionBeginUser;
+  if (dim == 3)
+    (void)snprintf(s, len, "(%g, %g, %g)", (double)x[0], (double)x[1], (double)x[2]);
+  else
+    (void)snprintf(s, len, "(%g, %g)", (double)x[0], (double)x[1]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A point within the nearest particle's cell (its circumscribed ball, radius sqrt(dim) h / 2) is
+ * that particle's. A mesh's cells are not balls: a point inside the body near an element's corner,
+ * or in an element beside a hole whose centroid is farther, can lie beyond it. Such a point, still
+ * within the particle's horizon, is taken at the nearest particle with a note (summary.json:
+ * snapped, distance); only a point farther than the horizon from every particle is outside. */
+static PetscErrorCode ProbeCheckInside(PeriSystem sys, PeriNode map, PeriProbe *pr, PetscReal dist, PetscReal h, PetscReal delta)
+{
+  const PetscInt dim = sys->disc.particles.dim;
+  char           at[96], used[96];
+
+  PetscFunctionBeginUser;
+  PetscCall(PointString(dim, pr->x, at, sizeof(at)));
+  PetscCall(PointString(dim, pr->particle_x, used, sizeof(used)));
+  PeriInputCheck(dist <= delta * (1 + 1e-9), sys->scene, map, pr->name, "the point lies outside the body: the nearest particle to %s, at %s, is %g away, farther than the horizon %g (a point within the horizon of a particle is taken at the nearest one, with a note)", at, used, (double)dist, (double)delta);
+  pr->snapped  = dist > 0.5 * PetscSqrtReal((PetscReal)dim) * h * (1 + 1e-9) ? PETSC_TRUE : PETSC_FALSE;
+  pr->distance = dist;
+  if (pr->snapped)
+    PetscCall(PetscPrintf(sys->comm, "perilin: note: probe '%s' %s lies %g from the nearest particle, outside its cell (spacing %g) but within the horizon %g: it samples the particle at %s\n", pr->name, at, (double)dist, (double)h, (double)delta, used));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -74,13 +108,12 @@ PetscErrorCode PeriReadProbes(PeriSystem sys)
   PetscCall(PetscCalloc1(map->n, &sys->fields.probes));
   for (PetscInt k = 0; k < map->n; k++) {
     PeriProbe *pr   = &sys->fields.probes[k];
-    PetscReal  dist = 0, h = 0;
+    PetscReal  dist = 0, h = 0, delta = 0;
     PetscInt   n;
     PetscCall(PetscStrncpy(pr->name, map->child[k]->key, sizeof(pr->name)));
     PetscCall(PeriSceneGetRealArray(s, map, map->child[k]->key, PETSC_TRUE, dim, dim, pr->x, &n));
-    PetscCall(ProbeLocate(sys, pr, &dist, &h));
-    /* inside the body: within the nearest particle's cell (its circumscribed ball) */
-    PeriInputCheck(dist <= 0.5 * PetscSqrtReal((PetscReal)dim) * h * (1 + 1e-9), s, map, map->child[k]->key, "the point lies outside the body (nearest particle at distance %g)", (double)dist);
+    PetscCall(ProbeLocate(sys, pr, &dist, &h, &delta));
+    PetscCall(ProbeCheckInside(sys, map, pr, dist, h, delta));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -349,6 +382,10 @@ PetscErrorCode PeriProbesSummary(PeriSystem sys, PeriJSON j)
     PetscCall(PeriJSONRealArray(j, "x", sys->disc.particles.dim, pr->x));
     PetscCall(PeriJSONRealArray(j, "particle_x", sys->disc.particles.dim, pr->particle_x));
     PetscCall(PeriJSONString(j, "sampling", "nearest particle"));
+    if (pr->snapped) {
+      PetscCall(PeriJSONBool(j, "snapped", PETSC_TRUE));
+      PetscCall(PeriJSONReal(j, "distance", pr->distance));
+    }
     PetscCall(PeriJSONRealArray(j, "u", sys->model->dofs, pr->u));
     PetscCall(PeriJSONReal(j, "W", pr->W));
     if (sys->fields.stress) {

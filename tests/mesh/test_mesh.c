@@ -6,7 +6,13 @@
  *     (bond-based): the least-squares slopes of ux along x and of uy along y over the particles one
  *     horizon inside the body match s/E and -nu s/E within TOL (relative). On this unstructured mesh
  *     (size 0.025, m = 3) npmb gives -2.8 % (xx) and +5.1 % (yy), pmb with the volume correction
- *     -6.4 % (xx): the PD discretization error of irregular particles, not exactness. */
+ *     -6.4 % (xx): the PD discretization error of irregular particles, not exactness.
+ *   test_mesh same SCENE MSH OTHER [ALIAS=GROUP ...]: SCENE read with particles.mesh MSH (a Gmsh
+ *     mesh) and with OTHER (the same mesh as Abaqus .inp or Exodus, tests/mesh/make_imports.sh) gives
+ *     the same particles (each of one matched to one of the other within 1e-9 of the body's size,
+ *     with the same volume to 1e-9) and every group of MSH the same particles (count, volume, face
+ *     area to 1e-9) under its name in OTHER; ALIAS=GROUP: OTHER's ALIAS also equals MSH's GROUP. One
+ *     rank (the reader is rank 0's). */
 #include "testing.h"
 #include <gmshc.h>
 
@@ -95,11 +101,98 @@ static PetscErrorCode TestUniform(const char scene[], PetscReal tol)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The particles of SCENE read with -particles_mesh mesh: on one rank, the problem itself. */
+static PetscErrorCode ReadWith(const char scene[], const char mesh[], PeriProblem *p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsSetValue(NULL, "-particles_mesh", mesh));
+  PetscCall(PeriTestRunScene(PETSC_COMM_SELF, scene, p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Every particle of a matched to a distinct one of b at the same place, with the same volume. */
+static PetscErrorCode SameParticles(const PeriParticles *a, const PeriParticles *b, PetscReal size)
+{
+  PetscBool *used;
+  PetscInt   matched = 0;
+
+  PetscFunctionBeginUser;
+  PeriTestClose("particles", (PetscReal)b->n, (PetscReal)a->n, 0);
+  PetscCall(PetscCalloc1(b->n, &used));
+  for (PetscInt i = 0; i < a->n; i++) {
+    PetscInt  best = -1;
+    PetscReal d2, bd = PETSC_MAX_REAL;
+    for (PetscInt j = 0; j < b->n; j++) {
+      d2 = 0;
+      for (PetscInt d = 0; d < 3; d++) d2 += PetscSqr(a->x[3 * i + d] - b->x[3 * j + d]);
+      if (d2 < bd) bd = d2, best = j;
+    }
+    if (best >= 0 && !used[best] && PetscSqrtReal(bd) <= 1e-9 * size && PetscAbsReal(a->volume[i] - b->volume[best]) <= 1e-9 * a->volume[i]) {
+      used[best] = PETSC_TRUE;
+      matched++;
+    }
+  }
+  PeriTestClose("particles at the same place with the same volume", (PetscReal)matched, (PetscReal)a->n, 0);
+  PetscCall(PetscFree(used));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static const PeriRegion *FindRegion(PeriProblem p, const char name[])
+{
+  for (PetscInt k = 0; k < p->sys->disc.nregions; k++)
+    if (!strcmp(p->sys->disc.regions[k].name, name)) return &p->sys->disc.regions[k];
+  return NULL;
+}
+
+/* OTHER's group name holds what MSH's group ref does. */
+static PetscErrorCode SameGroup(PeriProblem a, PeriProblem b, const char ref[], const char name[])
+{
+  const PeriRegion *ra = FindRegion(a, ref), *rb = FindRegion(b, name);
+  char              what[128];
+
+  PetscFunctionBeginUser;
+  PetscCheck(ra && rb, PETSC_COMM_SELF, PETSC_ERR_PLIB, "FAIL: group '%s' is missing", ra ? name : ref);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "group '%s' (as '%s'): particles", name, ref));
+  PeriTestClose(what, (PetscReal)rb->count, (PetscReal)ra->count, 0);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "group '%s' (as '%s'): volume", name, ref));
+  PeriTestClose(what, rb->volume, ra->volume, 1e-9 * ra->volume);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "group '%s' (as '%s'): face area", name, ref));
+  PeriTestClose(what, rb->face_area, ra->face_area, 1e-9 * PetscMax(ra->face_area, 1e-300));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode TestSame(const char scene[], const char msh[], const char other[], PetscInt nalias, char **alias)
+{
+  PeriProblem    a, b;
+  PeriParticles *pa;
+  PetscReal      size = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReadWith(scene, msh, &a));
+  PetscCall(ReadWith(scene, other, &b));
+  pa = &a->sys->disc.particles;
+  for (PetscInt d = 0; d < 3; d++) size = PetscMax(size, pa->upper[d] - pa->lower[d]);
+  PetscCall(SameParticles(pa, &b->sys->disc.particles, size));
+  for (PetscInt g = 0; g < pa->ngroups; g++) PetscCall(SameGroup(a, b, pa->groups[g].name, pa->groups[g].name));
+  for (PetscInt k = 0; k < nalias; k++) {
+    char *eq = strchr(alias[k], '=');
+    PetscCheck(eq, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "ALIAS=GROUP expected, not %s", alias[k]);
+    *eq = 0;
+    PetscCall(SameGroup(a, b, eq + 1, alias[k]));
+  }
+  PetscCall(PeriProblemDestroy(&a));
+  PetscCall(PeriProblemDestroy(&b));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 int main(int argc, char **argv)
 {
   PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 4, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_mesh read SCENE MESH VOLUME FACE | uniform SCENE TOL");
-  if (!strcmp(argv[1], "read")) {
+  if (!strcmp(argv[1], "same")) {
+    PetscCheck(argc >= 5, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_mesh same SCENE MSH OTHER [ALIAS=GROUP ...]");
+    PetscCall(TestSame(argv[2], argv[3], argv[4], argc - 5, argv + 5));
+  } else if (!strcmp(argv[1], "read")) {
     PetscCheck(argc >= 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_mesh read SCENE MESH VOLUME FACE");
     PetscCall(TestRead(argv[2], argv[3], atof(argv[4]), atof(argv[5])));
   } else {

@@ -15,6 +15,8 @@ typedef struct {
   PetscMPIInt rank;          /* the rank owning the nearest particle */
   PetscInt    particle;      /* its local index on that rank (-1 on the others) */
   PetscReal   particle_x[3]; /* its position */
+  PetscBool   snapped;       /* x lies outside that particle's cell, within its horizon */
+  PetscReal   distance;      /* |x - particle_x| */
   /* after a solve, on every rank: */
   PetscReal u[PERI_MAX_DOF];
   PetscReal W;

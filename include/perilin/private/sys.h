@@ -39,3 +39,8 @@ PETSC_EXTERN PetscErrorCode     PeriProgressDestroy(PeriProgress *);
 /* BLAS threads (src/sys/threads.c): one outside factorizations, the library's own around them. */
 PETSC_EXTERN PetscErrorCode PeriBLASThreadsInitialize(void);
 PETSC_EXTERN PetscErrorCode PeriBLASThreads(PetscBool);
+
+/* Python helpers in child processes (src/sys/child.c): plots, mesh conversion. */
+PETSC_EXTERN const char *PeriChildScript(const char[], const char[], const char[]);
+PETSC_EXTERN const char *PeriChildPython(const char[]);
+PETSC_EXTERN int         PeriChildRun(char *const[], const char[], int, char[], size_t);
