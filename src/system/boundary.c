@@ -64,7 +64,7 @@ const PeriSchema PeriBoundarySchema[] = {
 };
 
 /* {A: [[..], ..], b: [..]}, the mapping of section: a field A X + b with dim rows (b optional). */
-static PetscErrorCode ParseAffine(PeriSystem sys, PeriNode node, const char section[], PetscReal A[3][3], PetscReal b[3])
+PetscErrorCode PeriBoundaryParseAffine(PeriSystem sys, PeriNode node, const char section[], PetscReal A[3][3], PetscReal b[3])
 {
   PeriScene      s   = sys->scene;
   const PetscInt dim = sys->disc.particles.dim;
@@ -126,7 +126,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
       use[c] = PETSC_TRUE;
     }
   } else {
-    PetscCall(ParseAffine(sys, aff, "bc.<k>.affine", A, b0));
+    PetscCall(PeriBoundaryParseAffine(sys, aff, "bc.<k>.affine", A, b0));
     for (PetscInt a = 0; a < dim; a++) {
       PetscCall(AxisComponent(m, a, &axis_comp[a]));
       PeriInputCheck(axis_comp[a] >= 0, s, aff, NULL, "model %s has no displacement along axis %c", m->type, (char)('x' + a));
@@ -223,7 +223,7 @@ static PetscErrorCode AddLoad(PeriSystem sys, PeriNode item, PetscScalar *a)
   PeriInputCheck(!amp || sys->stiffness.needs.transient, s, item, "amplitude", "only a transient analysis (analysis.type: dynamic) has time");
   PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) + (field ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force, traction_field");
   if (field)
-    PetscCall(ParseAffine(sys, field, "loads.<k>.traction_field", A, F));
+    PetscCall(PeriBoundaryParseAffine(sys, field, "loads.<k>.traction_field", A, F));
   else
     PetscCall(PeriSceneGetRealArray(s, item, force ? "force" : traction ? "traction"
                                                                         : "body_force",

@@ -99,6 +99,7 @@ PETSC_EXTERN PetscReal      PeriAmplitudeValue(const PeriAmplitude *, PetscReal)
 PETSC_EXTERN PetscErrorCode PeriAmplitudeDestroy(PeriAmplitude *);
 
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriBoundaryParseAffine(PeriSystem, PeriNode, const char[], PetscReal[3][3], PetscReal[3]);
 PETSC_EXTERN PetscErrorCode PeriLoadsAssemble(PeriSystem, Vec);
 PETSC_EXTERN PetscErrorCode PeriLoadAssemble(PeriSystem, PetscInt, Vec);
 PETSC_EXTERN PetscErrorCode PeriReactionsSetUp(PeriSystem);
