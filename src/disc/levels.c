@@ -36,7 +36,21 @@ static void CellCoords(const SparseCells *sc, PetscInt dim, const PetscReal x[],
   for (PetscInt d = 0; d < 3; d++) c[d] = d < dim ? PetscMin((PetscInt)PetscFloorReal((x[d] - sc->lower[d]) / sc->size), sc->ncell[d] - 1) : 0;
 }
 
-/* The sparse cells of size over the m particles list[] of p, lower..upper their box. */
+typedef struct {
+  PetscReal key;
+  PetscInt  item;
+} KeyItem;
+
+/* by cell, then by particle: the order is the same on every run */
+static int CompareKeyItem(const void *a, const void *b)
+{
+  const KeyItem *x = (const KeyItem *)a, *y = (const KeyItem *)b;
+  if (x->key != y->key) return x->key < y->key ? -1 : 1;
+  return (x->item > y->item) - (x->item < y->item);
+}
+
+/* The sparse cells of size over the m particles list[] of p, lower..upper their box (libc's qsort:
+ * PETSc's quicksort slows to a crawl on the many equal keys of a cell). */
 static PetscErrorCode SparseCellsCreate(const PeriParticles *p, const PetscReal lower[], const PetscReal upper[], PetscReal size, PetscInt m, const PetscInt list[], SparseCells *sc)
 {
   PetscReal *key, total = 1;
@@ -50,13 +64,22 @@ static PetscErrorCode SparseCellsCreate(const PeriParticles *p, const PetscReal 
   }
   PetscCheck(total < 4e15, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "the body spans %g cells of its smallest horizon: too many to number exactly; is a particle's spacing or a coordinate wrong?", (double)total);
   PetscCall(PetscMalloc3(m, &key, m, &sc->item, m + 1, &sc->start));
-  for (PetscInt s = 0; s < m; s++) {
-    PetscInt c[3];
-    CellCoords(sc, p->dim, &p->x[3 * list[s]], c);
-    key[s]      = CellKey(sc, c);
-    sc->item[s] = list[s];
+  {
+    KeyItem *ki;
+    PetscCall(PetscMalloc1(m, &ki));
+    for (PetscInt s = 0; s < m; s++) {
+      PetscInt c[3];
+      CellCoords(sc, p->dim, &p->x[3 * list[s]], c);
+      ki[s].key  = CellKey(sc, c);
+      ki[s].item = list[s];
+    }
+    if (m) qsort(ki, (size_t)m, sizeof(*ki), CompareKeyItem);
+    for (PetscInt s = 0; s < m; s++) {
+      key[s]      = ki[s].key;
+      sc->item[s] = ki[s].item;
+    }
+    PetscCall(PetscFree(ki));
   }
-  PetscCall(PetscSortRealWithArrayInt(m, key, sc->item));
   sc->nkeys = 0;
   for (PetscInt s = 0; s < m; s++)
     if (!s || key[s] != key[s - 1]) {
@@ -75,47 +98,63 @@ static PetscErrorCode SparseCellsDestroy(SparseCells *sc)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Appends the bonds of i with the particles of sc within LEVELS_REACH cells (with j of a larger
- * global index when half). */
-static PetscErrorCode CellsBonds(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, const SparseCells *sc, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
+/* The first occupied cell of sc whose key is at least k. */
+static PetscInt LowerBound(const SparseCells *sc, PetscReal k)
 {
-  PetscInt ci[3], o[3], r[3];
+  PetscInt lo = 0, hi = sc->nkeys;
+  while (lo < hi) {
+    PetscInt mid = lo + (hi - lo) / 2;
+    if (sc->key[mid] < k)
+      lo = mid + 1;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* Appends the bonds of i with the particles of sc within LEVELS_REACH cells (with j of a larger
+ * global index when half). The cells of one row along x have consecutive keys: one bisection per
+ * row finds the first, and the row is walked from there. */
+static PetscErrorCode CellsBonds(const PeriParticles *p, const PetscReal horizon[], const PetscReal reach[], PeriPartialVolume pv, const SparseCells *sc, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
+{
+  PetscInt ci[3], c[3], r[3];
 
   PetscFunctionBeginUser;
   CellCoords(sc, p->dim, &p->x[3 * i], ci);
   for (PetscInt d = 0; d < 3; d++) r[d] = d < p->dim ? LEVELS_REACH : 0;
-  for (o[2] = -r[2]; o[2] <= r[2]; o[2]++)
-    for (o[1] = -r[1]; o[1] <= r[1]; o[1]++)
-      for (o[0] = -r[0]; o[0] <= r[0]; o[0]++) {
-        PetscInt c[3], loc, inside = 1;
-        for (PetscInt d = 0; d < 3; d++) {
-          c[d] = ci[d] + o[d];
-          inside &= c[d] >= 0 && c[d] < sc->ncell[d];
-        }
-        if (!inside) continue;
-        PetscCall(PetscFindReal(CellKey(sc, c), sc->nkeys, sc->key, 0.25, &loc));
-        if (loc < 0) continue;
+  for (c[2] = ci[2] - r[2]; c[2] <= ci[2] + r[2]; c[2]++)
+    for (c[1] = ci[1] - r[1]; c[1] <= ci[1] + r[1]; c[1]++) {
+      PetscInt  lo[3] = {PetscMax(ci[0] - r[0], 0), c[1], c[2]}, hi[3] = {PetscMin(ci[0] + r[0], sc->ncell[0] - 1), c[1], c[2]};
+      PetscReal khi;
+      if (c[1] < 0 || c[1] >= sc->ncell[1] || c[2] < 0 || c[2] >= sc->ncell[2]) continue;
+      khi = CellKey(sc, hi);
+      for (PetscInt loc = LowerBound(sc, CellKey(sc, lo)); loc < sc->nkeys && sc->key[loc] <= khi; loc++)
         for (PetscInt s = sc->start[loc]; s < sc->start[loc + 1]; s++) {
-          const PetscInt j = sc->item[s];
-          PetscReal      x[3];
+          const PetscInt  j = sc->item[s];
+          const PetscReal R = PetscMax(reach[i], reach[j]);
+          PetscReal       x[3];
           if (j == i || (half && PeriParticleGlobal(p, j) < PeriParticleGlobal(p, i))) continue;
           for (PetscInt d = 0; d < 3; d++) x[d] = p->x[3 * j + d] - p->x[3 * i + d];
+          if (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > R * R) continue; /* beyond both reaches: no bond */
           PetscCall(PeriBondsAdd(p, i, j, x, PetscMax(horizon[i], horizon[j]), pv, b, cap));
         }
-      }
+    }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Each particle's level by its reach, the number of levels and the smallest reach. */
-static PetscErrorCode Levels(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscInt level[], PetscInt *nl, PetscReal *rmin)
+/* Each particle's reach (its horizon plus what the partial volume adds), its level by it, the
+ * number of levels and the smallest reach. */
+static PetscErrorCode Levels(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscReal reach[], PetscInt level[], PetscInt *nl, PetscReal *rmin)
 {
   PetscFunctionBeginUser;
   *rmin = PETSC_MAX_REAL;
   *nl   = 1;
-  for (PetscInt k = 0; k < p->n; k++) *rmin = PetscMin(*rmin, PeriSearchRadius(pv, horizon[k], p->spacing[k]));
   for (PetscInt k = 0; k < p->n; k++) {
-    level[k] = (PetscInt)PetscFloorReal(PetscLog2Real(PeriSearchRadius(pv, horizon[k], p->spacing[k]) / *rmin));
-    level[k] = PetscMax(level[k], 0);
+    reach[k] = PeriSearchRadius(pv, horizon[k], p->spacing[k]);
+    *rmin    = PetscMin(*rmin, reach[k]);
+  }
+  for (PetscInt k = 0; k < p->n; k++) {
+    level[k] = PetscMax((PetscInt)PetscFloorReal(PetscLog2Real(reach[k] / *rmin)), 0);
     PetscCheck(level[k] < LEVELS_MAX, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "the horizons range over a factor above 2^%d: is a particle's volume wrong?", LEVELS_MAX);
     *nl = PetscMax(*nl, level[k] + 1);
   }
@@ -168,14 +207,14 @@ PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal 
 {
   SparseCells    cum[LEVELS_MAX], own[LEVELS_MAX];
   PetscInt      *level, nl, cap = 0;
-  PetscReal      rmin;
+  PetscReal      rmin, *reach;
   PetscErrorCode ierr = PETSC_SUCCESS;
 
   PetscFunctionBeginUser;
   PetscCheck(!p->periodic[0] && !p->periodic[1] && !p->periodic[2], PETSC_COMM_SELF, PETSC_ERR_SUP, "per-particle horizons on periodic axes are not implemented");
   PetscCall(PetscMemzero(b, sizeof(*b)));
-  PetscCall(PetscMalloc1(p->n, &level));
-  PetscCall(Levels(p, horizon, pv, level, &nl, &rmin));
+  PetscCall(PetscMalloc2(p->n, &level, p->n, &reach));
+  PetscCall(Levels(p, horizon, pv, reach, level, &nl, &rmin));
   PetscCall(LevelCells(p, level, nl, rmin, cum, own));
   b->rstart = rstart;
   b->rend   = rend;
@@ -183,15 +222,15 @@ PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal 
   b->offset[0] = 0;
   /* coincident particles are an input error: the cells are freed before it is passed on */
   for (PetscInt i = rstart; i < rend && !ierr; i++) {
-    ierr = CellsBonds(p, horizon, pv, &cum[level[i]], i, half, b, &cap);
-    for (PetscInt L = level[i] + 1; L < nl && !ierr; L++) ierr = CellsBonds(p, horizon, pv, &own[L], i, half, b, &cap);
+    ierr = CellsBonds(p, horizon, reach, pv, &cum[level[i]], i, half, b, &cap);
+    for (PetscInt L = level[i] + 1; L < nl && !ierr; L++) ierr = CellsBonds(p, horizon, reach, pv, &own[L], i, half, b, &cap);
     b->offset[i - rstart + 1] = b->nbonds;
   }
   for (PetscInt L = 0; L < nl; L++) {
     PetscCall(SparseCellsDestroy(&cum[L]));
     PetscCall(SparseCellsDestroy(&own[L]));
   }
-  PetscCall(PetscFree(level));
+  PetscCall(PetscFree2(level, reach));
   PetscCall(ierr);
   PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
   for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
