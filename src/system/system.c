@@ -336,7 +336,12 @@ static PetscErrorCode SetLocalView(PeriSystem sys)
   PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax)));
   if (sys->disc.horizon_m > 0) { /* the ghosts' too: a pair's horizon is the larger of its two */
     PetscCall(PetscMalloc1(sys->disc.particles.n, &sys->disc.horizon));
-    for (PetscInt k = 0; k < sys->disc.particles.n; k++) sys->disc.horizon[k] = sys->disc.horizon_m * sys->disc.particles.spacing[k];
+    sys->disc.horizon_min = PETSC_MAX_REAL;
+    for (PetscInt k = 0; k < sys->disc.particles.n; k++) {
+      sys->disc.horizon[k]  = sys->disc.horizon_m * sys->disc.particles.spacing[k];
+      sys->disc.horizon_min = PetscMin(sys->disc.horizon_min, sys->disc.horizon[k]);
+    }
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sys->disc.horizon_min, 1, MPIU_REAL, MPI_MIN, sys->comm));
     sys->model->horizon = sys->disc.horizon;
   }
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -28,6 +28,7 @@ PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
   PetscCall(PeriJSONInt(j, "ranks", sys->size));
   PetscCall(PeriJSONInt(j, "edge_cut", sys->run.log.edge_cut));
   PetscCall(PeriJSONReal(j, "horizon", sys->disc.delta));
+  if (sys->disc.horizon) PetscCall(PeriJSONReal(j, "horizon_min", sys->disc.horizon_min)); /* horizon.spacing: own: "horizon" is the largest */
   PetscCall(PeriJSONString(j, "partial_volume", PeriPartialVolumes[sys->disc.partial_volume]));
   PetscCall(PeriJSONString(j, "surface_correction", PeriSurfaceCorrections[sys->disc.surface]));
   PetscCall(PeriJSONBeginObject(j, "material"));

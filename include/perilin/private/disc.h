@@ -165,9 +165,10 @@ typedef struct {
   PeriHalo              halo;      /* the ghosts and the SF that refreshes them */
   PetscInt              nregions;
   PeriRegion           *regions;
-  PetscReal             delta;     /* the horizon: the body's one, or the largest of horizon[] */
-  PetscReal             horizon_m; /* horizon.spacing: own: delta_i = m h_i; 0: one delta */
-  PetscReal            *horizon;   /* horizon.spacing: own: each local particle's delta_i; else NULL */
+  PetscReal             delta;       /* the horizon: the body's one, or the largest of horizon[] */
+  PetscReal             horizon_m;   /* horizon.spacing: own: delta_i = m h_i; 0: one delta */
+  PetscReal            *horizon;     /* horizon.spacing: own: each local particle's delta_i; else NULL */
+  PetscReal             horizon_min; /* horizon.spacing: own: the smallest delta_i of the body */
   PeriPartialVolume     partial_volume;
   PeriSurfaceCorrection surface;
   PeriBonds             bonds;          /* once per pair, in the row of the smaller global index (owned rows, local j) */
