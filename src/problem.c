@@ -292,6 +292,30 @@ PetscErrorCode PeriProblemInterrupted(PeriProblem p, int *signal)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The displacements a static result is read by: the largest of each component, and the probes'
+ * (the first few; summary.json has them all). */
+#define PERI_REPORT_PROBES 6
+static PetscErrorCode ReportDisplacements(PeriProblem p)
+{
+  PeriSystem sys = p->sys;
+  PeriModel  m   = sys->model;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(p->comm, "perilin: largest displacement"));
+  for (PetscInt c = 0; c < m->dofs; c++) PetscCall(PetscPrintf(p->comm, "%s |%s| %g", c ? "," : "", m->components[c], (double)sys->fields.max_abs_u[c]));
+  PetscCall(PetscPrintf(p->comm, "\n"));
+  for (PetscInt k = 0; k < PetscMin(sys->fields.nprobes, PERI_REPORT_PROBES); k++) {
+    const PeriProbe *q     = &sys->fields.probes[k];
+    char             z[32] = "";
+    if (sys->disc.particles.dim == 3) PetscCall(PetscSNPrintf(z, sizeof(z), ", %g", (double)q->particle_x[2]));
+    PetscCall(PetscPrintf(p->comm, "perilin: probe %s at (%g, %g%s):", q->name, (double)q->particle_x[0], (double)q->particle_x[1], z));
+    for (PetscInt c = 0; c < m->dofs; c++) PetscCall(PetscPrintf(p->comm, " %s %g", m->components[c], (double)q->u[c]));
+    PetscCall(PetscPrintf(p->comm, "\n"));
+  }
+  if (sys->fields.nprobes > PERI_REPORT_PROBES) PetscCall(PetscPrintf(p->comm, "perilin: ... and %" PetscInt_FMT " more probes in summary.json\n", sys->fields.nprobes - PERI_REPORT_PROBES));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The one-paragraph report on stdout: what ran, what it cost, the main results. */
 PetscErrorCode PeriProblemReport(PeriProblem p)
 {
@@ -318,7 +342,9 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
       PetscCall(PetscPrintf(p->comm, "\n"));
     }
     if (t->active) PetscCall(PetscPrintf(p->comm, "perilin: torsion: torque %g per unit length, J = %g (solid rectangle exact %g, %+.2f %%), max shear stress %g at (%g, %g)\n", (double)t->torque, (double)t->J, (double)t->J_rectangle, 100 * (double)(t->J / t->J_rectangle - 1), (double)t->max_stress, (double)t->max_at[0], (double)t->max_at[1]));
-    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/\n", sys->fields.strain_energy, p->output_dir));
+    if (sys->fields.u_owned) PetscCall(ReportDisplacements(p));
+    PetscCall(PetscPrintf(p->comm, "perilin: strain energy %g; results in %s/: summary.json, scene.yaml%s (docs/summary.md)\n", sys->fields.strain_energy, p->output_dir, !p->vtk ? "" : p->size > 1 ? ", particles.pvtu"
+                                                                                                                                                                                                     : ", particles.vtu"));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

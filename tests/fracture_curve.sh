@@ -7,6 +7,7 @@
 #   2. edge_crack at its own spacing: bonds break in an equilibrium before the failure, and that
 #      equilibrium's particles.vtu carries them (damage > 0, read by VTK when python3-vtk9 is
 #      there); particles.pvd is written without output.every and indexes snapshots that exist;
+#      its steps.csv counts every attempt of a step in attempts and seconds (item 6);
 #   3. micropolar_shear (displacement control) goes on past the first load drop by default
 #      (runaway_fraction 1) to load_factor_max, many steps after the peak;
 #   4. docs/tools/plot_load_displacement.py writes a PNG for every quasi-static example and test
@@ -72,6 +73,45 @@ assert files[-1] == "particles.vtu" or files[-1] == "particles_%04d.vtu" % len(r
 for f in files:
     assert os.path.exists(os.path.join(out, f)), f
 print("ok: edge_crack: %d bonds broke before the last equilibrium; particles.pvd indexes %s" % (int(rows[-1]["broken_total"]), files))
+PY
+# the same run's per-step times (issue 28, item 6): every attempt of a step counts. The attempts
+# follow from the load factors alone by the halving rule of docs/failure.md (a failed trial halves
+# the step down to min_step; after an equilibrium the step is halved when more than 1 % of the
+# bonds broke, kept when some did, doubled up to load_factor_step when none did), and the rows'
+# seconds with unfinished_s (the failing step's bracketing) make up the loop's own timer, solve_s.
+"$pyany" - "$tmp/ec_fine" "$repo/examples/fracture/edge_crack.yaml" <<'PY' || bad "edge_crack's per-step times and attempts"
+import csv, json, os, sys
+out = sys.argv[1]
+d = json.load(open(os.path.join(out, "summary.json")))
+q = d["quasistatic"]
+rows = list(csv.DictReader(open(os.path.join(out, "steps.csv"))))
+step, min_step = 20.0, 0.25  # the example's load_factor_step and min_step
+
+
+def tries(dl, accepted):  # the trials from dl, halved (not below min_step) until accepted
+    n = 1
+    while dl > accepted * (1 + 1e-9):
+        dl, n = max(dl / 2, min_step), n + 1
+    return n
+
+
+dl, lam = step, 0.0
+for r in rows:
+    inc = float(r["load_factor"]) - lam
+    want = tries(dl, inc)
+    assert int(r["attempts"]) == want, ("step", r["step"], "tried", dl, "accepted", inc, r["attempts"], want)
+    broken = int(r["broken"])
+    dl = max(inc / 2, min_step) if broken > d["bonds"] / 100 else inc if broken else min(2 * inc, step)
+    lam = float(r["load_factor"])
+# the failing step: tried from dl, halved to min_step, every trial failed
+want = tries(dl, min_step)
+assert q["failed"] and q["unfinished_attempts"] == want, (q["unfinished_attempts"], want)
+assert max(int(r["attempts"]) for r in rows) > 1, "no step was retried"
+total = sum(float(r["seconds"]) for r in rows) + q["unfinished_s"]
+solve = d["timing"]["solve_s"]
+assert abs(total - solve) <= 0.02 * solve + 1e-3 * len(rows), (total, solve)
+retried = sum(float(r["seconds"]) for r in rows if int(r["attempts"]) > 1)
+print("ok: edge_crack: attempts of %d rows and of the failing step (%d) as the halving rule says; seconds + unfinished_s = %.3f s, solve_s %.3f s (retried steps %.3f s)" % (len(rows), want, total, solve, retried))
 PY
 # shellcheck source=/dev/null
 vtkpy=""

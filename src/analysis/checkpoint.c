@@ -8,7 +8,7 @@
 #include "perilin/private/analysis.h"
 
 #define PERI_CHECKPOINT_MAGIC   0x50455249 /* "PERI" */
-#define PERI_CHECKPOINT_VERSION 1
+#define PERI_CHECKPOINT_VERSION 2          /* 2: each step carries its attempts */
 #define PERI_CHECKPOINT_FILE    "checkpoint/state.bin"
 
 /* What ties a checkpoint to a run. */

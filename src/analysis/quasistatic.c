@@ -312,7 +312,7 @@ static PetscErrorCode ControlValue(PeriAnalysis an, PeriProbe *probe, PetscInt c
 
 static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriStep *s)
 {
-  char soft[48] = "";
+  char soft[48] = "", tries[32] = "";
 
   PetscFunctionBeginUser;
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
@@ -325,7 +325,8 @@ static PetscErrorCode Progress(PeriAnalysis an, const Settings *st, const PeriSt
     PetscCall(PetscPrintf(an->comm, "\r[%s] ", bar));
   }
   if (an->sys->bond_state.failure.softening) PetscCall(PetscSNPrintf(soft, sizeof(soft), "  softened %8" PetscInt_FMT, s->softened));
-  PetscCall(PetscPrintf(an->comm, "step %4" PetscInt_FMT "  lambda %-12.6g u %-12.5g broken %6" PetscInt_FMT " (total %8" PetscInt_FMT ")%s  equilibrium its %3" PetscInt_FMT "  ksp its %5" PetscInt_FMT "  %.2f s\n", QS(an)->nsteps, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, soft, s->iterations, s->ksp_iterations, (double)s->seconds));
+  if (s->attempts > 1) PetscCall(PetscSNPrintf(tries, sizeof(tries), " (%" PetscInt_FMT " attempts)", s->attempts));
+  PetscCall(PetscPrintf(an->comm, "step %4" PetscInt_FMT "  lambda %-12.6g u %-12.5g broken %6" PetscInt_FMT " (total %8" PetscInt_FMT ")%s  equilibrium its %3" PetscInt_FMT "  ksp its %5" PetscInt_FMT "  %.2f s%s\n", QS(an)->nsteps, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, soft, s->iterations, s->ksp_iterations, (double)s->seconds, tries));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -414,12 +415,15 @@ static PetscErrorCode PrintCriteria(PeriAnalysis an, const Settings *st)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The loop state that survives from step to step. */
+/* The loop state that survives from step to step, and the step in progress: when it began (the
+ * last equilibrium, or the loop's start) and how many trials it has taken so far. */
 typedef struct {
-  KSP        ksp;
-  PetscInt   since_setup, nbonds, nhold, npieces, *hold;
-  PetscReal *held;
-  PetscBool  lost, stale;
+  KSP            ksp;
+  PetscInt       since_setup, nbonds, nhold, npieces, *hold;
+  PetscReal     *held;
+  PetscBool      lost, stale;
+  PetscLogDouble mark;
+  PetscInt       attempts;
 } Loop;
 
 /* How one trial load factor ended. */
@@ -553,10 +557,11 @@ static PetscErrorCode Failed(PeriAnalysis an, PeriCheckpoint *eq, PetscReal tria
 }
 
 /* An accepted step: recorded, reported, saved, and the next step size chosen. */
-static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint *eq, PeriStep *s, PetscReal *dl, PetscInt nbonds)
+static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint *eq, PeriStep *s, PetscReal *dl, Loop *L)
 {
   PeriQuasistatic *q       = QS(an);
   const PetscInt   changes = s->broken; /* bonds broken or softened by more than 1 %, in every round */
+  PetscLogDouble   t;
 
   PetscFunctionBeginUser;
   /* what the step reports: bonds counted once, dead ones apart from softened ones */
@@ -567,6 +572,13 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint
   PetscCall(PeriSystemEvaluateReactions(an->sys, s->lambda));
   s->imbalance = an->sys->conditions.reactions.relative_imbalance;
   if (st->reaction >= 0) s->reaction = an->sys->conditions.reactions.force[st->reaction * PERI_MAX_DOF + st->component];
+  /* the step's time runs from the step before, so that it holds the attempts retried with a
+     smaller increment and the steps' times add up to the loop's (with unfinished_s) */
+  PetscCall(PetscTime(&t));
+  s->seconds  = t - L->mark;
+  s->attempts = PetscMax(L->attempts, 1); /* an event's scaled state takes no trial of its own */
+  L->mark     = t;
+  L->attempts = 0;
   PetscCall(RecordStep(q, s, &an->sys->conditions.reactions));
   q->peak_load_factor = s->lambda;
   q->broken_bonds     = s->broken_total;
@@ -576,25 +588,25 @@ static PetscErrorCode Accept(PeriAnalysis an, const Settings *st, PeriCheckpoint
   /* a run stopped here for a test takes the path of an interrupted one: the next poll ends it */
   if (q->nsteps == ((QSData *)an->data)->stop_after) PeriSignalSimulate(SIGINT);
   /* many breaks: smaller steps; none: back towards the scene's step */
-  if (st->adaptive) *dl = changes > nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : changes ? *dl
-                                                                                               : PetscMin(2 * *dl, st->step);
+  if (st->adaptive) *dl = changes > L->nbonds / 100 ? PetscMax(0.5 * *dl, st->min_step) : changes ? *dl
+                                                                                                  : PetscMin(2 * *dl, st->step);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The numbers of one step in a checkpoint: PeriStep as reals and integers (a viewer has no struct). */
 #define PERI_STEP_REALS 5
-#define PERI_STEP_INTS  5
+#define PERI_STEP_INTS  6
 
 static void StepPack(const PeriStep *s, PetscReal r[], PetscInt n[])
 {
   r[0] = s->lambda, r[1] = s->control_u, r[2] = s->seconds, r[3] = s->reaction, r[4] = s->imbalance;
-  n[0] = s->broken, n[1] = s->broken_total, n[2] = s->iterations, n[3] = s->ksp_iterations, n[4] = s->softened;
+  n[0] = s->broken, n[1] = s->broken_total, n[2] = s->iterations, n[3] = s->ksp_iterations, n[4] = s->softened, n[5] = s->attempts;
 }
 
 static void StepUnpack(const PetscReal r[], const PetscInt n[], PeriStep *s)
 {
   s->lambda = r[0], s->control_u = r[1], s->seconds = r[2], s->reaction = r[3], s->imbalance = r[4];
-  s->broken = n[0], s->broken_total = n[1], s->iterations = n[2], s->ksp_iterations = n[3], s->softened = n[4];
+  s->broken = n[0], s->broken_total = n[1], s->iterations = n[2], s->ksp_iterations = n[3], s->softened = n[4], s->attempts = n[5];
 }
 
 /* Room for n steps (and their reactions) and n snapshots, on reading a checkpoint. */
@@ -752,7 +764,7 @@ static PetscErrorCode Finish(PeriAnalysis an, const Settings *st)
   if (st->quiet) PetscFunctionReturn(PETSC_SUCCESS);
   if (an->sys->bond_state.failure.softening && q->nsteps) PetscCall(PetscSNPrintf(soft, sizeof(soft), " (%" PetscInt_FMT " softened)", q->steps[q->nsteps - 1].softened));
   PetscCall(PetscPrintf(an->comm, "perilin: quasistatic: %s; last equilibrium at load factor %g, %" PetscInt_FMT " bonds broken%s, %" PetscInt_FMT " solves, %" PetscInt_FMT " preconditioner set-ups\n", q->ending, (double)q->peak_load_factor, q->broken_bonds, soft, q->solves, q->pc_setups));
-  if (q->failed) PetscCall(PetscPrintf(an->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ")\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step));
+  if (q->failed) PetscCall(PetscPrintf(an->comm, "perilin: critical load factor %g (failure between %g and %g, in step %" PetscInt_FMT ": %" PetscInt_FMT " attempt(s), %.2f s)\n", (double)q->critical_load_factor, (double)q->peak_load_factor, (double)q->critical_load_factor, q->failure_step, q->unfinished_attempts, (double)q->unfinished_s));
   if (q->failed && !q->broken_bonds) PetscCall(PetscPrintf(an->comm, "perilin: note: %s\n", PERI_INTACT_NOTE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -790,7 +802,7 @@ static PetscErrorCode NextEvent(PeriAnalysis an, PetscReal lam, PetscReal *next)
 
 /* An equilibrium at load factor lam without a solve: the present state, whose response is linear
  * in the load factor until the next break, scaled from the load factor it was solved at. */
-static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, PeriCheckpoint *eq, PetscReal *at, PetscReal lam, PeriStep *solved, PetscInt nbonds)
+static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, PeriCheckpoint *eq, PetscReal *at, PetscReal lam, PeriStep *solved, Loop *L)
 {
   PeriStep  s  = {0};
   PetscReal dl = 0;
@@ -803,7 +815,7 @@ static PetscErrorCode AcceptScaled(PeriAnalysis an, const Settings *st, PeriChec
   *at            = lam;
   s.lambda       = lam;
   s.broken_total = QS(an)->broken_bonds;
-  PetscCall(Accept(an, st, eq, &s, &dl, nbonds));
+  PetscCall(Accept(an, st, eq, &s, &dl, L));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -832,29 +844,26 @@ static PetscErrorCode RunEvents(PeriAnalysis an, const Settings *st, Loop *L, Pe
   } else
     PetscCall(SolveAt(an, st, L, lambda, 0, PETSC_FALSE, &s0, &end, why, sizeof(why)));
   while (end == TRIAL_SETTLED) {
-    PetscReal      next, trial;
-    PeriStep       s = {0};
-    PetscLogDouble tstep, t;
-    PetscCall(PetscTime(&tstep));
+    PetscReal next, trial;
+    PeriStep  s = {0};
     PetscCall(NextEvent(an, lambda, &next));
     if (next * (1 + PERI_EVENT_WINDOW) >= st->max) {
-      PetscCall(AcceptScaled(an, st, eq, &lambda, st->max, &s0, L->nbonds));
+      PetscCall(AcceptScaled(an, st, eq, &lambda, st->max, &s0, L));
       break;
     }
-    PetscCall(AcceptScaled(an, st, eq, &lambda, next, &s0, L->nbonds));
+    PetscCall(AcceptScaled(an, st, eq, &lambda, next, &s0, L));
     trial = next * (1 + PERI_EVENT_WINDOW);
     PetscCall(VecScale(an->sys->fields.u, trial / lambda)); /* the same bonds: the solution at trial */
+    L->attempts++;
     PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, PETSC_TRUE, PETSC_TRUE, &s, &end, why, sizeof(why)));
     if (end == TRIAL_FAILED) PetscCall(Failed(an, eq, trial, &s, why));
     if (end != TRIAL_SETTLED) break;
-    lambda = trial;
-    PetscCall(PetscTime(&t));
+    lambda         = trial;
     s.lambda       = lambda;
     s.broken_total = QS(an)->broken_bonds + s.broken;
-    s.seconds      = t - tstep;
     {
       PetscReal dl = 0;
-      PetscCall(Accept(an, st, eq, &s, &dl, L->nbonds));
+      PetscCall(Accept(an, st, eq, &s, &dl, L));
       /* the state at the top of this loop: a restart goes on from here */
       PetscCall(WriteCheckpoint(an, eq, lambda, dl));
     }
@@ -873,12 +882,11 @@ static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L
   PetscFunctionBeginUser;
   if (an->restart[0]) PetscCall(Restart(an, L, eq, &lambda, &dl));
   while (lambda < st->max * (1 - 1e-12)) {
-    PetscReal      trial = PetscMin(lambda + dl, st->max);
-    PeriStep       s     = {0};
-    TrialEnd       end;
-    char           why[160] = "";
-    PetscLogDouble tstep, t;
-    PetscCall(PetscTime(&tstep));
+    PetscReal trial = PetscMin(lambda + dl, st->max);
+    PeriStep  s     = {0};
+    TrialEnd  end;
+    char      why[160] = "";
+    L->attempts++;
     PetscCall(Trial(an, st, L, trial, QS(an)->broken_bonds, st->adaptive, PETSC_FALSE, &s, &end, why, sizeof(why)));
     if (end == TRIAL_INTERRUPTED) {
       PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_FALSE, PETSC_TRUE));
@@ -896,12 +904,10 @@ static PetscErrorCode RunIncrements(PeriAnalysis an, const Settings *st, Loop *L
       PetscCall(Failed(an, eq, trial, &s, why));
       break;
     }
-    lambda = trial;
-    PetscCall(PetscTime(&t));
+    lambda         = trial;
     s.lambda       = lambda;
     s.broken_total = QS(an)->broken_bonds + s.broken;
-    s.seconds      = t - tstep;
-    PetscCall(Accept(an, st, eq, &s, &dl, L->nbonds));
+    PetscCall(Accept(an, st, eq, &s, &dl, L));
     PetscCall(WriteCheckpoint(an, eq, lambda, dl));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -927,6 +933,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscCallMPI(MPI_Allreduce(&an->sys->disc.bonds.nbonds, &L.nbonds, 1, MPIU_INT, MPI_SUM, an->comm));
   L.stale = PETSC_TRUE;
   PetscCall(PetscTime(&t0));
+  L.mark = t0;
   PetscCall(PrintCriteria(an, st));
   if (st->events)
     PetscCall(RunEvents(an, st, &L, &eq));
@@ -936,7 +943,9 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscCall(PetscFree2(L.hold, L.held));
   PetscCall(PeriCheckpointDestroy(&eq));
   PetscCall(PetscTime(&t));
-  an->sys->run.log.solve_s = t - t0;
+  an->sys->run.log.solve_s    = t - t0;
+  QS(an)->unfinished_s        = t - L.mark;
+  QS(an)->unfinished_attempts = L.attempts;
   PetscCall(Finish(an, st));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -984,12 +993,12 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
   PetscFunctionBeginUser;
   if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,softened,equilibrium_iterations,ksp_iterations,seconds") < 0;
+  bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,softened,equilibrium_iterations,ksp_iterations,seconds,attempts") < 0;
   bad |= ReactionColumns(an, fp, -1);
   bad |= fprintf(fp, "\n") < 0;
   for (PetscInt k = 0; k < QS(an)->nsteps; k++) {
     const PeriStep *s = &QS(an)->steps[k];
-    bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f", k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->softened, s->iterations, s->ksp_iterations, (double)s->seconds) < 0;
+    bad |= fprintf(fp, "%" PetscInt_FMT ",%.10g,%.10g,%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ",%.4f,%" PetscInt_FMT, k + 1, (double)s->lambda, (double)s->control_u, s->broken, s->broken_total, s->softened, s->iterations, s->ksp_iterations, (double)s->seconds, s->attempts) < 0;
     bad |= ReactionColumns(an, fp, k);
     bad |= fprintf(fp, "\n") < 0;
   }
@@ -1067,6 +1076,8 @@ static PetscErrorCode QSSummary(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONReal(j, "runaway_fraction", ST(an)->runaway));
   PetscCall(PeriJSONInt(j, "checkpoints", q->checkpoints));
   PetscCall(PeriJSONReal(j, "checkpoint_s", q->checkpoint_s));
+  PetscCall(PeriJSONReal(j, "unfinished_s", q->unfinished_s));
+  PetscCall(PeriJSONInt(j, "unfinished_attempts", q->unfinished_attempts));
   if (q->restart_step) PetscCall(PeriJSONString(j, "restarted_from", an->restart));
   if (q->restart_step) PetscCall(PeriJSONInt(j, "restart_step", q->restart_step));
   if (q->failed && !q->broken_bonds) PetscCall(PeriJSONString(j, "note", PERI_INTACT_NOTE));

@@ -9,10 +9,30 @@
 #include "perilin/private/scene_file.h"
 #include <yaml.h>
 
+#include <sys/stat.h>
+
+/* What a path that is no regular file is, or NULL for a regular file or none at all (whose open
+ * fails with its own message). */
+static const char *NotRegular(const char path[])
+{
+  struct stat st;
+
+  if (stat(path, &st)) return NULL;
+  if (S_ISREG(st.st_mode)) return NULL;
+  if (S_ISDIR(st.st_mode)) return "a directory";
+  if (S_ISFIFO(st.st_mode)) return "a pipe (FIFO)";
+  if (S_ISCHR(st.st_mode)) return "a character device";
+  if (S_ISBLK(st.st_mode)) return "a block device";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "not a regular file";
+}
+
 /*@C
   PeriSceneGetPath - the file named by map.key, relative to the scene file's directory unless
   absolute (particles.file, particles.mesh); the resolved scene holds it absolute. *found (may be
-  NULL) says whether it was given; path is left alone otherwise. Not collective.
+  NULL) says whether it was given; path is left alone otherwise. Every such key names an input
+  file, which must be a regular file: a device (/dev/zero) or a pipe may never end, and opening a
+  FIFO blocks until a writer comes, so they are refused by stat before any open. Not collective.
 @*/
 PetscErrorCode PeriSceneGetPath(PeriScene scene, PeriNode map, const char key[], PetscBool required, char path[], size_t size, PetscBool *found)
 {
@@ -28,6 +48,7 @@ PetscErrorCode PeriSceneGetPath(PeriScene scene, PeriNode map, const char key[],
   else
     PetscCall(PetscSNPrintf(path, size, "%s/%s", scene->dir, name));
   PetscCall(PeriSceneResolvePath(scene, map, key, path));
+  PeriInputCheck(!NotRegular(path), scene, map, key, "%s is %s: give a regular file (a device or a pipe may never end)", path, NotRegular(path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

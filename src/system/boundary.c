@@ -38,6 +38,7 @@ static const PeriKey bc_keys[] = {
     {"value", PERI_KEY_MAP, NULL, NULL, "[length] (theta: radians)", NULL, "map component -> prescribed value, e.g. {ux: 0.001}"},
     {"affine", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the prescribed field u = A X + b at the reference positions X: {A: [[..],..], b: [..]}; every translational component, never theta"},
     {"optional", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "skip the components of fix and value the model lacks (one scene for several models)"},
+    {"override", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "this item wins where an earlier item holds the same component of the same particle with another value (else that is an input error; equal values are always fine)"},
     {NULL},
 };
 static const PeriKey affine_keys[] = {
@@ -81,12 +82,60 @@ PetscErrorCode PeriBoundaryParseAffine(PeriSystem sys, PeriNode node, const char
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* value[], set[] and region[] (the condition's region, for its reaction) over the owned DOFs;
- * later conditions override earlier ones. */
-static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal value[], PetscBool set[], PetscInt region[])
+/* The owned DOFs' prescribed values as the bc items build them, item by item. */
+typedef struct {
+  PetscReal *value;
+  PetscBool *set;
+  PetscInt  *region; /* the condition's region, for its reaction (-1: none) */
+  PetscInt  *item;   /* the bc item that set the value (-1: none) */
+} Prescribed;
+
+/* Where bc item k first gave a component of a particle another value than an earlier item j. */
+typedef struct {
+  PetscInt  j, c;
+  PetscReal was, now, X[3];
+} Conflict;
+
+static PetscBool SameValue(PetscReal a, PetscReal b)
 {
-  PeriScene      s  = sys->scene;
-  PeriModel      m  = sys->model;
+  return (PetscBool)(PetscAbsReal(a - b) <= 1e-12 * PetscMax(PetscAbsReal(a), PetscAbsReal(b)));
+}
+
+/* A contradiction found on some rank (x->j >= 0) is the input error of every rank: the lowest rank
+ * with one tells the others which. Collective. */
+static PetscErrorCode ReportConflict(PeriSystem sys, PeriNode bc, PetscInt k, const Conflict *x)
+{
+  PetscMPIInt rank, size, first;
+  PetscReal   buf[7] = {(PetscReal)x->j, (PetscReal)x->c, x->was, x->now, x->X[0], x->X[1], x->X[2]};
+  PeriNode    earlier;
+  char        at[96];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(sys->comm, &rank));
+  PetscCallMPI(MPI_Comm_size(sys->comm, &size));
+  first = x->j >= 0 ? rank : size;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &first, 1, MPI_INT, MPI_MIN, sys->comm));
+  if (first == size) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCallMPI(MPI_Bcast(buf, 7, MPIU_REAL, first, sys->comm));
+  earlier = bc->child[(PetscInt)buf[0]];
+  if (sys->disc.particles.dim == 2)
+    PetscCall(PetscSNPrintf(at, sizeof(at), "(%g, %g)", (double)buf[4], (double)buf[5]));
+  else
+    PetscCall(PetscSNPrintf(at, sizeof(at), "(%g, %g, %g)", (double)buf[4], (double)buf[5], (double)buf[6]));
+  PeriInputCheck(PETSC_FALSE, sys->scene, bc->child[k], NULL, "contradicts %s (line %d): at the particle at %s it prescribes %s = %g, %s prescribes %g; give each component of a particle one value (regions that do not overlap), or override: true on this item to let it win", earlier->path, earlier->line, at, sys->model->components[(PetscInt)buf[1]], (double)buf[3], earlier->path, (double)buf[2]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* bc item k into P over the owned DOFs. Where an earlier item holds a component of a particle,
+ * a different value is an input error unless this item says override: true (then it wins).
+ * Collective. */
+static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Prescribed *P)
+{
+  PeriNode       item = bc->child[k];
+  Conflict       x    = {-1, -1, 0, 0, {0, 0, 0}};
+  PetscBool      over = PETSC_FALSE;
+  PeriScene      s    = sys->scene;
+  PeriModel      m    = sys->model;
   const PetscInt bs = m->dofs, dim = sys->disc.particles.dim;
   PeriRegion    *r;
   PeriNode       fix, val, aff;
@@ -100,6 +149,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
   PetscCall(PeriSceneCheckSection(s, item, "bc.<k>"));
   PetscCall(PeriRegionFind(s, item, "region", sys->disc.nregions, sys->disc.regions, &r));
   PetscCall(PeriSceneGetBool(s, item, "optional", &optional, NULL));
+  PetscCall(PeriSceneGetBool(s, item, "override", &over, NULL));
   PetscCall(PeriSceneGetNode(item, "fix", &fix));
   PetscCall(PeriSceneGetNode(item, "value", &val));
   PetscCall(PeriSceneGetNode(item, "affine", &aff));
@@ -141,13 +191,19 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode item, PetscReal va
         v[axis_comp[a]] = b0[a];
         for (PetscInt d = 0; d < dim; d++) v[axis_comp[a]] += A[a][d] * X[d];
       }
-    for (PetscInt c = 0; c < bs; c++)
-      if (use[c]) {
-        value[(i - sys->disc.bonds.rstart) * bs + c]  = v[c];
-        set[(i - sys->disc.bonds.rstart) * bs + c]    = PETSC_TRUE;
-        region[(i - sys->disc.bonds.rstart) * bs + c] = (PetscInt)(r - sys->disc.regions);
+    for (PetscInt c = 0; c < bs; c++) {
+      const PetscInt d = (i - sys->disc.bonds.rstart) * bs + c;
+      if (!use[c]) continue;
+      if (P->set[d] && !over && x.j < 0 && !SameValue(P->value[d], v[c])) {
+        x = (Conflict){P->item[d], c, P->value[d], v[c], {X[0], X[1], X[2]}};
       }
+      P->value[d]  = v[c];
+      P->set[d]    = PETSC_TRUE;
+      P->region[d] = (PetscInt)(r - sys->disc.regions);
+      P->item[d]   = k;
+    }
   }
+  PetscCall(ReportConflict(sys, bc, k, &x));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -159,6 +215,7 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   PeriScene      s  = sys->scene;
   const PetscInt bs = sys->model->dofs, nloc = (sys->disc.bonds.rend - sys->disc.bonds.rstart) * bs;
   PeriNode       bc;
+  Prescribed     P;
   PetscReal     *value;
   PetscBool     *set;
   PetscInt       n    = 0, *region;
@@ -167,11 +224,12 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "bc", &bc));
   PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
-  PetscCall(PetscCalloc3(nloc, &value, nloc, &set, nloc, &region));
-  for (PetscInt k = 0; k < nloc; k++) region[k] = -1; /* held by no bc item (an inactive component) */
+  PetscCall(PetscCalloc4(nloc, &P.value, nloc, &P.set, nloc, &P.region, nloc, &P.item));
+  value = P.value, set = P.set, region = P.region;
+  for (PetscInt k = 0; k < nloc; k++) region[k] = P.item[k] = -1; /* held by no bc item (an inactive component) */
   /* a bad condition is an input error, not an exit: free the work arrays before passing it on */
-  for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(sys, bc->child[k], value, set, region);
-  if (ierr) PetscCall(PetscFree3(value, set, region));
+  for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(sys, bc, k, &P);
+  if (ierr) PetscCall(PetscFree4(P.value, P.set, P.region, P.item));
   PetscCall(ierr);
   for (PetscInt c = 0; c < bs; c++) {
     if (!sys->model->inactive[c]) continue;
@@ -194,7 +252,7 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
       sys->conditions.constrained_region[n] = region[k];
       n++;
     }
-  PetscCall(PetscFree3(value, set, region));
+  PetscCall(PetscFree4(P.value, P.set, P.region, P.item));
   PetscCall(PeriReactionsSetUp(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

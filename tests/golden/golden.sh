@@ -12,7 +12,7 @@
 #
 # Compared (the rules, and why some keys are left out, are in golden.py's header):
 #   summary.json     minus the volatile keys (timing, memory_mb, memory_mb_max_rank, scene,
-#                    modal.factorization_s, modal.eigensolve_s, quasistatic.checkpoint_s), the values of build.* and
+#                    modal.factorization_s, modal.eigensolve_s, quasistatic.checkpoint_s and unfinished_s), the values of build.* and
 #                    command_line as "<varies>"; numbers to 1e-9 relative;
 #                    round-off quantities (residual norms, load_share_removed, the mean interior
 #                    strain of the bending scene) by order of magnitude only

@@ -36,8 +36,9 @@ typedef struct {
 
 /* One load step of the quasi-static analysis. */
 typedef struct {
-  PetscReal lambda, control_u, seconds;
+  PetscReal lambda, control_u, seconds;                       /* seconds: since the step before, every attempt of the step */
   PetscInt  broken, broken_total, iterations, ksp_iterations; /* broken: at this step (dead bonds), not counting softening */
+  PetscInt  attempts;                                         /* the trials of the step: 1, more when a smaller increment was retried */
   PetscInt  softened;                                         /* bonds softened (alive, less than their whole stiffness) at this equilibrium */
   PetscReal reaction, imbalance;                              /* the reaction region's force along the control component; the relative imbalance */
 } PeriStep;
@@ -59,6 +60,8 @@ typedef struct {
   PetscReal *reactions;                          /* per step, every region's reaction: nregions x PERI_MAX_DOF */
   PetscInt   checkpoints, restart_step;          /* checkpoints written; the step -restart continued from (0: none) */
   PetscReal  checkpoint_s;                       /* the time spent writing them */
+  PetscReal  unfinished_s;                       /* the time after the last equilibrium: the attempts of a step that reached none */
+  PetscInt   unfinished_attempts;                /* and their number (a failure's bracketing, an interrupted step) */
 } PeriQuasistatic;
 
 /* An analysis type (src/analysis/<name>.c): what it does with the system, and what it adds to
