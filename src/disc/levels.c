@@ -31,9 +31,11 @@ static PetscReal CellKey(const SparseCells *sc, const PetscInt c[3])
   return (PetscReal)c[0] + (PetscReal)sc->ncell[0] * ((PetscReal)c[1] + (PetscReal)sc->ncell[1] * (PetscReal)c[2]);
 }
 
+/* The cell of x, unclamped: a periodic image of a query may lie outside the box. The particles'
+ * own cells are within 0 .. ncell - 1 since ncell covers the box with one cell to spare. */
 static void CellCoords(const SparseCells *sc, PetscInt dim, const PetscReal x[], PetscInt c[3])
 {
-  for (PetscInt d = 0; d < 3; d++) c[d] = d < dim ? PetscMin((PetscInt)PetscFloorReal((x[d] - sc->lower[d]) / sc->size), sc->ncell[d] - 1) : 0;
+  for (PetscInt d = 0; d < 3; d++) c[d] = d < dim ? (PetscInt)PetscFloorReal((x[d] - sc->lower[d]) / sc->size) : 0;
 }
 
 typedef struct {
@@ -112,33 +114,78 @@ static PetscInt LowerBound(const SparseCells *sc, PetscReal k)
   return lo;
 }
 
-/* Appends the bonds of i with the particles of sc within LEVELS_REACH cells (with j of a larger
- * global index when half). The cells of one row along x have consecutive keys: one bisection per
- * row finds the first, and the row is walked from there. */
-static PetscErrorCode CellsBonds(const PeriParticles *p, const PetscReal horizon[], const PetscReal reach[], PeriPartialVolume pv, const SparseCells *sc, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
+/* Is the image shift w positive in lexicographic order? Of the two images of a particle's
+ * self-bond (+w, -w) only one is stored. */
+static PetscBool ImagePositive(const PetscInt w[3])
 {
-  PetscInt ci[3], c[3], r[3];
+  for (PetscInt d = 0; d < 3; d++)
+    if (w[d]) return w[d] > 0 ? PETSC_TRUE : PETSC_FALSE;
+  return PETSC_FALSE;
+}
+
+/* Is the pair (i, j) at image w stored in i's row? Once per pair and image: in the row of the
+ * smaller global index (half), and a particle's bond to its own image once, at +w; a full list
+ * leaves self-images out (it is the partitioner's graph). */
+static PetscBool PairStored(const PeriParticles *p, PetscInt i, PetscInt j, const PetscInt w[3], PetscBool half)
+{
+  if (j == i) return half && ImagePositive(w);
+  return !half || PeriParticleGlobal(p, j) > PeriParticleGlobal(p, i);
+}
+
+/* Appends the bonds of i with the particles of sc within LEVELS_REACH cells of i's image at
+ * X_i - w L (the bond vector X_j - X_i + w L, L the periodic lengths). The cells of one row along
+ * x have consecutive keys: one bisection per row finds the first, and the row is walked from
+ * there. */
+static PetscErrorCode CellsBonds(const PeriParticles *p, const PetscReal horizon[], const PetscReal reach[], PeriPartialVolume pv, const SparseCells *sc, PetscInt i, const PetscInt w[3], PetscBool half, PeriBonds *b, PetscInt *cap)
+{
+  PetscInt  ci[3], c[3], r[3];
+  PetscReal shift[3], y[3];
 
   PetscFunctionBeginUser;
-  CellCoords(sc, p->dim, &p->x[3 * i], ci);
-  for (PetscInt d = 0; d < 3; d++) r[d] = d < p->dim ? LEVELS_REACH : 0;
+  for (PetscInt d = 0; d < 3; d++) {
+    shift[d] = w[d] ? w[d] * (p->upper[d] - p->lower[d]) : 0;
+    y[d]     = p->x[3 * i + d] - shift[d];
+    r[d]     = d < p->dim ? LEVELS_REACH : 0;
+  }
+  CellCoords(sc, p->dim, y, ci);
   for (c[2] = ci[2] - r[2]; c[2] <= ci[2] + r[2]; c[2]++)
     for (c[1] = ci[1] - r[1]; c[1] <= ci[1] + r[1]; c[1]++) {
       PetscInt  lo[3] = {PetscMax(ci[0] - r[0], 0), c[1], c[2]}, hi[3] = {PetscMin(ci[0] + r[0], sc->ncell[0] - 1), c[1], c[2]};
       PetscReal khi;
-      if (c[1] < 0 || c[1] >= sc->ncell[1] || c[2] < 0 || c[2] >= sc->ncell[2]) continue;
+      if (c[1] < 0 || c[1] >= sc->ncell[1] || c[2] < 0 || c[2] >= sc->ncell[2] || lo[0] > hi[0]) continue;
       khi = CellKey(sc, hi);
       for (PetscInt loc = LowerBound(sc, CellKey(sc, lo)); loc < sc->nkeys && sc->key[loc] <= khi; loc++)
         for (PetscInt s = sc->start[loc]; s < sc->start[loc + 1]; s++) {
           const PetscInt  j = sc->item[s];
           const PetscReal R = PetscMax(reach[i], reach[j]);
           PetscReal       x[3];
-          if (j == i || (half && PeriParticleGlobal(p, j) < PeriParticleGlobal(p, i))) continue;
-          for (PetscInt d = 0; d < 3; d++) x[d] = p->x[3 * j + d] - p->x[3 * i + d];
+          if (!PairStored(p, i, j, w, half) || (j == i && !w[0] && !w[1] && !w[2])) continue;
+          for (PetscInt d = 0; d < 3; d++) x[d] = p->x[3 * j + d] - p->x[3 * i + d] + shift[d];
           if (x[0] * x[0] + x[1] * x[1] + x[2] * x[2] > R * R) continue; /* beyond both reaches: no bond */
           PetscCall(PeriBondsAdd(p, i, j, x, PetscMax(horizon[i], horizon[j]), pv, b, cap));
         }
     }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The bonds of i with the particles of sc whose pair radius is below cut, at every periodic image
+ * of i that comes within cut of the body's box (w = 0 alone without periodic axes). */
+static PetscErrorCode ImagesBonds(const PeriParticles *p, const PetscReal horizon[], const PetscReal reach[], PeriPartialVolume pv, const SparseCells *sc, PetscReal cut, PetscInt i, PetscBool half, PeriBonds *b, PetscInt *cap)
+{
+  PetscInt n[3], w[3];
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) n[d] = p->periodic[d] ? (PetscInt)PetscCeilReal(cut / (p->upper[d] - p->lower[d])) : 0;
+  for (w[2] = -n[2]; w[2] <= n[2]; w[2]++)
+    for (w[1] = -n[1]; w[1] <= n[1]; w[1]++)
+      for (w[0] = -n[0]; w[0] <= n[0]; w[0]++) {
+        PetscBool near = PETSC_TRUE;
+        for (PetscInt d = 0; d < 3 && near; d++) { /* the image's distance to the box along d */
+          PetscReal L = p->upper[d] - p->lower[d], y = p->x[3 * i + d] - w[d] * L;
+          near = (PetscBool)(!w[d] || (y < p->lower[d] ? p->lower[d] - y : y - p->upper[d]) <= cut);
+        }
+        if (near) PetscCall(CellsBonds(p, horizon, reach, pv, sc, i, w, half, b, cap));
+      }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -161,17 +208,23 @@ static PetscErrorCode Levels(const PeriParticles *p, const PetscReal horizon[], 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The box of the local view. */
+/* The box of the local view: the body's on periodic axes (the images' cells are then whole). */
 static void Box(const PeriParticles *p, PetscReal lo[], PetscReal hi[])
 {
   for (PetscInt d = 0; d < 3; d++) {
-    lo[d] = PETSC_MAX_REAL;
-    hi[d] = PETSC_MIN_REAL;
+    lo[d] = p->periodic[d] ? p->lower[d] : PETSC_MAX_REAL;
+    hi[d] = p->periodic[d] ? p->upper[d] : PETSC_MIN_REAL;
     for (PetscInt k = 0; k < p->n; k++) {
       lo[d] = PetscMin(lo[d], p->x[3 * k + d]);
       hi[d] = PetscMax(hi[d], p->x[3 * k + d]);
     }
   }
+}
+
+/* C_L: the largest pair radius that the cells of level L serve. */
+static PetscReal LevelCut(PetscReal rmin, PetscInt L)
+{
+  return PetscPowRealInt(2.0, L + 1) * rmin;
 }
 
 /* The cells of every level: cum[L] over the particles of levels <= L, own[L] over those of L. */
@@ -184,7 +237,7 @@ static PetscErrorCode LevelCells(const PeriParticles *p, const PetscInt level[],
   Box(p, lo, hi);
   PetscCall(PetscMalloc1(p->n, &list));
   for (PetscInt L = 0; L < nl; L++) {
-    PetscReal size = PetscPowRealInt(2.0, L + 1) * rmin / LEVELS_REACH;
+    PetscReal size = LevelCut(rmin, L) / LEVELS_REACH;
     PetscInt  m    = 0;
     for (PetscInt k = 0; k < p->n; k++)
       if (level[k] <= L) list[m++] = k;
@@ -201,7 +254,8 @@ static PetscErrorCode LevelCells(const PeriParticles *p, const PetscInt level[],
 /*@C
   PeriNeighborSearchLevels - PeriNeighborSearch for per-particle horizons (horizon[k] of each
   particle of p): a pair is bonded when its partial-volume factor for the larger of the two
-  horizons is positive. Bodies without periodic axes. Not collective.
+  horizons is positive, at every periodic image (a short periodic axis may give a pair several
+  bonds, as the one-horizon search does). Not collective.
 @*/
 PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
 {
@@ -211,7 +265,6 @@ PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal 
   PetscErrorCode ierr = PETSC_SUCCESS;
 
   PetscFunctionBeginUser;
-  PetscCheck(!p->periodic[0] && !p->periodic[1] && !p->periodic[2], PETSC_COMM_SELF, PETSC_ERR_SUP, "per-particle horizons on periodic axes are not implemented");
   PetscCall(PetscMemzero(b, sizeof(*b)));
   PetscCall(PetscMalloc2(p->n, &level, p->n, &reach));
   PetscCall(Levels(p, horizon, pv, reach, level, &nl, &rmin));
@@ -222,8 +275,8 @@ PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal 
   b->offset[0] = 0;
   /* coincident particles are an input error: the cells are freed before it is passed on */
   for (PetscInt i = rstart; i < rend && !ierr; i++) {
-    ierr = CellsBonds(p, horizon, reach, pv, &cum[level[i]], i, half, b, &cap);
-    for (PetscInt L = level[i] + 1; L < nl && !ierr; L++) ierr = CellsBonds(p, horizon, reach, pv, &own[L], i, half, b, &cap);
+    ierr = ImagesBonds(p, horizon, reach, pv, &cum[level[i]], LevelCut(rmin, level[i]), i, half, b, &cap);
+    for (PetscInt L = level[i] + 1; L < nl && !ierr; L++) ierr = ImagesBonds(p, horizon, reach, pv, &own[L], LevelCut(rmin, L), i, half, b, &cap);
     b->offset[i - rstart + 1] = b->nbonds;
   }
   for (PetscInt L = 0; L < nl; L++) {

@@ -41,7 +41,7 @@ const PeriSchema PeriSystemSchema[] = {
 };
 
 /* horizon.spacing: own: each particle's horizon is m times its own spacing, for the models that
- * calibrate per particle and bodies without periodic axes; delta becomes the largest. */
+ * calibrate per particle; delta becomes the largest. */
 static PetscErrorCode ReadOwnHorizon(PeriSystem sys, PeriNode h, PetscBool hasm, PetscReal m, PetscReal hmax)
 {
   PeriScene s   = sys->scene;
@@ -52,7 +52,6 @@ static PetscErrorCode ReadOwnHorizon(PeriSystem sys, PeriNode h, PetscBool hasm,
   if (!own) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(hasm, s, h, "spacing", "own needs horizon.m (the multiple of each particle's spacing), not horizon.delta");
   PeriInputCheck(sys->model->takes_own_horizon, s, h, "spacing", "model %s calibrates its springs on one horizon for the whole body; per-particle horizons are derived for pmb and npmb (docs/mesh.md, \"Per-particle horizons\"): use one of them or horizon.spacing: mean", sys->model->type);
-  for (PetscInt d = 0; d < 3; d++) PeriInputCheck(!sys->disc.particles.periodic[d], s, h, "spacing", "own is not implemented on periodic axes (grid.periodic); a periodic grid has one spacing, so horizon.spacing: mean gives the same horizon");
   sys->disc.horizon_m = m;
   sys->disc.delta     = m * hmax;
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -2,7 +2,9 @@
  * graded, jittered clouds whose spacing grows 100-fold along x in 2D and 10-fold in 3D, each
  * particle's horizon m times its own spacing, every pair within the larger of its two horizons
  * (with the partial-volume ramp of each kind) must be bonded exactly once, with its brute-force
- * partial-volume factor, in the row of its smaller index (half) and in both rows (full). */
+ * partial-volume factor, in the row of its smaller index (half) and in both rows (full). Then the
+ * same clouds periodic across the columns (y, and z in 3D), with coarse horizons beyond the
+ * period: every image of every pair (a particle's own images included) as brute force finds them. */
 #include "testing.h"
 
 /* A deterministic generator, so that the cloud is the same on every machine. */
@@ -45,36 +47,70 @@ static PetscErrorCode GradedCloud(PetscInt dim, PetscReal ratio, PeriParticles *
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Bond i-j of b (row i), or -1. */
-static PetscInt FindBond(const PeriBonds *b, PetscInt i, PetscInt j)
+/* Bond i-j of b (row i) with bond vector x, or -1. */
+static PetscInt FindBond(const PeriBonds *b, PetscInt i, PetscInt j, const PetscReal x[])
 {
   for (PetscInt k = b->offset[i]; k < b->offset[i + 1]; k++)
-    if (b->j[k] == j) return k;
+    if (b->j[k] == j && PetscAbsReal(b->xi[3 * k] - x[0]) + PetscAbsReal(b->xi[3 * k + 1] - x[1]) + PetscAbsReal(b->xi[3 * k + 2] - x[2]) < 1e-12) return k;
   return -1;
+}
+
+/* Wraps the cloud into 0 .. H across the columns: periodic in y (and z in 3D). */
+static void MakePeriodic(PeriParticles *p, PetscReal H)
+{
+  for (PetscInt d = 1; d < p->dim; d++) {
+    p->periodic[d] = PETSC_TRUE;
+    p->lower[d]    = 0;
+    p->upper[d]    = H;
+    for (PetscInt k = 0; k < p->n; k++) p->x[3 * k + d] -= H * PetscFloorReal(p->x[3 * k + d] / H);
+  }
+}
+
+/* Is image w of the pair (i, j) due in i's row? Self-images once (w positive) in half lists,
+ * never in full ones. */
+static PetscBool Due(PetscInt i, PetscInt j, const PetscInt w[], PetscBool half)
+{
+  if (j != i) return (PetscBool)(!half || j > i);
+  if (!half || (!w[0] && !w[1] && !w[2])) return PETSC_FALSE;
+  for (PetscInt d = 0; d < 3; d++)
+    if (w[d]) return (PetscBool)(w[d] > 0);
+  return PETSC_FALSE;
 }
 
 static PetscErrorCode Check(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscBool half)
 {
   PeriBonds b;
   PetscInt  expected = 0;
+  PetscInt  lo[3], hi[3], w[3];
+  PetscReal R = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PeriNeighborSearchLevels(p, horizon, pv, 0, p->n, half, &b));
+  for (PetscInt k = 0; k < p->n; k++) R = PetscMax(R, 2 * horizon[k]); /* beyond any ramp */
   for (PetscInt i = 0; i < p->n; i++)
     for (PetscInt j = 0; j < p->n; j++) {
-      PetscReal len2 = 0, alpha;
-      PetscInt  k;
-      if (j == i || (half && j < i)) continue;
-      for (PetscInt d = 0; d < 3; d++) len2 += PetscSqr(p->x[3 * j + d] - p->x[3 * i + d]);
-      alpha = PeriPartialVolumeFactor(pv, PetscSqrtReal(len2), PetscMax(horizon[i], horizon[j]), 0.5 * (p->spacing[i] + p->spacing[j]));
-      if (alpha <= 0) continue; /* a bond where none is due shows in the count below */
-      k = FindBond(&b, i, j);
-      PetscCheck(k >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "dim %" PetscInt_FMT ", partial volume %s: pair %" PetscInt_FMT "-%" PetscInt_FMT " at %g (horizons %g, %g) missing", p->dim, PeriPartialVolumes[pv], i, j, (double)PetscSqrtReal(len2), (double)horizon[i], (double)horizon[j]);
-      PetscCheck(b.alpha[k] == alpha, PETSC_COMM_SELF, PETSC_ERR_PLIB, "pair %" PetscInt_FMT "-%" PetscInt_FMT ": alpha %g, expected %g", i, j, (double)b.alpha[k], (double)alpha);
-      expected++;
+      for (PetscInt d = 0; d < 3; d++) { /* the images within R along each axis */
+        PetscReal L = p->upper[d] - p->lower[d], dx = p->x[3 * j + d] - p->x[3 * i + d];
+        lo[d] = p->periodic[d] ? (PetscInt)PetscCeilReal((-R - dx) / L) : 0;
+        hi[d] = p->periodic[d] ? (PetscInt)PetscFloorReal((R - dx) / L) : 0;
+      }
+      for (w[2] = lo[2]; w[2] <= hi[2]; w[2]++)
+        for (w[1] = lo[1]; w[1] <= hi[1]; w[1]++)
+          for (w[0] = lo[0]; w[0] <= hi[0]; w[0]++) {
+            PetscReal x[3], alpha;
+            PetscInt  k;
+            if (!Due(i, j, w, half)) continue;
+            for (PetscInt d = 0; d < 3; d++) x[d] = p->x[3 * j + d] - p->x[3 * i + d] + (w[d] ? w[d] * (p->upper[d] - p->lower[d]) : 0);
+            alpha = PeriPartialVolumeFactor(pv, PetscSqrtReal(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]), PetscMax(horizon[i], horizon[j]), 0.5 * (p->spacing[i] + p->spacing[j]));
+            if (alpha <= 0) continue; /* a bond where none is due shows in the count below */
+            k = FindBond(&b, i, j, x);
+            PetscCheck(k >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "dim %" PetscInt_FMT ", partial volume %s: pair %" PetscInt_FMT "-%" PetscInt_FMT " image (%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT ") (horizons %g, %g) missing", p->dim, PeriPartialVolumes[pv], i, j, w[0], w[1], w[2], (double)horizon[i], (double)horizon[j]);
+            PetscCheck(b.alpha[k] == alpha, PETSC_COMM_SELF, PETSC_ERR_PLIB, "pair %" PetscInt_FMT "-%" PetscInt_FMT ": alpha %g, expected %g", i, j, (double)b.alpha[k], (double)alpha);
+            expected++;
+          }
     }
   PetscCheck(b.nbonds == expected, PETSC_COMM_SELF, PETSC_ERR_PLIB, "%" PetscInt_FMT " bonds, expected %" PetscInt_FMT " (a pair listed twice?)", b.nbonds, expected);
-  PetscCall(PetscPrintf(PETSC_COMM_SELF, "ok: %" PetscInt_FMT "D, %" PetscInt_FMT " particles, partial volume %s, %s: %" PetscInt_FMT " bonds as brute force\n", p->dim, p->n, PeriPartialVolumes[pv], half ? "half" : "full", b.nbonds));
+  PetscCall(PetscPrintf(PETSC_COMM_SELF, "ok: %" PetscInt_FMT "D%s, %" PetscInt_FMT " particles, partial volume %s, %s: %" PetscInt_FMT " bonds as brute force\n", p->dim, p->periodic[1] ? " periodic" : "", p->n, PeriPartialVolumes[pv], half ? "half" : "full", b.nbonds));
   PetscCall(PeriBondsDestroy(&b));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -91,6 +127,10 @@ int main(int argc, char **argv)
     for (PetscInt k = 0; k < p.n; k++) horizon[k] = m * p.spacing[k];
     for (PetscInt pv = 0; pv < 3; pv++) PetscCall(Check(&p, horizon, (PeriPartialVolume)pv, PETSC_TRUE));
     PetscCall(Check(&p, horizon, PERI_PARTIAL_VOLUME_LINEAR_CONTINUED, PETSC_FALSE));
+    MakePeriodic(&p, 4 * (dim == 2 ? 100 : 10) * 0.01);
+    for (PetscInt k = 0; k < p.n; k++) horizon[k] *= dim == 2 ? 1.6 : 2.2; /* coarse horizons beyond the period: self-images */
+    PetscCall(Check(&p, horizon, PERI_PARTIAL_VOLUME_LINEAR_CONTINUED, PETSC_TRUE));
+    PetscCall(Check(&p, horizon, PERI_PARTIAL_VOLUME_NONE, PETSC_FALSE));
     PetscCall(PetscFree(horizon));
     PetscCall(PeriParticlesDestroy(&p));
   }
