@@ -156,6 +156,7 @@ typedef struct {
   PeriParticles *p;
   PetscInt       N;
   PetscReal     *x, *vol; /* a mesh's particles (rank 0, while reading) */
+  PetscReal      box[6];  /* a mesh's nodes' bounding box */
 } RootRead;
 
 /* particles.file, first pass: every line checked, the particles counted. */
@@ -206,7 +207,7 @@ static PetscErrorCode MeshReadRoot(void *ctx)
   RootRead *r = (RootRead *)ctx;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriMeshRead(r->scene, r->node, r->p->dim, r->p->thickness, &r->N, &r->x, &r->vol, &r->p->ngroups, &r->p->groups));
+  PetscCall(PeriMeshRead(r->scene, r->node, r->p->dim, r->p->thickness, &r->N, &r->x, &r->vol, &r->p->ngroups, &r->p->groups, r->box));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -261,7 +262,10 @@ static PetscErrorCode ReadBlock(MPI_Comm comm, PeriSource source, RootRead *r)
     else
       PetscCall(CSVDeal(r, &d));
     PetscCall(DealerDestroy(&d));
-    if (source == PERI_SOURCE_MESH) PetscCall(PetscFree2(r->x, r->vol));
+    if (source == PERI_SOURCE_MESH) {
+      PetscCall(PetscFree2(r->x, r->vol));
+      PeriParticlesPeriodicBox(r->p, r->box); /* broadcast below with the extent */
+    }
   } else
     PetscCall(ReceiveBlock(inner, tag, chunk, r->p));
   PetscCall(PetscCommDestroy(&inner));

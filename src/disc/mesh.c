@@ -346,6 +346,21 @@ static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[]
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* particles.refine: every element split uniformly that many times. */
+static PetscErrorCode MeshRefine(PeriScene scene, PeriNode node, const char path[])
+{
+  PetscInt refine = 0;
+  int      ierr   = 0;
+  char     msg[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetInt(scene, node, "refine", PETSC_FALSE, &refine, NULL));
+  for (PetscInt k = 0; k < refine && !ierr; k++) gmshModelMeshRefine(&ierr);
+  if (ierr) GmshLastError(msg, sizeof(msg));
+  PeriInputCheck(!ierr, scene, node, "refine", "Gmsh cannot refine %s: %s", path, msg);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* One particle per element of dimension dim: centroid, measure (x thickness in 2D); elem[tag] is
  * the particle of each element tag (-1 for none). */
 static PetscErrorCode MeshParticles(PeriScene scene, PeriNode node, const char path[], const MeshNodes *nodes, PetscInt dim, PetscReal thickness, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt **elem, size_t *maxelem)
@@ -506,10 +521,11 @@ static PetscErrorCode MeshGroups(PeriScene scene, PeriNode node, const char path
 /*@C
   PeriMeshRead - reads particles.mesh (a Gmsh mesh, or a .geo meshed with particles.size): one
   particle per element of dimension dim at its centroid with its exact volume (area x thickness in
-  2D), and the named physical groups. x, vol are allocated with PetscMalloc2; groups with
+  2D), the named physical groups, and box (lower, then upper corner) the nodes' bounding box: the
+  exact box of a body meshed periodically. x, vol are allocated with PetscMalloc2; groups with
   PetscCalloc1 (free with PeriMeshGroupsDestroy). Not collective: every rank reads the same file.
 @*/
-PetscErrorCode PeriMeshRead(PeriScene scene, PeriNode node, PetscInt dim, PetscReal thickness, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt *ngroups, PeriMeshGroup **groups)
+PetscErrorCode PeriMeshRead(PeriScene scene, PeriNode node, PetscInt dim, PetscReal thickness, PetscInt *n, PetscReal **x, PetscReal **vol, PetscInt *ngroups, PeriMeshGroup **groups, PetscReal box[6])
 {
   char        path[PETSC_MAX_PATH_LEN], dir[PETSC_MAX_PATH_LEN] = "", msh[PETSC_MAX_PATH_LEN] = "";
   PetscBool   geo = PETSC_FALSE, verbose;
@@ -526,7 +542,16 @@ PetscErrorCode PeriMeshRead(PeriScene scene, PeriNode node, PetscInt dim, PetscR
   PetscCall(GmshStart(verbose));
   if (format) PetscCall(MeshImport(scene, node, path, format, dir, sizeof(dir), msh, sizeof(msh)));
   PetscCall(MeshOpen(scene, node, path, dir, msh, geo, lc, dim));
+  PetscCall(MeshRefine(scene, node, path));
   PetscCall(NodesGet(&nodes));
+  for (PetscInt d = 0; d < 3; d++) {
+    box[d]     = d < dim ? PETSC_MAX_REAL : 0;
+    box[3 + d] = d < dim ? PETSC_MIN_REAL : 0;
+    for (size_t k = 0; k < nodes.n && d < dim; k++) {
+      box[d]     = PetscMin(box[d], nodes.xyz[3 * k + d]);
+      box[3 + d] = PetscMax(box[3 + d], nodes.xyz[3 * k + d]);
+    }
+  }
   PetscCall(MeshParticles(scene, node, path, &nodes, dim, thickness, n, x, vol, &elem, &maxelem));
   PetscCall(MeshGroups(scene, node, path, &nodes, dim, thickness, elem, *n, *x, ngroups, groups));
   PetscCall(PetscFree(elem));

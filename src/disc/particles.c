@@ -26,6 +26,8 @@ static const PeriKey particles_keys[] = {
     {"mesh", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "Gmsh mesh (.msh, any version Gmsh reads), geometry (.geo, meshed with size), Abaqus .inp or Exodus II (.exo, .e: converted with meshio), relative to the scene file: one particle per element of dimension dim, named physical groups, element and node sets and Exodus blocks as regions (docs/mesh.md)"},
     {"size", PERI_KEY_REAL, "required for a .geo", "(0, inf)", "[length]", NULL, "the largest element size Gmsh meshes a .geo with (Mesh.MeshSizeMax; smaller sizes in the .geo still refine)"},
     {"verbose", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "let Gmsh print its messages while it reads or meshes particles.mesh"},
+    {"refine", PERI_KEY_INT, "0", "[0, 4]", NULL, NULL, "particles.mesh: split every element uniformly this many times (Gmsh's RefineMesh: a triangle into 4, a tetrahedron into 8), the same mesh finer, as a convergence study refines (docs/mesh.md)"},
+    {"periodic", PERI_KEY_BOOLS, "all false", NULL, NULL, NULL, "particles.mesh: dim booleans, the periodic axes (minimum image); the period is the mesh nodes' extent along the axis (docs/mesh.md)"},
     {NULL},
 };
 const PeriSchema PeriParticlesSchema[] = {
@@ -34,23 +36,46 @@ const PeriSchema PeriParticlesSchema[] = {
     {NULL},
 };
 
+/*@C
+  PeriParticlesReadPeriodic - node.periodic (grid or particles) into p->periodic. Not collective.
+@*/
+PetscErrorCode PeriParticlesReadPeriodic(PeriScene scene, PeriNode node, PeriParticles *p)
+{
+  PeriNode per;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(node, "periodic", &per));
+  if (!per) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(per->kind == PERI_NODE_SEQ && per->n == p->dim, scene, per, NULL, "must be a list of %" PetscInt_FMT " booleans, e.g. [false, true]", p->dim);
+  for (PetscInt d = 0; d < p->dim; d++) PetscCall(PeriSceneParseBool(scene, per->child[d], &p->periodic[d]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriParticlesPeriodicBox - a mesh's body on its periodic axes spans the nodes' bounding box
+  (lower, then upper corner), not the particles' cells: the period is the mesh's length.
+@*/
+void PeriParticlesPeriodicBox(PeriParticles *p, const PetscReal box[6])
+{
+  for (PetscInt d = 0; d < p->dim; d++)
+    if (p->periodic[d]) {
+      p->lower[d] = box[d];
+      p->upper[d] = box[3 + d];
+    }
+}
+
 /* Reads grid.*: the box into p, the cells per axis and the spacing. */
 static PetscErrorCode GridParse(PeriScene scene, PeriNode grid, PetscInt dim, PeriParticles *p, PetscInt cells[3], PetscReal *h)
 {
   PetscReal lower[3] = {0, 0, 0}, upper[3] = {0, 0, 0};
   PetscInt  nl, nu, n = 1;
-  PeriNode  per;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneCheckSection(scene, grid, "grid"));
   PetscCall(PeriSceneGetRealArray(scene, grid, "lower", PETSC_TRUE, dim, dim, lower, &nl));
   PetscCall(PeriSceneGetRealArray(scene, grid, "upper", PETSC_TRUE, dim, dim, upper, &nu));
   PetscCall(PeriSceneGetReal(scene, grid, "spacing", PETSC_TRUE, h, NULL));
-  PetscCall(PeriSceneGetNode(grid, "periodic", &per));
-  if (per) {
-    PeriInputCheck(per->kind == PERI_NODE_SEQ && per->n == dim, scene, per, NULL, "must be a list of %" PetscInt_FMT " booleans, e.g. [false, true]", dim);
-    for (PetscInt d = 0; d < dim; d++) PetscCall(PeriSceneParseBool(scene, per->child[d], &p->periodic[d]));
-  }
+  PetscCall(PeriParticlesReadPeriodic(scene, grid, p));
   for (PetscInt d = 0; d < 3; d++) cells[d] = 1;
   for (PetscInt d = 0; d < dim; d++) {
     PetscReal L = upper[d] - lower[d], c;
@@ -351,12 +376,13 @@ static PetscErrorCode CSVCreate(PeriScene scene, PeriNode node, PetscInt dim, Pe
 static PetscErrorCode MeshCreate(PeriScene scene, PeriNode node, PetscInt dim, PeriParticles *p)
 {
   PetscInt   n, *src;
-  PetscReal *x, *vol;
+  PetscReal *x, *vol, box[6];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriMeshRead(scene, node, dim, p->thickness, &n, &x, &vol, &p->ngroups, &p->groups));
+  PetscCall(PeriMeshRead(scene, node, dim, p->thickness, &n, &x, &vol, &p->ngroups, &p->groups, box));
   PetscCall(PetscCalloc1(n, &src));
   PetscCall(CSVFill(p, n, x, vol, src));
+  PeriParticlesPeriodicBox(p, box);
   PetscCall(PetscFree2(x, vol));
   PetscCall(PetscFree(src));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -388,6 +414,9 @@ PetscErrorCode PeriParticlesSource(PeriScene scene, PetscInt dim, PetscReal thic
   PeriInputCheck(file || mesh, scene, csv, "file", "is required (or give particles.mesh)");
   PeriInputCheck(!(file && mesh), scene, csv, "mesh", "give either particles.file or particles.mesh, not both");
   *source = mesh ? PERI_SOURCE_MESH : PERI_SOURCE_FILE;
+  PetscCall(PeriSceneGetNode(csv, "periodic", &grid));
+  PeriInputCheck(mesh || !grid, scene, csv, "periodic", "applies to particles.mesh (whose nodes give the period); a particles.file has no box");
+  PetscCall(PeriParticlesReadPeriodic(scene, csv, p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

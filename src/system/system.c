@@ -17,6 +17,7 @@ static const char *const spacings[]     = {"mean", "own", NULL};
 static const PeriKey     horizon_keys[] = {
         {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the spacing: delta = m dx (may be fractional); m or delta is required"},
         {"delta", PERI_KEY_REAL, NULL, NULL, "[length]", NULL, "the horizon radius, instead of m"},
+        {"neighbors", PERI_KEY_INT, NULL, "[2, 1000]", NULL, NULL, "instead of m or delta: each particle's horizon holds this many neighbours (the midpoint of its k-th and (k+1)-th nearest distances; Ganzenmüller et al. take 30 on stochastic tetrahedral meshes), a pair bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md"},
         {"spacing", PERI_KEY_CHOICE, "mean", NULL, NULL, spacings, "the spacing m multiplies: mean (one horizon for the body) or own (each particle's own spacing: a horizon per particle, for graded and stochastic meshes; a pair is bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md)"},
         {NULL},
 };
@@ -40,6 +41,24 @@ const PeriSchema PeriSystemSchema[] = {
     {NULL},
 };
 
+/* horizon.neighbors: k. Until the search gives each particle its horizon (SetLocalView), delta and
+ * horizon_m hold the ball of k particles of the largest spacing: the partition's radius. */
+static PetscErrorCode ReadNeighborsHorizon(PeriSystem sys, PeriNode h, PetscReal hmax)
+{
+  PeriScene s = sys->scene;
+  PetscInt  k = 0, dim = sys->disc.particles.dim;
+  PetscBool has;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetInt(s, h, "neighbors", PETSC_FALSE, &k, &has));
+  if (!has) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(sys->model->takes_own_horizon, s, h, "neighbors", "model %s calibrates its springs on one horizon for the whole body; per-particle horizons are derived for pmb and npmb (docs/mesh.md, \"Per-particle horizons\"): use one of them or horizon.m", sys->model->type);
+  sys->disc.horizon_k = k;
+  sys->disc.horizon_m = dim == 3 ? PetscCbrtReal(3.0 * k / (4 * PETSC_PI)) : PetscSqrtReal(k / PETSC_PI);
+  sys->disc.delta     = sys->disc.horizon_m * hmax;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* horizon.spacing: own: each particle's horizon is m times its own spacing, for the models that
  * calibrate per particle; delta becomes the largest. */
 static PetscErrorCode ReadOwnHorizon(PeriSystem sys, PeriNode h, PetscBool hasm, PetscReal m, PetscReal hmax)
@@ -60,7 +79,7 @@ static PetscErrorCode ReadOwnHorizon(PeriSystem sys, PeriNode h, PetscBool hasm,
 static PetscErrorCode ReadHorizon(PeriSystem sys)
 {
   PeriScene s = sys->scene;
-  PeriNode  h;
+  PeriNode  h, kn, sp;
   PetscReal m = 0, hmax = 0;
   PetscBool hasm, hasd;
 
@@ -69,14 +88,20 @@ static PetscErrorCode ReadHorizon(PeriSystem sys)
   PetscCall(PeriSceneCheckSection(s, h, "horizon"));
   PetscCall(PeriSceneGetReal(s, h, "m", PETSC_FALSE, &m, &hasm));
   PetscCall(PeriSceneGetReal(s, h, "delta", PETSC_FALSE, &sys->disc.delta, &hasd));
-  PeriInputCheck(hasm || hasd, s, h, "m", "is required (or give horizon.delta)");
+  PetscCall(PeriSceneGetNode(h, "neighbors", &kn));
+  PeriInputCheck(hasm || hasd || kn, s, h, "m", "is required (or give horizon.delta or horizon.neighbors)");
   PeriInputCheck(!(hasm && hasd), s, h, "delta", "give horizon.m or horizon.delta, not both");
+  PeriInputCheck(!kn || !(hasm || hasd), s, h, "neighbors", "give horizon.neighbors alone: it sets each particle's horizon, as m or delta would");
+  PetscCall(PeriSceneGetNode(h, "spacing", &sp));
+  PeriInputCheck(!kn || !sp, s, h, "spacing", "horizon.neighbors gives every particle its own horizon already; spacing goes with m");
   if (hasm) {
     sys->disc.delta = m * sys->disc.particles.mean_spacing;
   }
   for (PetscInt k = 0; k < sys->disc.particles.n; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm)); /* the ranks' blocks */
   PetscCall(ReadOwnHorizon(sys, h, hasm, m, hmax));
+  PetscCall(ReadNeighborsHorizon(sys, h, hmax));
+  if (kn) PetscFunctionReturn(PETSC_SUCCESS); /* each particle's horizon is a search's result */
   {
     /* beyond the body's diagonal every particle bonds with every other: N^2 bonds, no locality */
     PetscReal diag2 = 0;
@@ -314,6 +339,51 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* horizon.neighbors, before the ghosts exist: each owned particle's horizon among this rank's
+ * particles alone bounds its horizon in the body (more candidates only bring the k-th nearer),
+ * so the largest of them is a ghost radius that brings every particle's k + 1 nearest. Kept in
+ * disc.horizon (owned entries) for SetHorizons; disc.delta becomes that bound. */
+static PetscErrorCode NeighborsHorizonBound(PeriSystem sys, const PeriParticles *owned)
+{
+  PetscReal bound = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(owned->n, &sys->disc.horizon));
+  PetscCall(PeriHorizonsByNeighbors(owned, owned->n, sys->disc.horizon_k + 1, sys->disc.horizon));
+  for (PetscInt k = 0; k < owned->n; k++) bound = PetscMax(bound, sys->disc.horizon[k]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bound, 1, MPIU_REAL, MPI_MAX, sys->comm));
+  sys->disc.delta = bound;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Each local particle's horizon (the ghosts' too: a pair's horizon is the larger of its two):
+ * m times its own spacing, or (horizon.neighbors) the one holding k neighbours, searched among
+ * the owned particles and the ghosts from the bound NeighborsHorizonBound left; delta the
+ * largest. */
+static PetscErrorCode SetHorizons(PeriSystem sys)
+{
+  PeriDisc  *d     = &sys->disc;
+  PetscReal *bound = d->horizon;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(d->particles.n, &d->horizon));
+  if (d->horizon_k) {
+    PetscCall(PetscArraycpy(d->horizon, bound, d->nowned));
+    PetscCall(PeriHorizonsByNeighbors(&d->particles, d->nowned, d->horizon_k, d->horizon));
+    PetscCall(PeriDiscOwnersToGhosts(d, MPIU_REAL, 1, d->horizon));
+    d->delta = 0;
+    for (PetscInt k = 0; k < d->nowned; k++) d->delta = PetscMax(d->delta, d->horizon[k]);
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &d->delta, 1, MPIU_REAL, MPI_MAX, sys->comm));
+  } else
+    for (PetscInt k = 0; k < d->particles.n; k++) d->horizon[k] = d->horizon_m * d->particles.spacing[k];
+  PetscCall(PetscFree(bound));
+  d->horizon_min = PETSC_MAX_REAL;
+  for (PetscInt k = 0; k < d->particles.n; k++) d->horizon_min = PetscMin(d->horizon_min, d->horizon[k]);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &d->horizon_min, 1, MPIU_REAL, MPI_MIN, sys->comm));
+  sys->model->horizon = d->horizon;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* This rank's local view: its owned particles, partitioned (-peri_partition) from the blocks each
  * rank created (PeriParticlesCreateBlock, PeriPartitionBlocks, PeriParticlesMigrate), with the
  * fictitious layer particles that mirror them, then the ghosts within the bonds' search radius. */
@@ -332,17 +402,9 @@ static PetscErrorCode SetLocalView(PeriSystem sys)
   PetscCall(PetscMemzero(&sys->disc.particles, sizeof(sys->disc.particles)));
   for (PetscInt k = 0; k < owned.n; k++) hmax = PetscMax(hmax, owned.spacing[k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
+  if (sys->disc.horizon_k) PetscCall(NeighborsHorizonBound(sys, &owned));
   PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax)));
-  if (sys->disc.horizon_m > 0) { /* the ghosts' too: a pair's horizon is the larger of its two */
-    PetscCall(PetscMalloc1(sys->disc.particles.n, &sys->disc.horizon));
-    sys->disc.horizon_min = PETSC_MAX_REAL;
-    for (PetscInt k = 0; k < sys->disc.particles.n; k++) {
-      sys->disc.horizon[k]  = sys->disc.horizon_m * sys->disc.particles.spacing[k];
-      sys->disc.horizon_min = PetscMin(sys->disc.horizon_min, sys->disc.horizon[k]);
-    }
-    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sys->disc.horizon_min, 1, MPIU_REAL, MPI_MIN, sys->comm));
-    sys->model->horizon = sys->disc.horizon;
-  }
+  if (sys->disc.horizon_m > 0) PetscCall(SetHorizons(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

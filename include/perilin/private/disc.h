@@ -61,7 +61,9 @@ typedef struct _n_PeriMeshGroup {
   PetscReal  measure; /* a group of dimension dim - 1: its length x thickness (2D) or area (3D); else 0 */
 } PeriMeshGroup;
 
-PETSC_EXTERN PetscErrorCode PeriMeshRead(PeriScene, PeriNode, PetscInt, PetscReal, PetscInt *, PetscReal **, PetscReal **, PetscInt *, PeriMeshGroup **);
+PETSC_EXTERN PetscErrorCode PeriMeshRead(PeriScene, PeriNode, PetscInt, PetscReal, PetscInt *, PetscReal **, PetscReal **, PetscInt *, PeriMeshGroup **, PetscReal[6]);
+PETSC_EXTERN PetscErrorCode PeriParticlesReadPeriodic(PeriScene, PeriNode, PeriParticles *);
+PETSC_EXTERN void           PeriParticlesPeriodicBox(PeriParticles *, const PetscReal[6]);
 PETSC_EXTERN PetscErrorCode PeriMeshGroupsDestroy(PetscInt *, PeriMeshGroup **);
 PETSC_EXTERN PetscErrorCode PeriMeshGroupsRestrict(PeriParticles *);
 
@@ -93,6 +95,7 @@ PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscRe
 PETSC_EXTERN PetscReal      PeriRegionTolerance(const PeriParticles *);
 
 PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *, PetscInt, PetscInt, PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsAdd(const PeriParticles *, PetscInt, PetscInt, const PetscReal[], PetscReal, PeriPartialVolume, PeriBonds *, PetscInt *);
 PETSC_EXTERN PetscErrorCode PeriBondsReserve(PeriBonds *, PetscInt, PetscInt *);
@@ -167,6 +170,7 @@ typedef struct {
   PeriRegion           *regions;
   PetscReal             delta;       /* the horizon: the body's one, or the largest of horizon[] */
   PetscReal             horizon_m;   /* horizon.spacing: own: delta_i = m h_i; 0: one delta */
+  PetscInt              horizon_k;   /* horizon.neighbors: delta_i holds k neighbours (horizon_m its estimate before the search); 0: none */
   PetscReal            *horizon;     /* horizon.spacing: own: each local particle's delta_i; else NULL */
   PetscReal             horizon_min; /* horizon.spacing: own: the smallest delta_i of the body */
   PeriPartialVolume     partial_volume;

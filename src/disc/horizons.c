@@ -1,0 +1,75 @@
+/* Per-particle horizons from a neighbour count (horizon.neighbors: k): Ganzenmüller et al.
+ * (sec. 3.1.2) give each particle of a stochastic mesh the horizon whose family holds 30
+ * neighbours, since a sliver's own volume says nothing about how far its neighbours are. A
+ * particle's horizon is the midpoint between its k-th and (k+1)-th nearest neighbours, so that
+ * its own ball holds exactly k of them however the distances round. */
+#include "perilin/private/disc.h"
+
+#define HORIZONS_GROWTH 1.6 /* a radius holding too few neighbours grows by this and is searched again */
+#define HORIZONS_ROUNDS 60  /* 1.6^60 ~ 1e12: beyond it the particle is alone in the body */
+
+static int CompareReal(const void *a, const void *b)
+{
+  const PetscReal x = *(const PetscReal *)a, y = *(const PetscReal *)b;
+  return (x > y) - (x < y);
+}
+
+/* From the bonds of row i within radius r (the search's pairs within the larger of the two
+ * radii: those beyond r are the other end's), the midpoint of the k-th and (k+1)-th distances;
+ * 0 when fewer than k + 1 lie within r. */
+static PetscReal RowHorizon(const PeriBonds *b, PetscInt i, PetscReal r, PetscInt k, PetscReal *buf)
+{
+  PetscInt m = 0;
+
+  for (PetscInt q = b->offset[i]; q < b->offset[i + 1]; q++)
+    if (b->length[q] <= r) buf[m++] = b->length[q];
+  if (m < k + 1) return 0;
+  qsort(buf, (size_t)m, sizeof(*buf), CompareReal);
+  return 0.5 * (buf[k - 1] + buf[k]);
+}
+
+/*@C
+  PeriHorizonsByNeighbors - for particles 0..nrows-1 of p, the horizon that holds exactly k of the
+  particles of p (the midpoint of the k-th and (k+1)-th nearest distances, periodic images
+  included). r[] holds, on entry, a radius per row known to hold k + 1 of them, or 0 for none
+  (then the search starts from 1.25 times the radius of the ball of k particles of its own spacing, and grows). Rows
+  beyond nrows (a rank's ghosts) are searched from, never for. Not collective; errors when p has
+  no k + 1 particles around a row.
+@*/
+PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *p, PetscInt nrows, PetscInt k, PetscReal r[])
+{
+  PetscReal *guess, *buf = NULL, gmin = PETSC_MAX_REAL;
+  PetscBool  pending = PETSC_TRUE;
+  PetscInt   cap     = 0;
+
+  PetscFunctionBeginUser;
+  if (!nrows) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc1(p->n, &guess));
+  for (PetscInt i = 0; i < nrows; i++) {
+    guess[i] = r[i] > 0 ? r[i] : 1.25 * PetscPowReal(p->dim == 3 ? 3.0 * k / (4 * PETSC_PI) : k / PETSC_PI, 1.0 / p->dim) * p->spacing[i];
+    gmin     = PetscMin(gmin, guess[i]);
+  }
+  for (PetscInt i = nrows; i < p->n; i++) guess[i] = gmin; /* the ghosts' only widen the search */
+  for (PetscInt round = 0; pending; round++) {
+    PeriBonds b;
+    PetscCheck(round < HORIZONS_ROUNDS, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "horizon.neighbors %" PetscInt_FMT ": a particle has fewer than %" PetscInt_FMT " others within reach (%" PetscInt_FMT " particles here); use fewer neighbours or fewer ranks", k, k + 1, p->n);
+    PetscCall(PeriNeighborSearchLevels(p, guess, PERI_PARTIAL_VOLUME_NONE, 0, nrows, PETSC_FALSE, &b));
+    pending = PETSC_FALSE;
+    for (PetscInt i = 0; i < nrows; i++) {
+      PetscInt m = b.offset[i + 1] - b.offset[i];
+      if (m > cap) {
+        PetscCall(PetscFree(buf));
+        cap = 2 * m;
+        PetscCall(PetscMalloc1(cap, &buf));
+      }
+      r[i] = RowHorizon(&b, i, guess[i], k, buf);
+      if (r[i] > 0) continue;
+      guess[i] *= HORIZONS_GROWTH;
+      pending = PETSC_TRUE;
+    }
+    PetscCall(PeriBondsDestroy(&b));
+  }
+  PetscCall(PetscFree(buf));
+  PetscCall(PetscFree(guess));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
