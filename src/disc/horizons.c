@@ -2,7 +2,8 @@
  * (sec. 3.1.2) give each particle of a stochastic mesh the horizon whose family holds 30
  * neighbours, since a sliver's own volume says nothing about how far its neighbours are. A
  * particle's horizon is the midpoint between its k-th and (k+1)-th nearest neighbours, so that
- * its own ball holds exactly k of them however the distances round. */
+ * its own ball holds exactly k of them however the distances round (all of them when several tie
+ * at the k-th distance). */
 #include "perilin/private/disc.h"
 
 #define HORIZONS_GROWTH 1.6 /* a radius holding too few neighbours grows by this and is searched again */
@@ -39,37 +40,39 @@ static PetscReal RowHorizon(const PeriBonds *b, PetscInt i, PetscReal r, PetscIn
 PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *p, PetscInt nrows, PetscInt k, PetscReal r[])
 {
   PetscReal *guess, *buf = NULL, gmin = PETSC_MAX_REAL;
-  PetscBool  pending = PETSC_TRUE;
-  PetscInt   cap     = 0;
+  PetscInt   cap = 0, *pending, npending = nrows;
 
   PetscFunctionBeginUser;
   if (!nrows) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc1(p->n, &guess));
+  PetscCall(PetscMalloc2(p->n, &guess, nrows, &pending));
   for (PetscInt i = 0; i < nrows; i++) {
-    guess[i] = r[i] > 0 ? r[i] : 1.25 * PetscPowReal(p->dim == 3 ? 3.0 * k / (4 * PETSC_PI) : k / PETSC_PI, 1.0 / p->dim) * p->spacing[i];
-    gmin     = PetscMin(gmin, guess[i]);
+    guess[i]   = r[i] > 0 ? r[i] : 1.25 * PetscPowReal(p->dim == 3 ? 3.0 * k / (4 * PETSC_PI) : k / PETSC_PI, 1.0 / p->dim) * p->spacing[i];
+    gmin       = PetscMin(gmin, guess[i]);
+    pending[i] = i;
   }
   for (PetscInt i = nrows; i < p->n; i++) guess[i] = gmin; /* the ghosts' only widen the search */
-  for (PetscInt round = 0; pending; round++) {
+  /* each round searches the rows still short of k + 1 neighbours, with their radii grown */
+  for (PetscInt round = 0; npending; round++) {
     PeriBonds b;
+    PetscInt  left = 0;
     PetscCheck(round < HORIZONS_ROUNDS, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "horizon.neighbors %" PetscInt_FMT ": a particle has fewer than %" PetscInt_FMT " others within reach (%" PetscInt_FMT " particles here); use fewer neighbours or fewer ranks", k, k + 1, p->n);
-    PetscCall(PeriNeighborSearchLevels(p, guess, PERI_PARTIAL_VOLUME_NONE, 0, nrows, PETSC_FALSE, &b));
-    pending = PETSC_FALSE;
-    for (PetscInt i = 0; i < nrows; i++) {
-      PetscInt m = b.offset[i + 1] - b.offset[i];
+    PetscCall(PeriNeighborSearchLevelsRows(p, guess, PERI_PARTIAL_VOLUME_NONE, npending, pending, 0, PETSC_FALSE, &b));
+    for (PetscInt q = 0; q < npending; q++) {
+      const PetscInt i = pending[q], m = b.offset[q + 1] - b.offset[q];
       if (m > cap) {
         PetscCall(PetscFree(buf));
         cap = 2 * m;
         PetscCall(PetscMalloc1(cap, &buf));
       }
-      r[i] = RowHorizon(&b, i, guess[i], k, buf);
+      r[i] = RowHorizon(&b, q, guess[i], k, buf);
       if (r[i] > 0) continue;
       guess[i] *= HORIZONS_GROWTH;
-      pending = PETSC_TRUE;
+      pending[left++] = i;
     }
+    npending = left;
     PetscCall(PeriBondsDestroy(&b));
   }
   PetscCall(PetscFree(buf));
-  PetscCall(PetscFree(guess));
+  PetscCall(PetscFree2(guess, pending));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -259,6 +259,17 @@ static PetscErrorCode LevelCells(const PeriParticles *p, const PetscInt level[],
 @*/
 PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
 {
+  PetscFunctionBeginUser;
+  PetscCall(PeriNeighborSearchLevelsRows(p, horizon, pv, rend - rstart, NULL, rstart, half, b));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriNeighborSearchLevelsRows - PeriNeighborSearchLevels for the rows rows[0..nrows-1] of p, or
+  (rows NULL) rstart..rstart+nrows-1: row r of b is particle rows[r]. Not collective.
+@*/
+PetscErrorCode PeriNeighborSearchLevelsRows(const PeriParticles *p, const PetscReal horizon[], PeriPartialVolume pv, PetscInt nrows, const PetscInt rows[], PetscInt rstart, PetscBool half, PeriBonds *b)
+{
   SparseCells    cum[LEVELS_MAX], own[LEVELS_MAX];
   PetscInt      *level, nl, cap = 0;
   PetscReal      rmin, *reach;
@@ -269,15 +280,16 @@ PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *p, const PetscReal 
   PetscCall(PetscMalloc2(p->n, &level, p->n, &reach));
   PetscCall(Levels(p, horizon, pv, reach, level, &nl, &rmin));
   PetscCall(LevelCells(p, level, nl, rmin, cum, own));
-  b->rstart = rstart;
-  b->rend   = rend;
-  PetscCall(PetscMalloc1(rend - rstart + 1, &b->offset));
+  b->rstart = rows ? 0 : rstart;
+  b->rend   = b->rstart + nrows;
+  PetscCall(PetscMalloc1(nrows + 1, &b->offset));
   b->offset[0] = 0;
   /* coincident particles are an input error: the cells are freed before it is passed on */
-  for (PetscInt i = rstart; i < rend && !ierr; i++) {
-    ierr = ImagesBonds(p, horizon, reach, pv, &cum[level[i]], LevelCut(rmin, level[i]), i, half, b, &cap);
+  for (PetscInt r = 0; r < nrows && !ierr; r++) {
+    const PetscInt i = rows ? rows[r] : rstart + r;
+    ierr             = ImagesBonds(p, horizon, reach, pv, &cum[level[i]], LevelCut(rmin, level[i]), i, half, b, &cap);
     for (PetscInt L = level[i] + 1; L < nl && !ierr; L++) ierr = ImagesBonds(p, horizon, reach, pv, &own[L], LevelCut(rmin, L), i, half, b, &cap);
-    b->offset[i - rstart + 1] = b->nbonds;
+    b->offset[r + 1] = b->nbonds;
   }
   for (PetscInt L = 0; L < nl; L++) {
     PetscCall(SparseCellsDestroy(&cum[L]));

@@ -301,7 +301,8 @@ PetscErrorCode PeriSystemFindProbe(PeriSystem sys, const char name[], PeriProbe 
 
 /*@C
   PeriSystemAddFields - the system's per-particle fields besides the solution, over this rank's
-  particles (a list of PeriSystemFieldListCreate): volume, neighbours, rank, and where they exist
+  particles (a list of PeriSystemFieldListCreate): volume, neighbours, each particle's horizon
+  (per-particle horizons), rank, and where they exist
   strain energy density and antiplane shear stresses; then the features' own (damage:
   PeriFailureAddFields; mirror images: PeriLayersAddFields; the conditions: fixed components,
   prescribed values, applied forces, regions: PeriConditionsAddFields). Each rank's piece: its owned particles, local 0..nowned-1.
@@ -311,6 +312,7 @@ PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
   PetscFunctionBeginUser;
   PetscCall(PeriFieldListAddReal(fl, "volume", 1, sys->disc.particles.volume, 1, NULL));
   PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count));
+  if (sys->disc.horizon) PetscCall(PeriFieldListAddReal(fl, "horizon", 1, sys->disc.horizon, 1, NULL)); /* per-particle horizons */
   PetscCall(PeriFieldListAddIntConstant(fl, "rank", sys->rank));
   if (sys->fields.W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->fields.W, 1, NULL));
   if (sys->fields.tau) {
