@@ -7,7 +7,9 @@
 /* Why K cannot be matrix-free for this system and analysis, or NULL when it can. */
 const char *PeriMatrixFreeWhyNot(PeriSystem sys)
 {
-  if (!sys->model->central_force) return "the model's bonds are not all central springs (pmb, npmb and cpmb are)";
+  const char *why = PeriOperatorWhyNotModel(sys->model);
+
+  if (why) return why;
   if (!sys->stiffness.needs.matrix_free) return "the analysis needs K's entries (matrix_free serves the static, quasi-static, tune and explicit dynamic analyses)";
   if (sys->conditions.layers.T) return "fictitious layers eliminate K's rows through its entries";
   return NULL;
@@ -22,7 +24,7 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
   PeriNode    node;
 
   PetscFunctionBeginUser;
-  *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->stiffness.operator_kind == PERI_OPERATOR_AUTO));
+  *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || (sys->stiffness.operator_kind == PERI_OPERATOR_AUTO && sys->model->central_force)));
   if (*mf && sys->stiffness.operator_kind == PERI_OPERATOR_AUTO) {
     /* the short-range stiffness serves AMG, the diagonal Jacobi; another -pc_type (a
        factorization) gets K itself */
