@@ -622,6 +622,36 @@ PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The shear and micropolar forms: P <- V P V with V = diag(sqrt(K_rr / P_rr)), so that P's diagonal
+ * is K's. The per-particle scale of the short range comes from the energy of a uniform expansion,
+ * which the normal springs (spread over the whole horizon) carry; the shear and rotational springs
+ * of gerstle weigh 1/|xi|^2 and 1/|xi| and sit mostly in the short bonds, so that scale
+ * overstated them (the 57,600-particle gerstle lamina: 48 CG iterations, with this 38). Broken
+ * bonds would have to change P as scaled: matrix_free is refused for these forms with failure
+ * (PeriMatrixFreeWhyNot). Collective. */
+static PetscErrorCode MatchDiagonal(PeriOperator op, Mat P)
+{
+  Vec                pd;
+  const PetscScalar *ka, *pa;
+  PetscScalar       *va;
+
+  PetscFunctionBeginUser;
+  if (op->kdiag_stale) PetscCall(ComputeDiagonal(op));
+  PetscCall(VecDuplicate(op->kdiag, &pd));
+  PetscCall(MatGetDiagonal(P, pd));
+  PetscCall(VecGetArrayRead(op->kdiag, &ka));
+  PetscCall(VecGetArrayRead(pd, &pa));
+  PetscCall(VecGetArrayWrite(op->xm, &va));
+  /* a DOF without bonds keeps its row */
+  for (PetscInt r = 0; r < op->nloc * op->bs; r++) va[r] = PetscRealPart(pa[r]) > 0 && PetscRealPart(ka[r]) > 0 ? PetscSqrtReal(PetscRealPart(ka[r]) / PetscRealPart(pa[r])) : 1;
+  PetscCall(VecRestoreArrayWrite(op->xm, &va));
+  PetscCall(VecRestoreArrayRead(pd, &pa));
+  PetscCall(VecRestoreArrayRead(op->kdiag, &ka));
+  PetscCall(VecDestroy(&pd));
+  PetscCall(MatDiagonalScale(P, op->xm, op->xm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriOperatorPreconditioner - sys->stiffness.Kpc, the preconditioning matrix of the matrix-free K, assembled
   on first use: the short bonds' blocks (k e e^T = w w^T, the assembly's own), restricted and
@@ -633,6 +663,7 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
   if (sys->stiffness.Kpc) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
   PetscCall(PeriAssembleShortRange(sys, &sys->stiffness.op->short_range, PERI_BROKEN_SHARE, &sys->stiffness.Kpc));
+  if (sys->stiffness.op->form != FORM_CENTRAL) PetscCall(MatchDiagonal(sys->stiffness.op, sys->stiffness.Kpc));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   if (!sys->run.log.pc_matrix_counted) { /* summary.json's matrix_mb counts it with the operator */
     PetscReal mb;
@@ -670,6 +701,7 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
   for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= op->form == FORM_CENTRAL ? PetscSqrtReal(factor) : factor;
   if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc.bonds, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(op->form == FORM_CENTRAL, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the preconditioning matrix of shear and micropolar bonds is diagonally scaled and cannot follow a broken bond");
   for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc.bonds, i, k) * Ke[a];
   PetscCall(MatSetValuesBlocked(sys->stiffness.Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
