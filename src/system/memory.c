@@ -72,7 +72,7 @@ static PetscErrorCode SearchRadius(PeriScene s, PetscReal h, PetscReal *r)
 
 /* Whether the run will apply K matrix-free (PeriSystemAssemble's rule, solver.operator): bonds the
  * operator applies, an analysis that allows it (needs.matrix_free), and operator matrix_free, or
- * auto with central springs and the default or a diagonal PC. Fictitious layers (which turn it off) are not looked at: the estimate is then
+ * auto with the default or a diagonal PC. Fictitious layers (which turn it off) are not looked at: the estimate is then
  * low by the matrix. */
 static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const PeriSystemNeeds *needs, PetscBool *mf)
 {
@@ -85,7 +85,7 @@ static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const PeriSystemNeeds
   PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &solver));
   if (solver) PetscCall(PeriSceneGetString(s, solver, "operator", PETSC_FALSE, op, sizeof(op), NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
-  *mf = (PetscBool)(!strcmp(op, "matrix_free") || (!strcmp(op, "auto") && m->central_force && PeriOperatorServesPC(pc)));
+  *mf = (PetscBool)(!strcmp(op, "matrix_free") || (!strcmp(op, "auto") && PeriOperatorServesPC(pc)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -239,6 +239,7 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m,
   PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
   failure = grid ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(MatrixFree(s, m, needs, &mf));
+  if (failure && !m->central_force) mf = PETSC_FALSE; /* PeriMatrixFreeWhyNot */
   PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, needs, mf, &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));

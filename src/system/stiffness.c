@@ -18,16 +18,17 @@ const char *PeriMatrixFreeWhyNot(PeriSystem sys)
   return NULL;
 }
 
-/* solver.operator: matrix_free applies to central-force models solved once as assembled (the
- * static analysis), without fictitious layers; auto takes it with GAMG (the default), where
- * it wins (docs/performance.md), and assembled K elsewhere. */
+/* solver.operator: matrix_free applies to the bond-based models whose blocks operator.c knows
+ * (central, 2D shear and micropolar) in the analyses that allow it, without fictitious layers
+ * (and for shear and micropolar bonds without failure); auto takes it with GAMG (the default),
+ * where it wins (docs/performance.md), and assembled K elsewhere. */
 static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 {
   const char *why = PeriMatrixFreeWhyNot(sys);
   PeriNode    node;
 
   PetscFunctionBeginUser;
-  *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || (sys->stiffness.operator_kind == PERI_OPERATOR_AUTO && sys->model->central_force)));
+  *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->stiffness.operator_kind == PERI_OPERATOR_AUTO));
   if (*mf && sys->stiffness.operator_kind == PERI_OPERATOR_AUTO) {
     /* the short-range stiffness serves AMG, the diagonal Jacobi; another -pc_type (a
        factorization) gets K itself */
