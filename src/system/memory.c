@@ -70,9 +70,9 @@ static PetscErrorCode SearchRadius(PeriScene s, PetscReal h, PetscReal *r)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether the run will apply K matrix-free (PeriSystemAssemble's rule, solver.operator): central
- * springs, an analysis that allows it (needs.matrix_free), and operator matrix_free, or auto with
- * the default or a diagonal PC. Fictitious layers (which turn it off) are not looked at: the estimate is then
+/* Whether the run will apply K matrix-free (PeriSystemAssemble's rule, solver.operator): bonds the
+ * operator applies, an analysis that allows it (needs.matrix_free), and operator matrix_free, or
+ * auto with the default or a diagonal PC. Fictitious layers (which turn it off) are not looked at: the estimate is then
  * low by the matrix. */
 static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const PeriSystemNeeds *needs, PetscBool *mf)
 {
@@ -81,7 +81,7 @@ static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const PeriSystemNeeds
 
   PetscFunctionBeginUser;
   *mf = PETSC_FALSE;
-  if (!m->central_force || !needs->matrix_free) PetscFunctionReturn(PETSC_SUCCESS);
+  if (PeriOperatorWhyNotModel(m) || !needs->matrix_free) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetMap(s, s->root, "solver", PETSC_FALSE, &solver));
   if (solver) PetscCall(PeriSceneGetString(s, solver, "operator", PETSC_FALSE, op, sizeof(op), NULL));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
@@ -135,7 +135,9 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
                                                                                : ball);
   nnz    = n * blocks * dofs * dofs;
   matrix = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
-  if (mf) reserved += e->nbonds * (sizeof(PetscInt) + dofs * sizeof(PetscReal));
+  if (mf) reserved += e->nbonds * (sizeof(PetscInt) + (m->central_force ? dofs : dofs == 2 ? 3
+                                                                                           : 7) *
+                                                          sizeof(PetscReal)); /* operator.c's forms */
   /* GAMG's scalar graph (matrix / dofs^2), its coarse levels and prolongators and CG's vectors:
      PERI_MEMORY_SOLVER graphs, fitted to the peaks of 2D plates (2 DOFs, 1e4-1e6 particles, where
      the whole run peaks at 2.5x the matrix as in docs/performance.md) and 3D blocks (3 DOFs) */
@@ -237,6 +239,7 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m,
   PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
   failure = grid ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(MatrixFree(s, m, needs, &mf));
+  if (failure && !m->central_force) mf = PETSC_FALSE; /* PeriMatrixFreeWhyNot */
   PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, needs, mf, &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));

@@ -1,9 +1,19 @@
-/* The matrix-free operator of central-force bond models (solver.operator: matrix_free): K u applied
- * bond by bond from one vector per bond, w = sqrt(k) e (k the bond's spring constant, e its unit
- * vector: the bond's block is k e e^T), 28 bytes per bond where the assembled K holds two dim x dim
- * blocks per bond in each of two rows (about 150 bytes in 3D). AMG then works on an assembled
- * short-range stiffness (the bonds no longer than solver.pc_radius times their ends' nearest-neighbour
- * distance, scaled to the full family's stiffness): a few shells instead of the whole horizon. */
+/* The matrix-free operator of bond-based models (solver.operator: matrix_free): K u applied bond by
+ * bond from the few numbers that each bond's block is made of, in one of three forms:
+ *   central force (pmb, npmb, cpmb): k [e e^T, -e e^T; -e e^T, e e^T], stored as w = sqrt(k) e
+ *     (k the spring constant, e the unit vector), 28 bytes per bond in 3D where the assembled K
+ *     holds two dim x dim blocks per bond in each of two rows (about 150 bytes);
+ *   shear (pds, 2D): [A, -A; -A, A], A = k_n e e^T + k_t t t^T, stored as A's 3 entries;
+ *   micropolar (mppd, gerstle; ux, uy, theta): translations move both ends alike and the sliding
+ *     sees the sum of the rotations, so the 6 x 6 block is
+ *       [ A    c  -A    c ]
+ *       [ c^T  a  -c^T  b ]
+ *       [-A   -c   A   -c ]
+ *       [ c^T  b  -c^T  a ]   stored as A (3), c (2), a and b: 7 numbers (60 bytes) against 72.
+ * The form comes from the block itself (CollectBonds checks that it has it). AMG then works on an
+ * assembled short-range stiffness (the bonds no longer than solver.pc_radius times their ends'
+ * nearest-neighbour distance, scaled to the full family's stiffness): a few shells instead of the
+ * whole horizon. */
 #include "perilin/private/system.h"
 
 /* The share of its block that a broken bond keeps in the preconditioning matrix. */
@@ -11,12 +21,21 @@
 #  define PERI_BROKEN_SHARE 1e-2
 #endif
 
+/* The forms of a bond's block (top of the file), and the numbers each stores per bond. */
+typedef enum {
+  FORM_CENTRAL,
+  FORM_SHEAR,
+  FORM_MICROPOLAR
+} BondForm;
+
 struct _p_PeriOperator {
   PetscInt       refct; /* the system's reference and one per shell: a reused preconditioner may keep a shell after the system rebuilt its operator */
   PetscInt       nloc, bs, nghost;
+  BondForm       form;
+  PetscInt       nw;  /* numbers per bond: bs (central), 3 (shear), 7 (micropolar) */
   PetscInt      *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
   PetscInt      *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
-  PetscReal     *w;   /* bs per bond: sqrt(k) e */
+  PetscReal     *w;   /* nw per bond: sqrt(k) e; A (xx, xy, yy); A, c (x, y), a, b */
   PetscInt      *ghost;
   PetscInt      *slot;        /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
   PeriShortRange short_range; /* the preconditioning matrix's bonds and their scales */
@@ -35,8 +54,8 @@ typedef struct {
   PetscReal   *hd;   /* their diagonal values */
 } Shell;
 
-/* y_i += sum_b w_b (w_b . (u_i - u_j)), and the opposite at j, on the local forms (owned, then
- * ghosts). Called with a literal bs, so that the compiler unrolls the inner loops. */
+/* The central form: y_i += sum_b w_b (w_b . (u_i - u_j)), and the opposite at j, on the local
+ * forms (owned, then ghosts). Called with a literal bs, so that the compiler unrolls the inner loops. */
 static inline void BondLoop(const PeriOperator op, const PetscInt bs, const PetscScalar *x, PetscScalar *y)
 {
   for (PetscInt i = 0; i < op->nloc; i++) {
@@ -56,6 +75,77 @@ static inline void BondLoop(const PeriOperator op, const PetscInt bs, const Pets
   }
 }
 
+/* The shear form in 2D: f = A (u_i - u_j) at i, -f at j. */
+static void ShearLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y)
+{
+  for (PetscInt i = 0; i < op->nloc; i++) {
+    const PetscScalar *ui = x + 2 * i;
+    PetscScalar        ax = 0, ay = 0;
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal   *A  = op->w + 3 * b;
+      const PetscScalar *uj = x + 2 * op->jl[b];
+      PetscScalar       *yj = y + 2 * op->jl[b];
+      const PetscScalar  dx = ui[0] - uj[0], dy = ui[1] - uj[1];
+      const PetscScalar  fx = A[0] * dx + A[1] * dy, fy = A[1] * dx + A[2] * dy;
+      ax += fx;
+      ay += fy;
+      yj[0] -= fx;
+      yj[1] -= fy;
+    }
+    y[2 * i] += ax;
+    y[2 * i + 1] += ay;
+  }
+}
+
+/* The micropolar form (ux, uy, theta): with d = u_i - u_j and s = theta_i + theta_j, the forces
+ * are A d + c s at i and their opposite at j, the moments c.d + a theta_i + b theta_j at i and
+ * c.d + b theta_i + a theta_j at j. */
+static void MicropolarLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y)
+{
+  for (PetscInt i = 0; i < op->nloc; i++) {
+    const PetscScalar *ui = x + 3 * i;
+    PetscScalar        ax = 0, ay = 0, am = 0;
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal   *w  = op->w + 7 * b;
+      const PetscScalar *uj = x + 3 * op->jl[b];
+      PetscScalar       *yj = y + 3 * op->jl[b];
+      const PetscScalar  dx = ui[0] - uj[0], dy = ui[1] - uj[1], s = ui[2] + uj[2];
+      const PetscScalar  fx = w[0] * dx + w[1] * dy + w[3] * s, fy = w[1] * dx + w[2] * dy + w[4] * s, cd = w[3] * dx + w[4] * dy;
+      ax += fx;
+      ay += fy;
+      am += cd + w[5] * ui[2] + w[6] * uj[2];
+      yj[0] -= fx;
+      yj[1] -= fy;
+      yj[2] += cd + w[6] * ui[2] + w[5] * uj[2];
+    }
+    y[3 * i] += ax;
+    y[3 * i + 1] += ay;
+    y[3 * i + 2] += am;
+  }
+}
+
+/* The bond loop of the operator's form; literal block sizes, so that the compiler unrolls. */
+static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y)
+{
+  if (op->form == FORM_MICROPOLAR)
+    MicropolarLoop(op, x, y);
+  else if (op->form == FORM_SHEAR)
+    ShearLoop(op, x, y);
+  else if (op->bs == 3)
+    BondLoop(op, 3, x, y);
+  else if (op->bs == 2)
+    BondLoop(op, 2, x, y);
+  else
+    BondLoop(op, op->bs, x, y);
+}
+
+/* Flops of one product per bond, for -log_view. */
+static PetscReal FormFlops(const PeriOperator op)
+{
+  return op->form == FORM_MICROPOLAR ? 32 : op->form == FORM_SHEAR ? 14
+                                                                   : 6.0 * op->bs;
+}
+
 /* op->ym = K op->xm (owned part of xm set): ghosts in, the bond loop, ghost contributions back. */
 static PetscErrorCode ApplyK(PeriOperator op)
 {
@@ -72,19 +162,14 @@ static PetscErrorCode ApplyK(PeriOperator op)
   PetscCall(VecSet(yl, 0));
   PetscCall(VecGetArrayRead(xl, &xa));
   PetscCall(VecGetArray(yl, &ya));
-  if (op->bs == 3)
-    BondLoop(op, 3, xa, ya);
-  else if (op->bs == 2)
-    BondLoop(op, 2, xa, ya);
-  else
-    BondLoop(op, op->bs, xa, ya);
+  FormLoop(op, xa, ya);
   PetscCall(VecRestoreArray(yl, &ya));
   PetscCall(VecRestoreArrayRead(xl, &xa));
   PetscCall(VecGhostRestoreLocalForm(op->ym, &yl));
   PetscCall(VecGhostRestoreLocalForm(op->xm, &xl));
   PetscCall(VecGhostUpdateBegin(op->ym, ADD_VALUES, SCATTER_REVERSE));
   PetscCall(VecGhostUpdateEnd(op->ym, ADD_VALUES, SCATTER_REVERSE));
-  PetscCall(PetscLogFlops(6.0 * op->ptr[op->nloc] * op->bs));
+  PetscCall(PetscLogFlops(FormFlops(op) * op->ptr[op->nloc]));
   PetscCall(PetscLogEventEnd(PERI_EVENT_MatMultFree, 0, 0, 0, 0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -244,21 +329,94 @@ PetscErrorCode PeriOperatorCreateMat(PeriSystem sys, Mat *A)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The spring constant k of a central-force bond block Ke = k [e e^T, -e e^T; -e e^T, e e^T]: its
- * trace over the first dim x dim block; an error when the block is not of that form. */
-static PetscErrorCode SpringConstant(PeriModel m, const PeriBondGeometry *g, const PetscReal Ke[], PetscReal *k)
+/*@C
+  PeriOperatorWhyNotModel - why the matrix-free operator cannot apply the model's bonds, or NULL
+  when their blocks have one of its forms (central force, or a 2D shear or micropolar bond).
+  Not collective.
+@*/
+const char *PeriOperatorWhyNotModel(PeriModel m)
 {
-  const PetscInt n   = 2 * m->dofs;
-  PetscReal      dev = 0;
+  if (m->central_force) return NULL;
+  if (!m->ops.bond_stiffness || m->ops.family_stiffness) return "the model has no per-bond blocks";
+  if (m->dim == 2 && (m->dofs == 2 || m->dofs == 3)) return NULL;
+  return "the model's bonds are neither central springs (pmb, npmb, cpmb) nor 2D shear (pds) or micropolar (mppd, gerstle) bonds";
+}
+
+/* The form of the model's blocks and the numbers it stores per bond. */
+static void ModelForm(PeriModel m, PeriOperator op)
+{
+  op->form = m->central_force ? FORM_CENTRAL : m->dofs == 2 ? FORM_SHEAR
+                                                            : FORM_MICROPOLAR;
+  op->nw   = op->form == FORM_CENTRAL ? m->dofs : op->form == FORM_SHEAR ? 3
+                                                                         : 7;
+}
+
+/* The numbers w[] of bond block Ke in the operator's form (top of the file); for the central form
+ * k is the trace of the first dim x dim block. */
+static void FormNumbers(const PeriOperator op, const PeriBondGeometry *g, const PetscReal Ke[], PetscReal w[])
+{
+  const PetscInt n = 2 * op->bs;
+  PetscReal      k = 0;
+
+  if (op->form == FORM_CENTRAL) {
+    for (PetscInt a = 0; a < op->bs; a++) k += Ke[a * n + a];
+    for (PetscInt d = 0; d < op->bs; d++) w[d] = PetscSqrtReal(PetscMax(k, 0)) * g->xi[d] / g->length;
+    return;
+  }
+  w[0] = Ke[0];
+  w[1] = Ke[1];
+  w[2] = Ke[n + 1];
+  if (op->form == FORM_SHEAR) return;
+  w[3] = Ke[2];
+  w[4] = Ke[n + 2];
+  w[5] = Ke[2 * n + 2];
+  w[6] = Ke[2 * n + 5];
+}
+
+/* The block that the numbers w[] stand for: what FormNumbers read it from, if it had the form. */
+static void FormBlock(const PeriOperator op, const PetscReal w[], PetscReal Ke[])
+{
+  const PetscInt n = 2 * op->bs, nu = op->form == FORM_MICROPOLAR ? 2 : op->bs;
+  PetscReal      A[PERI_MAX_DOF * PERI_MAX_DOF];
+
+  for (PetscInt r = 0; r < nu; r++)
+    for (PetscInt c = 0; c < nu; c++) A[r * nu + c] = op->form == FORM_CENTRAL ? w[r] * w[c] : w[r + c];
+  for (PetscInt a = 0; a < n * n; a++) Ke[a] = 0;
+  for (PetscInt e = 0; e < 2; e++)
+    for (PetscInt f = 0; f < 2; f++)
+      for (PetscInt r = 0; r < nu; r++)
+        for (PetscInt c = 0; c < nu; c++) Ke[(e * op->bs + r) * n + f * op->bs + c] = (e == f ? 1 : -1) * A[r * nu + c];
+  if (op->form != FORM_MICROPOLAR) return;
+  for (PetscInt e = 0; e < 2; e++)
+    for (PetscInt r = 0; r < 2; r++) { /* c couples each end's forces to both rotations, and back */
+      const PetscReal sign    = e ? -1 : 1;
+      Ke[(3 * e + r) * n + 2] = Ke[(3 * e + r) * n + 5] = sign * w[3 + r];
+      Ke[2 * n + 3 * e + r] = Ke[5 * n + 3 * e + r] = sign * w[3 + r];
+    }
+  Ke[2 * n + 2] = Ke[5 * n + 5] = w[5];
+  Ke[2 * n + 5] = Ke[5 * n + 2] = w[6];
+}
+
+/* The operator's numbers of bond block Ke, checked: an error when Ke does not have the form. */
+static PetscErrorCode BondNumbers(PeriModel m, const PeriOperator op, const PeriBondGeometry *g, const PetscReal Ke[], PetscReal w[])
+{
+  const PetscInt n = 2 * op->bs;
+  PetscReal      Kf[4 * PERI_MAX_DOF * PERI_MAX_DOF], dev = 0, size = 0;
 
   PetscFunctionBeginUser;
-  *k = 0;
-  for (PetscInt a = 0; a < m->dim; a++) *k += Ke[a * n + a];
+  FormNumbers(op, g, Ke, w);
+  FormBlock(op, w, Kf);
+  for (PetscInt a = 0; a < n * n; a++) {
+    size = PetscMax(size, PetscAbsReal(Ke[a]));
+    dev  = PetscMax(dev, PetscAbsReal(Ke[a] - Kf[a]));
+  }
   /* moduli beyond double precision: the solve's check of K's diagonal names the units */
-  if (PetscIsInfOrNanReal(*k)) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt a = 0; a < m->dim; a++)
-    for (PetscInt c = 0; c < m->dim; c++) dev = PetscMax(dev, PetscAbsReal(Ke[a * n + c] - *k * g->xi[a] * g->xi[c] / (g->length * g->length)));
-  PetscCheck(dev <= 1e-10 * PetscAbsReal(*k) && *k >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "model %s: bond %" PetscInt_FMT "-%" PetscInt_FMT " is not a central spring with k >= 0 (k = %g, deviation %g): the matrix-free operator cannot apply it", m->type, g->i, g->j, (double)*k, (double)dev);
+  if (PetscIsInfOrNanReal(size)) PetscFunctionReturn(PETSC_SUCCESS);
+  /* a central spring with k < 0 is rebuilt with k = 0, and fails here too */
+  PetscCheck(dev <= 1e-10 * size, PETSC_COMM_SELF, PETSC_ERR_PLIB, "model %s: the block of bond %" PetscInt_FMT "-%" PetscInt_FMT " is not of the %s form (deviation %g of %g): the matrix-free operator cannot apply it", m->type, g->i, g->j,
+             op->form == FORM_CENTRAL ? "central-spring (k >= 0)" : op->form == FORM_SHEAR ? "shear"
+                                                                                           : "micropolar",
+             (double)dev, (double)size);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -280,21 +438,19 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(op->nloc + 1, &op->ptr));
-  PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->bs, &op->w));
+  PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->nw, &op->w));
   PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
   if (sys->bond_state.failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
   op->nghost = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     op->ptr[i - b->rstart] = nb;
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscReal kb;
       if (op->slot) op->slot[k] = -1;
       if (!OperatorBond(b, i, k)) continue;
       if (op->slot) op->slot[k] = nb;
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
-      PetscCall(SpringConstant(m, &g, Ke, &kb));
-      for (PetscInt d = 0; d < op->bs; d++) op->w[nb * op->bs + d] = PetscSqrtReal(kb) * g.xi[d] / g.length;
+      PetscCall(BondNumbers(m, op, &g, Ke, op->w + nb * op->nw));
       if (g.j < sys->disc.nowned)
         op->jl[nb] = g.j;
       else { /* for now -1 - its global index: numbered below, as the ghosted vectors number them */
@@ -316,7 +472,20 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* op->kdiag: the diagonal of K, the sum over the bonds at each end of w w. Collective. */
+/* The diagonal of a bond's block at either end from its numbers w[]. */
+static void FormDiagonal(const PeriOperator op, const PetscReal w[], PetscReal diag[])
+{
+  if (op->form == FORM_CENTRAL)
+    for (PetscInt d = 0; d < op->bs; d++) diag[d] = PetscSqr(w[d]);
+  else {
+    diag[0] = w[0];
+    diag[1] = w[2];
+    if (op->form == FORM_MICROPOLAR) diag[2] = w[5];
+  }
+}
+
+/* op->kdiag: the diagonal of K, the sum over the bonds at each end of their blocks' diagonals.
+ * Collective. */
 static PetscErrorCode ComputeDiagonal(PeriOperator op)
 {
   Vec          yl;
@@ -327,11 +496,14 @@ static PetscErrorCode ComputeDiagonal(PeriOperator op)
   PetscCall(VecSet(yl, 0));
   PetscCall(VecGetArray(yl, &ya));
   for (PetscInt i = 0; i < op->nloc; i++)
-    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      PetscReal diag[PERI_MAX_DOF];
+      FormDiagonal(op, op->w + op->nw * b, diag);
       for (PetscInt d = 0; d < op->bs; d++) {
-        ya[op->bs * i + d] += PetscSqr(op->w[op->bs * b + d]);
-        ya[op->bs * op->jl[b] + d] += PetscSqr(op->w[op->bs * b + d]);
+        ya[op->bs * i + d] += diag[d];
+        ya[op->bs * op->jl[b] + d] += diag[d];
       }
+    }
   PetscCall(VecRestoreArray(yl, &ya));
   PetscCall(VecGhostRestoreLocalForm(op->ym, &yl));
   PetscCall(VecGhostUpdateBegin(op->ym, ADD_VALUES, SCATTER_REVERSE));
@@ -353,7 +525,8 @@ static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
 }
 
 /* Per particle of the local view, sum of k |xi|^2 over its bonds (full) and over those of the short
- * range (part): the energies a uniform expansion stores in them, up to a common factor. Collective. */
+ * range (part): the energies a uniform expansion stores in them, up to a common factor (with k the
+ * trace of the translational block for the shear and micropolar forms). Collective. */
 static PetscErrorCode ExpansionEnergies(PeriSystem sys, PeriOperator op, PetscReal full[], PetscReal part[])
 {
   const PeriDisc  *disc = &sys->disc;
@@ -365,10 +538,11 @@ static PetscErrorCode ExpansionEnergies(PeriSystem sys, PeriOperator op, PetscRe
   PetscCall(PetscArrayzero(part, disc->particles.n));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscReal e = 0;
+      PetscReal e = 0, diag[PERI_MAX_DOF];
       if (!OperatorBond(b, i, k)) continue;
-      for (PetscInt d = 0; d < op->bs; d++) e += PetscSqr(op->w[op->bs * t + d] * b->length[k]);
-      t++;
+      /* the trace of the translational block times |xi|^2: k |xi|^2 for a central spring */
+      FormDiagonal(op, op->w + op->nw * t++, diag);
+      for (PetscInt d = 0; d < (op->form == FORM_MICROPOLAR ? 2 : op->bs); d++) e += diag[d] * PetscSqr(b->length[k]);
       full[i] += e;
       full[b->j[k]] += e;
       if (!PeriShortRangeHolds(&op->short_range, b, i, k)) continue;
@@ -429,7 +603,8 @@ PetscBool PeriOperatorPCWithoutMatrix(const char pc[])
 }
 
 /*@C
-  PeriOperatorCreate - the matrix-free operator of a central-force bond model from the live bonds,
+  PeriOperatorCreate - the matrix-free operator of a bond-based model from the live bonds (central
+  force, or 2D shear or micropolar: PeriOperatorWhyNotModel),
   and the choice of its preconditioning matrix's bonds (those within radius nearest-neighbour
   distances; PeriOperatorPreconditioner assembles it). Collective.
 @*/
@@ -440,9 +615,40 @@ PetscErrorCode PeriOperatorCreate(PeriSystem sys, PetscReal radius, PeriOperator
   (*op)->refct = 1;
   (*op)->bs    = sys->model->dofs;
   (*op)->nloc  = sys->disc.bonds.rend - sys->disc.bonds.rstart;
+  ModelForm(sys->model, *op);
   PetscCall(CollectBonds(sys, *op));
   PetscCall(SetUpGhosts(sys, *op));
   PetscCall(ChooseShortRange(sys, *op, radius));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The shear and micropolar forms: P <- V P V with V = diag(sqrt(K_rr / P_rr)), so that P's diagonal
+ * is K's. The per-particle scale of the short range comes from the energy of a uniform expansion,
+ * which the normal springs (spread over the whole horizon) carry; the shear and rotational springs
+ * of gerstle weigh 1/|xi|^2 and 1/|xi| and sit mostly in the short bonds, so that scale
+ * overstated them (the 57,600-particle gerstle lamina: 48 CG iterations, with this 38). Broken
+ * bonds would have to change P as scaled: matrix_free is refused for these forms with failure
+ * (PeriMatrixFreeWhyNot). Collective. */
+static PetscErrorCode MatchDiagonal(PeriOperator op, Mat P)
+{
+  Vec                pd;
+  const PetscScalar *ka, *pa;
+  PetscScalar       *va;
+
+  PetscFunctionBeginUser;
+  if (op->kdiag_stale) PetscCall(ComputeDiagonal(op));
+  PetscCall(VecDuplicate(op->kdiag, &pd));
+  PetscCall(MatGetDiagonal(P, pd));
+  PetscCall(VecGetArrayRead(op->kdiag, &ka));
+  PetscCall(VecGetArrayRead(pd, &pa));
+  PetscCall(VecGetArrayWrite(op->xm, &va));
+  /* a DOF without bonds keeps its row */
+  for (PetscInt r = 0; r < op->nloc * op->bs; r++) va[r] = PetscRealPart(pa[r]) > 0 && PetscRealPart(ka[r]) > 0 ? PetscSqrtReal(PetscRealPart(ka[r]) / PetscRealPart(pa[r])) : 1;
+  PetscCall(VecRestoreArrayWrite(op->xm, &va));
+  PetscCall(VecRestoreArrayRead(pd, &pa));
+  PetscCall(VecRestoreArrayRead(op->kdiag, &ka));
+  PetscCall(VecDestroy(&pd));
+  PetscCall(MatDiagonalScale(P, op->xm, op->xm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -457,6 +663,7 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
   if (sys->stiffness.Kpc) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
   PetscCall(PeriAssembleShortRange(sys, &sys->stiffness.op->short_range, PERI_BROKEN_SHARE, &sys->stiffness.Kpc));
+  if (sys->stiffness.op->form != FORM_CENTRAL) PetscCall(MatchDiagonal(sys->stiffness.op, sys->stiffness.Kpc));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   if (!sys->run.log.pc_matrix_counted) { /* summary.json's matrix_mb counts it with the operator */
     PetscReal mb;
@@ -471,14 +678,14 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
 PetscErrorCode PeriOperatorMemoryMB(PeriSystem sys, PeriOperator op, PetscReal *mb)
 {
   PetscFunctionBeginUser;
-  *mb = (op->ptr[op->nloc] * (sizeof(PetscInt) + op->bs * sizeof(PetscReal)) + (op->nloc + 1 + op->nghost) * sizeof(PetscInt) + (2 * op->nghost + 2 * op->nloc) * op->bs * sizeof(PetscScalar)) / 1048576.0;
+  *mb = (op->ptr[op->nloc] * (sizeof(PetscInt) + op->nw * sizeof(PetscReal)) + (op->nloc + 1 + op->nghost) * sizeof(PetscInt) + (2 * op->nghost + 2 * op->nloc) * op->bs * sizeof(PetscScalar)) / 1048576.0;
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, mb, 1, MPIU_REAL, MPI_SUM, sys->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
   PeriOperatorScaleBond - bond k of owned particle i keeps factor times its stiffness: w scales by
-  sqrt(factor). In the preconditioning matrix a broken bond keeps PERI_BROKEN_SHARE of its block
+  sqrt(factor) (central form), the block's numbers by factor (the others). In the preconditioning matrix a broken bond keeps PERI_BROKEN_SHARE of its block
   (Ke, the block before the change), so that P stays positive definite where K was at the start
   (without them a particle could lose every short bond and keep longer ones) while its cracks
   are nearly K's; softening leaves P as it is. Not collective; PeriOperatorScaled follows the last.
@@ -492,8 +699,9 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
 
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
-  for (PetscInt d = 0; d < op->bs; d++) op->w[op->bs * t + d] *= PetscSqrtReal(factor);
+  for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= op->form == FORM_CENTRAL ? PetscSqrtReal(factor) : factor;
   if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc.bonds, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(op->form == FORM_CENTRAL, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the preconditioning matrix of shear and micropolar bonds is diagonally scaled and cannot follow a broken bond");
   for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc.bonds, i, k) * Ke[a];
   PetscCall(MatSetValuesBlocked(sys->stiffness.Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);

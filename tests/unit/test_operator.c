@@ -1,20 +1,24 @@
 /* The matrix-free operator (solver.operator: matrix_free, src/system/operator.c) against the
- * assembled K of the same scene, for every registered model type whose bonds are central springs
- * (model->central_force; no names here), on the scenes given (2D and 3D):
+ * assembled K of the same scene, for every registered model type the operator applies to
+ * (PeriOperatorWhyNotModel: central springs, 2D shear and micropolar bonds; no names here), on
+ * the scenes given (2D and 3D; the shear and micropolar types at nu = 0.2, where their shear
+ * springs act):
  *   1. A x = K x for a random x:                    ||A x - K x|| <= TOL ||K x||;
  *   2. the diagonals agree:                         ||diag A - diag K|| <= TOL ||diag K||;
  *   3. after MatScale and MatZeroRowsColumns with a prescribed x, both on each: the adjusted
  *      right-hand sides and the products agree to TOL;
- *   4. the preconditioning matrix P (the short-range stiffness): rigid translations are null
- *      vectors, ||P t|| <= TOL ||P||_1 ||t||, and the energy of a uniform expansion u = X is K's,
- *      |u^T P u - u^T K u| <= TOL u^T K u (the scaling promises it);
+ *   4. the preconditioning matrix P (the short-range stiffness), central springs: rigid
+ *      translations are null vectors, ||P t|| <= TOL ||P||_1 ||t||, and the energy of a uniform
+ *      expansion u = X is K's, |u^T P u - u^T K u| <= TOL u^T K u (the scaling promises it);
+ *      shear and micropolar bonds: P's diagonal is K's (their scaling promises that instead);
  *   5. the static solve of each scene (its own model) gives the same strain energy and largest
  *      displacements with either operator, to the solver tolerance (1e-8 relative);
  *   6. on the slender beam (third scene) the default CG + Jacobi of a small 3D body hands over to
  *      GAMG after PERI_JACOBI_BUDGET iterations, and the answer is still the assembled K's (5);
  *   7. the same for a periodic body narrower than the horizon (fourth scene): bonds to several
- *      images of a particle and to its own.
- * usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml */
+ *      images of a particle and to its own;
+ *   8. 5 for the micropolar cantilever (fifth scene, gerstle).
+ * usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml operator_micropolar_2d.yaml */
 #include "testing.h"
 
 #define TOL 1e-12
@@ -137,9 +141,14 @@ static PetscErrorCode ExpansionAndTranslations(PeriSystem sys, Mat M, PetscReal 
 
 static PetscErrorCode CheckPreconditioner(const char name[], PeriSystem sys, Mat K)
 {
-  PetscReal eK, eP, tP, tK;
+  PetscReal eK, eP, tP, tK, err;
 
   PetscFunctionBeginUser;
+  if (!sys->model->central_force) {
+    PetscCall(DiagonalError(sys->stiffness.Kpc, K, &err));
+    PetscCall(Assert(name, "P: ||diag P - diag K|| / ||diag K||", err, TOL));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(ExpansionAndTranslations(sys, K, &eK, &tK));
   PetscCall(ExpansionAndTranslations(sys, sys->stiffness.Kpc, &eP, &tP));
   PetscCall(Assert(name, "P: ||P t|| / (||P||_1 ||t||) over translations", tP, TOL));
@@ -148,7 +157,7 @@ static PetscErrorCode CheckPreconditioner(const char name[], PeriSystem sys, Mat
 }
 
 /* One model on one scene: K assembled, then the matrix-free pair (A, P), compared. */
-static PetscErrorCode CheckCase(const char scene[], const char type[], const char surface[])
+static PetscErrorCode CheckCase(const char scene[], const char type[], const char surface[], PetscBool shear)
 {
   PeriProblem p;
   Mat         K;
@@ -160,6 +169,7 @@ static PetscErrorCode CheckCase(const char scene[], const char type[], const cha
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s on %s (surface %s)", type, scene, surface));
   PetscCall(PeriTestSetOption("-model_type", type));
   PetscCall(PeriTestSetOption("-corrections_surface", surface));
+  PetscCall(PeriTestSetOption("-material_nu", shear ? "0.2" : NULL));
   PetscCall(PeriProblemCreate(PETSC_COMM_WORLD, &p));
   PetscCall(PeriProblemLoad(p, scene));
   PetscCall(PeriProblemSetUp(p));
@@ -186,9 +196,10 @@ static PetscErrorCode CheckCase(const char scene[], const char type[], const cha
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether the type accepts dim (plane stress in 2D) with central-force bonds, and its surface
- * correction for the test (volume where it takes one). */
-static PetscErrorCode Probe(const char type[], PetscInt dim, PetscBool *central, const char **surface)
+/* Whether the type accepts dim (plane stress in 2D) with bonds the operator applies (*applies),
+ * whether they are shear or micropolar ones, and its surface correction for the test (volume
+ * where it takes one and has no lattice calibration). */
+static PetscErrorCode Probe(const char type[], PetscInt dim, PetscBool *applies, PetscBool *shear, const char **surface)
 {
   PeriModel      m = NULL;
   PetscErrorCode ierr;
@@ -197,11 +208,13 @@ static PetscErrorCode Probe(const char type[], PetscInt dim, PetscBool *central,
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   ierr = PeriModelCreate(type, dim, PETSC_FALSE, &m);
   PetscCall(PetscPopErrorHandler());
-  *central = PETSC_FALSE;
+  *applies = PETSC_FALSE;
   if (ierr == PETSC_ERR_USER_INPUT) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ierr);
-  *central = m->central_force;
-  *surface = m->allows_surface_correction ? "volume" : "none";
+  *applies = (PetscBool)!PeriOperatorWhyNotModel(m);
+  *shear   = (PetscBool)!m->central_force;
+  /* the lattice calibration (a default) corrects surfaces itself */
+  *surface = m->allows_surface_correction && m->calibration != PERI_CALIBRATION_LATTICE ? "volume" : "none";
   PetscCall(PeriModelDestroy(&m));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -236,10 +249,10 @@ int main(int argc, char **argv)
 {
   char     list[1024], **types;
   int      ntypes;
-  PetscInt ncases = 0;
+  PetscInt ncases = 0, nshear = 0;
 
   PetscCall(PeriInitialize(&argc, &argv, NULL));
-  PetscCheck(argc >= 5, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml");
+  PetscCheck(argc >= 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml operator_micropolar_2d.yaml");
   PetscCall(PeriInitializePackage());
   PetscCall(PeriModelListTypes(list, sizeof(list)));
   for (size_t k = 0; list[k]; k++)
@@ -249,24 +262,27 @@ int main(int argc, char **argv)
     for (int t = 0; t < ntypes; t++) {
       PeriScene   scene;
       PetscInt    dim;
-      PetscBool   central = PETSC_FALSE;
+      PetscBool   applies = PETSC_FALSE, shear = PETSC_FALSE;
       const char *surface = NULL;
       PetscCall(PeriSceneCreateFromFile(argv[s], 0, NULL, &scene));
       PetscCall(PeriSceneGetInt(scene, scene->root, "dim", PETSC_TRUE, &dim, NULL));
       PetscCall(PeriSceneDestroy(&scene));
-      PetscCall(Probe(types[t], dim, &central, &surface));
-      if (!central) continue;
-      PetscCall(CheckCase(argv[s], types[t], surface));
+      PetscCall(Probe(types[t], dim, &applies, &shear, &surface));
+      if (!applies) continue;
+      PetscCall(CheckCase(argv[s], types[t], surface, shear));
       ncases++;
+      nshear += shear;
     }
   /* the scenes' own models and corrections from here on */
   PetscCall(PeriTestSetOption("-model_type", NULL));
   PetscCall(PeriTestSetOption("-corrections_surface", NULL));
+  PetscCall(PeriTestSetOption("-material_nu", NULL));
   PetscCall(CheckSolve(argv[1], PCGAMG));   /* 2D: GAMG */
   PetscCall(CheckSolve(argv[2], PCJACOBI)); /* a small 3D body: Jacobi */
   PetscCall(CheckSolve(argv[3], PCGAMG));   /* slender: Jacobi, then GAMG */
   PetscCall(CheckSolve(argv[4], PCGAMG));   /* periodic */
-  PetscCheck(ncases >= 4, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "only %" PetscInt_FMT " cases ran: expected the central-force models (pmb, npmb, cpmb) in 2D and 3D", ncases);
+  PetscCall(CheckSolve(argv[5], PCGAMG));   /* micropolar */
+  PetscCheck(ncases >= 7 && nshear >= 3, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "only %" PetscInt_FMT " cases ran (%" PetscInt_FMT " shear or micropolar): expected the central-force models (pmb, npmb, cpmb) in 2D and 3D and pds, mppd and gerstle in 2D", ncases, nshear);
   PetscCall(PetscStrToArrayDestroy(ntypes, types));
   PetscCall(PeriFinalize());
   return 0;

@@ -78,6 +78,7 @@ PETSC_EXTERN PetscErrorCode PeriStiffnessRowSums(PeriSystem, Vec);
 PETSC_EXTERN PetscErrorCode PeriAssembleShortRange(PeriSystem, const PeriShortRange *, PetscReal, Mat *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[], PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriStiffnessScaled(PeriSystem);
+PETSC_EXTERN const char    *PeriOperatorWhyNotModel(PeriModel);
 PETSC_EXTERN PetscErrorCode PeriOperatorCreate(PeriSystem, PetscReal, PeriOperator *);
 PETSC_EXTERN PetscErrorCode PeriOperatorPreconditioner(PeriSystem);
 PETSC_EXTERN PetscBool      PeriOperatorServesPC(const char[]);
