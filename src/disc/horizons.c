@@ -16,9 +16,9 @@ static int CompareReal(const void *a, const void *b)
 }
 
 /* From the bonds of row i within radius r (the search's pairs within the larger of the two
- * radii: those beyond r are the other end's), the midpoint of the k-th and (k+1)-th distances;
- * 0 when fewer than k + 1 lie within r. */
-static PetscReal RowHorizon(const PeriBonds *b, PetscInt i, PetscReal r, PetscInt k, PetscReal *buf)
+ * radii: those beyond r are the other end's), the midpoint of the k-th and (k+1)-th distances
+ * and the (k+1)-th; 0 when fewer than k + 1 lie within r. */
+static PetscReal RowHorizon(const PeriBonds *b, PetscInt i, PetscReal r, PetscInt k, PetscReal *buf, PetscReal *kplus1)
 {
   PetscInt m = 0;
 
@@ -26,18 +26,20 @@ static PetscReal RowHorizon(const PeriBonds *b, PetscInt i, PetscReal r, PetscIn
     if (b->length[q] <= r) buf[m++] = b->length[q];
   if (m < k + 1) return 0;
   qsort(buf, (size_t)m, sizeof(*buf), CompareReal);
+  *kplus1 = buf[k];
   return 0.5 * (buf[k - 1] + buf[k]);
 }
 
 /*@C
   PeriHorizonsByNeighbors - for particles 0..nrows-1 of p, the horizon that holds exactly k of the
   particles of p (the midpoint of the k-th and (k+1)-th nearest distances, periodic images
-  included). r[] holds, on entry, a radius per row known to hold k + 1 of them, or 0 for none
+  included), and bound[] (unless NULL) the (k+1)-th nearest distance: a radius that holds k + 1.
+  r[] holds, on entry, a radius per row known to hold k + 1 of them, or 0 for none
   (then the search starts from 1.25 times the radius of the ball of k particles of its own spacing, and grows). Rows
   beyond nrows (a rank's ghosts) are searched from, never for. Not collective; errors when p has
   no k + 1 particles around a row.
 @*/
-PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *p, PetscInt nrows, PetscInt k, PetscReal r[])
+PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *p, PetscInt nrows, PetscInt k, PetscReal r[], PetscReal bound[])
 {
   PetscReal *guess, *buf = NULL, gmin = PETSC_MAX_REAL;
   PetscInt   cap = 0, *pending, npending = nrows;
@@ -64,7 +66,9 @@ PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *p, PetscInt nrows, P
         cap = 2 * m;
         PetscCall(PetscMalloc1(cap, &buf));
       }
-      r[i] = RowHorizon(&b, q, guess[i], k, buf);
+      PetscReal kplus1 = 0;
+      r[i]             = RowHorizon(&b, q, guess[i], k, buf, &kplus1);
+      if (bound) bound[i] = kplus1;
       if (r[i] > 0) continue;
       guess[i] *= HORIZONS_GROWTH;
       pending[left++] = i;

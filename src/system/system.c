@@ -340,43 +340,48 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
 }
 
 /* horizon.neighbors, before the ghosts exist: each owned particle's horizon among this rank's
- * particles alone bounds its horizon in the body (more candidates only bring the k-th nearer),
- * so the largest of them is a ghost radius that brings every particle's k + 1 nearest. Kept in
- * disc.horizon (owned entries) for SetHorizons; disc.delta becomes that bound. */
+ * particles alone, and its (k+1)-th nearest distance there, which bounds the true one (more
+ * candidates only bring it nearer): the largest bound is a ghost radius that brings every
+ * particle's k + 1 nearest. On one rank the horizons are final. Kept (horizons, then bounds) in
+ * disc.horizon for SetHorizons; disc.delta becomes the largest bound. */
 static PetscErrorCode NeighborsHorizonBound(PeriSystem sys, const PeriParticles *owned)
 {
   PetscReal bound = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc1(owned->n, &sys->disc.horizon));
-  PetscCall(PeriHorizonsByNeighbors(owned, owned->n, sys->disc.horizon_k + 1, sys->disc.horizon));
-  for (PetscInt k = 0; k < owned->n; k++) bound = PetscMax(bound, sys->disc.horizon[k]);
+  PetscCall(PetscCalloc1(2 * owned->n + 1, &sys->disc.horizon));
+  PetscCall(PeriHorizonsByNeighbors(owned, owned->n, sys->disc.horizon_k, sys->disc.horizon, sys->disc.horizon + owned->n));
+  for (PetscInt k = 0; k < owned->n; k++) bound = PetscMax(bound, sys->disc.horizon[owned->n + k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bound, 1, MPIU_REAL, MPI_MAX, sys->comm));
   sys->disc.delta = bound;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Each local particle's horizon (the ghosts' too: a pair's horizon is the larger of its two):
- * m times its own spacing, or (horizon.neighbors) the one holding k neighbours, searched among
- * the owned particles and the ghosts from the bound NeighborsHorizonBound left; delta the
- * largest. */
+ * m times its own spacing, or (horizon.neighbors) the one holding k neighbours: on several ranks
+ * searched again among the owned particles and the ghosts from the bounds NeighborsHorizonBound
+ * left, the ghosts' copied from their owners; delta the largest. */
 static PetscErrorCode SetHorizons(PeriSystem sys)
 {
   PeriDisc  *d     = &sys->disc;
-  PetscReal *bound = d->horizon;
+  PetscReal *first = d->horizon;
 
   PetscFunctionBeginUser;
   PetscCall(PetscCalloc1(d->particles.n, &d->horizon));
   if (d->horizon_k) {
-    PetscCall(PetscArraycpy(d->horizon, bound, d->nowned));
-    PetscCall(PeriHorizonsByNeighbors(&d->particles, d->nowned, d->horizon_k, d->horizon));
+    if (sys->size == 1)
+      PetscCall(PetscArraycpy(d->horizon, first, d->nowned));
+    else {
+      PetscCall(PetscArraycpy(d->horizon, first + d->nowned, d->nowned));
+      PetscCall(PeriHorizonsByNeighbors(&d->particles, d->nowned, d->horizon_k, d->horizon, NULL));
+    }
     PetscCall(PeriDiscOwnersToGhosts(d, MPIU_REAL, 1, d->horizon));
     d->delta = 0;
     for (PetscInt k = 0; k < d->nowned; k++) d->delta = PetscMax(d->delta, d->horizon[k]);
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &d->delta, 1, MPIU_REAL, MPI_MAX, sys->comm));
   } else
     for (PetscInt k = 0; k < d->particles.n; k++) d->horizon[k] = d->horizon_m * d->particles.spacing[k];
-  PetscCall(PetscFree(bound));
+  PetscCall(PetscFree(first));
   d->horizon_min = PETSC_MAX_REAL;
   for (PetscInt k = 0; k < d->particles.n; k++) d->horizon_min = PetscMin(d->horizon_min, d->horizon[k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &d->horizon_min, 1, MPIU_REAL, MPI_MIN, sys->comm));

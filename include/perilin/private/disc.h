@@ -95,7 +95,7 @@ PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscRe
 PETSC_EXTERN PetscReal      PeriRegionTolerance(const PeriParticles *);
 
 PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
-PETSC_EXTERN PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *, PetscInt, PetscInt, PetscReal[]);
+PETSC_EXTERN PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *, PetscInt, PetscInt, PetscReal[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevelsRows(const PeriParticles *, const PetscReal[], PeriPartialVolume, PetscInt, const PetscInt[], PetscInt, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsAdd(const PeriParticles *, PetscInt, PetscInt, const PetscReal[], PetscReal, PeriPartialVolume, PeriBonds *, PetscInt *);
