@@ -21,10 +21,7 @@ const char *PeriMatrixFreeWhyNot(PeriSystem sys)
 /* solver.operator: matrix_free applies to the bond-based models whose blocks operator.c knows
  * (central, 2D shear and micropolar) in the analyses that allow it, without fictitious layers
  * (and for shear and micropolar bonds without failure); auto takes it with GAMG (the default),
- * where it wins (docs/performance.md), and assembled K elsewhere. Not with per-particle horizons:
- * the preconditioning matrix keeps the bonds within pc_radius of each end's shortest one, and on
- * a stochastic tetrahedral mesh split by particles.refine that set loses rank (GAMG's Chebyshev
- * then SOR smoothing fail, DIVERGED_INDEFINITE_PC; docs/mesh.md). */
+ * where it wins (docs/performance.md), and assembled K elsewhere. */
 static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 {
   const char *why = PeriMatrixFreeWhyNot(sys);
@@ -32,7 +29,6 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 
   PetscFunctionBeginUser;
   *mf = (PetscBool)(!why && (sys->stiffness.operator_kind == PERI_OPERATOR_MATRIX_FREE || sys->stiffness.operator_kind == PERI_OPERATOR_AUTO));
-  if (*mf && sys->stiffness.operator_kind == PERI_OPERATOR_AUTO && sys->disc.horizon_m > 0) *mf = PETSC_FALSE;
   if (*mf && sys->stiffness.operator_kind == PERI_OPERATOR_AUTO) {
     /* the short-range stiffness serves AMG, the diagonal Jacobi; another -pc_type (a
        factorization) gets K itself */

@@ -15,7 +15,7 @@ static const PeriKey     model_keys[] = {
 };
 static const char *const spacings[]     = {"mean", "own", NULL};
 static const PeriKey     horizon_keys[] = {
-        {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the spacing: delta = m dx (may be fractional); m or delta is required"},
+        {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the spacing: delta = m dx (may be fractional); m, delta or neighbors is required"},
         {"delta", PERI_KEY_REAL, NULL, NULL, "[length]", NULL, "the horizon radius, instead of m"},
         {"neighbors", PERI_KEY_INT, NULL, "[2, 1000]", NULL, NULL, "instead of m or delta: each particle's horizon holds this many neighbours (the midpoint of its k-th and (k+1)-th nearest distances; Ganzenmüller et al. take 30 on stochastic tetrahedral meshes), a pair bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md"},
         {"spacing", PERI_KEY_CHOICE, "mean", NULL, NULL, spacings, "the spacing m multiplies: mean (one horizon for the body) or own (each particle's own spacing: a horizon per particle, for graded and stochastic meshes; a pair is bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md)"},
