@@ -29,7 +29,7 @@
 /* The owned-owned live bonds seen from both ends: for particle p, entries off[p]..off[p+1]-1 name
  * the other particle and the bond (its row and index; end 1 when p is the bond's j). */
 typedef struct {
-  PetscInt *off, *nbr, *row, *bond, *end;
+  PetscInt *off, *nbr, *row, *bond, *end, *twin; /* twin: the same bond's entry at the other end */
 } Adjacency;
 
 static PetscErrorCode AdjacencyCreate(PeriSystem sys, Adjacency *a)
@@ -49,7 +49,7 @@ static PetscErrorCode AdjacencyCreate(PeriSystem sys, Adjacency *a)
       }
   for (PetscInt i = 0; i < no; i++) a->off[i + 1] += a->off[i];
   n = a->off[no];
-  PetscCall(PetscMalloc4(n, &a->nbr, n, &a->row, n, &a->bond, n, &a->end));
+  PetscCall(PetscMalloc5(n, &a->nbr, n, &a->row, n, &a->bond, n, &a->end, n, &a->twin));
   PetscCall(PetscMalloc1(no, &fill));
   PetscCall(PetscArraycpy(fill, a->off, no));
   for (PetscInt i = 0; i < no; i++)
@@ -61,6 +61,10 @@ static PetscErrorCode AdjacencyCreate(PeriSystem sys, Adjacency *a)
           a->row[s]  = i;
           a->bond[s] = k;
           a->end[s]  = e;
+          if (e) {
+            a->twin[s]          = fill[i] - 1;
+            a->twin[a->twin[s]] = s;
+          }
         }
   PetscCall(PetscFree(fill));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -69,7 +73,7 @@ static PetscErrorCode AdjacencyCreate(PeriSystem sys, Adjacency *a)
 static PetscErrorCode AdjacencyDestroy(Adjacency *a)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscFree4(a->nbr, a->row, a->bond, a->end));
+  PetscCall(PetscFree5(a->nbr, a->row, a->bond, a->end, a->twin));
   PetscCall(PetscFree(a->off));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -174,16 +178,13 @@ static PetscErrorCode Grow(PeriSystem sys, const Adjacency *a, Growth *w, PetscI
   while (head < tail) {
     PetscInt p = w->queue[head++];
     for (PetscInt s = a->off[p]; s < a->off[p + 1]; s++) {
-      PetscInt q = a->nbr[s], r;
+      PetscInt q = a->nbr[s];
       if (w->piece[q] >= 0) continue;
       if (w->tag[q] != b) {
         PetscCall(PetscArrayzero(&w->acc[q * bs * bs], bs * bs));
         w->tag[q] = b;
       }
-      /* the entry of the same bond at q's end */
-      for (r = a->off[q]; r < a->off[q + 1]; r++)
-        if (a->nbr[r] == p && a->bond[r] == a->bond[s] && a->row[r] == a->row[s]) break;
-      PetscCall(AddOwnBlock(sys, a, r, &w->acc[q * bs * bs]));
+      PetscCall(AddOwnBlock(sys, a, a->twin[s], &w->acc[q * bs * bs])); /* the bond's block at q's end */
       if (PeriBlockHolds(bs, &w->acc[q * bs * bs], w->active)) {
         w->piece[q]      = b;
         w->queue[tail++] = q;
