@@ -378,7 +378,8 @@ typedef struct {
   PetscReal *gx, *blk;
 } Gathered;
 
-static PetscErrorCode GatherInts(MPI_Comm comm, PetscInt n, const PetscInt mine[], PetscInt per, PetscInt **all, PetscInt *total)
+/* Rank 0 gets every rank's n x per values of type t (bytes each), in rank order; *total: the rows. */
+static PetscErrorCode GatherRows(MPI_Comm comm, PetscInt n, const void *mine, PetscInt per, MPI_Datatype t, size_t bytes, void **all, PetscInt *total)
 {
   PetscMPIInt size, rank, *cnt, *dsp, m = (PetscMPIInt)(n * per);
 
@@ -390,42 +391,22 @@ static PetscErrorCode GatherInts(MPI_Comm comm, PetscInt n, const PetscInt mine[
   dsp[0] = 0;
   if (!rank)
     for (PetscMPIInt q = 0; q < size; q++) dsp[q + 1] = dsp[q] + cnt[q];
-  *total = rank ? 0 : dsp[size] / per;
-  PetscCall(PetscMalloc1(rank ? 0 : dsp[size], all));
-  PetscCallMPI(MPI_Gatherv(mine, m, MPIU_INT, *all, cnt, dsp, MPIU_INT, 0, comm));
-  PetscCall(PetscFree2(cnt, dsp));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode GatherReals(MPI_Comm comm, PetscInt n, const PetscReal mine[], PetscInt per, PetscReal **all)
-{
-  PetscMPIInt size, rank, *cnt, *dsp, m = (PetscMPIInt)(n * per);
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCall(PetscMalloc2(size, &cnt, size + 1, &dsp));
-  PetscCallMPI(MPI_Gather(&m, 1, MPI_INT, cnt, 1, MPI_INT, 0, comm));
-  dsp[0] = 0;
-  if (!rank)
-    for (PetscMPIInt q = 0; q < size; q++) dsp[q + 1] = dsp[q] + cnt[q];
-  PetscCall(PetscMalloc1(rank ? 0 : dsp[size], all));
-  PetscCallMPI(MPI_Gatherv(mine, m, MPIU_REAL, *all, cnt, dsp, MPIU_REAL, 0, comm));
+  if (total) *total = rank ? 0 : dsp[size] / per;
+  PetscCall(PetscMalloc(bytes * (rank ? 0 : dsp[size]), all));
+  PetscCallMPI(MPI_Gatherv(mine, m, t, *all, cnt, dsp, t, 0, comm));
   PetscCall(PetscFree2(cnt, dsp));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode Gather(PeriSystem sys, const Reduced *r, Gathered *g)
 {
-  PetscInt n;
-
   PetscFunctionBeginUser;
-  PetscCall(GatherInts(sys->comm, r->ng, r->gdofs, 1, &g->gdofs, &g->N));
-  PetscCall(GatherInts(sys->comm, r->ng, r->gcount, 1, &g->gcount, &n));
-  PetscCall(GatherInts(sys->comm, r->ng, r->gpiece, 1, &g->gpiece, &n));
-  PetscCall(GatherReals(sys->comm, r->ng, r->gx, 3, &g->gx));
-  PetscCall(GatherInts(sys->comm, r->nblk, r->key, 2, &g->key, &g->nblk));
-  PetscCall(GatherReals(sys->comm, r->nblk, r->blk, 36, &g->blk));
+  PetscCall(GatherRows(sys->comm, r->ng, r->gdofs, 1, MPIU_INT, sizeof(PetscInt), (void **)&g->gdofs, &g->N));
+  PetscCall(GatherRows(sys->comm, r->ng, r->gcount, 1, MPIU_INT, sizeof(PetscInt), (void **)&g->gcount, NULL));
+  PetscCall(GatherRows(sys->comm, r->ng, r->gpiece, 1, MPIU_INT, sizeof(PetscInt), (void **)&g->gpiece, NULL));
+  PetscCall(GatherRows(sys->comm, r->ng, r->gx, 3, MPIU_REAL, sizeof(PetscReal), (void **)&g->gx, NULL));
+  PetscCall(GatherRows(sys->comm, r->nblk, r->key, 2, MPIU_INT, sizeof(PetscInt), (void **)&g->key, &g->nblk));
+  PetscCall(GatherRows(sys->comm, r->nblk, r->blk, 36, MPIU_REAL, sizeof(PetscReal), (void **)&g->blk, NULL));
   PetscCall(PetscMalloc1(g->N + 1, &g->start));
   g->start[0] = 0;
   for (PetscInt a = 0; a < g->N; a++) g->start[a + 1] = g->start[a] + g->gdofs[a];
