@@ -1,6 +1,7 @@
 /* perilin SCENE.yaml [options]: run a scene, write its output set; perilin -help, perilin -version. */
 #include "perilin.h"
 #include "perilin/private/output.h" /* PeriOutputSetDiscard: the error path */
+#include "perilin/private/sys.h"    /* PeriSignalPending: the exit status of a stopped read */
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -233,7 +234,7 @@ int main(int argc, char **argv)
     (void)PeriProblemDestroy(&p);
     PetscCall(PetscPopErrorHandler());
     PetscCall(PeriFinalize());
-    return 1;
+    return PeriSignalPending() ? 128 + PeriSignalPending() : 1; /* a read the signal stopped: as a shell says it */
   }
   PetscCall(PeriFinalize());
   return status;

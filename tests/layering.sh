@@ -16,7 +16,7 @@ fail=0
 order=(src/main src src/analysis src/system src/disc src/model_api models src/scene src/output src/sys)
 # Headers a folder may include (besides system and library headers).
 declare -A allow=(
-  [src/main]="perilin.h perilin/private/output.h"
+  [src/main]="perilin.h perilin/private/output.h perilin/private/sys.h"
   [src]="perilin.h perilin/private/problem.h perilin/private/analysis.h perilin/private/system.h perilin/private/scene_file.h perilin/private/model_registry.h perilin/private/sys.h"
   [src/analysis]="perilin/private/analysis.h perilin/private/system.h analysis_list.h"
   [src/system]="perilin/private/system.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/disc.h perilin/private/model_registry.h perilin/private/output.h perilin/private/scene_file.h perilin/private/sys.h"

@@ -222,6 +222,11 @@ PetscErrorCode PeriCSVNext(PeriCSV *csv, PetscReal x[], PetscReal *vol, PetscInt
     int       nf;
     PetscBool skip, rest;
 
+    if (PeriSignalPending()) { /* a file of millions of lines takes seconds: SIGTERM ends it */
+      PetscCall(PetscSNPrintf(csv->stop, sizeof(csv->stop), "interrupted by %s while reading: nothing was written", PeriSignalName(PeriSignalPending())));
+      *problem = csv->stop;
+      break;
+    }
     csv->lineno++;
     PetscCall(CSVLineSplit(line_text, v, &nf, &skip, &rest));
     if (skip) continue;

@@ -11,7 +11,24 @@
 typedef struct {
   yaml_parser_t parser;
   const char   *file;
+  FILE         *fp;
 } Reader;
+
+/* libyaml's input: fread, except that a signal (SIGTERM, SIGHUP, SIGINT) ends the reading. A scene
+ * may come from a pipe that never ends ("perilin <(generator)"): the signal interrupts the read
+ * (the handler has no SA_RESTART), and a read is not begun once it was recorded. */
+static int ReadInput(void *ctx, unsigned char *buffer, size_t size, size_t *size_read)
+{
+  Reader *r = (Reader *)ctx;
+
+  *size_read = 0;
+  while (!PeriSignalPending()) {
+    *size_read = fread(buffer, 1, size, r->fp);
+    if (*size_read || !ferror(r->fp) || errno != EINTR) return !ferror(r->fp);
+    clearerr(r->fp); /* another signal's handler interrupted the read: read on */
+  }
+  return 0;
+}
 
 /* The line of byte offset in the file: libyaml gives only the offset of an error found while it
  * decodes the input (bad UTF-8, control characters). */
@@ -31,7 +48,10 @@ static PetscErrorCode ReaderNext(Reader *r, yaml_event_t *ev)
 {
   PetscFunctionBeginUser;
   if (PetscUnlikely(!yaml_parser_parse(&r->parser, ev))) {
-    int line = r->parser.error == YAML_READER_ERROR ? LineAtOffset(r->file, r->parser.problem_offset) : (int)r->parser.problem_mark.line + 1;
+    int line;
+
+    PetscCheck(!PeriSignalPending(), PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "interrupted by %s while reading the scene %s: nothing was written", PeriSignalName(PeriSignalPending()), r->file);
+    line = r->parser.error == YAML_READER_ERROR ? LineAtOffset(r->file, r->parser.problem_offset) : (int)r->parser.problem_mark.line + 1;
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "%s:%d: invalid YAML: %s", r->file, line, r->parser.problem ? r->parser.problem : "syntax error");
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -430,8 +450,9 @@ PetscErrorCode PeriSceneCreateFromFile(const char file[], PetscInt nowners, cons
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "cannot open scene file %s: %s", file, strerror(err));
   }
   r.file = s->file;
+  r.fp   = fp;
   PetscCheck(yaml_parser_initialize(&r.parser), PETSC_COMM_SELF, PETSC_ERR_LIB, "libyaml could not initialize");
-  yaml_parser_set_input_file(&r.parser, fp);
+  yaml_parser_set_input(&r.parser, ReadInput, &r);
   *scene = s;
   /* the parser and the file are closed whatever the outcome; the tree read so far is the scene's */
   ierr = ReadDocument(&r, s);

@@ -9,16 +9,17 @@
  * particle that its bonds do not resist: central bonds in 2D within about 1e-5 rad of one line. */
 #define PERI_HOLD_PIVOT 1e-10
 
-/* Whether point a comes before b (x, then y, then z): the first particle is the same on any ranks. */
-static PetscBool Before(const PetscReal a[], const PetscReal b[])
+/* PeriPointBefore - whether point a comes before b (x, then y, then z): the first particle is the
+ * same on any ranks. */
+PetscBool PeriPointBefore(const PetscReal a[], const PetscReal b[])
 {
   for (PetscInt d = 0; d < 3; d++)
     if (a[d] != b[d]) return (PetscBool)(a[d] < b[d]);
   return PETSC_FALSE;
 }
 
-/* The smallest region of the scene (besides all) that holds local particle i, or "". */
-static const char *RegionOf(PeriSystem sys, PetscInt i)
+/* PeriRegionOf - the smallest region of the scene (besides all) that holds local particle i, or "". */
+const char *PeriRegionOf(PeriSystem sys, PetscInt i)
 {
   const PeriDisc *d    = &sys->disc;
   const char     *name = "";
@@ -46,7 +47,7 @@ static PetscErrorCode Refuse(PeriSystem sys, const PetscBool bad[], const char w
   for (PetscInt i = 0; i < sys->disc.nowned; i++)
     if (bad[i]) {
       count++;
-      if (first < 0 || Before(&p->x[3 * i], &p->x[3 * first])) first = i;
+      if (first < 0 || PeriPointBefore(&p->x[3 * i], &p->x[3 * first])) first = i;
     }
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &count, 1, MPIU_INT, MPI_SUM, sys->comm));
   if (!count) PetscFunctionReturn(PETSC_SUCCESS);
@@ -59,10 +60,10 @@ static PetscErrorCode Refuse(PeriSystem sys, const PetscBool bad[], const char w
   }
   PetscCallMPI(MPI_Allgather(mine, 4, MPIU_REAL, all, 4, MPIU_REAL, sys->comm));
   for (PetscMPIInt r = 0; r < size; r++)
-    if (all[4 * r] > 0 && (root < 0 || Before(&all[4 * r + 1], &all[4 * root + 1]))) root = r;
+    if (all[4 * r] > 0 && (root < 0 || PeriPointBefore(&all[4 * r + 1], &all[4 * root + 1]))) root = r;
   PetscCall(PetscFree(all));
   if (rank == root) {
-    const char *region = RegionOf(sys, first);
+    const char *region = PeriRegionOf(sys, first);
     PetscCall(PetscSNPrintf(where, sizeof(where), "(%g, %g, %g)%s%s%s, with %" PetscInt_FMT " bond%s, spacing %g", (double)p->x[3 * first], (double)p->x[3 * first + 1], (double)p->x[3 * first + 2], region[0] ? " in region '" : "", region, region[0] ? "'" : "", sys->disc.neighbor_count[first], sys->disc.neighbor_count[first] == 1 ? "" : "s", (double)p->spacing[first]));
   }
   PetscCallMPI(MPI_Bcast(where, sizeof(where), MPI_CHAR, root, sys->comm));
@@ -87,12 +88,12 @@ PetscErrorCode PeriCheckBonded(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether the block A (bs x bs) is nonsingular on the DOFs free[]: LDL^T of A scaled to a unit
+/* PeriBlockHolds - whether the block A (bs x bs) is nonsingular on the DOFs free[]: LDL^T of A scaled to a unit
  * diagonal (so that the test does not depend on units, a rotation's stiffness beside a
  * displacement's), a pivot near 0 being a motion without energy. A negative pivot is no such
  * motion: the negative shear springs of nu > 1/3 make the block indefinite, and the solver, not
  * this check, answers for that (docs/models: CG stops with a reason, a direct solver solves). */
-static PetscBool Holds(PetscInt bs, const PetscReal A[], const PetscBool free[])
+PetscBool PeriBlockHolds(PetscInt bs, const PetscReal A[], const PetscBool free[])
 {
   PetscInt  f[PERI_MAX_DOF], n = 0;
   PetscReal L[PERI_MAX_DOF][PERI_MAX_DOF], d[PERI_MAX_DOF], sc[PERI_MAX_DOF];
@@ -187,7 +188,7 @@ PetscErrorCode PeriCheckHeld(PeriSystem sys)
       PetscCall(PetscFindInt((sys->disc.rstart + i) * bs + c, sys->conditions.nconstrained, sys->conditions.constrained, &loc));
       free[c] = (PetscBool)(!sys->model->inactive[c] && loc < 0);
     }
-    bad[i] = (PetscBool)(!PeriParticleIsFictitious(&sys->disc.particles, i) && !Holds(bs, &A[i * bs * bs], free));
+    bad[i] = (PetscBool)(!PeriParticleIsFictitious(&sys->disc.particles, i) && !PeriBlockHolds(bs, &A[i * bs * bs], free));
     nbad += bad[i];
   }
   PetscCall(PetscFree(A));

@@ -518,6 +518,7 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
   /* after the bcs, which may hold what the bonds do not, and the loads, which tell held pieces */
   PetscCall(PeriCheckHeld(sys));
+  PetscCall(PeriCheckMechanisms(sys)); /* pieces of many particles, after the single ones */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -4,7 +4,9 @@
 # "# exit:" line), print "perilin: error:" exactly once with a message matching its "# expect:"
 # line, and leave no output behind. Header lines at the top of a case (all optional but expect):
 #   # expect: REGEX        grep -E against stderr
-#   # args: OPTIONS        extra options, word-split by the shell
+#   # args: OPTIONS        extra options, word-split by the shell; $out in them is the output
+#                          directory (a setup may make inputs beside it, "$out.fifo": the runner's
+#                          temporary directory holds both and is removed at the end)
 #   # ranks: N             run under mpiexec -n N
 #   # exit: STATUS         the exact exit status expected
 #   # setup: COMMAND       run by bash before perilin, with $out the output directory
@@ -98,12 +100,13 @@ for scene in "${scenes[@]}"; do
   name=$(basename "$scene" .yaml)
   expect=$(header expect "$scene")
   args=$(header args "$scene")
+  out="$tmp/$name-out"
+  args=${args//\$out/$out} # inputs the setup made in the run's own directory, removed with it
   ranks=$(header ranks "$scene")
   want_exit=$(header exit "$scene")
   setup=$(header setup "$scene")
   keep=$(header keep "$scene")
   signal=$(header signal "$scene")
-  out="$tmp/$name-out"
   rm -rf "$out"
   problem=""
   if [ -z "$expect" ]; then problem="no '# expect:' line"; fi

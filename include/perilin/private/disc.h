@@ -34,6 +34,7 @@ typedef struct {
   FILE     *fp;
   PetscInt  dim, lineno, n; /* lines read, particles read */
   PetscBool header;
+  char      stop[96]; /* the problem of a read stopped by a signal */
 } PeriCSV;
 PETSC_EXTERN PetscErrorCode PeriCSVOpen(PeriScene, PeriNode, PetscInt, PeriCSV *);
 PETSC_EXTERN PetscErrorCode PeriCSVNext(PeriCSV *, PetscReal[], PetscReal *, PetscInt *, PetscBool *, const char **);

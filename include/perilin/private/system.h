@@ -94,6 +94,11 @@ PETSC_EXTERN PetscInt       PeriSystemMaxFamily(PeriSystem);
 /* particles their bonds cannot hold, refused before a solve (src/system/holding.c) */
 PETSC_EXTERN PetscErrorCode PeriCheckBonded(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriCheckHeld(PeriSystem);
+PETSC_EXTERN PetscBool      PeriBlockHolds(PetscInt, const PetscReal[], const PetscBool[]);
+PETSC_EXTERN const char    *PeriRegionOf(PeriSystem, PetscInt);
+PETSC_EXTERN PetscBool      PeriPointBefore(const PetscReal[], const PetscReal[]);
+/* pieces their bonds join to the rest too weakly to hold, refused before a solve (src/system/mechanism.c) */
+PETSC_EXTERN PetscErrorCode PeriCheckMechanisms(PeriSystem);
 
 /* assembly (src/system/assembly.c) */
 /* One element of the energy, as PeriElementsForEach visits it: a live bond of a bond-based model,
