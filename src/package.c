@@ -28,6 +28,7 @@ PetscErrorCode PeriInitializePackage(void)
   PetscCall(PetscClassIdRegister("perilin", &id));
   PetscCall(PetscLogEventRegister("PeriPartition", id, &PERI_EVENT_Partition));
   PetscCall(PetscLogEventRegister("PeriNeighbors", id, &PERI_EVENT_Neighbors));
+  PetscCall(PetscLogEventRegister("PeriMechanisms", id, &PERI_EVENT_Mechanisms));
   PetscCall(PetscLogEventRegister("PeriAssembly", id, &PERI_EVENT_Assembly));
   PetscCall(PetscLogEventRegister("PeriSolve", id, &PERI_EVENT_Solve));
   PetscCall(PetscLogEventRegister("PeriMatMultFree", id, &PERI_EVENT_MatMultFree));

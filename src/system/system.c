@@ -518,7 +518,9 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
   /* after the bcs, which may hold what the bonds do not, and the loads, which tell held pieces */
   PetscCall(PeriCheckHeld(sys));
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
   PetscCall(PeriCheckMechanisms(sys)); /* pieces of many particles, after the single ones */
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
