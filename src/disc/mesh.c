@@ -57,8 +57,10 @@ static PetscErrorCode GmshStart(PetscBool verbose)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Gmsh's last error message, for errors that name the file. */
-static void GmshLastError(char msg[], size_t size)
+/*@C
+  PeriGmshLastError - Gmsh's last error message, for errors that name the file. Not collective.
+@*/
+void PeriGmshLastError(char msg[], size_t size)
 {
   char *e    = NULL;
   int   ierr = 0;
@@ -72,7 +74,7 @@ static void GmshLastError(char msg[], size_t size)
   do {                                                                                 \
     if (PetscUnlikely(ierr)) {                                                         \
       char peri_msg_[256];                                                             \
-      GmshLastError(peri_msg_, sizeof(peri_msg_));                                     \
+      PeriGmshLastError(peri_msg_, sizeof(peri_msg_));                                 \
       SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh: %s failed: %s", what, peri_msg_); \
     }                                                                                  \
   } while (0)
@@ -309,17 +311,16 @@ static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[]
 
   PetscFunctionBeginUser;
   gmshOpen(dir[0] ? msh : path, &ierr);
-  if (ierr) GmshLastError(msg, sizeof(msg));
+  if (ierr) PeriGmshLastError(msg, sizeof(msg));
   if (dir[0]) {
     PetscCall(PetscSNPrintf(log, sizeof(log), "%s/log", dir));
     ImportRemove(dir, msh, log);
   }
   PeriInputCheck(!ierr, scene, node, "mesh", "Gmsh cannot read %s: %s", path, msg);
   if (geo) {
-    gmshOptionSetNumber("Mesh.MeshSizeMax", lc, &ierr);
-    gmshModelMeshGenerate((int)dim, &ierr);
-    if (ierr) GmshLastError(msg, sizeof(msg));
-    PeriInputCheck(!ierr, scene, node, "mesh", "Gmsh cannot mesh %s in %" PetscInt_FMT "D: %s", path, dim, msg);
+    PetscBool ok;
+    PetscCall(PeriMeshGenerateIsolated(path, dim, lc, &ok, msg, sizeof(msg)));
+    PeriInputCheck(ok, scene, node, "mesh", "Gmsh cannot mesh %s in %" PetscInt_FMT "D: %s", path, dim, msg);
   }
   gmshModelMeshGetElementTypes(&types, &ntypes, -1, -1, &ierr);
   GmshCheck(ierr, "reading the element types");
@@ -356,7 +357,7 @@ static PetscErrorCode MeshRefine(PeriScene scene, PeriNode node, const char path
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetInt(scene, node, "refine", PETSC_FALSE, &refine, NULL));
   for (PetscInt k = 0; k < refine && !ierr; k++) gmshModelMeshRefine(&ierr);
-  if (ierr) GmshLastError(msg, sizeof(msg));
+  if (ierr) PeriGmshLastError(msg, sizeof(msg));
   PeriInputCheck(!ierr, scene, node, "refine", "Gmsh cannot refine %s: %s", path, msg);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

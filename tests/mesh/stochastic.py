@@ -3,6 +3,8 @@
 neighbors RUN1 RUN2 K: every particle's horizon (particles.vtu's "horizon") holds exactly K other
   particles within it (more only when several tie at the K-th distance), counted by brute force over the periodic images in y and z (the box 200 x
   4 x 4), and the horizons of the 2-rank run (RUN2) equal the 1-rank run's to 1e-12 relative.
+strain RUN: prints exx fitted over 50 < x < 150 of tests/mesh/stochastic_tension.yaml's run
+  against s / M (s = 1e-3, E = 1, nu = 1/4); a measurement, exit 0.
 pulse RUN0 RUN1: the pulse's centre at t = 94 (history.csv's pulse_position) nears the exact
   c t = sqrt((K + 4G/3)/rho) t (nu = 1/4: c = 1.3416) as the mesh is split: the error of the
   split mesh (RUN1) at most 1/1.3 of the coarse one's (measured 1/1.51, docs/mesh.md).
@@ -67,6 +69,26 @@ def pulse(run0, run1):
     return abs(e1) <= abs(e0) / 1.3
 
 
+def strain(run, s=1e-3, E=1.0, nu=0.25):
+    r = vtkXMLUnstructuredGridReader()
+    r.SetFileName(run + "/particles.vtu")
+    r.Update()
+    g = r.GetOutput()
+    X = vtk_to_numpy(g.GetPoints().GetData()).astype(float)
+    u = vtk_to_numpy(g.GetPointData().GetArray("displacement")).astype(float)
+    M = E / (3 * (1 - 2 * nu)) + 4 / 3 * E / (2 * (1 + nu))
+    m = (X[:, 0] > 50) & (X[:, 0] < 150)
+    slope = np.polyfit(X[m, 0], u[m, 0], 1)[0]
+    print(f"interior exx {slope:.6e} against s/M {s / M:.6e}: {100 * (slope * M / s - 1):+.2f} %")
+    return True
+
+
 if __name__ == "__main__":
-    ok = neighbors(sys.argv[2], sys.argv[3], int(sys.argv[4])) if sys.argv[1] == "neighbors" else pulse(sys.argv[2], sys.argv[3])
+    cmd = sys.argv[1]
+    if cmd == "neighbors":
+        ok = neighbors(sys.argv[2], sys.argv[3], int(sys.argv[4]))
+    elif cmd == "strain":
+        ok = strain(sys.argv[2])
+    else:
+        ok = pulse(sys.argv[2], sys.argv[3])
     sys.exit(0 if ok else 1)

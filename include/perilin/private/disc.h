@@ -62,6 +62,8 @@ typedef struct _n_PeriMeshGroup {
   PetscReal  measure; /* a group of dimension dim - 1: its length x thickness (2D) or area (3D); else 0 */
 } PeriMeshGroup;
 
+PETSC_EXTERN void           PeriGmshLastError(char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriMeshGenerateIsolated(const char[], PetscInt, PetscReal, PetscBool *, char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriMeshRead(PeriScene, PeriNode, PetscInt, PetscReal, PetscInt *, PetscReal **, PetscReal **, PetscInt *, PeriMeshGroup **, PetscReal[6]);
 PETSC_EXTERN PetscErrorCode PeriParticlesReadPeriodic(PeriScene, PeriNode, PeriParticles *);
 PETSC_EXTERN void           PeriParticlesPeriodicBox(PeriParticles *, const PetscReal[6]);

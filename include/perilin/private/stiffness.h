@@ -23,7 +23,7 @@ typedef struct _p_PeriOperator *PeriOperator;
 
 /* The bonds of the short-range stiffness that preconditions a matrix-free K, chosen per particle
  * of the local view so that a graded body keeps every particle in it: a bond enters when it is no
- * longer than the larger reach of its ends (pc_radius times that end's shortest bond), its block
+ * longer than the larger reach of its ends (pc_radius times that end's 2 dim-th shortest bond), its block
  * scaled by the mean of its ends' scales (what the particle's whole family stores under a uniform
  * expansion over what its short bonds store). */
 typedef struct {
