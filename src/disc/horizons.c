@@ -73,6 +73,7 @@ PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *p, PetscInt nrows, P
       guess[i] *= HORIZONS_GROWTH;
       pending[left++] = i;
     }
+    PetscCall(PetscInfo(NULL, "horizon.neighbors %" PetscInt_FMT ": round %" PetscInt_FMT " searched %" PetscInt_FMT " rows, %" PetscInt_FMT " short of %" PetscInt_FMT " neighbours\n", k, round, npending, left, k + 1));
     npending = left;
     PetscCall(PeriBondsDestroy(&b));
   }

@@ -57,19 +57,6 @@ static PetscErrorCode GmshStart(PetscBool verbose)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriGmshLastError - Gmsh's last error message, for errors that name the file. Not collective.
-@*/
-void PeriGmshLastError(char msg[], size_t size)
-{
-  char *e    = NULL;
-  int   ierr = 0;
-
-  gmshLoggerGetLastError(&e, &ierr);
-  (void)PetscStrncpy(msg, !ierr && e && e[0] ? e : "unknown Gmsh error", size);
-  if (e) gmshFree(e);
-}
-
 #define GmshCheck(ierr, what)                                                          \
   do {                                                                                 \
     if (PetscUnlikely(ierr)) {                                                         \

@@ -1,4 +1,4 @@
-/* Meshing a .geo in a child process. Gmsh 4.8 ends the whole process on some errors its C API
+/* Meshing a .geo in a child process, and Gmsh's last error message. Gmsh 4.8 ends the whole process on some errors its C API
  * does not return: a MathEval size field with a function it cannot parse (Rand, say) throws a C++
  * exception inside an OpenMP region, and std::terminate aborts (SIGABRT) with a backtrace and no
  * message a user can act on. A forked child meshes the model the parent opened and writes it to a
@@ -12,6 +12,19 @@
 #include <string.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+/*@C
+  PeriGmshLastError - Gmsh's last error message, for errors that name the file. Not collective.
+@*/
+void PeriGmshLastError(char msg[], size_t size)
+{
+  char *e    = NULL;
+  int   ierr = 0;
+
+  gmshLoggerGetLastError(&e, &ierr);
+  (void)PetscStrncpy(msg, !ierr && e && e[0] ? e : "unknown Gmsh error", size);
+  if (e) gmshFree(e);
+}
 
 /* The child: default signal handling (not PETSc's or perilin's, which would act for the run),
  * Gmsh's messages off, the mesh generated and written to msh; its error message into log. Never
