@@ -3,7 +3,7 @@
 // x = 126 at t = 94 and its front 150, so 200 is all the run sees). Twelve balls at random places
 // (Gmsh's Rand: the same numbers on every run) with random radii ask for elements of 0.25-0.6
 // inside and the largest size (particles.size) outside; Mesh.Optimize = 0 leaves the slivers
-// Delaunay made. At particles.size 3: 1443 tetrahedra, radii cbrt(V) over a range of about 20
+// Delaunay made. At particles.size 3: 1443 tetrahedra, radii cbrt(V) over a range of 10
 // (docs/mesh.md, "A pressure pulse on stochastic meshes"); particles.refine splits each into 8.
 SetFactory("Built-in");
 L = 200;
