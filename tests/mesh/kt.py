@@ -12,28 +12,20 @@ when the second run (2 ranks) differs from the first by more than 1e-6 relative.
 """
 import json, sys
 import numpy as np
-import os
-from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader, vtkXMLUnstructuredGridReader
-from vtkmodules.util.numpy_support import vtk_to_numpy
+import particles_vtk
 
 R, S, HEYWOOD, TOL = 0.05, 1.0e6, 3.03, 0.08
 
 
 def kt(run):
-    # one rank writes particles.vtu, several ranks particles.pvtu over one piece per rank
-    parallel = os.path.exists(run + "/particles.pvtu")
-    r = vtkXMLPUnstructuredGridReader() if parallel else vtkXMLUnstructuredGridReader()
-    r.SetFileName(run + ("/particles.pvtu" if parallel else "/particles.vtu"))
-    r.Update()
-    g = r.GetOutput()
-    X = vtk_to_numpy(g.GetPoints().GetData())
+    X, array = particles_vtk.read(run)
     rr, th = np.hypot(X[:, 0], X[:, 1]), np.arctan2(X[:, 1], X[:, 0])
     q = (R / rr) ** 2
     kirsch = 1 - q * (1.5 * np.cos(2 * th) + np.cos(4 * th)) + 1.5 * q * q * np.cos(4 * th)
     sel = (rr < 2 * R) & (np.abs(np.abs(th) - np.pi / 2) < np.radians(30))
     out = {"particles": int(sel.sum())}
     for name in ("stress", "elastic_stress"):
-        s = vtk_to_numpy(g.GetPointData().GetArray(name))[:, 0] / S
+        s = array(name)[:, 0] / S
         out[name] = 3 * (s[sel] @ kirsch[sel]) / (kirsch[sel] @ kirsch[sel])
     return out
 

@@ -9,22 +9,16 @@ pulse RUN0 RUN1: the pulse's centre at t = 94 (history.csv's pulse_position) nea
   c t = sqrt((K + 4G/3)/rho) t (nu = 1/4: c = 1.3416) as the mesh is split: the error of the
   split mesh (RUN1) at most 1/1.3 of the coarse one's (measured 1/1.51, docs/mesh.md).
 """
-import csv, math, os, sys
+import csv, math, sys
 import numpy as np
-from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader, vtkXMLUnstructuredGridReader
-from vtkmodules.util.numpy_support import vtk_to_numpy
+import particles_vtk
 
 W = 4.0  # the period in y and z
 
 
 def particles(run):
-    parallel = os.path.exists(run + "/particles.pvtu")
-    r = vtkXMLPUnstructuredGridReader() if parallel else vtkXMLUnstructuredGridReader()
-    r.SetFileName(run + ("/particles.pvtu" if parallel else "/particles.vtu"))
-    r.Update()
-    g = r.GetOutput()
-    X = vtk_to_numpy(g.GetPoints().GetData()).astype(float)
-    h = vtk_to_numpy(g.GetPointData().GetArray("horizon")).astype(float)
+    X, array = particles_vtk.read(run)
+    h = array("horizon")
     order = np.lexsort((X[:, 2], X[:, 1], X[:, 0]))
     return X[order], h[order]
 
@@ -70,12 +64,8 @@ def pulse(run0, run1):
 
 
 def strain(run, s=1e-3, E=1.0, nu=0.25):
-    r = vtkXMLUnstructuredGridReader()
-    r.SetFileName(run + "/particles.vtu")
-    r.Update()
-    g = r.GetOutput()
-    X = vtk_to_numpy(g.GetPoints().GetData()).astype(float)
-    u = vtk_to_numpy(g.GetPointData().GetArray("displacement")).astype(float)
+    X, array = particles_vtk.read(run)
+    u = array("displacement")
     M = E / (3 * (1 - 2 * nu)) + 4 / 3 * E / (2 * (1 + nu))
     m = (X[:, 0] > 50) & (X[:, 0] < 150)
     slope = np.polyfit(X[m, 0], u[m, 0], 1)[0]
