@@ -44,14 +44,20 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 
 /* The static solves' default PC: GAMG, but Jacobi on a matrix-free K of a small 3D body, where CG
  * needs a few hundred of the cheap products and no preconditioning matrix is stored: faster and
- * lighter up to about 5e5 particles and 200 spacings across (docs/performance.md, "Matrix-free"). */
+ * lighter up to about 5e5 particles and 200 spacings across (docs/performance.md, "Matrix-free");
+ * and on a 2D body of shear or micropolar bonds up to 80 spacings across, where GAMG's set-up
+ * with three DOFs per particle costs more than Jacobi's iterations (2x on the lamina of
+ * examples/lamina, 1.6x over the whole micropolar shear run; docs/performance.md, "Defaults"). */
 static void DefaultPC(PeriSystem sys)
 {
   const PeriParticles *pt     = &sys->disc.particles;
+  const PeriModel      m      = sys->model;
   PetscReal            extent = 0;
 
   for (PetscInt d = 0; d < pt->dim; d++) extent = PetscMax(extent, pt->upper[d] - pt->lower[d]);
-  if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
+  if (pt->dim == 2 && !m->central_force && m->dofs >= 2 && extent <= PERI_JACOBI_MAX_SPAN_2D * pt->mean_spacing)
+    PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
+  else if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
     PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
   else
     PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default));
@@ -77,8 +83,10 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
     DefaultPC(sys);
     PetscCall(PeriOperatorCreateMat(sys, &sys->stiffness.K));
     PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
-  } else
+  } else {
+    DefaultPC(sys);
     PetscCall(PeriAssembleStiffness(sys, &sys->stiffness.K));
+  }
   PetscCall(PetscTime(&t1));
   sys->run.log.assembly_s = t1 - t0;
   if (sys->run.log.matrix_mb == 0) { /* the first assembly: K's size and the memory it took */

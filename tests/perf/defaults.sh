@@ -5,7 +5,8 @@
 # static run does) against {assembled, matrix_free} x {GAMG, Jacobi, hypre BoomerAMG} with CG,
 # each the median of REPEAT runs on one rank, and prints the default's time over the fastest
 # converged one's (target <= 1.3) and which that was. Large benchmarks take minutes.
-# Usage: defaults.sh PERILIN [REPEAT [SCENE...]]   (default: every scene listed below)
+# Usage: defaults.sh PERILIN [REPEAT [SCENE...]]   (default: every scene listed below; a SCENE is
+#   examples/SCENE.yaml; options in $DEFAULTS_OPTS go to every run, e.g. -grid_spacing 0.005)
 set -euo pipefail
 exe=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
 repeat=${2:-3}
@@ -30,11 +31,12 @@ for op in ("assembled", "matrix_free"):
 scene["analysis"] = {"type": "tune", "repeat": int(sys.argv[3]), "configurations": configs}
 yaml.safe_dump(scene, open(sys.argv[2], "w"), sort_keys=False)
 PY
-  if ! "$exe" "$tune" -quiet -output_vtk false -output_plots false -output_dir "$tmp/$(basename "$s")" > "$tmp/log" 2>&1; then
+  # shellcheck disable=SC2086
+  if ! "$exe" "$tune" ${DEFAULTS_OPTS:-} -quiet -output_vtk false -output_plots false -output_dir "$tmp/$(basename "$s")" > "$tmp/log" 2>&1; then
     printf "%-28s failed: %s\n" "$s" "$(grep -m1 error "$tmp/log" | cut -c1-120)"
     continue
   fi
-  /usr/bin/python3 - "$tmp/$(basename "$s")/tune.csv" "$s" <<'PY'
+  /usr/bin/python3 - "$tmp/$(basename "$s")/tune.csv" "$s" ${DEFAULTS_ROWS:+rows} <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 conv = [r for r in rows if r["converged"] in ("1", "true", "yes", "True")]
@@ -44,5 +46,8 @@ best = min(others, key=lambda r: float(r["total_s"]))
 d, b = float(default["total_s"]), float(best["total_s"])
 mark = "" if d <= 1.3 * b else "  <-- above 1.3"
 print(f"{sys.argv[2]:28s} {d:9.4f} {b:9.4f} {d / b:6.2f}  {best['configuration']}{mark}")
+if len(sys.argv) > 3:  # DEFAULTS_ROWS=1: every row
+    for r in rows:
+        print(f"    {r['configuration']:62s} {r['converged']:>5s} {r['iterations']:>6s} {float(r['total_s']):9.4f}")
 PY
 done
