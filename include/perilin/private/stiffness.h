@@ -12,7 +12,7 @@ typedef struct _p_PeriSystem *PeriSystem;
  * CG + Jacobi on a matrix-free K (PeriSystemAssemble). */
 #define PERI_JACOBI_MAX_PARTICLES 500000
 #define PERI_JACOBI_MAX_SPAN      200
-#define PERI_JACOBI_MAX_SPAN_2D   80 /* 2D shear and micropolar bodies, assembled or not (tests/perf/defaults.sh) */
+#define PERI_JACOBI_MAX_SPAN_2D   80  /* 2D shear and micropolar bodies, assembled or not (tests/perf/defaults.sh) */
 #define PERI_JACOBI_BUDGET        400 /* iterations, about the cost of GAMG's set-up and solve */
 typedef enum {
   PERI_OPERATOR_AUTO,
