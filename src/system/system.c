@@ -46,12 +46,14 @@ const PeriSchema PeriSystemSchema[] = {
 static PetscErrorCode ReadNeighborsHorizon(PeriSystem sys, PeriNode h, PetscReal hmax)
 {
   PeriScene s = sys->scene;
-  PetscInt  k = 0, dim = sys->disc.particles.dim;
+  PetscInt  k = 0, dim = sys->disc.particles.dim, N = sys->disc.particles.n;
   PetscBool has;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetInt(s, h, "neighbors", PETSC_FALSE, &k, &has));
   if (!has) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &N, 1, MPIU_INT, MPI_SUM, sys->comm)); /* the ranks' blocks */
+  PeriInputCheck(k < N, s, h, "neighbors", "%" PetscInt_FMT " neighbours per horizon need more than %" PetscInt_FMT " particles; the body has %" PetscInt_FMT, k, k, N);
   PeriInputCheck(sys->model->takes_own_horizon, s, h, "neighbors", "model %s calibrates its springs on one horizon for the whole body; per-particle horizons are derived for pmb and npmb (docs/mesh.md, \"Per-particle horizons\"): use one of them or horizon.m", sys->model->type);
   sys->disc.horizon_k = k;
   sys->disc.horizon_m = dim == 3 ? PetscCbrtReal(3.0 * k / (4 * PETSC_PI)) : PetscSqrtReal(k / PETSC_PI);
