@@ -455,8 +455,9 @@ static PetscErrorCode CheckModes(PeriAnalysis an, PetscReal eps_tol)
 }
 
 /* K on the free DOFs, and what preconditions it. A matrix-free K is restricted without a copy
- * (R K R^T) and its short-range stiffness serves GAMG (*Pff); an assembled K is copied and then
- * freed, since only K_ff is used (the 230,400-particle lamina: 0.87 GB). */
+ * (R K R^T) and the free block of its short-range stiffness serves GAMG (*Pff); an assembled K is
+ * copied. Only the free blocks are used: the full matrices are freed (an assembled K of the
+ * 230,400-particle lamina: 0.87 GB). */
 static PetscErrorCode FreeStiffness(PeriAnalysis an, IS isfree, Mat *Kff, Mat *Pff)
 {
   PeriStiffness *S = &an->sys->stiffness;
@@ -467,6 +468,7 @@ static PetscErrorCode FreeStiffness(PeriAnalysis an, IS isfree, Mat *Kff, Mat *P
     PetscCall(MatCreateSubMatrixVirtual(S->K, isfree, isfree, Kff));
     PetscCall(PeriOperatorPreconditioner(an->sys));
     PetscCall(MatCreateSubMatrix(S->Kpc, isfree, isfree, MAT_INITIAL_MATRIX, Pff));
+    PetscCall(MatDestroy(&S->Kpc)); /* only its free block is used */
     PetscCall(MatSetOption(*Pff, MAT_SYMMETRIC, PETSC_TRUE));
     /* for GAMG: the rigid modes on the free DOFs */
     PetscCall(PeriSetNearNullSpace(an->sys, *Pff, isfree));
