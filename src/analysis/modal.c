@@ -898,14 +898,15 @@ static PetscErrorCode SolversFromOptions_Modal(MPI_Comm comm, const char ksp_typ
 
 static const char *const modal_files[] = {"modes.csv", "modes.pvd", "mode_#.vtu", "mode_#.pvtu", "mode_#", "modes.png", NULL};
 
-/* K is assembled AIJ and factored (its fill measured in docs/performance.md); the mass comes from
- * the system's mass service. */
+/* K is assembled AIJ and factored (its fill measured in docs/performance.md), or from
+ * MODAL_LOBPCG_MIN_DOFS DOFs on matrix-free for LOBPCG (analysis.eigensolver auto); the mass comes
+ * from the system's mass service. */
 const PeriAnalysisType PeriAnalysis_Modal = {
     .name          = "modal",
     .help          = "natural frequencies and mode shapes (SLEPc, shift-and-invert)",
     .schema        = modal_schema,
     .option_prefix = "st_",
     .files         = modal_files,
-    .needs         = {.factor_fill = 0.45},
+    .needs         = {.factor_fill = 0.45, .iterative_dofs = MODAL_LOBPCG_MIN_DOFS},
     .ops           = {.setfromscene = SetFromScene_Modal, .setup = SetUp_Modal, .run = PeriAnalysisRun_Modal, .fields = ModalAddFields, .files = ModalFiles, .summary = ModalSummary, .report = ModalReport, .solvers_from_options = SolversFromOptions_Modal, .destroy = ModalDestroy},
 };
