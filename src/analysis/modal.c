@@ -236,24 +236,34 @@ static PetscErrorCode ProgressMonitor(EPS eps, PetscInt its, PetscInt nconv, Pet
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The spectral transformation of the given type, its linear solver a single application of a PC
+ * of the given type (returned, for its own settings). */
+static PetscErrorCode SetTransform(EPS eps, STType st_type, PCType pc_type, PC *pc)
+{
+  ST  st;
+  KSP ksp;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STSetType(st, st_type));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, pc));
+  PetscCall(PCSetType(*pc, pc_type));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Krylov-Schur, shift-and-invert at sigma with a direct factorization (MUMPS Cholesky when PETSc
  * has it): the nreq pairs nearest sigma. */
 static PetscErrorCode SetShiftInvert(EPS eps, PetscReal sigma)
 {
-  ST  st;
-  KSP ksp;
-  PC  pc;
+  PC pc;
 
   PetscFunctionBeginUser;
   PetscCall(EPSSetTarget(eps, sigma));
   PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
   PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
-  PetscCall(EPSGetST(eps, &st));
-  PetscCall(STSetType(st, STSINVERT));
-  PetscCall(STGetKSP(st, &ksp));
-  PetscCall(KSPSetType(ksp, KSPPREONLY));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCCHOLESKY));
+  PetscCall(SetTransform(eps, STSINVERT, PCCHOLESKY, &pc));
 #if defined(PETSC_HAVE_MUMPS)
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
 #endif
@@ -268,22 +278,17 @@ static PetscErrorCode SetShiftInvert(EPS eps, PetscReal sigma)
  * 2.5e-8 at 57,600. The frequencies, quadratic in it, agree with the factorization's to 1e-12. */
 static PetscErrorCode SetLOBPCG(EPS eps, Mat P, PetscInt nreq)
 {
-  ST  st;
-  KSP ksp;
-  PC  pc;
+  ST st;
+  PC pc;
 
   PetscFunctionBeginUser;
   PetscCall(EPSSetType(eps, EPSLOBPCG));
   PetscCall(EPSSetWhichEigenpairs(eps, EPS_SMALLEST_REAL));
   PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
   PetscCall(EPSLOBPCGSetBlockSize(eps, nreq + 2));
+  PetscCall(SetTransform(eps, STPRECOND, PCGAMG, &pc));
   PetscCall(EPSGetST(eps, &st));
-  PetscCall(STSetType(st, STPRECOND));
   if (P) PetscCall(STSetPreconditionerMat(st, P));
-  PetscCall(STGetKSP(st, &ksp));
-  PetscCall(KSPSetType(ksp, KSPPREONLY));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCGAMG));
   /* aggregates of the wide stencil's squared graph are too coarse: 58 LOBPCG iterations on the
      57,600-particle lamina with the squared graph, 37 without */
   PetscCall(PCGAMGSetAggressiveLevels(pc, 0));

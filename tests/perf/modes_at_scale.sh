@@ -21,17 +21,14 @@ trap 'rm -rf "$work"' EXIT
 cd "$work"
 for r in $(seq "$reps"); do
   for s in $solvers; do
-    /usr/bin/time -f "%e %M" -o t.txt "$perilin" "$scene" -model_type gerstle -grid_spacing "$dx" -analysis_nev 10 -analysis_eigensolver "$s" \
+    /usr/bin/time -a -o runs.txt -f "$s %e %M" "$perilin" "$scene" -model_type gerstle -grid_spacing "$dx" -analysis_nev 10 -analysis_eigensolver "$s" \
       -output_dir "$s" -output_vtk false -output_plots false -quiet "$@" > /dev/null
-    echo "$s $(cat t.txt)" >> times.txt
   done
 done
 python3 - <<'PY'
 import json, os, statistics
-t = {}
-for line in open("times.txt"):
-    k, w, kb = line.split()
-    t.setdefault(k, []).append((float(w), int(kb) / 1048576))
+runs = [line.split() for line in open("runs.txt")]
+t = {k: [(float(w), int(kb) / 1048576) for s, w, kb in runs if s == k] for k, _, _ in runs}
 mem = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
 f = {}
 for k, v in t.items():
