@@ -1,9 +1,22 @@
 /* Modal analysis: natural frequencies and mode shapes from K x = omega^2 M x (SLEPc, EPS_GHEP),
- * shift-and-invert around a target with a direct factorization, on the free DOFs only (prescribed
- * DOFs are removed, so they give no spurious eigenvalues). M is lumped: rho V_i per translation,
+ * shift-and-invert around a target with a direct factorization, or on large bodies LOBPCG with
+ * algebraic multigrid (analysis.eigensolver), on the free DOFs only (prescribed DOFs are removed,
+ * so they give no spurious eigenvalues). M is lumped: rho V_i per translation,
  * rho V_i (dx^2 + dy^2)/12 per rotation (Diana & Casolo sec. 3.1, with r_i^2 for their r_i). */
 #include "perilin/private/analysis.h"
 #include <slepceps.h>
+
+/* analysis.eigensolver */
+typedef enum {
+  EIGENSOLVER_AUTO,
+  EIGENSOLVER_SHIFT_INVERT,
+  EIGENSOLVER_LOBPCG
+} Eigensolver;
+static const char *const eigensolvers[] = {"auto", "shift_invert", "lobpcg", NULL};
+
+/* auto takes LOBPCG from this many DOFs on: below it the factorization is faster, above it its
+ * fill outgrows the machine (docs/performance.md, "Modes at scale (issue 29, item 1)") */
+#define MODAL_LOBPCG_MIN_DOFS 300000
 
 /* the analysis' results (its data) */
 static inline PeriModal *Modal(PeriAnalysis an)
@@ -48,6 +61,7 @@ static PetscErrorCode SetFromScene_Modal(PeriAnalysis an, PeriScene s, PeriNode 
   an->data = md;
   PetscCall(PeriSceneGetInt(s, a, "nev", PETSC_FALSE, &md->nev, NULL));
   PetscCall(PeriSceneGetReal(s, a, "target_hz", PETSC_FALSE, &md->target_hz, NULL));
+  PetscCall(PeriSceneGetChoice(s, a, "eigensolver", eigensolvers, &md->eigensolver, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -222,13 +236,71 @@ static PetscErrorCode ProgressMonitor(EPS eps, PetscInt its, PetscInt nconv, Pet
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Krylov-Schur, shift-and-invert at sigma with a direct factorization, the nreq pairs nearest
- * sigma; then every -eps_* and -st_* option; then the check of the inner solves. */
-static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
+/* The spectral transformation of the given type, its linear solver a single application of a PC
+ * of the given type (returned, for its own settings). */
+static PetscErrorCode SetTransform(EPS eps, STType st_type, PCType pc_type, PC *pc)
+{
+  ST  st;
+  KSP ksp;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STSetType(st, st_type));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, pc));
+  PetscCall(PCSetType(*pc, pc_type));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Krylov-Schur, shift-and-invert at sigma with a direct factorization (MUMPS Cholesky when PETSc
+ * has it): the nreq pairs nearest sigma. */
+static PetscErrorCode SetShiftInvert(EPS eps, PetscReal sigma)
+{
+  PC pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSSetTarget(eps, sigma));
+  PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+  PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
+  PetscCall(SetTransform(eps, STSINVERT, PCCHOLESKY, &pc));
+#if defined(PETSC_HAVE_MUMPS)
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+#endif
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* LOBPCG for the nreq lowest pairs, preconditioned by one GAMG cycle on P (the short-range
+ * stiffness of a matrix-free K, or K itself). Its block holds two pairs more than asked for (on the
+ * 14,400-particle lamina, 10 modes: blocks of 12, 16 and 20 took 7.0, 8.2 and 8.5 s). perilin's
+ * mode residual is SLEPc's relative error times a factor that grows with the body (1e-8 left
+ * 1.1e-6 at 57,600 particles, above the 1e-6 accepted; 1e-9 left 9.1e-7 at 921,600): 1e-10 leaves
+ * 2.5e-8 at 57,600. The frequencies, quadratic in it, agree with the factorization's to 1e-12. */
+static PetscErrorCode SetLOBPCG(EPS eps, Mat P, PetscInt nreq)
+{
+  ST st;
+  PC pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSSetType(eps, EPSLOBPCG));
+  PetscCall(EPSSetWhichEigenpairs(eps, EPS_SMALLEST_REAL));
+  PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
+  PetscCall(EPSLOBPCGSetBlockSize(eps, nreq + 2));
+  PetscCall(SetTransform(eps, STPRECOND, PCGAMG, &pc));
+  PetscCall(EPSGetST(eps, &st));
+  if (P) PetscCall(STSetPreconditionerMat(st, P));
+  /* aggregates of the wide stencil's squared graph are too coarse: 58 LOBPCG iterations on the
+     57,600-particle lamina with the squared graph, 37 without */
+  PetscCall(PCGAMGSetAggressiveLevels(pc, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The eigensolver analysis.eigensolver chose (SetShiftInvert or SetLOBPCG), then every -eps_* and
+ * -st_* option; then the check of the inner solves. */
+static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, Mat Pff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
 {
   ST        st;
   KSP       ksp;
-  PC        pc;
   PetscBool precond;
 
   PetscFunctionBeginUser;
@@ -236,22 +308,16 @@ static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, PetscReal sig
   PetscCall(EPSSetOperators(*eps, Kff, Mff));
   PetscCall(EPSSetProblemType(*eps, EPS_GHEP));
   PetscCall(EPSSetDimensions(*eps, nreq, PETSC_DEFAULT, PETSC_DEFAULT));
-  PetscCall(EPSSetTarget(*eps, sigma));
-  PetscCall(EPSSetWhichEigenpairs(*eps, EPS_TARGET_MAGNITUDE));
-  PetscCall(EPSSetTolerances(*eps, 1e-10, PETSC_DEFAULT));
-  PetscCall(EPSGetST(*eps, &st));
-  PetscCall(STSetType(st, STSINVERT));
-  PetscCall(STGetKSP(st, &ksp));
-  PetscCall(KSPSetType(ksp, KSPPREONLY));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCCHOLESKY));
-#if defined(PETSC_HAVE_MUMPS)
-  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-#endif
+  if (Modal(an)->eigensolver == EIGENSOLVER_LOBPCG)
+    PetscCall(SetLOBPCG(*eps, Pff, nreq));
+  else
+    PetscCall(SetShiftInvert(*eps, sigma));
   PetscCall(EPSSetFromOptions(*eps));
   if (PeriProgressActive(an->sys->run.progress)) PetscCall(EPSMonitorSet(*eps, ProgressMonitor, an->sys->run.progress, NULL));
-  /* STPRECOND (Davidson methods) solves only approximately by design: there only the modes
-   * themselves are checked */
+  /* STPRECOND (Davidson methods, LOBPCG) solves only approximately by design: there only the
+   * modes themselves are checked */
+  PetscCall(EPSGetST(*eps, &st));
+  PetscCall(STGetKSP(st, &ksp));
   PetscCall(PetscObjectTypeCompare((PetscObject)st, STPRECOND, &precond));
   inner->an      = an;
   inner->r       = NULL;
@@ -393,8 +459,36 @@ static PetscErrorCode CheckModes(PeriAnalysis an, PetscReal eps_tol)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* K on the free DOFs, and what preconditions it. A matrix-free K is restricted without a copy
+ * (R K R^T) and the free block of its short-range stiffness serves GAMG (*Pff); an assembled K is
+ * copied. Only the free blocks are used: the full matrices are freed (an assembled K of the
+ * 230,400-particle lamina: 0.87 GB). */
+static PetscErrorCode FreeStiffness(PeriAnalysis an, IS isfree, Mat *Kff, Mat *Pff)
+{
+  PeriStiffness *S = &an->sys->stiffness;
+
+  PetscFunctionBeginUser;
+  *Pff = NULL;
+  if (S->op) {
+    PetscCall(MatCreateSubMatrixVirtual(S->K, isfree, isfree, Kff));
+    PetscCall(PeriOperatorPreconditioner(an->sys));
+    PetscCall(MatCreateSubMatrix(S->Kpc, isfree, isfree, MAT_INITIAL_MATRIX, Pff));
+    PetscCall(MatDestroy(&S->Kpc)); /* only its free block is used */
+    PetscCall(MatSetOption(*Pff, MAT_SYMMETRIC, PETSC_TRUE));
+    /* for GAMG: the rigid modes on the free DOFs */
+    PetscCall(PeriSetNearNullSpace(an->sys, *Pff, isfree));
+  } else {
+    PetscCall(MatCreateSubMatrix(S->K, isfree, isfree, MAT_INITIAL_MATRIX, Kff));
+    PetscCall(MatDestroy(&S->K));
+    /* for an inner solve by algebraic multigrid (-st_pc_type gamg): the rigid modes on the free DOFs */
+    PetscCall(PeriSetNearNullSpace(an->sys, *Kff, isfree));
+  }
+  PetscCall(MatSetOption(*Kff, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The mass, the free DOFs and the blocks of K and M on them. */
-static PetscErrorCode SetUpModal(PeriAnalysis an, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff)
+static PetscErrorCode SetUpModal(PeriAnalysis an, Mat *M, Vec *mdiag, IS *isfree, Mat *Kff, Mat *Mff, Mat *Pff)
 {
   PeriModal *md = Modal(an);
 
@@ -408,11 +502,8 @@ static PetscErrorCode SetUpModal(PeriAnalysis an, Mat *M, Vec *mdiag, IS *isfree
   PetscCall(FreeDOFs(an, isfree));
   PetscCall(ISGetSize(*isfree, &md->nfree_dofs));
   PetscCheck(md->nfree_dofs > 0, an->comm, PETSC_ERR_USER_INPUT, "%s: every DOF is prescribed: there is no mode to compute", an->sys->scene->file);
-  PetscCall(MatCreateSubMatrix(an->sys->stiffness.K, *isfree, *isfree, MAT_INITIAL_MATRIX, Kff));
-  /* for an inner solve by algebraic multigrid (-st_pc_type gamg): the rigid modes on the free DOFs */
-  PetscCall(PeriSetNearNullSpace(an->sys, *Kff, *isfree));
+  PetscCall(FreeStiffness(an, *isfree, Kff, Pff));
   PetscCall(MatCreateSubMatrix(*M, *isfree, *isfree, MAT_INITIAL_MATRIX, Mff));
-  PetscCall(MatSetOption(*Kff, MAT_SYMMETRIC, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -485,7 +576,7 @@ static PetscErrorCode RecordSolver(PeriAnalysis an, EPS eps, PetscInt nev, const
 
 /* What one modal solve holds: freed whether it succeeds or a check stops it inside SLEPc. */
 typedef struct {
-  Mat        M, Kff, Mff; /* M: borrowed from the mass service */
+  Mat        M, Kff, Mff, Pff; /* M: borrowed from the mass service; Pff: NULL but with a matrix-free K */
   IS         isfree;
   Vec        mdiag; /* borrowed from the mass service */
   EPS        eps;
@@ -501,6 +592,7 @@ static PetscErrorCode ModalWorkDestroy(ModalWork *w)
   PetscCall(EPSDestroy(&w->eps));
   PetscCall(MatDestroy(&w->Kff));
   PetscCall(MatDestroy(&w->Mff));
+  PetscCall(MatDestroy(&w->Pff));
   PetscCall(ISDestroy(&w->isfree));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -515,20 +607,21 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
-  PetscCall(SetUpModal(an, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff));
+  PetscCall(SetUpModal(an, &w->M, &w->mdiag, &w->isfree, &w->Kff, &w->Mff, &w->Pff));
   md = Modal(an);
   PetscCall(PeriRigidMotionFree(an->sys, &nfree, what, sizeof(what), NULL));
   md->nrigid = 0;
 
-  /* the scale of the largest omega^2 */
-  PetscCall(MatNorm(w->Kff, NORM_1, &Knorm));
+  /* the scale of the largest omega^2 (a matrix-free K's from its short-range stiffness, whose
+     diagonal is K's) */
+  PetscCall(MatNorm(w->Pff ? w->Pff : w->Kff, NORM_1, &Knorm));
   PetscCall(MatNorm(w->Mff, NORM_1, &Mnorm));
   scale = Knorm / Mnorm;
   sigma = PetscSqr(2 * PETSC_PI * target_hz);
   /* a free body makes K singular: shift just below its zero eigenvalues */
   if (nfree && target_hz == 0) sigma = -1e-8 * scale;
 
-  PetscCall(CreateEPS(an, w->Kff, w->Mff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
+  PetscCall(CreateEPS(an, w->Kff, w->Mff, w->Pff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
   /* the factorization (MUMPS) and its solves run with the BLAS threads (src/sys/threads.c) */
   PetscCall(PeriBLASThreads(PETSC_TRUE));
   PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_PHASE, "factorization"));
@@ -555,8 +648,37 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
         break;
       }
   PetscCall(RecordSolver(an, w->eps, nev, &w->inner));
+  /* SLEPc's LOBPCG stops at -eps_max_it with what it has: fewer modes than asked is a failure */
+  PetscCheck(md->eigensolver != EIGENSOLVER_LOBPCG || md->nmodes >= PetscMin(nev, md->nfree_dofs), an->comm, PETSC_ERR_NOT_CONVERGED,
+             "%s: LOBPCG converged %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for in %" PetscInt_FMT " iterations: raise -eps_max_it, or use analysis.eigensolver: shift_invert", an->sys->scene->file, md->nmodes,
+             PetscMin(nev, md->nfree_dofs), an->sys->fields.solve.iterations);
   PetscCheck(md->nmodes > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: only rigid-body modes converged (%" PetscInt_FMT "): ask for more with analysis.nev", an->sys->scene->file, md->nrigid);
   if (md->nmodes < nev) PetscCall(PetscPrintf(an->comm, "perilin: warning: %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for converged (the body has %" PetscInt_FMT " free DOFs)\n", md->nmodes, nev, md->nfree_dofs));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* analysis.eigensolver as run. auto takes LOBPCG from MODAL_LOBPCG_MIN_DOFS DOFs on, for a held
+ * body without a target: LOBPCG finds the lowest modes only, and a free body's zero modes would
+ * leave GAMG a singular matrix. LOBPCG applies K matrix-free where the operator can (solver.operator
+ * auto); the factorization needs K's entries. Before K is built. Collective. */
+static PetscErrorCode ChooseEigensolver(PeriAnalysis an)
+{
+  PeriModal     *md = Modal(an);
+  PeriStiffness *S  = &an->sys->stiffness;
+  PeriNode       node;
+  PetscInt       nfree;
+  PetscBool      lowest;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriRigidMotionFree(an->sys, &nfree, NULL, 0, NULL));
+  lowest = (PetscBool)(!nfree && md->target_hz == 0);
+  if (md->eigensolver == EIGENSOLVER_AUTO) md->eigensolver = lowest && an->sys->disc.N * an->sys->model->dofs >= MODAL_LOBPCG_MIN_DOFS ? EIGENSOLVER_LOBPCG : EIGENSOLVER_SHIFT_INVERT;
+  PetscCall(PeriSceneGetNode(an->sys->scene->root, "analysis", &node));
+  PeriInputCheck(md->eigensolver != EIGENSOLVER_LOBPCG || lowest, an->sys->scene, node, "eigensolver", "lobpcg computes the lowest modes of a held body, and this one %s: use shift_invert (or auto)",
+                 nfree ? "can move as a rigid body" : "asks for the modes nearest analysis.target_hz");
+  if (md->eigensolver == EIGENSOLVER_SHIFT_INVERT) PetscFunctionReturn(PETSC_SUCCESS);
+  S->needs.matrix_free = PETSC_TRUE;
+  if (S->operator_kind == PERI_OPERATOR_AUTO && !PeriMatrixFreeWhyNot(an->sys)) S->operator_kind = PERI_OPERATOR_MATRIX_FREE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -577,6 +699,7 @@ static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(an->sys->stiffness.mat_type, MATAIJ, sizeof(an->sys->stiffness.mat_type)));
+  PetscCall(ChooseEigensolver(an));
   if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
   PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
@@ -692,6 +815,7 @@ static PetscErrorCode ModalSummary(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONInt(j, "free_dofs", md->nfree_dofs));
   PetscCall(PeriJSONReal(j, "total_mass", md->total_mass));
   PetscCall(PeriJSONString(j, "axis", (const char *[]){"x", "y", "z"}[md->axis]));
+  PetscCall(PeriJSONString(j, "eigensolver", eigensolvers[md->eigensolver]));
   PetscCall(PeriJSONReal(j, "factorization_s", md->factor_s));
   PetscCall(PeriJSONReal(j, "eigensolve_s", md->solve_s));
   if (md->longitudinal_speed > 0) PetscCall(PeriJSONReal(j, "longitudinal_speed", md->longitudinal_speed));
@@ -750,6 +874,7 @@ static PetscErrorCode ModalDestroy(PeriAnalysis an)
 static const PeriKey modal_keys[] = {
     {"nev", PERI_KEY_INT, "6", "[1, inf)", NULL, NULL, "number of modes"},
     {"target_hz", PERI_KEY_REAL, "0", "[0, inf)", "[1/time]", NULL, "compute the modes nearest this frequency (0: the lowest)"},
+    {"eigensolver", PERI_KEY_CHOICE, "auto", NULL, NULL, eigensolvers, "shift_invert: Krylov-Schur, shift-and-invert with a direct factorization of K; lobpcg: LOBPCG with algebraic multigrid, K matrix-free where it can be (the lowest modes of a held body only); auto: lobpcg from 300,000 DOFs on where it applies, else shift_invert (docs/modal.md)"},
     {NULL},
 };
 static const PeriSchema modal_schema[] = {{"analysis", modal_keys}, {NULL}};
@@ -778,14 +903,15 @@ static PetscErrorCode SolversFromOptions_Modal(MPI_Comm comm, const char ksp_typ
 
 static const char *const modal_files[] = {"modes.csv", "modes.pvd", "mode_#.vtu", "mode_#.pvtu", "mode_#", "modes.png", NULL};
 
-/* K is assembled AIJ and factored (its fill measured in docs/performance.md); the mass comes from
- * the system's mass service. */
+/* K is assembled AIJ and factored (its fill measured in docs/performance.md), or from
+ * MODAL_LOBPCG_MIN_DOFS DOFs on matrix-free for LOBPCG (analysis.eigensolver auto); the mass comes
+ * from the system's mass service. */
 const PeriAnalysisType PeriAnalysis_Modal = {
     .name          = "modal",
     .help          = "natural frequencies and mode shapes (SLEPc, shift-and-invert)",
     .schema        = modal_schema,
     .option_prefix = "st_",
     .files         = modal_files,
-    .needs         = {.factor_fill = 0.45},
+    .needs         = {.factor_fill = 0.45, .iterative_dofs = MODAL_LOBPCG_MIN_DOFS},
     .ops           = {.setfromscene = SetFromScene_Modal, .setup = SetUp_Modal, .run = PeriAnalysisRun_Modal, .fields = ModalAddFields, .files = ModalFiles, .summary = ModalSummary, .report = ModalReport, .solvers_from_options = SolversFromOptions_Modal, .destroy = ModalDestroy},
 };

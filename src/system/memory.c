@@ -215,11 +215,12 @@ static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
 @*/
 PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m, const PeriSystemNeeds *needs)
 {
-  MemoryEstimate e = {0};
-  PetscReal      h = 0, r = 0, cells[3];
-  PetscBool      run = PETSC_TRUE, failure, periodic[3], mf;
-  PeriNode       grid;
-  PetscErrorCode ierr;
+  MemoryEstimate  e = {0};
+  PeriSystemNeeds at;
+  PetscReal       h = 0, r = 0, cells[3];
+  PetscBool       run = PETSC_TRUE, failure, periodic[3], mf;
+  PeriNode        grid;
+  PetscErrorCode  ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_memory_check", &run, NULL));
@@ -238,9 +239,16 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m,
   if (ierr || !(e.n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
   failure = grid ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(MatrixFree(s, m, needs, &mf));
+  at      = *needs;
+  if (at.iterative_dofs > 0 && e.n * m->dofs >= at.iterative_dofs) {
+    /* the analysis' iterative default (a modal LOBPCG): no factor, and K matrix-free where the
+       operator applies (solver.operator assembled or a forced factorization then need more) */
+    at.factor_fill = 0;
+    mf             = (PetscBool)!PeriOperatorWhyNotModel(m);
+  } else
+    PetscCall(MatrixFree(s, m, &at, &mf));
   if (failure && !m->central_force) mf = PETSC_FALSE; /* PeriMatrixFreeWhyNot */
-  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, needs, mf, &e));
+  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, &at, mf, &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));

@@ -32,6 +32,7 @@ typedef struct {
   PetscReal *shapes;                           /* rank 0: min(nmodes, PERI_MAX_VTU_MODES) x n x dofs, each scaled to max |u| = 1 */
   PetscInt   nshapes;
   PetscReal  factor_s, solve_s;
+  PetscInt   eigensolver; /* analysis.eigensolver: as read (0 auto), then as run */
 } PeriModal;
 
 /* One load step of the quasi-static analysis. */
