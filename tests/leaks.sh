@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # leaks.sh PERILIN EXAMPLES_DIR: runs a static, two modal (factorization, LOBPCG) and a quasi-static example and three failing
-# runs (an input error, a solver failure) under PETSc's -malloc_debug -malloc_dump, and fails when
+# runs (an input error, a solver failure, a LOBPCG out of iterations) under PETSc's -malloc_debug -malloc_dump, and fails when
 # any run reports an unfreed block ("[rank] N bytes Function() at file:line"), reports corrupted
 # memory, or ends differently than expected. Coarse grids keep the whole test at a few seconds.
 set -u
