@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# leaks.sh PERILIN EXAMPLES_DIR: runs a static, a modal and a quasi-static example and two failing
-# runs (an input error, a solver failure) under PETSc's -malloc_debug -malloc_dump, and fails when
+# leaks.sh PERILIN EXAMPLES_DIR: runs a static, two modal (factorization, LOBPCG) and a quasi-static example and three failing
+# runs (an input error, a solver failure, a LOBPCG out of iterations) under PETSc's -malloc_debug -malloc_dump, and fails when
 # any run reports an unfreed block ("[rank] N bytes Function() at file:line"), reports corrupted
 # memory, or ends differently than expected. Coarse grids keep the whole test at a few seconds.
 set -u
@@ -41,6 +41,8 @@ check() {
 
 check static 0 'strain energy' pmb/plate_traction.yaml -grid_spacing 0.02
 check modal 0 'modes \(Hz\)' lamina/modal.yaml -grid_spacing 0.05
+check modal_lobpcg 0 'modes \(Hz\)' lamina/modal.yaml -grid_spacing 0.05 -model_type gerstle -analysis_eigensolver lobpcg
+check modal_lobpcg_failure 1 'converged no mode' lamina/modal.yaml -grid_spacing 0.05 -model_type gerstle -analysis_eigensolver lobpcg -eps_max_it 2
 check quasistatic 0 'strain energy' antiplane/cracked_bar.yaml -grid_spacing 0.05 -analysis_min_step 0.25 -quiet
 check input_error 1 "unknown model 'nosuch'" pmb/plate_traction.yaml -grid_spacing 0.02 -model_type nosuch
 check solver_failure 1 'did not converge' pmb/plate_traction.yaml -grid_spacing 0.02 -ksp_max_it 1

@@ -686,10 +686,12 @@ static PetscErrorCode ChooseEigensolver(PeriAnalysis an)
   PeriAnalysisRun_Modal - analysis.nev natural modes of the constrained body. Without a target
   (analysis.target_hz = 0) the lowest, in ascending frequency; with one, the nev whose frequencies
   lie nearest it, in order of |f - target| (ties: the lower first). Rigid-body modes of a free
-  body are counted and skipped. Every inner solve of the spectral transform must leave a true
-  relative residual below PeriResidualTolerance(-st_ksp_rtol), and every returned mode a relative
-  residual ||K x - omega^2 M x|| / (omega^2 ||M x||) below PeriResidualTolerance(-eps_tol): else
-  the run fails with PETSC_ERR_NOT_CONVERGED. Options: every -eps_* and -st_* option (e.g.
+  body are counted and skipped. The eigensolver is analysis.eigensolver's (ChooseEigensolver):
+  shift-and-invert with a factorization, or LOBPCG with GAMG. Every inner solve of the spectral
+  transform must leave a true relative residual below PeriResidualTolerance(-st_ksp_rtol) (LOBPCG's
+  preconditioner excepted), every returned mode a relative residual ||K x - omega^2 M x|| /
+  (omega^2 ||M x||) below PeriResidualTolerance(-eps_tol), and LOBPCG must return all the modes
+  asked for: else the run fails with PETSC_ERR_NOT_CONVERGED. Options: every -eps_* and -st_* option (e.g.
   -st_pc_factor_mat_solver_type, -eps_tol). SLEPc must be initialized. Collective.
 @*/
 static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
