@@ -29,46 +29,41 @@
  * with a note: the body did not reduce to few rigid pieces. */
 #define PERI_MECH_MAX_DOFS 1500
 
-/* The owned-owned live bonds seen from both ends: for particle p, entries off[p]..off[p+1]-1 name
- * the other particle and the bond (its row and index; end 1 when p is the bond's j). */
+/* The owned-owned live bonds seen from both ends. A bond is stored once, in its row (the smaller
+ * global index), so a particle's own row gives one end; the other end is indexed here: for
+ * particle p, rnbr[roff[p] .. roff[p+1]-1] are the rows whose bond reaches p. 4 bytes a bond (a
+ * full two-ended copy with bond numbers and twins took 40: 256 MB on a 641,601-particle plate). */
 typedef struct {
-  PetscInt *off, *nbr, *row, *bond, *end, *twin; /* twin: the same bond's entry at the other end */
+  PetscInt *roff, *rnbr;
 } Adjacency;
 
-static PetscErrorCode AdjacencyCreate(PeriSystem sys, Adjacency *a)
+/* Whether bond k of owned particle i joins two owned, real particles and is live. */
+static PetscBool Eligible(PeriSystem sys, PetscInt i, PetscInt k)
 {
   const PeriBonds     *b  = &sys->disc.bonds;
   const PeriParticles *pt = &sys->disc.particles;
-  const PetscInt       no = sys->disc.nowned;
-  PetscInt            *fill, n = 0;
+
+  return (PetscBool)(b->live[k] && b->j[k] != i && b->j[k] < sys->disc.nowned && !PeriParticleIsFictitious(pt, i) && !PeriParticleIsFictitious(pt, b->j[k]));
+}
+
+static PetscErrorCode AdjacencyCreate(PeriSystem sys, Adjacency *a)
+{
+  const PeriBonds *b  = &sys->disc.bonds;
+  const PetscInt   no = sys->disc.nowned;
+  PetscInt        *fill;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc1(no + 1, &a->off));
+  PetscCall(PetscCalloc1(no + 1, &a->roff));
   for (PetscInt i = 0; i < no; i++)
     for (PetscInt k = b->offset[i]; k < b->offset[i + 1]; k++)
-      if (b->live[k] && b->j[k] != i && b->j[k] < no && !PeriParticleIsFictitious(pt, i) && !PeriParticleIsFictitious(pt, b->j[k])) {
-        a->off[i + 1]++;
-        a->off[b->j[k] + 1]++;
-      }
-  for (PetscInt i = 0; i < no; i++) a->off[i + 1] += a->off[i];
-  n = a->off[no];
-  PetscCall(PetscMalloc5(n, &a->nbr, n, &a->row, n, &a->bond, n, &a->end, n, &a->twin));
+      if (Eligible(sys, i, k)) a->roff[b->j[k] + 1]++;
+  for (PetscInt i = 0; i < no; i++) a->roff[i + 1] += a->roff[i];
+  PetscCall(PetscMalloc1(a->roff[no], &a->rnbr));
   PetscCall(PetscMalloc1(no, &fill));
-  PetscCall(PetscArraycpy(fill, a->off, no));
+  PetscCall(PetscArraycpy(fill, a->roff, no));
   for (PetscInt i = 0; i < no; i++)
     for (PetscInt k = b->offset[i]; k < b->offset[i + 1]; k++)
-      if (b->live[k] && b->j[k] != i && b->j[k] < no && !PeriParticleIsFictitious(pt, i) && !PeriParticleIsFictitious(pt, b->j[k]))
-        for (PetscInt e = 0; e < 2; e++) {
-          PetscInt p = e ? b->j[k] : i, s = fill[p]++;
-          a->nbr[s]  = e ? i : b->j[k];
-          a->row[s]  = i;
-          a->bond[s] = k;
-          a->end[s]  = e;
-          if (e) {
-            a->twin[s]          = fill[i] - 1;
-            a->twin[a->twin[s]] = s;
-          }
-        }
+      if (Eligible(sys, i, k)) a->rnbr[fill[b->j[k]]++] = i;
   PetscCall(PetscFree(fill));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -76,20 +71,50 @@ static PetscErrorCode AdjacencyCreate(PeriSystem sys, Adjacency *a)
 static PetscErrorCode AdjacencyDestroy(Adjacency *a)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscFree5(a->nbr, a->row, a->bond, a->end, a->twin));
-  PetscCall(PetscFree(a->off));
+  PetscCall(PetscFree(a->rnbr));
+  PetscCall(PetscFree(a->roff));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The block of adjacency entry s at its particle's end (bs x bs), added to A. */
-static PetscErrorCode AddOwnBlock(PeriSystem sys, const Adjacency *a, PetscInt s, PetscReal A[])
+/* A walk over the neighbours of p: its own row's eligible bonds, then the rows that reach it. */
+typedef struct {
+  PetscInt p, k, s;
+} Walk;
+
+static Walk WalkStart(PeriSystem sys, const Adjacency *a, PetscInt p)
 {
-  const PetscInt   bs = sys->model->dofs, nb = 2 * bs, e = a->end[s];
+  Walk w = {p, sys->disc.bonds.offset[p], a->roff[p]};
+  return w;
+}
+
+/* The next neighbour q of the walk's particle; *row is the row that stores their bond. */
+static PetscBool WalkNext(PeriSystem sys, const Adjacency *a, Walk *w, PetscInt *q, PetscInt *row)
+{
+  const PeriBonds *b = &sys->disc.bonds;
+
+  for (; w->k < b->offset[w->p + 1]; w->k++)
+    if (Eligible(sys, w->p, w->k)) {
+      *q   = b->j[w->k++];
+      *row = w->p;
+      return PETSC_TRUE;
+    }
+  if (w->s == a->roff[w->p + 1]) return PETSC_FALSE;
+  *q = *row = a->rnbr[w->s++];
+  return PETSC_TRUE;
+}
+
+/* The block of the bond between p and q at q's end (bs x bs), added to A; row is the bond's row. */
+static PetscErrorCode AddBlockAt(PeriSystem sys, PetscInt p, PetscInt q, PetscInt row, PetscReal A[])
+{
+  const PeriBonds *b  = &sys->disc.bonds;
+  const PetscInt   bs = sys->model->dofs, nb = 2 * bs, e = (q == row) ? 0 : 1, other = (q == row) ? p : q;
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
   PeriBondGeometry g;
+  PetscInt         k = b->offset[row];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriBondStiffness(sys, a->row[s], a->bond[s], 1, &g, Ke));
+  while (b->j[k] != other) k++; /* one bond per pair (periodic bodies are not checked) */
+  PetscCall(PeriBondStiffness(sys, row, k, 1, &g, Ke));
   for (PetscInt r = 0; r < bs; r++)
     for (PetscInt c = 0; c < bs; c++) A[r * bs + c] += Ke[(e * bs + r) * nb + e * bs + c];
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -140,10 +165,13 @@ static PetscBool ModesIndependent(PeriSystem sys, PetscInt n, const PetscInt set
 }
 
 /* Whether local particles p and q share a bond of the adjacency. */
-static PetscBool Bonded(const Adjacency *a, PetscInt p, PetscInt q)
+static PetscBool Bonded(PeriSystem sys, const Adjacency *a, PetscInt p, PetscInt q)
 {
-  for (PetscInt s = a->off[p]; s < a->off[p + 1]; s++)
-    if (a->nbr[s] == q) return PETSC_TRUE;
+  Walk     w = WalkStart(sys, a, p);
+  PetscInt n, row;
+
+  while (WalkNext(sys, a, &w, &n, &row))
+    if (n == q) return PETSC_TRUE;
   return PETSC_FALSE;
 }
 
@@ -155,11 +183,11 @@ static PetscInt Seed(PeriSystem sys, const Adjacency *a, const PetscInt piece[],
   seed[0] = p;
   if (ModesIndependent(sys, 1, seed)) return 1;
   for (PetscInt n = 1; n <= sys->model->dim; n++) {
-    PetscInt next = -1;
-    for (PetscInt s = a->off[p]; s < a->off[p + 1]; s++) {
-      PetscInt  q  = a->nbr[s];
+    PetscInt next = -1, q, row;
+    Walk     w    = WalkStart(sys, a, p);
+    while (WalkNext(sys, a, &w, &q, &row)) {
       PetscBool ok = (PetscBool)(piece[q] < 0);
-      for (PetscInt t = 0; t < n && ok; t++) ok = (PetscBool)(seed[t] != q && Bonded(a, seed[t], q));
+      for (PetscInt t = 0; t < n && ok; t++) ok = (PetscBool)(seed[t] != q && Bonded(sys, a, seed[t], q));
       if (!ok) continue;
       seed[n] = q;
       if (ModesIndependent(sys, n + 1, seed)) return n + 1;
@@ -189,15 +217,15 @@ static PetscErrorCode Grow(PeriSystem sys, const Adjacency *a, Growth *w, PetscI
     w->queue[tail++]  = seed[t];
   }
   while (head < tail) {
-    PetscInt p = w->queue[head++];
-    for (PetscInt s = a->off[p]; s < a->off[p + 1]; s++) {
-      PetscInt q = a->nbr[s];
+    PetscInt p  = w->queue[head++], q, row;
+    Walk     it = WalkStart(sys, a, p);
+    while (WalkNext(sys, a, &it, &q, &row)) {
       if (w->piece[q] >= 0) continue;
       if (w->tag[q] != b) {
         PetscCall(PetscArrayzero(&w->acc[q * bs * bs], bs * bs));
         w->tag[q] = b;
       }
-      PetscCall(AddOwnBlock(sys, a, a->twin[s], &w->acc[q * bs * bs])); /* the bond's block at q's end */
+      PetscCall(AddBlockAt(sys, p, q, row, &w->acc[q * bs * bs]));
       if (PeriBlockHolds(bs, &w->acc[q * bs * bs], w->active)) {
         w->piece[q]      = b;
         w->queue[tail++] = q;
