@@ -87,6 +87,10 @@ struct _p_PeriScene {
    * getters applied, input files made absolute (PeriSceneGetPath), the output directory. The
    * getters never read it: only the resolved scene (scene.yaml of the output set) merges it in. */
   PeriNode resolved;
+  /* A multigrid level's view of the scene (src/system/multigrid.c): grid.spacing and
+   * horizon.delta times 2^coarsen, the grid's cells halved (rounded up) per level about the box's
+   * centre; 0 for the scene itself. */
+  PetscInt coarsen;
 };
 
 PETSC_EXTERN PetscErrorCode PeriSceneWhere(PeriScene, PeriNode, const char[], char[], size_t);

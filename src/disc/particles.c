@@ -90,6 +90,15 @@ static PetscErrorCode GridParse(PeriScene scene, PeriNode grid, PetscInt dim, Pe
     p->lower[d] = lower[d];
     p->upper[d] = upper[d];
   }
+  for (PetscInt l = 0; l < scene->coarsen; l++) { /* a multigrid level: the same box, centred */
+    *h *= 2;
+    for (PetscInt d = 0; d < dim; d++) {
+      const PetscReal mid = 0.5 * (lower[d] + upper[d]);
+      cells[d]            = (cells[d] + 1) / 2;
+      p->lower[d]         = mid - 0.5 * cells[d] * *h;
+      p->upper[d]         = mid + 0.5 * cells[d] * *h;
+    }
+  }
   p->mean_spacing = *h;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

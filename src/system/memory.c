@@ -277,9 +277,9 @@ PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released
   PetscCall(PetscStrncpy(pc, sys->stiffness.pc_default, sizeof(pc)));
   PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
   if (!release || !sys->stiffness.K || sys->conditions.layers.T || !sys->disc.bonds.xi) PetscFunctionReturn(PETSC_SUCCESS);
-  if (sys->stiffness.op) {
-    if (strcmp(pc, PCGAMG)) PetscFunctionReturn(PETSC_SUCCESS);
-    PetscCall(PeriOperatorPreconditioner(sys));
+  if (sys->stiffness.op) { /* GAMG reads the short-range stiffness, the multigrid its own levels */
+    if (strcmp(pc, PCGAMG) && strcmp(pc, PCMG)) PetscFunctionReturn(PETSC_SUCCESS);
+    if (!strcmp(pc, PCGAMG)) PetscCall(PeriOperatorPreconditioner(sys));
   }
   PetscCall(PeriBondsReleaseGeometry(&sys->disc.particles, &sys->disc.bonds, released));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -301,6 +301,22 @@ static PetscErrorCode ShellDestroy(void *ctx)
 }
 
 /*@C
+  PeriOperatorMatHeld - the factor a shell of PeriOperatorCreateMat applies K with (MatScale) and its
+  held rows (local, sorted: MatZeroRowsColumns). Not collective.
+@*/
+PetscErrorCode PeriOperatorMatHeld(Mat A, PetscReal *scale, PetscInt *n, const PetscInt **held)
+{
+  Shell *sh;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sh));
+  *scale = sh->scale;
+  *n     = sh->nheld;
+  *held  = sh->held;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
   PeriOperatorCreateMat - a MATSHELL applying K from the operator's bond data (which it keeps a
   reference to: it applies the changes PeriOperatorScaleBond makes); MatScale, MatGetDiagonal and MatZeroRowsColumns work on
   it as on an assembled K. Collective.
@@ -643,10 +659,11 @@ PetscBool PeriOperatorServesPC(const char pc[])
   return (PetscBool)(!strcmp(pc, PCGAMG) || PeriOperatorPCWithoutMatrix(pc));
 }
 
-/* Whether the PC works from the matrix-free K alone, without a preconditioning matrix. */
+/* Whether the PC works from the matrix-free K alone, without a preconditioning matrix: Jacobi,
+ * none, and the geometric multigrid (src/system/multigrid.c), whose levels are matrix-free too. */
 PetscBool PeriOperatorPCWithoutMatrix(const char pc[])
 {
-  return (PetscBool)(!strcmp(pc, PCJACOBI) || !strcmp(pc, PCNONE));
+  return (PetscBool)(!strcmp(pc, PCJACOBI) || !strcmp(pc, PCNONE) || !strcmp(pc, PCMG));
 }
 
 /*@C

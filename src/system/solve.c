@@ -424,6 +424,32 @@ static PetscErrorCode EliminatePrescribed(PeriSystem sys, Mat A, Mat P, Vec b, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* -pc_type mg: the geometric multigrid's levels on the first solve (PeriMultigridSetUp); a later
+ * solve's fresh shell A becomes the finest level's operator, the coarse levels stay. */
+static PetscErrorCode MultigridLevels(PeriSystem sys, KSP ksp, Mat A)
+{
+  PC          pc;
+  PetscBool   mg;
+  PetscObject built;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  if (!mg) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscObjectQuery((PetscObject)pc, "perilin_multigrid", &built));
+  if (!built) {
+    PetscCall(PeriMultigridSetUp(sys, ksp, A));
+    PetscCall(PetscObjectCompose((PetscObject)pc, "perilin_multigrid", (PetscObject)A));
+  } else {
+    KSP      fine;
+    PetscInt L;
+    PetscCall(PCMGGetLevels(pc, &L));
+    PetscCall(PCMGGetSmoother(pc, L - 1, &fine));
+    PetscCall(KSPSetOperators(fine, A, A));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Solves A u = b for sys->fields.u with *ksp (created on first use), once more with SOR smoothing when
  * GAMG's Chebyshev smoother fails (SmootherFallback). */
 static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, Vec b, KSPConvergedReason *reason)
@@ -437,6 +463,7 @@ static PetscErrorCode SolveWithFallback(PeriSystem sys, KSP *ksp, Mat A, Mat P, 
   PetscCall(KSPSetOperators(*ksp, A, P));
   /* a factorization uses the BLAS threads (src/sys/threads.c) */
   PetscCall(KSPGetPC(*ksp, &pc));
+  PetscCall(MultigridLevels(sys, *ksp, A));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, ""));
   PetscCall(PeriBLASThreads(factor));
   PetscCall(PeriProgressUpdate(sys->run.progress, PERI_PROGRESS_PHASE, "solve"));

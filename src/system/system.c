@@ -98,7 +98,8 @@ static PetscErrorCode ReadHorizon(PeriSystem sys)
   PeriInputCheck(!kn || !sp, s, h, "spacing", "horizon.neighbors gives every particle its own horizon already; spacing goes with m");
   if (hasm) {
     sys->disc.delta = m * sys->disc.particles.mean_spacing;
-  }
+  } else if (hasd)
+    sys->disc.delta *= PetscPowInt(2, s->coarsen); /* a multigrid level keeps m */
   for (PetscInt k = 0; k < sys->disc.particles.n; k++) hmax = PetscMax(hmax, sys->disc.particles.spacing[k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm)); /* the ranks' blocks */
   PetscCall(ReadOwnHorizon(sys, h, hasm, m, hmax));
@@ -523,6 +524,31 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PetscLogEventBegin(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
   PetscCall(PeriCheckMechanisms(sys)); /* pieces of many particles, after the single ones */
   PetscCall(PetscLogEventEnd(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemSetUpCoarse - a multigrid level of the scene (scene->coarsen > 0: the grid at 2^coarsen
+  times the spacing, src/system/multigrid.c): the model, particles, partition, bonds, corrections
+  and calibration, without regions, conditions, probes or checks, which the level does not use
+  (its held DOFs come from the finer level's). Collective.
+@*/
+PetscErrorCode PeriSystemSetUpCoarse(PeriSystem sys)
+{
+  PeriScene s = sys->scene;
+  PeriNode  mat;
+
+  PetscFunctionBeginUser;
+  PetscCall(CreateModel(sys));
+  PetscCall(ReadSolver(sys));
+  PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
+  PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
+  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
+  PetscCall(ReadHorizon(sys));
+  PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
+  PetscCall(ReadCorrections(sys));
+  PetscCall(SetUpBonds(sys));
+  PetscCall(Calibrate(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -85,6 +85,8 @@ PETSC_EXTERN PetscErrorCode PeriSystemCreate(MPI_Comm, PeriScene, PeriSystem *);
 PETSC_EXTERN PetscErrorCode PeriSystemSetFromScene(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemSetNeeds(PeriSystem, const PeriSystemNeeds *);
 PETSC_EXTERN PetscErrorCode PeriSystemSetUp(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemSetUpCoarse(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriMultigridSetUp(PeriSystem, KSP, Mat);
 PETSC_EXTERN PetscErrorCode PeriSystemDestroy(PeriSystem *);
 PETSC_EXTERN PetscErrorCode PeriSystemCreateVec(PeriSystem, Vec *);
 PETSC_EXTERN PetscErrorCode PeriSystemBondGeometry(PeriSystem, PetscInt, PetscInt, PeriBondGeometry *);
