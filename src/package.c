@@ -168,7 +168,7 @@ static const char *const own_options[][2] = {
     {"-peri_memory_check <bool>", "refuse a scene that does not fit in the node's available memory; default true"},
     {"-peri_release_bond_geometry <bool>", "free the bonds' geometry while a static solve runs; default true"},
     {"-peri_read_chunk N", "particles per chunk rank 0 deals out from particles.file or .mesh; default 65536"},
-    {"-peri_malloc_mmap_threshold N", "arrays of N bytes and more (N <= 32 MiB) are mapped on their own; default 0 (off)"},
+    {"-peri_malloc_mmap_threshold N", "arrays of N bytes and more (N <= 32 MiB) are mapped on their own; default 32 MiB, 0: off"},
     {"-scene_doc_update FILE", "rewrite the key tables of FILE (docs/scene.md) from the declared keys"},
     {"-scene_doc_check FILE", "fail when the key tables of FILE are out of date"},
 };

@@ -39,13 +39,16 @@ PetscReal PeriHeapInUseMB(void)
   PETSc loads turn off glibc's mmap and heap trimming (M_MMAP_MAX 0 from Debian's libsuperlu_dist,
   M_TRIM_THRESHOLD -1): every array then comes from the heap and none goes back, so a run's peak
   was the heap's high-water mark (issue 14, item 4). With -peri_malloc_mmap_threshold N (bytes, at
-  most 32 MiB), arrays of N bytes and more are mapped and unmapped on their own: 4 % less peak on
-  the 641,601-particle plate, none at 160,801, for 4-6 % more CPU time (page faults), so the
-  default 0 keeps the libraries' setting (docs/performance.md). Not collective.
+  most 32 MiB; default 32 MiB), arrays of N bytes and more are mapped and unmapped on their own, so
+  the bonds' geometry, released for the solve and restored after it, does not leave a hole that
+  the solver's smaller arrays split: 787 -> 718 MB on the 641,601-particle plate with the
+  multigrid, for 4 % more wall time (page faults of the remapped arrays); arrays below 32 MiB
+  (runs below about 10^5 particles) are not affected. 0 keeps the libraries' setting
+  (docs/performance.md, issue 29 item 3). Not collective.
 @*/
 PetscErrorCode PeriMallocInitialize(void)
 {
-  PetscInt threshold = 0;
+  PetscInt threshold = 32 << 20;
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_malloc_mmap_threshold", &threshold, NULL));

@@ -2,6 +2,9 @@
  * needs the grid (disc) and the model's DOFs, so it lives with the system. */
 #include "perilin/private/system.h"
 #include <unistd.h>
+#if defined(__GLIBC__)
+#  include <malloc.h>
+#endif
 
 /* What a run holds at its peak, from the scene alone (docs/performance.md, "Memory"). */
 typedef struct {
@@ -282,6 +285,9 @@ PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released
     if (!strcmp(pc, PCGAMG)) PetscCall(PeriOperatorPreconditioner(sys));
   }
   PetscCall(PeriBondsReleaseGeometry(&sys->disc.particles, &sys->disc.bonds, released));
+#if defined(__GLIBC__)
+  if (*released) malloc_trim(0); /* the freed pages go back, whatever the arrays' sizes */
+#endif
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -292,6 +298,11 @@ PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem sys, PetscBool *released
 PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem sys, PetscBool released)
 {
   PetscFunctionBeginUser;
+#if defined(__GLIBC__)
+  /* the solver's arrays, freed by now, go back to the system first: the geometry takes their
+     pages instead of adding its own above the heap's high-water mark */
+  if (released) malloc_trim(0);
+#endif
   if (released) PetscCall(PeriBondsRestoreGeometry(&sys->disc.particles, sys->disc.delta, sys->disc.horizon, sys->disc.partial_volume, &sys->disc.bonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
