@@ -29,7 +29,7 @@ else
 fi
 [ "$fail" -ne 0 ] && sed 's/^/    /' "$tmp/stderr"
 
-"$perilin" "$scene" -output_dir "$tmp/global" -options_left -options_view -log_view -malloc_dump -malloc_debug -ksp_monitor -ksp_view -ksp_converged_reason -pc_gamg_threshold 0.01 -mg_levels_ksp_type richardson -mat_type aij -info :none > "$tmp/stdout" 2> "$tmp/stderr" < /dev/null
+"$perilin" "$scene" -output_dir "$tmp/global" -options_left -options_view -log_view -malloc_dump -malloc_debug -ksp_monitor -ksp_view -ksp_converged_reason -pc_type gamg -pc_gamg_threshold 0.01 -mg_levels_ksp_type richardson -mat_type aij -info :none > "$tmp/stdout" 2> "$tmp/stderr" < /dev/null
 code=$?
 if [ "$code" -ne 0 ] || grep -q 'perilin: error' "$tmp/stderr"; then
   echo "FAIL global options: exit status $code"; sed 's/^/    /' "$tmp/stderr" | head -5; fail=1

@@ -125,12 +125,12 @@ static PetscErrorCode SetFromScene_Tune(PeriAnalysis an, PeriScene s, PeriNode a
 
 /* The built-in list: CG with GAMG, hypre's BoomerAMG, Jacobi and block Jacobi (ILU(0) blocks: K is symmetric, so CG, not GMRES), a
  * direct Cholesky (MUMPS's on several ranks) on an assembled K, and GAMG and Jacobi on a
- * matrix-free K where the model and scene allow one. */
+ * matrix-free K where the model and scene allow one, with the geometric multigrid on a grid body. */
 static PetscErrorCode DefaultConfigurations(PeriAnalysis an)
 {
   Tune       *T  = TUNE(an);
   const char *as = PeriMatrixFreeWhyNot(an->sys) ? "" : " -solver_operator assembled";
-  char        line[8][128];
+  char        line[10][128];
   PetscInt    n = 0;
 
   PetscFunctionBeginUser;
@@ -141,6 +141,7 @@ static PetscErrorCode DefaultConfigurations(PeriAnalysis an)
 #endif
   PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type cg -pc_type jacobi%s", as));
   if (as[0]) PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type cg -pc_type jacobi -solver_operator matrix_free"));
+  if (as[0] && !PeriMultigridWhyNotBody(an->sys)) PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type cg -pc_type mg -solver_operator matrix_free"));
   PetscCall(PetscSNPrintf(line[n++], sizeof(line[0]), "-ksp_type cg -pc_type bjacobi%s", as));
 #if !defined(PETSC_HAVE_MUMPS)
   if (an->sys->size == 1)

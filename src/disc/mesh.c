@@ -5,7 +5,7 @@
  * measure; named physical groups become particle sets (docs/mesh.md). Rank 0 reads: Gmsh is not
  * MPI-aware. */
 #include "perilin/private/disc.h"
-#include <gmshc.h>
+#include "perilin/private/gmsh_api.h"
 #include <unistd.h>
 #include <errno.h>
 #include <stdlib.h>
@@ -43,6 +43,7 @@ static PetscErrorCode GmshStart(PetscBool verbose)
 
   PetscFunctionBeginUser;
   if (!gmsh_started) {
+    PetscCall(PeriGmshLoad());
     gmshInitialize(0, NULL, 0, &ierr);
     PetscCheck(!ierr, PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh failed to initialize");
     gmsh_started = PETSC_TRUE;

@@ -4,7 +4,7 @@
  * message a user can act on. A forked child meshes the model the parent opened and writes it to a
  * scratch .msh; the parent reads that, or reports how the child ended. */
 #include "perilin/private/disc.h"
-#include <gmshc.h>
+#include "perilin/private/gmsh_api.h"
 #include <errno.h>
 #include <signal.h>
 #include <stdio.h>

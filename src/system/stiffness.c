@@ -42,7 +42,9 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The static solves' default PC: GAMG, but Jacobi on a matrix-free K of a small 3D body, where CG
+/* The static solves' default PC: GAMG, or perilin's geometric multigrid on a matrix-free K of a
+ * grid body (src/system/multigrid.c: 1.8-2.4x faster than GAMG and 25-30 % less memory on the
+ * bench plates, block and lamina; docs/performance.md, issue 29 item 3), but Jacobi on a matrix-free K of a small 3D body, where CG
  * needs a few hundred of the cheap products and no preconditioning matrix is stored: faster and
  * lighter up to about 5e5 particles and 200 spacings across (docs/performance.md, "Matrix-free");
  * and on a 2D body of shear or micropolar bonds up to 80 spacings across, where GAMG's set-up
@@ -59,6 +61,8 @@ static void DefaultPC(PeriSystem sys)
     PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
   else if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
     PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
+  else if (sys->stiffness.op && PeriMultigridApplies(sys))
+    PetscStrncpy(sys->stiffness.pc_default, PCMG, sizeof(sys->stiffness.pc_default));
   else
     PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default));
 }

@@ -307,6 +307,8 @@ static PetscErrorCode ReadShearModuli(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscErrorCode CreateLevel(PeriSystem, PetscInt, PeriSystem *);
+
 PetscErrorCode PeriSystemCreate(MPI_Comm comm, PeriScene scene, PeriSystem *system)
 {
   PeriSystem sys;
@@ -318,7 +320,9 @@ PetscErrorCode PeriSystemCreate(MPI_Comm comm, PeriScene scene, PeriSystem *syst
   PetscCallMPI(MPI_Comm_rank(comm, &sys->rank));
   PetscCallMPI(MPI_Comm_size(comm, &sys->size));
   PetscCall(PeriProgressCreate(comm, &sys->run.progress));
-  *system = sys;
+  sys->stiffness.levels.create  = CreateLevel;
+  sys->stiffness.levels.destroy = PeriSystemDestroy;
+  *system                       = sys;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -489,7 +493,8 @@ static PetscErrorCode Calibrate(PeriSystem sys)
   cal.combine       = CombineCopies;
   cal.ctx           = &sys->disc;
   PetscCall(sys->model->ops.calibrate(sys->model, &cal));
-  if (sys->model->warning[0]) PetscCall(PetscPrintf(sys->comm, "perilin: warning: %s\n", sys->model->warning));
+  /* a multigrid level's calibration repeats the scene's: its warning was given already */
+  if (sys->model->warning[0] && !sys->scene->coarsen) PetscCall(PetscPrintf(sys->comm, "perilin: warning: %s\n", sys->model->warning));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -528,31 +533,6 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
 }
 
 /*@C
-  PeriSystemSetUpCoarse - a multigrid level of the scene (scene->coarsen > 0: the grid at 2^coarsen
-  times the spacing, src/system/multigrid.c): the model, particles, partition, bonds, corrections
-  and calibration, without regions, conditions, probes or checks, which the level does not use
-  (its held DOFs come from the finer level's). Collective.
-@*/
-PetscErrorCode PeriSystemSetUpCoarse(PeriSystem sys)
-{
-  PeriScene s = sys->scene;
-  PeriNode  mat;
-
-  PetscFunctionBeginUser;
-  PetscCall(CreateModel(sys));
-  PetscCall(ReadSolver(sys));
-  PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
-  PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
-  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
-  PetscCall(ReadHorizon(sys));
-  PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
-  PetscCall(ReadCorrections(sys));
-  PetscCall(SetUpBonds(sys));
-  PetscCall(Calibrate(sys));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
   PeriSystemSetNeeds - what the analysis asks of the stiffness (its type's needs), before
   PeriSystemSetUp: the memory estimate of the set-up reads it. Not collective.
 @*/
@@ -581,5 +561,43 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PeriProgressDestroy(&sys->run.progress));
   PetscCall(PetscFree(sys));
   *system = NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A multigrid level of the scene (scene->coarsen > 0: the grid at 2^coarsen times the spacing,
+ * src/system/multigrid.c): the model, particles, partition, bonds, corrections and calibration,
+ * without regions, conditions, probes or checks, which the level does not use (its held DOFs
+ * come from the finer level's). Collective. */
+static PetscErrorCode SetUpCoarse(PeriSystem sys)
+{
+  PeriScene s = sys->scene;
+  PeriNode  mat;
+
+  PetscFunctionBeginUser;
+  PetscCall(CreateModel(sys));
+  PetscCall(ReadSolver(sys));
+  PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
+  PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
+  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
+  PetscCall(ReadHorizon(sys));
+  PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
+  PetscCall(ReadCorrections(sys));
+  PetscCall(SetUpBonds(sys));
+  PetscCall(Calibrate(sys));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The system's level factory (PeriLevelFactory): level l of fine's scene, set up. Collective. */
+static PetscErrorCode CreateLevel(PeriSystem fine, PetscInt l, PeriSystem *c)
+{
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemCreate(fine->comm, fine->scene, c));
+  (*c)->stiffness.needs = fine->stiffness.needs;
+  fine->scene->coarsen  = l;
+  ierr                  = SetUpCoarse(*c);
+  fine->scene->coarsen  = 0;
+  PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

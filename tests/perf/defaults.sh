@@ -28,6 +28,8 @@ configs = ["-ksp_type cg -solver_operator auto", "-solver_operator auto"]  # the
 for op in ("assembled", "matrix_free"):
     for pc in ("-pc_type gamg", "-pc_type jacobi", "-pc_type hypre -pc_hypre_type boomeramg"):
         configs.append(f"-ksp_type cg {pc} -solver_operator {op}")
+if "grid" in scene and not (scene["grid"].get("periodic")):  # the geometric multigrid: grid bodies
+    configs.append("-ksp_type cg -pc_type mg -solver_operator matrix_free")
 scene["analysis"] = {"type": "tune", "repeat": int(sys.argv[3]), "configurations": configs}
 yaml.safe_dump(scene, open(sys.argv[2], "w"), sort_keys=False)
 PY

@@ -56,6 +56,14 @@ typedef struct {
   PetscBool transient;      /* runs in time: loads may carry an amplitude (loads.<k>.amplitude) */
 } PeriSystemNeeds;
 
+/* How the geometric multigrid (src/system/multigrid.c) gets the coarse levels of a system: the
+ * system's own factory (src/system/system.c), so that the solver, below the system's set-up,
+ * calls it without depending on it. */
+typedef struct {
+  PetscErrorCode (*create)(PeriSystem, PetscInt, PeriSystem *); /* level l of the scene, set up */
+  PetscErrorCode (*destroy)(PeriSystem *);
+} PeriLevelFactory;
+
 /* K and how it is applied and solved. */
 typedef struct {
   Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
@@ -67,6 +75,7 @@ typedef struct {
   char             mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
   PeriSystemNeeds  needs;                   /* the analysis' (PeriSystemSetNeeds), before the set-up */
   PetscReal        residual_tol;            /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
+  PeriLevelFactory levels;                  /* coarse versions of the system, for the geometric multigrid */
 } PeriStiffness;
 
 PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
