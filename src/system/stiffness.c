@@ -42,29 +42,32 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The static solves' default PC: GAMG, or perilin's geometric multigrid on a matrix-free K of a
- * grid body (src/system/multigrid.c: 1.8-2.4x faster than GAMG and 25-30 % less memory on the
- * bench plates, block and lamina; docs/performance.md, issue 29 item 3), but Jacobi on a matrix-free K of a small 3D body, where CG
- * needs a few hundred of the cheap products and no preconditioning matrix is stored: faster and
- * lighter up to about 5e5 particles and 200 spacings across (docs/performance.md, "Matrix-free");
- * and on a 2D body of shear or micropolar bonds up to 80 spacings across, where GAMG's set-up
- * with three DOFs per particle costs more than Jacobi's iterations (2x on the lamina of
- * examples/lamina, 1.6x over the whole micropolar shear run; docs/performance.md, "Defaults"). */
+/* The static solves' default PC (docs/performance.md, "Defaults that pick the fastest" and
+ * "Geometric multigrid"), from the measured crossovers:
+ *   - Jacobi on a 2D body of shear or micropolar bonds up to PERI_JACOBI_MAX_SPAN_2D spacings
+ *     across, where a few hundred cheap products beat any set-up (mppd lamina, 61 spacings:
+ *     0.046 s against 0.058 s for the multigrid and 2x faster than GAMG);
+ *   - perilin's geometric multigrid on a matrix-free K of a grid body (src/system/multigrid.c),
+ *     2D, or 3D from PERI_MG_MIN_PARTICLES_3D particles on (27,000: a tie with Jacobi; 64,000:
+ *     1.4x faster); 1.8-2.4x faster than GAMG with 25-30 % less memory;
+ *   - Jacobi on a matrix-free K of a smaller 3D body, up to about 5e5 particles and 200 spacings
+ *     across where the multigrid does not apply (no stored preconditioning matrix);
+ *   - GAMG elsewhere (assembled K, meshes, periodic bodies, failure). */
 static void DefaultPC(PeriSystem sys)
 {
   const PeriParticles *pt     = &sys->disc.particles;
   const PeriModel      m      = sys->model;
+  const char          *pc     = PCGAMG;
   PetscReal            extent = 0;
 
   for (PetscInt d = 0; d < pt->dim; d++) extent = PetscMax(extent, pt->upper[d] - pt->lower[d]);
   if (pt->dim == 2 && !m->central_force && m->dofs >= 2 && extent <= PERI_JACOBI_MAX_SPAN_2D * pt->mean_spacing)
-    PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
+    pc = PCJACOBI;
+  else if (sys->stiffness.op && PeriMultigridApplies(sys) && (pt->dim == 2 || sys->disc.N >= PERI_MG_MIN_PARTICLES_3D))
+    pc = PCMG;
   else if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
-    PetscStrncpy(sys->stiffness.pc_default, PCJACOBI, sizeof(sys->stiffness.pc_default));
-  else if (sys->stiffness.op && PeriMultigridApplies(sys))
-    PetscStrncpy(sys->stiffness.pc_default, PCMG, sizeof(sys->stiffness.pc_default));
-  else
-    PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default));
+    pc = PCJACOBI;
+  PetscStrncpy(sys->stiffness.pc_default, pc, sizeof(sys->stiffness.pc_default));
 }
 
 PetscErrorCode PeriSystemAssemble(PeriSystem sys)
