@@ -29,6 +29,7 @@ PetscErrorCode PeriInitializePackage(void)
   PetscCall(PetscLogEventRegister("PeriPartition", id, &PERI_EVENT_Partition));
   PetscCall(PetscLogEventRegister("PeriNeighbors", id, &PERI_EVENT_Neighbors));
   PetscCall(PetscLogEventRegister("PeriMechanisms", id, &PERI_EVENT_Mechanisms));
+  PetscCall(PetscLogEventRegister("PeriMultigrid", id, &PERI_EVENT_Multigrid)); /* the geometric multigrid's levels */
   PetscCall(PetscLogEventRegister("PeriAssembly", id, &PERI_EVENT_Assembly));
   PetscCall(PetscLogEventRegister("PeriSolve", id, &PERI_EVENT_Solve));
   PetscCall(PetscLogEventRegister("PeriMatMultFree", id, &PERI_EVENT_MatMultFree));

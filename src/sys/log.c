@@ -6,7 +6,7 @@
 #  include <malloc.h>
 #endif
 
-PetscLogEvent PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve, PERI_EVENT_MatMultFree, PERI_EVENT_Mechanisms;
+PetscLogEvent PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve, PERI_EVENT_MatMultFree, PERI_EVENT_Mechanisms, PERI_EVENT_Multigrid;
 PetscLogStage PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
 
 /* This process's peak resident memory so far (MB): the operating system's count, which sees

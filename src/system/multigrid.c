@@ -308,6 +308,7 @@ PetscErrorCode PeriMultigridSetUp(PeriSystem sys, KSP ksp, Mat A)
 
   PetscFunctionBeginUser;
   PetscCheck(!why, sys->comm, PETSC_ERR_USER_INPUT, "%s: -pc_type mg (perilin's geometric multigrid) cannot apply: %s; use -pc_type gamg", sys->scene->file, why);
+  PetscCall(PetscLogEventBegin(PERI_EVENT_Multigrid, 0, 0, 0, 0));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(Levels(sys, pc, &L));
   PetscCall(PCMGSetLevels(pc, L, NULL));
@@ -335,6 +336,7 @@ PetscErrorCode PeriMultigridSetUp(PeriSystem sys, KSP ksp, Mat A)
   }
   PetscCall(PetscFree(heldf));
   PetscCall(sys->stiffness.levels.destroy(&f));
+  PetscCall(PetscLogEventEnd(PERI_EVENT_Multigrid, 0, 0, 0, 0));
   PetscCall(PetscInfo(pc, "perilin multigrid: %" PetscInt_FMT " levels\n", L));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -6,7 +6,7 @@
 # bytes an assembled BAIJ K would take (blocks = particles + 2 bonds, bs^2 doubles and a column
 # index each, and a row pointer per particle; the item's target is <= 1.5 at 640,000 particles).
 # A benchmark, not a test.
-# Usage: tests/perf/multigrid.sh build/perilin [REPEAT] [-- perilin options for every run]
+# Usage: tests/perf/multigrid_cost.sh build/perilin [REPEAT] [-- perilin options for every run]
 set -euo pipefail
 perilin=$(realpath "$1")
 repeat=${2:-3}
