@@ -92,6 +92,21 @@ static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const PeriSystemNeeds
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether a static solve will run the geometric multigrid (DefaultPC's rule, without the body's
+ * thinness, which only the grid's cells tell): a matrix-free K of a grid body, not periodic,
+ * without failure, the default PC or -pc_type mg, 2D or 3D from PERI_MG_MIN_PARTICLES_3D. */
+static PetscBool Multigrid(PeriScene s, PeriModel m, const PeriSystemNeeds *needs, PetscBool mf, PetscBool failure, PetscReal n, const PetscBool periodic[])
+{
+  char      pc[64] = PCMG;
+  PetscBool per    = PETSC_FALSE;
+
+  for (PetscInt d = 0; d < m->dim; d++) per = (PetscBool)(per || periodic[d]);
+  if (!mf || failure || per || !needs->static_solver || (m->dim == 3 && n < PERI_MG_MIN_PARTICLES_3D)) return PETSC_FALSE;
+  if (PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL)) return PETSC_FALSE;
+  (void)s;
+  return (PetscBool)!strcmp(pc, PCMG);
+}
+
 /* Lattice points within r spacings of a particle, itself excluded. */
 static PetscReal BallCount(PetscInt dim, PetscReal r)
 {
@@ -113,7 +128,7 @@ static PetscReal SurfaceShare(PetscInt dim, PetscReal r, const PetscReal cells[]
  * nonzero; BAIJ: 8, and an index per block) and the solver, for n particles of dofs DOFs, a
  * search radius of r spacings and the share of pairs the faces leave. State-based models also list
  * each family in full and couple particles up to 2 delta apart. */
-static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const PeriSystemNeeds *needs, PetscBool mf, MemoryEstimate *e)
+static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const PeriSystemNeeds *needs, PetscBool mf, PetscBool mg, MemoryEstimate *e)
 {
   const PetscReal dofs = m->dofs, ball = BallCount(m->dim, r);
   PetscReal       reserved, per_bond, blocks, nnz, matrix;
@@ -138,6 +153,10 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
                                                                                : ball);
   nnz    = n * blocks * dofs * dofs;
   matrix = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
+  /* the geometric multigrid stores no matrix but the coarsest's: its levels hold a third of the
+     finest's operator and 15 more vectors (docs/performance.md, "Geometric multigrid") */
+  if (mg) matrix = 0;
+  if (mg) reserved += e->nbonds / 3 * (sizeof(PetscInt) + dofs * sizeof(PetscReal)) + 15 * n * dofs * sizeof(PetscScalar);
   if (mf) reserved += e->nbonds * (sizeof(PetscInt) + (m->central_force ? dofs : dofs == 2 ? 3
                                                                                            : 7) *
                                                           sizeof(PetscReal)); /* operator.c's forms */
@@ -251,7 +270,7 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m,
   } else
     PetscCall(MatrixFree(s, m, &at, &mf));
   if (failure && !m->central_force) mf = PETSC_FALSE; /* PeriMatrixFreeWhyNot */
-  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, &at, mf, &e));
+  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, &at, mf, Multigrid(s, m, &at, mf, failure, e.n, periodic), &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));
