@@ -270,13 +270,26 @@ static PetscErrorCode SetShiftInvert(EPS eps, PetscReal sigma)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* LOBPCG for the nreq lowest pairs, preconditioned by one GAMG cycle on P (the short-range
+/* Whether LOBPCG is preconditioned by the geometric multigrid: a matrix-free K of a grid body
+ * (PeriMultigridApplies), unless -st_pc_type asks for another PC. On the 230,400-particle gerstle
+ * lamina it replaced GAMG on the short-range stiffness (docs/performance.md, "Modes at scale"). */
+static PetscBool UseMultigrid(PeriAnalysis an)
+{
+  PetscBool set = PETSC_FALSE;
+
+  if (Modal(an)->eigensolver != EIGENSOLVER_LOBPCG || !an->sys->stiffness.op || !PeriMultigridApplies(an->sys)) return PETSC_FALSE;
+  PetscOptionsHasName(NULL, NULL, "-st_pc_type", &set);
+  return (PetscBool)!set;
+}
+
+/* LOBPCG for the nreq lowest pairs, preconditioned by one V-cycle of the geometric multigrid
+ * (UseMultigrid) or one GAMG cycle on P (the short-range
  * stiffness of a matrix-free K, or K itself). Its block holds two pairs more than asked for (on the
  * 14,400-particle lamina, 10 modes: blocks of 12, 16 and 20 took 7.0, 8.2 and 8.5 s). perilin's
  * mode residual is SLEPc's relative error times a factor that grows with the body (1e-8 left
  * 1.1e-6 at 57,600 particles, above the 1e-6 accepted; 1e-9 left 9.1e-7 at 921,600): 1e-10 leaves
  * 2.5e-8 at 57,600. The frequencies, quadratic in it, agree with the factorization's to 1e-12. */
-static PetscErrorCode SetLOBPCG(EPS eps, Mat P, PetscInt nreq)
+static PetscErrorCode SetLOBPCG(PeriAnalysis an, EPS eps, Mat P, IS isfree, PetscInt nreq)
 {
   ST st;
   PC pc;
@@ -286,6 +299,11 @@ static PetscErrorCode SetLOBPCG(EPS eps, Mat P, PetscInt nreq)
   PetscCall(EPSSetWhichEigenpairs(eps, EPS_SMALLEST_REAL));
   PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
   PetscCall(EPSLOBPCGSetBlockSize(eps, nreq + 2));
+  if (UseMultigrid(an)) { /* one V-cycle of the geometric multigrid (src/system/multigrid.c) */
+    PetscCall(SetTransform(eps, STPRECOND, PCSHELL, &pc));
+    PetscCall(PeriMultigridSetUpFree(an->sys, isfree, pc));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(SetTransform(eps, STPRECOND, PCGAMG, &pc));
   PetscCall(EPSGetST(eps, &st));
   if (P) PetscCall(STSetPreconditionerMat(st, P));
@@ -297,7 +315,7 @@ static PetscErrorCode SetLOBPCG(EPS eps, Mat P, PetscInt nreq)
 
 /* The eigensolver analysis.eigensolver chose (SetShiftInvert or SetLOBPCG), then every -eps_* and
  * -st_* option; then the check of the inner solves. */
-static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, Mat Pff, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
+static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, Mat Pff, IS isfree, PetscReal sigma, PetscInt nreq, InnerCheck *inner, EPS *eps)
 {
   ST        st;
   KSP       ksp;
@@ -309,7 +327,7 @@ static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, Mat Pff, Pets
   PetscCall(EPSSetProblemType(*eps, EPS_GHEP));
   PetscCall(EPSSetDimensions(*eps, nreq, PETSC_DEFAULT, PETSC_DEFAULT));
   if (Modal(an)->eigensolver == EIGENSOLVER_LOBPCG)
-    PetscCall(SetLOBPCG(*eps, Pff, nreq));
+    PetscCall(SetLOBPCG(an, *eps, Pff, isfree, nreq));
   else
     PetscCall(SetShiftInvert(*eps, sigma));
   PetscCall(EPSSetFromOptions(*eps));
@@ -459,9 +477,25 @@ static PetscErrorCode CheckModes(PeriAnalysis an, PetscReal eps_tol)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The free block of a matrix-free K's short-range stiffness, for GAMG (*Pff), with the rigid
+ * modes on the free DOFs; the full matrix is freed. */
+static PetscErrorCode FreeShortRange(PeriAnalysis an, IS isfree, Mat *Pff)
+{
+  PeriStiffness *S = &an->sys->stiffness;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriOperatorPreconditioner(an->sys));
+  PetscCall(MatCreateSubMatrix(S->Kpc, isfree, isfree, MAT_INITIAL_MATRIX, Pff));
+  PetscCall(MatDestroy(&S->Kpc)); /* only its free block is used */
+  PetscCall(MatSetOption(*Pff, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(PeriSetNearNullSpace(an->sys, *Pff, isfree));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* K on the free DOFs, and what preconditions it. A matrix-free K is restricted without a copy
- * (R K R^T) and the free block of its short-range stiffness serves GAMG (*Pff); an assembled K is
- * copied. Only the free blocks are used: the full matrices are freed (an assembled K of the
+ * (R K R^T), and the free block of its short-range stiffness serves GAMG (*Pff) unless the
+ * geometric multigrid does (its levels are matrix-free too: *Pff NULL); an assembled K is copied.
+ * Only the free blocks are used: the full matrices are freed (an assembled K of the
  * 230,400-particle lamina: 0.87 GB). */
 static PetscErrorCode FreeStiffness(PeriAnalysis an, IS isfree, Mat *Kff, Mat *Pff)
 {
@@ -471,12 +505,7 @@ static PetscErrorCode FreeStiffness(PeriAnalysis an, IS isfree, Mat *Kff, Mat *P
   *Pff = NULL;
   if (S->op) {
     PetscCall(MatCreateSubMatrixVirtual(S->K, isfree, isfree, Kff));
-    PetscCall(PeriOperatorPreconditioner(an->sys));
-    PetscCall(MatCreateSubMatrix(S->Kpc, isfree, isfree, MAT_INITIAL_MATRIX, Pff));
-    PetscCall(MatDestroy(&S->Kpc)); /* only its free block is used */
-    PetscCall(MatSetOption(*Pff, MAT_SYMMETRIC, PETSC_TRUE));
-    /* for GAMG: the rigid modes on the free DOFs */
-    PetscCall(PeriSetNearNullSpace(an->sys, *Pff, isfree));
+    if (!UseMultigrid(an)) PetscCall(FreeShortRange(an, isfree, Pff));
   } else {
     PetscCall(MatCreateSubMatrix(S->K, isfree, isfree, MAT_INITIAL_MATRIX, Kff));
     PetscCall(MatDestroy(&S->K));
@@ -614,14 +643,23 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
 
   /* the scale of the largest omega^2 (a matrix-free K's from its short-range stiffness, whose
      diagonal is K's) */
-  PetscCall(MatNorm(w->Pff ? w->Pff : w->Kff, NORM_1, &Knorm));
+  if (w->Pff || !an->sys->stiffness.op)
+    PetscCall(MatNorm(w->Pff ? w->Pff : w->Kff, NORM_1, &Knorm));
+  else { /* the multigrid's matrix-free K: twice its largest diagonal, a bound of its 1-norm's order */
+    Vec d;
+    PetscCall(MatCreateVecs(an->sys->stiffness.K, &d, NULL));
+    PetscCall(MatGetDiagonal(an->sys->stiffness.K, d));
+    PetscCall(VecMax(d, NULL, &Knorm));
+    PetscCall(VecDestroy(&d));
+    Knorm *= 2;
+  }
   PetscCall(MatNorm(w->Mff, NORM_1, &Mnorm));
   scale = Knorm / Mnorm;
   sigma = PetscSqr(2 * PETSC_PI * target_hz);
   /* a free body makes K singular: shift just below its zero eigenvalues */
   if (nfree && target_hz == 0) sigma = -1e-8 * scale;
 
-  PetscCall(CreateEPS(an, w->Kff, w->Mff, w->Pff, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
+  PetscCall(CreateEPS(an, w->Kff, w->Mff, w->Pff, w->isfree, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
   /* the factorization (MUMPS) and its solves run with the BLAS threads (src/sys/threads.c) */
   PetscCall(PeriBLASThreads(PETSC_TRUE));
   PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_PHASE, "factorization"));

@@ -171,11 +171,11 @@ static PetscErrorCode CellOwners(PeriSystem c, const PetscInt cells[3], PetscInt
  * corner of largest weight). Collective. */
 static PetscErrorCode Interpolation(PeriSystem f, PeriSystem c, const PetscBool heldf[], Mat *T, PetscBool **heldc)
 {
-  const PetscInt     bs = f->model->dofs, nn = 1 << f->model->dim, nf = f->disc.nowned;
-  PetscInt           cells[3], *key, *glob;
-  PetscReal         *w;
-  Vec                mark;
-  const PetscScalar *ma;
+  const PetscInt bs = f->model->dofs, nn = 1 << f->model->dim, nf = f->disc.nowned;
+  PetscInt       cells[3], *key, *glob;
+  PetscReal     *w;
+  Vec            mark;
+  PetscScalar   *ma;
 
   PetscFunctionBeginUser;
   GridCells(&c->disc.particles, cells);
@@ -202,9 +202,16 @@ static PetscErrorCode Interpolation(PeriSystem f, PeriSystem c, const PetscBool 
   PetscCall(VecAssemblyBegin(mark));
   PetscCall(VecAssemblyEnd(mark));
   PetscCall(PetscMalloc1(bs * c->disc.nowned, heldc));
-  PetscCall(VecGetArrayRead(mark, &ma));
-  for (PetscInt r = 0; r < bs * c->disc.nowned; r++) (*heldc)[r] = (PetscBool)(PetscRealPart(ma[r]) > 0);
-  PetscCall(VecRestoreArrayRead(mark, &ma));
+  PetscCall(VecGetArray(mark, &ma));
+  for (PetscInt r = 0; r < bs * c->disc.nowned; r++) {
+    (*heldc)[r] = (PetscBool)(PetscRealPart(ma[r]) > 0);
+    ma[r]       = (*heldc)[r] ? 0 : 1;
+  }
+  PetscCall(VecRestoreArray(mark, &ma));
+  /* nor does a held coarse DOF: its column goes, so that no residual reaches it and no correction
+     leaves it (else the coarse solve turns the residual restricted there into a correction of the
+     size of 1 / its unit diagonal: on an unscaled K, 10^7 times too large) */
+  PetscCall(MatDiagonalScale(*T, NULL, mark));
   PetscCall(VecDestroy(&mark));
   PetscCall(PetscFree3(key, glob, w));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -338,5 +345,85 @@ PetscErrorCode PeriMultigridSetUp(PeriSystem sys, KSP ksp, Mat A)
   PetscCall(sys->stiffness.levels.destroy(&f));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Multigrid, 0, 0, 0, 0));
   PetscCall(PetscInfo(pc, "perilin multigrid: %" PetscInt_FMT " levels\n", L));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* One V-cycle of the multigrid on the free DOFs of K (PeriMultigridSetUpFree): the full-space
+ * cycle of a shell with the other DOFs held, between copies in and out of the free ones. */
+typedef struct {
+  KSP ksp;  /* preonly + PCMG on every DOF */
+  IS  free; /* the free DOFs (global rows of K) */
+  Vec b, x; /* full-space work vectors */
+} FreeCycle;
+
+static PetscErrorCode FreeCycleApply(PC pc, Vec r, Vec z)
+{
+  FreeCycle *c;
+
+  PetscFunctionBeginUser;
+  PetscCall(PCShellGetContext(pc, &c));
+  PetscCall(VecSet(c->b, 0));
+  PetscCall(VecISCopy(c->b, c->free, SCATTER_FORWARD, r));
+  PetscCall(KSPSolve(c->ksp, c->b, c->x));
+  PetscCall(VecISCopy(c->x, c->free, SCATTER_REVERSE, z));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode FreeCycleDestroy(PC pc)
+{
+  FreeCycle *c;
+
+  PetscFunctionBeginUser;
+  PetscCall(PCShellGetContext(pc, &c));
+  PetscCall(KSPDestroy(&c->ksp));
+  PetscCall(ISDestroy(&c->free));
+  PetscCall(VecDestroy(&c->b));
+  PetscCall(VecDestroy(&c->x));
+  PetscCall(PetscFree(c));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriMultigridSetUpFree - makes pc (of an eigensolver's or solver's operator on the free DOFs
+  isfree of the matrix-free K, such as R K R^T) one V-cycle of the geometric multigrid: K's levels
+  with every other DOF held. Options: -modal_pc_mg_levels, -modal_mg_levels_*, -modal_mg_coarse_*.
+  Collective.
+@*/
+PetscErrorCode PeriMultigridSetUpFree(PeriSystem sys, IS isfree, PC pc)
+{
+  const PetscInt  bs = sys->model->dofs;
+  FreeCycle      *c;
+  Mat             A;
+  IS              held;
+  PC              mg;
+  PetscInt        n;
+  const PetscInt *rows;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&c));
+  PetscCall(PeriOperatorCreateMat(sys, &A));
+  PetscCall(ISComplement(isfree, bs * sys->disc.rstart, bs * (sys->disc.rstart + sys->disc.nowned), &held));
+  PetscCall(ISGetLocalSize(held, &n));
+  PetscCall(ISGetIndices(held, &rows));
+  PetscCall(MatZeroRowsColumns(A, n, rows, 1, NULL, NULL));
+  PetscCall(ISRestoreIndices(held, &rows));
+  PetscCall(ISDestroy(&held));
+  PetscCall(KSPCreate(sys->comm, &c->ksp));
+  PetscCall(KSPSetOptionsPrefix(c->ksp, "modal_"));
+  PetscCall(KSPSetType(c->ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(c->ksp, &mg));
+  PetscCall(PCSetType(mg, PCMG));
+  PetscCall(KSPSetOperators(c->ksp, A, A));
+  PetscCall(PeriMultigridSetUp(sys, c->ksp, A));
+  PetscCall(KSPSetUp(c->ksp));
+  PetscCall(MatCreateVecs(A, &c->x, &c->b));
+  PetscCall(MatDestroy(&A));
+  PetscCall(PetscObjectReference((PetscObject)isfree));
+  c->free = isfree;
+  PetscCall(PCSetType(pc, PCSHELL));
+  PetscCall(PCShellSetContext(pc, c));
+  PetscCall(PCShellSetApply(pc, FreeCycleApply));
+  PetscCall(PCShellSetDestroy(pc, FreeCycleDestroy));
+  PetscCall(PCShellSetName(pc, "perilin geometric multigrid (one V-cycle)"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

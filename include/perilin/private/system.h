@@ -87,6 +87,7 @@ PETSC_EXTERN PetscErrorCode PeriSystemSetNeeds(PeriSystem, const PeriSystemNeeds
 PETSC_EXTERN PetscErrorCode PeriSystemSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriMultigridSetUp(PeriSystem, KSP, Mat);
 PETSC_EXTERN PetscBool      PeriMultigridApplies(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriMultigridSetUpFree(PeriSystem, IS, PC);
 PETSC_EXTERN const char    *PeriMultigridWhyNotBody(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemDestroy(PeriSystem *);
 PETSC_EXTERN PetscErrorCode PeriSystemCreateVec(PeriSystem, Vec *);
