@@ -331,7 +331,8 @@ PetscErrorCode PeriSystemCreate(MPI_Comm comm, PeriScene scene, PeriSystem *syst
   material.thickness, and the memory estimate, so that these errors come before any large
   allocation. Collective.
 @*/
-PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
+/* The model (dim, model.*), solver.* and material.thickness. */
+static PetscErrorCode ReadModel(PeriSystem sys)
 {
   PeriScene s = sys->scene;
   PeriNode  mat;
@@ -341,8 +342,15 @@ PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
   PetscCall(ReadSolver(sys));
   PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
   PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PeriSystemSetFromScene(PeriSystem sys)
+{
+  PetscFunctionBeginUser;
+  PetscCall(ReadModel(sys));
   /* before any large allocation: a scene that cannot fit is refused with its size */
-  PetscCall(PeriParticlesCheckMemory(sys->comm, s, sys->model, &sys->stiffness.needs));
+  PetscCall(PeriParticlesCheckMemory(sys->comm, sys->scene, sys->model, &sys->stiffness.needs));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -571,13 +579,9 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
 static PetscErrorCode SetUpCoarse(PeriSystem sys)
 {
   PeriScene s = sys->scene;
-  PeriNode  mat;
 
   PetscFunctionBeginUser;
-  PetscCall(CreateModel(sys));
-  PetscCall(ReadSolver(sys));
-  PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
-  PetscCall(PeriSceneGetReal(s, mat, "thickness", PETSC_FALSE, &sys->materials.thickness, NULL));
+  PetscCall(ReadModel(sys));
   PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
   PetscCall(ReadHorizon(sys));
   PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
