@@ -45,8 +45,9 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
 /* The static solves' default PC (docs/performance.md, "Defaults that pick the fastest" and
  * "Geometric multigrid"), from the measured crossovers:
  *   - Jacobi on a 2D body of shear or micropolar bonds up to PERI_JACOBI_MAX_SPAN_2D spacings
- *     across, where a few hundred cheap products beat any set-up (mppd lamina, 61 spacings:
- *     0.046 s against 0.058 s for the multigrid and 2x faster than GAMG);
+ *     across, where a few hundred cheap products beat any set-up (2x faster than GAMG; against
+ *     the multigrid: the mppd lamina at 61 spacings 0.046 s against 0.058 s, the gerstle lamina
+ *     at 60 spacings 0.056 s against 0.042 s);
  *   - perilin's geometric multigrid on a matrix-free K of a grid body (src/system/multigrid.c),
  *     2D, or 3D from PERI_MG_MIN_PARTICLES_3D particles on (27,000: a tie with Jacobi; 64,000:
  *     1.4x faster); 1.8-2.4x faster than GAMG with 25-30 % less memory;
