@@ -302,6 +302,27 @@ PetscErrorCode PeriStaticKSPCreate(PeriSystem sys, PetscBool symmetric, KSP *ksp
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The default geometric multigrid (not one asked for by -pc_type) whose V-cycle is not positive
+ * definite: the coarse levels' springs of a body at its model's limit (pds at nu = 1/3: no shear
+ * springs) can leave them indefinite. Jacobi needs no levels: retried with it, said. */
+static PetscErrorCode MultigridFallback(PeriSystem sys, KSP ksp, KSPConvergedReason reason, PetscBool *retry)
+{
+  PC        pc;
+  PetscBool mg, set;
+
+  PetscFunctionBeginUser;
+  *retry = PETSC_FALSE;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-pc_type", &set));
+  if (reason != KSP_DIVERGED_INDEFINITE_PC || !mg || set) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PCSetType(pc, PCJACOBI));
+  PetscCall(KSPSetTolerances(ksp, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
+  PetscCall(PetscPrintf(sys->comm, "perilin: note: the geometric multigrid's V-cycle is not positive definite here (%s); retrying with Jacobi (-pc_type jacobi)\n", KSPConvergedReasons[reason]));
+  *retry = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* GAMG's default Chebyshev smoother misjudges the spectrum when the stiffness jumps by orders of
  * magnitude (an interface): switch the levels to symmetric SOR, unless told otherwise. Returns
  * whether it did. */
@@ -314,6 +335,8 @@ static PetscErrorCode SmootherFallback(PeriSystem sys, KSP ksp, KSPConvergedReas
   PetscFunctionBeginUser;
   *retry = PETSC_FALSE;
   PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(MultigridFallback(sys, ksp, reason, retry));
+  if (*retry) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &gamg));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-mg_levels_ksp_type", &set));
   if (reason != KSP_DIVERGED_INDEFINITE_PC || !gamg || set) PetscFunctionReturn(PETSC_SUCCESS);
