@@ -343,6 +343,9 @@ PetscErrorCode PeriMultigridSetUp(PeriSystem sys, KSP ksp, Mat A)
   }
   PetscCall(PetscFree(heldf));
   PetscCall(sys->stiffness.levels.destroy(&f));
+  /* -pc_mg_* once more, now that the levels exist: PCMGSetLevels forgets what the KSP's
+     set-up read before (-pc_mg_multiplicative_cycles, -pc_mg_cycle_type) */
+  PetscCall(PCSetFromOptions(pc));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Multigrid, 0, 0, 0, 0));
   PetscCall(PetscInfo(pc, "perilin multigrid: %" PetscInt_FMT " levels\n", L));
   PetscFunctionReturn(PETSC_SUCCESS);
