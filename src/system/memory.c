@@ -95,7 +95,7 @@ static PetscErrorCode MatrixFree(PeriScene s, PeriModel m, const PeriSystemNeeds
 /* Whether a static solve will run the geometric multigrid (DefaultPC's rule, without the body's
  * thinness, which only the grid's cells tell): a matrix-free K of a grid body, not periodic,
  * without failure, the default PC or -pc_type mg, 2D or 3D from PERI_MG_MIN_PARTICLES_3D. */
-static PetscBool Multigrid(PeriScene s, PeriModel m, const PeriSystemNeeds *needs, PetscBool mf, PetscBool failure, PetscReal n, const PetscBool periodic[])
+static PetscBool Multigrid(PeriModel m, const PeriSystemNeeds *needs, PetscBool mf, PetscBool failure, PetscReal n, const PetscBool periodic[])
 {
   char      pc[64] = PCMG;
   PetscBool per    = PETSC_FALSE;
@@ -103,7 +103,6 @@ static PetscBool Multigrid(PeriScene s, PeriModel m, const PeriSystemNeeds *need
   for (PetscInt d = 0; d < m->dim; d++) per = (PetscBool)(per || periodic[d]);
   if (!mf || failure || per || !needs->static_solver || (m->dim == 3 && n < PERI_MG_MIN_PARTICLES_3D)) return PETSC_FALSE;
   if (PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL)) return PETSC_FALSE;
-  (void)s;
   return (PetscBool)!strcmp(pc, PCMG);
 }
 
@@ -270,7 +269,7 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m,
   } else
     PetscCall(MatrixFree(s, m, &at, &mf));
   if (failure && !m->central_force) mf = PETSC_FALSE; /* PeriMatrixFreeWhyNot */
-  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, &at, mf, Multigrid(s, m, &at, mf, failure, e.n, periodic), &e));
+  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, &at, mf, Multigrid(m, &at, mf, failure, e.n, periodic), &e));
   PetscCall(NodeBalance(comm, &e));
   PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
   PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));

@@ -67,7 +67,7 @@ const char *PeriMultigridWhyNotBody(PeriSystem sys)
   PeriNode grid = NULL;
   PetscInt most, take;
 
-  PeriSceneGetMap(sys->scene, sys->scene->root, "grid", PETSC_FALSE, &grid);
+  (void)PeriSceneGetNode(sys->scene->root, "grid", &grid); /* the scene was read: no error here */
   if (!grid) return "the body does not come from a grid (its coarse levels are the grid at twice the spacing)";
   for (PetscInt d = 0; d < 3; d++)
     if (sys->disc.particles.periodic[d]) return "the body is periodic";
