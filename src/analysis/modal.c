@@ -298,11 +298,12 @@ static PetscErrorCode SetLOBPCG(PeriAnalysis an, EPS eps, Mat P, IS isfree, Pets
   PC pc;
 
   PetscFunctionBeginUser;
-  PetscCall(EPSSetType(eps, EPSLOBPCG));
+  PetscCall(PeriEPSRegisterLOBPCG());
+  PetscCall(EPSSetType(eps, PERI_EPSLOBPCG));
   PetscCall(EPSSetWhichEigenpairs(eps, EPS_SMALLEST_REAL));
   PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
-  PetscCall(EPSLOBPCGSetBlockSize(eps, nreq + 2));
-  if (UseMultigrid(an)) { /* one V-cycle of the geometric multigrid (src/system/multigrid.c) */
+  PetscCall(EPSLOBPCGSetBlockSize(eps, nreq + 2)); /* for -eps_type lobpcg */
+  if (UseMultigrid(an)) {                          /* one V-cycle of the geometric multigrid (src/system/multigrid.c) */
     PetscCall(SetTransform(eps, STPRECOND, PCSHELL, &pc));
     PetscCall(PeriMultigridSetUpFree(an->sys, isfree, pc));
     PetscFunctionReturn(PETSC_SUCCESS);

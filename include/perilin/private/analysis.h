@@ -133,6 +133,9 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointBegin(PeriAnalysis, PetscViewe
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointEnd(PeriAnalysis, PetscViewer *, const char[]);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis, PetscViewer *, char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
+/* perilin's LOBPCG as a SLEPc eigensolver type (src/analysis/lobpcg.c) */
+#define PERI_EPSLOBPCG "perilin_lobpcg"
+PETSC_EXTERN PetscErrorCode PeriEPSRegisterLOBPCG(void);
 PETSC_EXTERN PetscErrorCode PeriAnalysisFind(const char[], const PeriAnalysisType **);
 PETSC_EXTERN PetscErrorCode PeriAnalysisListTypes(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAnalysisGetTypes(PetscInt *, const PeriAnalysisType *const **);
