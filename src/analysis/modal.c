@@ -16,10 +16,11 @@ static const char *const eigensolvers[] = {"auto", "shift_invert", "lobpcg", NUL
 
 /* auto takes LOBPCG from this many DOFs on: below it the factorization is faster, above it its
  * fill outgrows the machine (docs/performance.md, "Modes at scale (issue 29, item 1)"); with the
- * geometric multigrid (a matrix-free K of a grid body) from MODAL_LOBPCG_MIN_DOFS_MG on (the
- * gerstle lamina at 43,200 DOFs: 2.3 s against the factorization's 2.9 s, a third of its memory) */
+ * geometric multigrid (a matrix-free K of a grid body) from MODAL_LOBPCG_MIN_DOFS_MG on (perilin's
+ * LOBPCG on the gerstle lamina, 10 modes: a tie at 4,800 DOFs, 0.67 s against 0.76 s at 10,800,
+ * 1.8 s against 2.8 s at 43,200) */
 #define MODAL_LOBPCG_MIN_DOFS    300000
-#define MODAL_LOBPCG_MIN_DOFS_MG 30000
+#define MODAL_LOBPCG_MIN_DOFS_MG 8000
 
 /* the analysis' results (its data) */
 static inline PeriModal *Modal(PeriAnalysis an)
@@ -733,7 +734,8 @@ static PetscErrorCode ChooseEigensolver(PeriAnalysis an)
   (analysis.target_hz = 0) the lowest, in ascending frequency; with one, the nev whose frequencies
   lie nearest it, in order of |f - target| (ties: the lower first). Rigid-body modes of a free
   body are counted and skipped. The eigensolver is analysis.eigensolver's (ChooseEigensolver):
-  shift-and-invert with a factorization, or LOBPCG with GAMG. Every inner solve of the spectral
+  shift-and-invert with a factorization, or perilin's LOBPCG (lobpcg.c) with the geometric
+  multigrid or GAMG. Every inner solve of the spectral
   transform must leave a true relative residual below PeriResidualTolerance(-st_ksp_rtol) (LOBPCG's
   preconditioner excepted), every returned mode a relative residual ||K x - omega^2 M x|| /
   (omega^2 ||M x||) below PeriResidualTolerance(-eps_tol), and LOBPCG must return all the modes
@@ -922,7 +924,7 @@ static PetscErrorCode ModalDestroy(PeriAnalysis an)
 static const PeriKey modal_keys[] = {
     {"nev", PERI_KEY_INT, "6", "[1, inf)", NULL, NULL, "number of modes"},
     {"target_hz", PERI_KEY_REAL, "0", "[0, inf)", "[1/time]", NULL, "compute the modes nearest this frequency (0: the lowest)"},
-    {"eigensolver", PERI_KEY_CHOICE, "auto", NULL, NULL, eigensolvers, "shift_invert: Krylov-Schur, shift-and-invert with a direct factorization of K; lobpcg: LOBPCG with algebraic multigrid, K matrix-free where it can be (the lowest modes of a held body only); auto: lobpcg from 300,000 DOFs on where it applies, else shift_invert (docs/modal.md)"},
+    {"eigensolver", PERI_KEY_CHOICE, "auto", NULL, NULL, eigensolvers, "shift_invert: Krylov-Schur, shift-and-invert with a direct factorization of K; lobpcg: LOBPCG preconditioned by multigrid (geometric on grid bodies, else algebraic), K matrix-free where it can be (the lowest modes of a held body only); auto: lobpcg from 8,000 DOFs on grid bodies and 300,000 elsewhere where it applies, else shift_invert (docs/modal.md)"},
     {NULL},
 };
 static const PeriSchema modal_schema[] = {{"analysis", modal_keys}, {NULL}};
