@@ -570,21 +570,6 @@ static PetscErrorCode SolveAttempt(PeriSystem sys, KSP *ksp, PetscReal lambda, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* K in AIJ for GAMG, where the default Jacobi had it in BAIJ (JacobiFormat in stiffness.c), and
- * the next assemblies too. */
-static PetscErrorCode GAMGFormat(PeriSystem sys)
-{
-  PetscBool baij;
-
-  PetscFunctionBeginUser;
-  if (sys->stiffness.op) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)sys->stiffness.K, &baij, MATSEQBAIJ, MATMPIBAIJ, ""));
-  if (!baij) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(MatConvert(sys->stiffness.K, MATAIJ, MAT_INPLACE_MATRIX, &sys->stiffness.K));
-  PetscCall(PetscStrncpy(sys->stiffness.mat_type, MATAIJ, sizeof(sys->stiffness.mat_type)));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /*@C
   PeriStaticSolve - solves K u = lambda f for sys->fields.u with the prescribed values and the layers'
   offsets scaled by lambda, and the DOFs hold[] held at held[] (fragments). Fictitious layers are
@@ -605,7 +590,6 @@ PetscErrorCode PeriStaticSolve(PeriSystem sys, KSP *ksp, PetscReal lambda, Petsc
     PetscCall(PetscPrintf(sys->comm, "perilin: note: CG + Jacobi did not converge in %d iterations; GAMG on the short-range stiffness goes on from there\n", PERI_JACOBI_BUDGET));
     PetscCall(PetscStrncpy(sys->stiffness.pc_default, PCGAMG, sizeof(sys->stiffness.pc_default)));
     PetscCall(KSPDestroy(ksp));
-    PetscCall(GAMGFormat(sys));
     PetscCall(PeriStaticKSPCreate(sys, sys->fields.solve.symmetric, ksp));
     PetscCall(KSPSetInitialGuessNonzero(*ksp, PETSC_TRUE));
     PetscCall(SolveAttempt(sys, ksp, lambda, inplace, nhold, hold, held, reason));

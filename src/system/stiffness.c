@@ -71,22 +71,6 @@ static void DefaultPC(PeriSystem sys)
   PetscStrncpy(sys->stiffness.pc_default, pc, sizeof(sys->stiffness.pc_default));
 }
 
-/* A default Jacobi reads an assembled K in blocks (BAIJ) where PeriStaticDefaultMatType chose AIJ
- * for the GAMG that an unset -pc_type implies (PETSc 3.18's GAMG takes AIJ only): Jacobi's
- * products are faster on BAIJ (fracture/micropolar_shear's first solve: see docs/performance.md,
- * "Defaults that pick the fastest"). PeriStaticSolve converts K back to AIJ if GAMG takes over. */
-static PetscErrorCode JacobiFormat(PeriSystem sys)
-{
-  PetscBool set, aij, jacobi;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-pc_type", &set));
-  PetscCall(PetscStrcmp(sys->stiffness.mat_type, MATAIJ, &aij));
-  PetscCall(PetscStrcmp(sys->stiffness.pc_default, PCJACOBI, &jacobi));
-  if (sys->stiffness.needs.static_solver && !set && aij && jacobi) PetscCall(PetscStrncpy(sys->stiffness.mat_type, MATBAIJ, sizeof(sys->stiffness.mat_type)));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 PetscErrorCode PeriSystemAssemble(PeriSystem sys)
 {
   PetscLogDouble t0, t1;
@@ -109,7 +93,6 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
     PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   } else {
     DefaultPC(sys);
-    PetscCall(JacobiFormat(sys));
     PetscCall(PeriAssembleStiffness(sys, &sys->stiffness.K));
   }
   PetscCall(PetscTime(&t1));
