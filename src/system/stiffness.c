@@ -42,33 +42,53 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the body is held along at least an edge's worth of DOFs (a clamp), not at a few points
+ * (pins): as many constrained DOFs as the model's DOFs per particle times the span in spacings.
+ * Collective. */
+static PetscErrorCode Clamped(PeriSystem sys, PetscReal span, PetscBool *clamped)
+{
+  PetscInt n = sys->conditions.nconstrained, N;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPIU_Allreduce(&n, &N, 1, MPIU_INT, MPI_SUM, sys->comm));
+  *clamped = (PetscBool)(N >= sys->model->dofs * span);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The static solves' default PC (docs/performance.md, "Defaults that pick the fastest" and
  * "Geometric multigrid"), from the measured crossovers:
  *   - Jacobi on a 2D body of shear or micropolar bonds up to PERI_JACOBI_MAX_SPAN_2D spacings
- *     across, where a few hundred cheap products beat any set-up (2x faster than GAMG; against
- *     the multigrid: the mppd lamina at 61 spacings 0.046 s against 0.058 s, the gerstle lamina
- *     at 60 spacings 0.056 s against 0.042 s);
+ *     across, where a few hundred cheap products beat any set-up (2x faster than GAMG); up to
+ *     PERI_JACOBI_MAX_SPAN_2D_CLAMPED where the body is clamped (Clamped) and the multigrid
+ *     applies: its coarse levels hold a clamp well and points poorly (the mppd lamina held by two
+ *     pins: 32-34 CG iterations; clamped at its base: 13-17, as the gerstle one);
  *   - perilin's geometric multigrid on a matrix-free K of a grid body (src/system/multigrid.c),
  *     2D, or 3D from PERI_MG_MIN_PARTICLES_3D particles on (27,000: a tie with Jacobi; 64,000:
  *     1.4x faster); 1.8-2.4x faster than GAMG with 25-30 % less memory;
  *   - Jacobi on a matrix-free K of a smaller 3D body, up to about 5e5 particles and 200 spacings
  *     across where the multigrid does not apply (no stored preconditioning matrix);
  *   - GAMG elsewhere (assembled K, meshes, periodic bodies, failure). */
-static void DefaultPC(PeriSystem sys)
+static PetscErrorCode DefaultPC(PeriSystem sys)
 {
   const PeriParticles *pt     = &sys->disc.particles;
   const PeriModel      m      = sys->model;
   const char          *pc     = PCGAMG;
-  PetscReal            extent = 0;
+  const PetscBool      mg     = (PetscBool)(sys->stiffness.op && PeriMultigridApplies(sys) && (pt->dim == 2 || sys->disc.N >= PERI_MG_MIN_PARTICLES_3D));
+  PetscReal            extent = 0, span;
+  PetscBool            clamped;
 
+  PetscFunctionBeginUser;
   for (PetscInt d = 0; d < pt->dim; d++) extent = PetscMax(extent, pt->upper[d] - pt->lower[d]);
-  if (pt->dim == 2 && !m->central_force && m->dofs >= 2 && extent <= PERI_JACOBI_MAX_SPAN_2D * pt->mean_spacing)
+  span = extent / pt->mean_spacing;
+  PetscCall(Clamped(sys, span, &clamped));
+  if (pt->dim == 2 && !m->central_force && m->dofs >= 2 && span <= (mg && clamped ? PERI_JACOBI_MAX_SPAN_2D_CLAMPED : PERI_JACOBI_MAX_SPAN_2D))
     pc = PCJACOBI;
-  else if (sys->stiffness.op && PeriMultigridApplies(sys) && (pt->dim == 2 || sys->disc.N >= PERI_MG_MIN_PARTICLES_3D))
+  else if (mg)
     pc = PCMG;
-  else if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && extent <= PERI_JACOBI_MAX_SPAN * pt->mean_spacing)
+  else if (sys->stiffness.op && pt->dim == 3 && sys->disc.N <= PERI_JACOBI_MAX_PARTICLES && span <= PERI_JACOBI_MAX_SPAN)
     pc = PCJACOBI;
-  PetscStrncpy(sys->stiffness.pc_default, pc, sizeof(sys->stiffness.pc_default));
+  PetscCall(PetscStrncpy(sys->stiffness.pc_default, pc, sizeof(sys->stiffness.pc_default)));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode PeriSystemAssemble(PeriSystem sys)
@@ -88,11 +108,11 @@ PetscErrorCode PeriSystemAssemble(PeriSystem sys)
   if (mf) {
     PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
     PetscCall(PeriOperatorCreate(sys, sys->stiffness.pc_radius, &sys->stiffness.op));
-    DefaultPC(sys);
+    PetscCall(DefaultPC(sys));
     PetscCall(PeriOperatorCreateMat(sys, &sys->stiffness.K));
     PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   } else {
-    DefaultPC(sys);
+    PetscCall(DefaultPC(sys));
     PetscCall(PeriAssembleStiffness(sys, &sys->stiffness.K));
   }
   PetscCall(PetscTime(&t1));

@@ -17,8 +17,11 @@
  *      GAMG after PERI_JACOBI_BUDGET iterations, and the answer is still the assembled K's (5);
  *   7. the same for a periodic body narrower than the horizon (fourth scene): bonds to several
  *      images of a particle and to its own;
- *   8. 5 for the micropolar cantilever (fifth scene, gerstle).
- * usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml operator_micropolar_2d.yaml */
+ *   8. 5 for the micropolar cantilever (fifth scene, gerstle): Jacobi at 30 spacings, the multigrid
+ *      at 50 (clamped) and 100; and for the mppd lamina held by two pins at 61 spacings (sixth
+ *      scene, examples/lamina/bending.yaml): Jacobi.
+ * usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml operator_micropolar_2d.yaml
+ *   examples/lamina/bending.yaml */
 #include "testing.h"
 
 #define TOL 1e-12
@@ -252,7 +255,7 @@ int main(int argc, char **argv)
   PetscInt ncases = 0, nshear = 0;
 
   PetscCall(PeriInitialize(&argc, &argv, NULL));
-  PetscCheck(argc >= 6, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml operator_micropolar_2d.yaml");
+  PetscCheck(argc >= 7, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_operator operator_2d.yaml operator_3d.yaml operator_beam_3d.yaml operator_periodic_2d.yaml operator_micropolar_2d.yaml lamina/bending.yaml");
   PetscCall(PeriInitializePackage());
   PetscCall(PeriModelListTypes(list, sizeof(list)));
   for (size_t k = 0; list[k]; k++)
@@ -282,9 +285,12 @@ int main(int argc, char **argv)
   PetscCall(CheckSolve(argv[3], PCGAMG));   /* slender: Jacobi, then GAMG */
   PetscCall(CheckSolve(argv[4], PCGAMG));   /* periodic */
   PetscCall(CheckSolve(argv[5], PCJACOBI)); /* a small 2D micropolar body (30 spacings): Jacobi */
+  PetscCall(PeriTestSetOption("-grid_spacing", "0.012"));
+  PetscCall(CheckSolve(argv[5], PCMG)); /* the same at 50 spacings, clamped: the multigrid from 48 on */
   PetscCall(PeriTestSetOption("-grid_spacing", "0.006"));
-  PetscCall(CheckSolve(argv[5], PCMG)); /* the same at 100 spacings, above 80: the multigrid */
+  PetscCall(CheckSolve(argv[5], PCMG)); /* the same at 100 spacings: the multigrid */
   PetscCall(PeriTestSetOption("-grid_spacing", NULL));
+  PetscCall(CheckSolve(argv[6], PCJACOBI)); /* the mppd lamina at 61 spacings held by two pins: Jacobi up to 64 */
   PetscCheck(ncases >= 7 && nshear >= 3, PETSC_COMM_WORLD, PETSC_ERR_PLIB, "only %" PetscInt_FMT " cases ran (%" PetscInt_FMT " shear or micropolar): expected the central-force models (pmb, npmb, cpmb) in 2D and 3D and pds, mppd and gerstle in 2D", ncases, nshear);
   PetscCall(PetscStrToArrayDestroy(ntypes, types));
   PetscCall(PeriFinalize());
