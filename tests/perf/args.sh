@@ -11,3 +11,15 @@ perf_args() {
   [[ $# -gt 0 ]] && shift
   PERF_REST=("$@")
 }
+
+# `perf_scenes "$0" "$@"` for the scripts called as SCRIPT PERILIN [REPEAT [SCENE...]]: sets exe
+# (PERILIN, absolute), repeat (default 3), root (the repository) and the array scenes (the rest).
+perf_scenes() {
+  local script=$1
+  shift
+  exe=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
+  repeat=${2:-3}
+  shift $(($# < 2 ? $# : 2))
+  root=$(cd "$(dirname "$script")/../.." && pwd)
+  scenes=("$@")
+}

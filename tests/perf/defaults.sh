@@ -8,11 +8,9 @@
 # Usage: defaults.sh PERILIN [REPEAT [SCENE...]]   (default: every scene listed below; a SCENE is
 #   examples/SCENE.yaml; options in $DEFAULTS_OPTS go to every run, e.g. -grid_spacing 0.005)
 set -euo pipefail
-exe=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
-repeat=${2:-3}
-shift $(($# < 2 ? $# : 2))
-root=$(cd "$(dirname "$0")/../.." && pwd)
-scenes=("$@")
+# shellcheck source=tests/perf/args.sh
+. "$(dirname "$0")/args.sh"
+perf_scenes "$0" "$@"
 [ ${#scenes[@]} -gt 0 ] || scenes=(antiplane/bimaterial antiplane/square_bar bench/block_3d bench/lamina_2d bench/lamina_bending_2d bench/plate_2d fracture/edge_crack fracture/micropolar_shear lamina/bending lamina/shear lamina/traction mesh/bar_tet mesh/plate_hole mesh/plate_hole_graded pmb/energy_density pmb/plate_traction torsion/rect_bar torsion/torsion_edge_crack)
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"; rm -f "$root"/examples/*/.defaults_tune_*.yaml' EXIT
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1

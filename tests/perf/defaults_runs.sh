@@ -9,11 +9,9 @@
 # Usage: defaults_runs.sh PERILIN [REPEAT [SCENE...]]   (SCENE: examples/SCENE.yaml; default: the
 #   quasi-static examples)
 set -euo pipefail
-exe=$(cd "$(dirname "$1")" && pwd)/$(basename "$1")
-repeat=${2:-3}
-shift $(($# < 2 ? $# : 2))
-root=$(cd "$(dirname "$0")/../.." && pwd)
-scenes=("$@")
+# shellcheck source=tests/perf/args.sh
+. "$(dirname "$0")/args.sh"
+perf_scenes "$0" "$@"
 [ ${#scenes[@]} -gt 0 ] || scenes=(fracture/edge_crack fracture/micropolar_shear antiplane/cracked_bar)
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -36,20 +34,20 @@ for s in "${scenes[@]}"; do
       if /usr/bin/time -o "$tmp/t" -f "%e" "$exe" "$root/examples/$s.yaml" $opts -quiet -output_vtk false -output_plots false -output_dir "$out" > "$tmp/log" 2>&1; then
         echo "$k $(cat "$tmp/t") ok" >> "$tmp/runs"
       else
-        echo "$k 0 $(grep -m1 -o 'error: .*' "$tmp/log" | cut -c8-90 | tr ' ' '_')" >> "$tmp/runs"
+        echo "$k 0 $(grep -m1 -o 'error: .*' "$tmp/log" | cut -c8-90)" >> "$tmp/runs"
       fi
     done
   done
   /usr/bin/python3 - "$s" "$tmp" "${configs[@]}" <<'PY'
 import json, os, statistics, sys
 scene, tmp, configs = sys.argv[1], sys.argv[2], [c.split("|")[0] for c in sys.argv[3:]]
-runs = [line.split(None, 2) for line in open(os.path.join(tmp, "runs"))]
+runs = [(line.split(None, 2) + [""])[:3] for line in open(os.path.join(tmp, "runs"))]
 print(f"{scene}:")
 best, med = None, {}
 for k, name in enumerate(configs):
     mine = [r for r in runs if int(r[0]) == k]
     if any(r[2].strip() != "ok" for r in mine):
-        print(f"  {name:24s} failed: {mine[0][2].strip().replace('_', ' ')}")
+        print(f"  {name:24s} failed: {mine[0][2].strip()}")
         continue
     med[k] = statistics.median(float(r[1]) for r in mine)
     d = json.load(open(os.path.join(tmp, f"o{k}", "summary.json")))
