@@ -26,7 +26,7 @@ configs=("default|"
   "multigrid, matrix-free|-ksp_type cg -pc_type mg -solver_operator matrix_free")
 for s in "${scenes[@]}"; do
   : > "$tmp/runs"
-  for r in $(seq "$repeat"); do
+  for _ in $(seq "$repeat"); do
     for k in "${!configs[@]}"; do
       opts=${configs[$k]#*|}
       out=$tmp/o$k
