@@ -1,3 +1,4 @@
+# shellcheck shell=bash disable=SC2034  # sourced: the variables it sets are its callers'
 # Sourced by the benchmarks of tests/perf: `perf_args NAME "$@"` puts the words before "--" into
 # the array NAME and the words after it into the array PERF_REST (options for every run).
 perf_args() {
