@@ -195,7 +195,16 @@ int main(int argc, char **argv)
     PetscCall(FieldError(p, Bimaterial, &e1));
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s bimaterial u_z error", models[k]));
     PeriTestClose(what, e1, 0, 0.01);
+    /* the default PC (stiffness.c, DefaultPC): Jacobi on a 2D antiplane body without failure up to
+       100 spacings (the bar: 100), GAMG beyond (the twisted rectangle at 0.01: 200) */
+    PetscCheck(!strcmp(p->sys->fields.solve.pc_type, PCJACOBI), PETSC_COMM_WORLD, PETSC_ERR_PLIB, "the bimaterial bar at 100 spacings ran PC %s, expected jacobi", p->sys->fields.solve.pc_type);
     PetscCall(PeriProblemDestroy(&p));
+    if (k == 0) {
+      PetscCall(Run(argv[3], models[k], "0.01", &p));
+      PetscCheck(!strcmp(p->sys->fields.solve.pc_type, PCGAMG), PETSC_COMM_WORLD, PETSC_ERR_PLIB, "the rectangle at 200 spacings ran PC %s, expected gamg", p->sys->fields.solve.pc_type);
+      PetscCall(PetscPrintf(PETSC_COMM_WORLD, "ok: the default PC: jacobi at 100 spacings, gamg at 200\n"));
+      PetscCall(PeriProblemDestroy(&p));
+    }
     /* layout B, the interface through a row of particles (y0 = dx/2). antiplane: the series
        modulus of every bond (cut at the interface) makes the exact solution's bond forces those of
        a homogeneous bar, so it is exact at any y0 (measured 3.9e-10 at 0.02, 0.01, 0.005: the
