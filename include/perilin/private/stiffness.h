@@ -13,8 +13,8 @@ typedef struct _p_PeriSystem *PeriSystem;
 #define PERI_JACOBI_MAX_PARTICLES       500000
 #define PERI_JACOBI_MAX_SPAN            200
 #define PERI_JACOBI_MAX_SPAN_2D         64    /* 2D shear and micropolar bodies held at points, assembled or not (tests/perf/defaults.sh: the pinned mppd lamina at 61 spacings runs Jacobi in 0.046 s, the multigrid in 0.058 s) */
+#define PERI_JACOBI_MAX_SPAN_2D_CLAMPED 48    /* the same clamped along an edge, where the multigrid applies (the clamped gerstle lamina, the default Jacobi over the fastest: 1.06 at 40 spacings, Jacobi the fastest; 1.18 at 50 and 1.35 at 60, the multigrid the fastest) */
 #define PERI_JACOBI_MAX_SPAN_ANTIPLANE  100   /* 2D antiplane bodies (one DOF per particle) without bond failure, assembled (tests/perf/defaults.sh: bimaterial, square_bar, rect_bar, all at 100 spacings, fastest with Jacobi, GAMG 1.02-1.31x; torsion_edge_crack at 200 keeps GAMG) */
-#define PERI_JACOBI_MAX_SPAN_2D_CLAMPED 48    /* the same clamped along an edge, where the multigrid applies (the clamped gerstle lamina, Jacobi over the multigrid: 0.94 at 40 spacings, 1.18 at 50, 1.35 at 60) */
 #define PERI_MG_MIN_PARTICLES_3D        30000 /* 3D grid bodies: the geometric multigrid from here on, Jacobi below */
 #define PERI_JACOBI_BUDGET              400   /* iterations, about the cost of GAMG's set-up and solve */
 typedef enum {
