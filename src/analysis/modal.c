@@ -691,7 +691,7 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
         break;
       }
   PetscCall(RecordSolver(an, w->eps, nev, &w->inner));
-  /* SLEPc's LOBPCG stops at -eps_max_it with what it has: fewer modes than asked is a failure */
+  /* LOBPCG stops at -eps_max_it with what it has: fewer modes than asked is a failure */
   PetscCheck(md->eigensolver != EIGENSOLVER_LOBPCG || md->nmodes >= PetscMin(nev, md->nfree_dofs), an->comm, PETSC_ERR_NOT_CONVERGED,
              "%s: LOBPCG converged %" PetscInt_FMT " of the %" PetscInt_FMT " modes asked for in %" PetscInt_FMT " iterations: raise -eps_max_it, or use analysis.eigensolver: shift_invert", an->sys->scene->file, md->nmodes,
              PetscMin(nev, md->nfree_dofs), an->sys->fields.solve.iterations);
