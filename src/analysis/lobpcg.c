@@ -131,7 +131,6 @@ static PetscErrorCode Symmetrize(DS ds, DSMatType m, PetscInt n, PetscBool *chol
   PetscBLASInt bn, info = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(DSGetLeadingDimension(ds, &ld));
   PetscCall(DSGetMat(ds, m, &G));
   PetscCall(MatDenseGetArray(G, &g));
   PetscCall(MatDenseGetLDA(G, &ld));

@@ -299,7 +299,6 @@ static PetscErrorCode SetLOBPCG(PeriAnalysis an, EPS eps, Mat P, IS isfree, Pets
   PC pc;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriEPSRegisterLOBPCG());
   PetscCall(EPSSetType(eps, PERI_EPSLOBPCG));
   PetscCall(EPSSetWhichEigenpairs(eps, EPS_SMALLEST_REAL));
   PetscCall(EPSSetTolerances(eps, 1e-10, PETSC_DEFAULT));
@@ -327,6 +326,7 @@ static PetscErrorCode CreateEPS(PeriAnalysis an, Mat Kff, Mat Mff, Mat Pff, IS i
   PetscBool precond;
 
   PetscFunctionBeginUser;
+  PetscCall(PeriEPSRegisterLOBPCG()); /* also for -eps_type perilin_lobpcg with shift_invert: refused with its reason */
   PetscCall(EPSCreate(an->comm, eps));
   PetscCall(EPSSetOperators(*eps, Kff, Mff));
   PetscCall(EPSSetProblemType(*eps, EPS_GHEP));
