@@ -57,6 +57,16 @@ typedef struct {
      on its whole family fam[0..n-1] (all with fam[k].i == i): ((n+1) dofs)^2, row-major, the DOFs
      of i first, then those of fam[0], fam[1], ... */
   PetscErrorCode (*family_stiffness)(PeriModel, PetscInt, const PeriBondGeometry[], PetscReal[]);
+  /* Family models with a scalar state per particle (the LPS dilatation; models/lps.c), else NULL.
+     Their energy is the pair springs of bond_stiffness plus sum_i (1/2) A_i theta_i^2, where
+     theta_i = sum over i's live bonds of gi . (u_j - u_i) (each bond (i, j) adds gi to theta_i and
+     gj to theta_j, both times the same u_j - u_i). bond_state writes the bond's gi and gj (dofs
+     each); state_modulus returns A_i of local particle i (it may be negative: the springs keep the
+     whole positive). The system applies, assembles and breaks this term from these two kernels
+     (src/system/operator.c, assembly.c); a broken bond leaves both its spring and its share of
+     the states. */
+  void (*bond_state)(PeriModel, const PeriBondGeometry *, PetscReal[], PetscReal[]);
+  PetscReal (*state_modulus)(PeriModel, PetscInt);
   /* The critical value of the first measure (stretch, shear angle) of this bond for the energy
      release rate G: breaking every bond across a unit crack area releases G. May be NULL. */
   PetscReal (*critical_from_G)(PeriModel, const PeriBondGeometry *, PetscReal);
@@ -92,6 +102,14 @@ struct _p_PeriModel {
      criteria find theirs by kind (PeriModelMeasureIndex) */
   const PeriMeasureKind *measure_kinds;
 };
+
+/* Whether the model's energy couples a particle's whole family (state-based): through a dense
+   family block (family_stiffness) or a per-particle state (bond_state). Such a stiffness reaches
+   two horizons. */
+static inline PetscBool PeriModelHasFamilies(PeriModel m)
+{
+  return (PetscBool)(m->ops.family_stiffness || m->ops.bond_state);
+}
 
 PETSC_EXTERN PetscReal       PeriModelIsotropicEnergy(PeriModel);
 PETSC_EXTERN PetscReal       PeriModelHorizonMoment(PeriModel, PetscInt);

@@ -83,6 +83,23 @@ static void RowAdd(PetscInt bs, PetscInt j, const PetscReal *B, PetscInt ld, Pet
     for (PetscInt c = 0; c < bs; c++) dst[a * bs + c] += B[a * ld + c];
 }
 
+/* The family block of a model with a per-particle state (ops.bond_state): A_i G G^T with
+ * G = (-sum_t g_t, g_1, ..., g_n), g_t the weights of bond t toward theta_i. */
+static void StateFamilyBlock(PeriModel m, PetscInt n, const PeriBondGeometry fam[], PetscReal G[], PetscReal Ke[])
+{
+  const PetscInt  bs = m->dofs, N = (n + 1) * bs;
+  const PetscReal A = n ? m->ops.state_modulus(m, fam[0].i) : 0;
+  PetscReal       gj[PERI_MAX_DOF];
+
+  for (PetscInt c = 0; c < bs; c++) G[c] = 0;
+  for (PetscInt t = 0; t < n; t++) {
+    m->ops.bond_state(m, &fam[t], &G[(t + 1) * bs], gj);
+    for (PetscInt c = 0; c < bs; c++) G[c] -= G[(t + 1) * bs + c];
+  }
+  for (PetscInt a = 0; a < N; a++)
+    for (PetscInt c = 0; c < N; c++) Ke[a * N + c] = A * G[a] * G[c];
+}
+
 /* Visits the families of the owned particles (state-based models). */
 static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
 {
@@ -104,7 +121,10 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
   for (PetscInt i = sys->disc.family.rstart; i < sys->disc.family.rend; i++) {
     PetscInt n;
     PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
-    PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
+    if (m->ops.family_stiffness)
+      PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
+    else
+      StateFamilyBlock(m, n, fam, work, Ke);
     idx[0] = i;
     for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
     for (PetscInt t = 0; t <= n; t++) gidx[t] = sys->disc.particles.global[idx[t]];
@@ -168,6 +188,7 @@ PetscErrorCode PeriElementsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
     PetscCall(FamiliesForEach(sys, fn, ctx));
   else
     PetscCall(BondsForEach(sys, fn, ctx));
+  if (sys->model->ops.bond_state) PetscCall(FamiliesForEach(sys, fn, ctx)); /* the springs, then the states */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -471,7 +492,7 @@ PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
-  if (sys->model->ops.family_stiffness)
+  if (PeriModelHasFamilies(sys->model))
     PetscCall(AssembleFamilies(sys, K));
   else
     PetscCall(AssembleBonds(sys, &all, K));

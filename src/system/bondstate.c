@@ -82,10 +82,11 @@ PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fr
   PetscCall(PeriStiffnessScaled(sys));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, sys->comm));
   if (released) PetscCallMPI(MPI_Allreduce(&energy, released, 1, MPIU_REAL, MPI_SUM, sys->comm));
-  if (*nbroken && !m->ops.bond_stiffness) {
-    PetscCall(PeriFamilySync(sys));
-    PetscCall(PeriSystemAssemble(sys));
-  }
+  /* state-based models: the families follow the bonds (the energy, stresses and reactions read
+     them); an assembled K of a family model is reassembled from them (a matrix-free one dropped
+     the bonds' springs and state weights together, PeriOperatorScaleBond) */
+  if (*nbroken && PeriModelHasFamilies(m)) PetscCall(PeriFamilySync(sys));
+  if (*nbroken && PeriModelHasFamilies(m) && (!m->ops.bond_stiffness || !sys->stiffness.op)) PetscCall(PeriSystemAssemble(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

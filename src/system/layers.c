@@ -58,7 +58,7 @@ static PetscErrorCode ReadTorsion(PeriSystem sys)
 static PetscInt LayerCells(PeriSystem sys, PetscReal h)
 {
   PetscReal R = PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, h);
-  return (sys->model->ops.family_stiffness ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
+  return (PeriModelHasFamilies(sys->model) ? 2 : 1) * (PetscInt)PetscFloorReal(R * (1 - 1e-12) / h);
 }
 
 /* Reads one boundary_layers item into sys->conditions.layers and sets the depth nl of its face in lo or hi. */

@@ -148,7 +148,7 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   per_bond = sizeof(PetscReal) + (failure ? 1 + sizeof(PetscReal) : 0);
   /* a matrix-free K: its matrix is the short-range one (1.75 spacings, PeriOperatorPreconditioner)
      beside the operator's partner and sqrt(k) e per bond */
-  blocks = 1 + share * (mf ? BallCount(m->dim, 1.75) : m->ops.family_stiffness ? BallCount(m->dim, 2 * r)
+  blocks = 1 + share * (mf ? BallCount(m->dim, 1.75) : PeriModelHasFamilies(m) ? BallCount(m->dim, 2 * r)
                                                                                : ball);
   nnz    = n * blocks * dofs * dofs;
   matrix = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
@@ -162,7 +162,7 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   /* GAMG's scalar graph (matrix / dofs^2), its coarse levels and prolongators and CG's vectors:
      PERI_MEMORY_SOLVER graphs, fitted to the peaks of 2D plates (2 DOFs, 1e4-1e6 particles, where
      the whole run peaks at 2.5x the matrix as in docs/performance.md) and 3D blocks (3 DOFs) */
-  e->shared = (reserved + e->nbonds * per_bond) * (m->ops.family_stiffness ? 3 : 1) + matrix * (1 + PERI_MEMORY_SOLVER / (dofs * dofs)) + 10 * n * dofs * sizeof(PetscScalar);
+  e->shared = (reserved + e->nbonds * per_bond) * (PeriModelHasFamilies(m) ? 3 : 1) + matrix * (1 + PERI_MEMORY_SOLVER / (dofs * dofs)) + 10 * n * dofs * sizeof(PetscScalar);
   /* the analysis' copies of K (the quasi-static loop solves on one) and its factorization (the
      modal shift-and-invert: nested-dissection fill grew as 0.45 log2(n) matrices on the 2D lamina,
      3,600 to 230,400 particles) */

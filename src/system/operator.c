@@ -29,15 +29,21 @@ typedef enum {
 } BondForm;
 
 struct _p_PeriOperator {
-  PetscInt       refct; /* the system's reference and one per shell: a reused preconditioner may keep a shell after the system rebuilt its operator */
-  PetscInt       nloc, bs, nghost;
-  BondForm       form;
-  PetscInt       nw;  /* numbers per bond: bs (central), 3 (shear), 7 (micropolar) */
-  PetscInt      *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
-  PetscInt      *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
-  PetscReal     *w;   /* nw per bond: sqrt(k) e; A (xx, xy, yy); A, c (x, y), a, b */
-  PetscInt      *ghost;
-  PetscInt      *slot;        /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
+  PetscInt   refct; /* the system's reference and one per shell: a reused preconditioner may keep a shell after the system rebuilt its operator */
+  PetscInt   nloc, bs, nghost;
+  BondForm   form;
+  PetscInt   nw;  /* numbers per bond: bs (central), 3 (shear), 7 (micropolar) */
+  PetscInt  *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
+  PetscInt  *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
+  PetscReal *w;   /* nw per bond: sqrt(k) e; A (xx, xy, yy); A, c (x, y), a, b */
+  PetscInt  *ghost;
+  PetscInt  *slot; /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
+  /* The state term of family models (ops.bond_state; the LPS dilatation), else NULL: per bond the
+     weights toward theta_i and theta_j as multiples p of w (2 numbers: they are parallel to the
+     bond), per particle of the operator's local numbering the modulus A_i. A broken bond's w = 0
+     takes it out of both terms at once. */
+  PetscReal     *p, *A;
+  Vec            theta;       /* ghosted, one per particle: the states, then A theta */
   PeriShortRange short_range; /* the preconditioning matrix's bonds and their scales */
   Vec            xm, ym;      /* ghosted work vectors: the input with held DOFs zeroed, and K of it */
   Vec            kdiag;       /* the diagonal of K */
@@ -124,6 +130,81 @@ static void MicropolarLoop(const PeriOperator op, const PetscScalar *x, PetscSca
   }
 }
 
+/* The state term's first pass: theta_i += p_i s and theta_j += p_j s, s = w . (u_j - u_i), over
+ * the local view (the states of ghosts and of particles with bonds elsewhere are partial). */
+static inline void StateLoop(const PeriOperator op, const PetscInt bs, const PetscScalar *x, PetscScalar *th)
+{
+  for (PetscInt i = 0; i < op->nloc; i++) {
+    const PetscScalar *ui  = x + bs * i;
+    PetscScalar        acc = 0;
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal   *w  = op->w + bs * b;
+      const PetscScalar *uj = x + bs * op->jl[b];
+      PetscScalar        t  = 0;
+      for (PetscInt d = 0; d < bs; d++) t += w[d] * (uj[d] - ui[d]);
+      acc += op->p[2 * b] * t;
+      th[op->jl[b]] += op->p[2 * b + 1] * t;
+    }
+    th[i] += acc;
+  }
+}
+
+/* The second pass, springs and states together: with q = A theta (complete on the local view),
+ * the bond's force along w is s + p_i q_i + p_j q_j, on j, and its opposite on i. */
+static inline void SpringStateLoop(const PeriOperator op, const PetscInt bs, const PetscScalar *x, const PetscScalar *q, PetscScalar *y)
+{
+  for (PetscInt i = 0; i < op->nloc; i++) {
+    const PetscScalar *ui                = x + bs * i;
+    PetscScalar        acc[PERI_MAX_DOF] = {0};
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal   *w  = op->w + bs * b;
+      const PetscScalar *uj = x + bs * op->jl[b];
+      PetscScalar       *yj = y + bs * op->jl[b], t = 0;
+      for (PetscInt d = 0; d < bs; d++) t += w[d] * (uj[d] - ui[d]);
+      t += op->p[2 * b] * q[i] + op->p[2 * b + 1] * q[op->jl[b]];
+      for (PetscInt d = 0; d < bs; d++) {
+        acc[d] -= t * w[d];
+        yj[d] += t * w[d];
+      }
+    }
+    for (PetscInt d = 0; d < bs; d++) y[bs * i + d] += acc[d];
+  }
+}
+
+/* The two passes of a family model's product, with the states' ghost exchange between them:
+ * every bond is stored once, so an owned state sums the contributions of every rank that holds
+ * one of its bonds (reverse), and the ghosts then get their owners' sums (forward). */
+static PetscErrorCode StateProduct(const PeriOperator op, const PetscScalar *x, PetscScalar *y)
+{
+  Vec          tl;
+  PetscScalar *th;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGhostGetLocalForm(op->theta, &tl));
+  PetscCall(VecSet(tl, 0));
+  PetscCall(VecGetArray(tl, &th));
+  if (op->bs == 3)
+    StateLoop(op, 3, x, th);
+  else
+    StateLoop(op, op->bs, x, th);
+  PetscCall(VecRestoreArray(tl, &th));
+  PetscCall(VecGhostRestoreLocalForm(op->theta, &tl));
+  PetscCall(VecGhostUpdateBegin(op->theta, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateEnd(op->theta, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateBegin(op->theta, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGhostUpdateEnd(op->theta, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGhostGetLocalForm(op->theta, &tl));
+  PetscCall(VecGetArray(tl, &th));
+  for (PetscInt i = 0; i < op->nloc + op->nghost; i++) th[i] *= op->A[i];
+  if (op->bs == 3)
+    SpringStateLoop(op, 3, x, th, y);
+  else
+    SpringStateLoop(op, op->bs, x, th, y);
+  PetscCall(VecRestoreArray(tl, &th));
+  PetscCall(VecGhostRestoreLocalForm(op->theta, &tl));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The bond loop of the operator's form; literal block sizes, so that the compiler unrolls. */
 static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y)
 {
@@ -143,6 +224,7 @@ static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y
 static PetscReal FormFlops(const PeriOperator op)
 {
   return op->form == FORM_MICROPOLAR ? 32 : op->form == FORM_SHEAR ? 14
+                                        : op->p                    ? 10.0 * op->bs + 8
                                                                    : 6.0 * op->bs;
 }
 
@@ -162,7 +244,10 @@ static PetscErrorCode ApplyK(PeriOperator op)
   PetscCall(VecSet(yl, 0));
   PetscCall(VecGetArrayRead(xl, &xa));
   PetscCall(VecGetArray(yl, &ya));
-  FormLoop(op, xa, ya);
+  if (op->p)
+    PetscCall(StateProduct(op, xa, ya));
+  else
+    FormLoop(op, xa, ya);
   PetscCall(VecRestoreArray(yl, &ya));
   PetscCall(VecRestoreArrayRead(xl, &xa));
   PetscCall(VecGhostRestoreLocalForm(op->ym, &yl));
@@ -436,6 +521,28 @@ static PetscErrorCode BondNumbers(PeriModel m, const PeriOperator op, const Peri
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The bond's state weights gi, gj (ops.bond_state) as multiples of its numbers w (the central
+ * form): an error when they are not parallel to it. */
+static PetscErrorCode StateNumbers(PeriModel m, const PeriOperator op, const PeriBondGeometry *g, const PetscReal w[], PetscReal p[])
+{
+  PetscReal gv[2][PERI_MAX_DOF], ww = 0;
+
+  PetscFunctionBeginUser;
+  m->ops.bond_state(m, g, gv[0], gv[1]);
+  for (PetscInt d = 0; d < op->bs; d++) ww += w[d] * w[d];
+  for (PetscInt e = 0; e < 2; e++) {
+    PetscReal gw = 0, dev = 0, size = 0;
+    for (PetscInt d = 0; d < op->bs; d++) gw += gv[e][d] * w[d];
+    p[e] = ww > 0 ? gw / ww : 0;
+    for (PetscInt d = 0; d < op->bs; d++) {
+      size = PetscMax(size, PetscAbsReal(gv[e][d]));
+      dev  = PetscMax(dev, PetscAbsReal(gv[e][d] - p[e] * w[d]));
+    }
+    PetscCheck(dev <= 1e-10 * size, PETSC_COMM_SELF, PETSC_ERR_PLIB, "model %s: the state weights of bond %" PetscInt_FMT "-%" PetscInt_FMT " are not along its spring (deviation %g of %g): the matrix-free operator cannot apply them", m->type, g->i, g->j, (double)dev, (double)size);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Whether stored bond k of particle i is one of the operator's: live, and not a self-image (whose
  * block cancels). */
 static inline PetscBool OperatorBond(const PeriBonds *b, PetscInt i, PetscInt k)
@@ -457,6 +564,7 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->nw, &op->w));
   PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
   if (sys->bond_state.failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
+  if (m->ops.bond_state) PetscCall(PetscMalloc1(2 * b->nbonds, &op->p));
   op->nghost = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     op->ptr[i - b->rstart] = nb;
@@ -467,6 +575,7 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
       PetscCall(BondNumbers(m, op, &g, Ke, op->w + nb * op->nw));
+      if (op->p) PetscCall(StateNumbers(m, op, &g, op->w + nb * op->nw, op->p + 2 * nb));
       if (g.j < sys->disc.nowned)
         op->jl[nb] = g.j;
       else { /* for now -1 - its global index: numbered below, as the ghosted vectors number them */
@@ -500,6 +609,42 @@ static void FormDiagonal(const PeriOperator op, const PetscReal w[], PetscReal d
   }
 }
 
+/* The state term's diagonal, added to ya (the local form of ym): sum_q A_q (d theta_q / d u_p)^2.
+ * A bond (i, j) adds p_i w to theta_i's gradient at j and -p_i w at i, p_j w to theta_j's at j and
+ * -p_j w at i: the neighbours' terms go straight in, a particle's own gradient S_p is summed over
+ * the ranks first (in xm's local form, scratch here). Collective. */
+static PetscErrorCode StateDiagonal(PeriOperator op, PetscScalar *ya)
+{
+  const PetscInt bs = op->bs;
+  Vec            sl;
+  PetscScalar   *S;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGhostGetLocalForm(op->xm, &sl));
+  PetscCall(VecSet(sl, 0));
+  PetscCall(VecGetArray(sl, &S));
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal *w = op->w + bs * b, pi = op->p[2 * b], pj = op->p[2 * b + 1];
+      const PetscInt   j = op->jl[b];
+      for (PetscInt d = 0; d < bs; d++) {
+        S[bs * i + d] -= pi * w[d];
+        S[bs * j + d] += pj * w[d];
+        ya[bs * j + d] += op->A[i] * PetscSqr(pi * w[d]);
+        ya[bs * i + d] += op->A[j] * PetscSqr(pj * w[d]);
+      }
+    }
+  PetscCall(VecRestoreArray(sl, &S));
+  PetscCall(VecGhostRestoreLocalForm(op->xm, &sl));
+  PetscCall(VecGhostUpdateBegin(op->xm, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateEnd(op->xm, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGetArray(op->xm, &S));
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += op->A[i] * PetscSqr(S[bs * i + d]);
+  PetscCall(VecRestoreArray(op->xm, &S));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* op->kdiag: the diagonal of K, the sum over the bonds at each end of their blocks' diagonals.
  * Collective. */
 static PetscErrorCode ComputeDiagonal(PeriOperator op)
@@ -520,6 +665,7 @@ static PetscErrorCode ComputeDiagonal(PeriOperator op)
         ya[op->bs * op->jl[b] + d] += diag[d];
       }
     }
+  if (op->p) PetscCall(StateDiagonal(op, ya));
   PetscCall(VecRestoreArray(yl, &ya));
   PetscCall(VecGhostRestoreLocalForm(op->ym, &yl));
   PetscCall(VecGhostUpdateBegin(op->ym, ADD_VALUES, SCATTER_REVERSE));
@@ -529,14 +675,67 @@ static PetscErrorCode ComputeDiagonal(PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The state term's ghosted states and its moduli A on the operator's local numbering (the
+ * ghosts' from their owners). */
+static PetscErrorCode SetUpStates(PeriSystem sys, PeriOperator op)
+{
+  Vec                al;
+  const PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecCreateGhost(sys->comm, op->nloc, PETSC_DECIDE, op->nghost, op->ghost, &op->theta));
+  PetscCall(VecGhostGetLocalForm(op->theta, &al));
+  PetscCall(VecGetArray(al, (PetscScalar **)&a));
+  for (PetscInt i = 0; i < op->nloc; i++) ((PetscScalar *)a)[i] = sys->model->ops.state_modulus(sys->model, i);
+  PetscCall(VecRestoreArray(al, (PetscScalar **)&a));
+  PetscCall(VecGhostRestoreLocalForm(op->theta, &al));
+  PetscCall(VecGhostUpdateBegin(op->theta, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGhostUpdateEnd(op->theta, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(PetscMalloc1(op->nloc + op->nghost, &op->A));
+  PetscCall(VecGhostGetLocalForm(op->theta, &al));
+  PetscCall(VecGetArrayRead(al, &a));
+  for (PetscInt i = 0; i < op->nloc + op->nghost; i++) op->A[i] = PetscRealPart(a[i]);
+  PetscCall(VecRestoreArrayRead(al, &a));
+  PetscCall(VecGhostRestoreLocalForm(op->theta, &al));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The ghosted work vectors and the diagonal. */
 static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
 {
   PetscFunctionBeginUser;
   PetscCall(VecCreateGhostBlock(sys->comm, op->bs, op->nloc * op->bs, PETSC_DECIDE, op->nghost, op->ghost, &op->xm));
   PetscCall(VecDuplicate(op->xm, &op->ym));
+  if (op->p) PetscCall(SetUpStates(sys, op));
   PetscCall(PeriSystemCreateVec(sys, &op->kdiag));
   PetscCall(ComputeDiagonal(op));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Adds to each owned particle's full the state term's energy of the uniform expansion u = X on
+ * the springs' scale (where a spring's k |xi|^2 is twice its energy at each end): 2 A_i theta_i^2,
+ * so that the scaled short-range springs store the whole K's energy of it. Collective. */
+static PetscErrorCode AddStateExpansion(PeriSystem sys, PeriOperator op, PetscReal full[])
+{
+  const PeriDisc  *disc = &sys->disc;
+  const PeriBonds *b    = &disc->bonds;
+  PetscReal       *theta;
+  PetscInt         t = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(disc->particles.n, &theta));
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscReal s = 0;
+      if (!OperatorBond(b, i, k)) continue;
+      for (PetscInt d = 0; d < op->bs; d++) s += op->w[op->nw * t + d] * b->xi[3 * k + d];
+      theta[i] += op->p[2 * t] * s;
+      theta[b->j[k]] += op->p[2 * t + 1] * s;
+      t++;
+    }
+  PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_SUM, theta));
+  for (PetscInt i = 0; i < disc->nowned; i++) full[i] = PetscMax(full[i] + 2 * sys->model->ops.state_modulus(sys->model, i) * PetscSqr(theta[i]), 0);
+  PetscCall(PetscFree(theta));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -567,6 +766,7 @@ static PetscErrorCode ExpansionEnergies(PeriSystem sys, PeriOperator op, PetscRe
     }
   PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_SUM, full));
   PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_SUM, part));
+  if (op->p) PetscCall(AddStateExpansion(sys, op, full));
   PetscCall(PeriDiscOwnersToGhosts(disc, MPIU_REAL, 1, full));
   PetscCall(PeriDiscOwnersToGhosts(disc, MPIU_REAL, 1, part));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -796,6 +996,9 @@ PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
   PetscCall(PetscFree2((*op)->short_range.reach, (*op)->short_range.scale));
   PetscCall(PetscFree((*op)->ghost));
   PetscCall(PetscFree((*op)->slot));
+  PetscCall(PetscFree((*op)->p));
+  PetscCall(PetscFree((*op)->A));
+  PetscCall(VecDestroy(&(*op)->theta));
   PetscCall(VecDestroy(&(*op)->xm));
   PetscCall(VecDestroy(&(*op)->ym));
   PetscCall(VecDestroy(&(*op)->kdiag));

@@ -437,7 +437,7 @@ static PetscErrorCode SearchBonds(PeriSystem sys)
   PetscFunctionBeginUser;
   PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_TRUE, &d->bonds));
   /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
-  if (sys->model->ops.family_stiffness) PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_FALSE, &d->family));
+  if (PeriModelHasFamilies(sys->model)) PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_FALSE, &d->family));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
