@@ -32,6 +32,7 @@ typedef struct {
   PeriNode       unode;                      /* analysis.displacement, or NULL */
   PetscReal      displacement[3];            /* analysis.displacement.value, on the particles of region */
   PetscInt       pulse_axis;                 /* the pulse's axis */
+  PetscInt       pulse_dir;                  /* the axis it displaces along: pulse_axis (a longitudinal wave) or across it (a shear wave) */
   PeriAmplitude  amp;                        /* analysis.amplitude: of every load without one of its own */
   PetscInt       nloads;                     /* loads.<k> in the scene */
   PeriAmplitude *load_amp;                   /* loads.<k>.amplitude (shape step where absent) */
@@ -92,6 +93,7 @@ static const PeriKey dyn_pulse_keys[] = {
     {"center", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "its position along axis"},
     {"width", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "its width w"},
     {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the pulse lies and displaces: x, y or z"},
+    {"direction", PERI_KEY_STRING, "axis", NULL, NULL, NULL, "the displacement's direction x, y or z when not along axis: across it, a shear wave"},
     {"profile", PERI_KEY_CHOICE, "gaussian", NULL, NULL, dyn_profiles, "gaussian: amplitude exp(-((x - center)/width)^2); cosine: amplitude cos(pi (x - center)/width), a standing wave (with center 0 and width the bar's length, a free bar's lowest longitudinal mode)"},
     {NULL},
 };
@@ -220,10 +222,11 @@ static PetscErrorCode ReadLoadAmplitudes(Dynamic *d, PeriScene s)
 /* analysis.* before any particle exists. */
 static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNode a)
 {
-  Dynamic *d;
-  PeriNode p, amp;
-  PetscInt kind    = 0;
-  char     axis[8] = "x";
+  Dynamic  *d;
+  PeriNode  p, amp;
+  PetscInt  kind    = 0;
+  char      axis[8] = "x";
+  PetscBool found;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&d));
@@ -247,6 +250,9 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
     PetscCall(PeriSceneGetString(s, p, "axis", PETSC_FALSE, axis, sizeof(axis), NULL));
     PeriInputCheck(!strcmp(axis, "x") || !strcmp(axis, "y") || !strcmp(axis, "z"), s, p, "axis", "must be x, y or z, got '%s'", axis);
     d->pulse_axis = axis[0] - 'x';
+    PetscCall(PeriSceneGetString(s, p, "direction", PETSC_FALSE, axis, sizeof(axis), &found));
+    PeriInputCheck(!found || !strcmp(axis, "x") || !strcmp(axis, "y") || !strcmp(axis, "z"), s, p, "direction", "must be x, y or z, got '%s'", axis);
+    d->pulse_dir = found ? axis[0] - 'x' : d->pulse_axis;
     PetscCall(PeriSceneGetChoice(s, p, "profile", dyn_profiles, &d->profile, NULL));
   }
   PetscCall(ReadRegionValue(s, a, "velocity", &d->vnode, d->velocity));
@@ -269,7 +275,7 @@ static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
   PetscFunctionBeginUser;
   PeriInputCheck(!an->sys->conditions.layers.nfaces, s, s->root, "boundary_layers", "the fictitious layers carry static conditions; a dynamic analysis takes bc only");
   PeriInputCheck(!d->pulse || d->pulse_axis < an->sys->disc.particles.dim, s, s->root, "analysis.pulse.axis", "the body is %" PetscInt_FMT "D", an->sys->disc.particles.dim);
-  PeriInputCheck(!d->pulse || PeriModelTranslation(an->sys->model, d->pulse_axis) >= 0, s, s->root, "analysis.pulse.axis", "model %s does not translate along this axis", an->sys->model->type);
+  PeriInputCheck(!d->pulse || PeriModelTranslation(an->sys->model, d->pulse_dir) >= 0, s, s->root, d->pulse_dir == d->pulse_axis ? "analysis.pulse.axis" : "analysis.pulse.direction", "model %s does not translate along this axis", an->sys->model->type);
   PetscCall(PeriMassSetUp(an->sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -286,7 +292,7 @@ static PetscErrorCode RowSums(PeriAnalysis an, Vec rows)
 
   PetscFunctionBeginUser;
   if (an->sys->stiffness.op) {
-    PetscCall(PeriStiffnessRowSums(an->sys, rows));
+    PetscCall(PeriOperatorRowSums(an->sys, rows));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
@@ -370,7 +376,7 @@ static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
   PetscCall(VecSet(u, 0));
   if (d->initial_file[0]) PetscCall(PeriSystemReadDOFs(sys, d->initial_file, d->initial_array, d->initial_scale, u));
   if (d->pulse) {
-    const PetscInt c = PeriModelTranslation(sys->model, d->pulse_axis);
+    const PetscInt c = PeriModelTranslation(sys->model, d->pulse_dir);
     PetscCall(VecGetArray(u, &a));
     for (PetscInt i = 0; i < nloc; i++) {
       const PetscReal x = sys->disc.particles.x[3 * i + d->pulse_axis];
@@ -696,7 +702,7 @@ static PetscErrorCode PulsePosition(PeriAnalysis an, Vec q)
 {
   Dynamic           *d   = DYN(an);
   PeriSystem         sys = an->sys;
-  const PetscInt     bs = sys->model->dofs, c = PeriModelTranslation(sys->model, d->pulse_axis), nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
+  const PetscInt     bs = sys->model->dofs, c = PeriModelTranslation(sys->model, d->pulse_dir), nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
   const PetscScalar *u;
   PetscReal          umax = 0, sum[2] = {0, 0};
 

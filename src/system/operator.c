@@ -938,6 +938,97 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Ghost exchange of a ghosted vector: the ranks' partial sums to the owner, then back. */
+static PetscErrorCode GhostSum(Vec v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecGhostUpdateBegin(v, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateEnd(v, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateBegin(v, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGhostUpdateEnd(v, INSERT_VALUES, SCATTER_FORWARD));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The state term's share of the absolute row sums of K, from above: sum_q |A_q| |G_q,r| ||G_q||_1
+ * with G_q the gradient of theta_q (StateDiagonal). Adds to ya (ym's local form, reduced by the
+ * caller). Uses xm and theta as scratch. Collective. */
+static PetscErrorCode StateRowSums(PeriOperator op, PetscScalar *ya)
+{
+  const PetscInt bs = op->bs;
+  Vec            sl, tl;
+  PetscScalar   *S, *T;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGhostGetLocalForm(op->xm, &sl));
+  PetscCall(VecGhostGetLocalForm(op->theta, &tl));
+  PetscCall(VecSet(sl, 0));
+  PetscCall(VecSet(tl, 0));
+  PetscCall(VecGetArray(sl, &S));
+  PetscCall(VecGetArray(tl, &T));
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal *w = op->w + bs * b, pi = op->p[2 * b], pj = op->p[2 * b + 1];
+      const PetscInt   j = op->jl[b];
+      for (PetscInt d = 0; d < bs; d++) {
+        S[bs * i + d] -= pi * w[d];
+        S[bs * j + d] += pj * w[d];
+        T[i] += PetscAbsReal(pi * w[d]);
+        T[j] += PetscAbsReal(pj * w[d]);
+      }
+    }
+  PetscCall(VecRestoreArray(tl, &T));
+  PetscCall(VecRestoreArray(sl, &S));
+  PetscCall(GhostSum(op->xm));
+  PetscCall(GhostSum(op->theta));
+  PetscCall(VecGetArray(sl, &S));
+  PetscCall(VecGetArray(tl, &T));
+  for (PetscInt i = 0; i < op->nloc + op->nghost; i++) { /* T becomes |A| ||G||_1 */
+    for (PetscInt d = 0; d < bs; d++) T[i] += PetscAbsScalar(S[bs * i + d]);
+    T[i] *= PetscAbsReal(op->A[i]);
+  }
+  for (PetscInt i = 0; i < op->nloc; i++) {
+    for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += T[i] * PetscAbsScalar(S[bs * i + d]);
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal *w = op->w + bs * b;
+      const PetscInt   j = op->jl[b];
+      for (PetscInt d = 0; d < bs; d++) {
+        ya[bs * j + d] += T[i] * PetscAbsReal(op->p[2 * b] * w[d]);
+        ya[bs * i + d] += T[j] * PetscAbsReal(op->p[2 * b + 1] * w[d]);
+      }
+    }
+  }
+  PetscCall(VecRestoreArray(tl, &T));
+  PetscCall(VecRestoreArray(sl, &S));
+  PetscCall(VecGhostRestoreLocalForm(op->theta, &tl));
+  PetscCall(VecGhostRestoreLocalForm(op->xm, &sl));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriOperatorRowSums - the absolute row sums of a matrix-free K from above, for Gershgorin's bound:
+  the bonds' blocks (PeriStiffnessRowSums) and the state term's. Collective.
+@*/
+PetscErrorCode PeriOperatorRowSums(PeriSystem sys, Vec sums)
+{
+  PeriOperator op = sys->stiffness.op;
+  Vec          yl;
+  PetscScalar *ya;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriStiffnessRowSums(sys, sums));
+  if (!op->p) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecGhostGetLocalForm(op->ym, &yl));
+  PetscCall(VecSet(yl, 0));
+  PetscCall(VecGetArray(yl, &ya));
+  PetscCall(StateRowSums(op, ya));
+  PetscCall(VecRestoreArray(yl, &ya));
+  PetscCall(VecGhostRestoreLocalForm(op->ym, &yl));
+  PetscCall(VecGhostUpdateBegin(op->ym, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateEnd(op->ym, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecAXPY(sums, 1, op->ym));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The bytes the operator holds, all ranks. */
 PetscErrorCode PeriOperatorMemoryMB(PeriSystem sys, PeriOperator op, PetscReal *mb)
 {

@@ -99,6 +99,7 @@ PETSC_EXTERN PetscBool      PeriOperatorServesPC(const char[]);
 PETSC_EXTERN PetscBool      PeriOperatorPCWithoutMatrix(const char[]);
 PETSC_EXTERN PetscErrorCode PeriOperatorCreateMat(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriOperatorMatHeld(Mat, PetscReal *, PetscInt *, const PetscInt **);
+PETSC_EXTERN PetscErrorCode PeriOperatorRowSums(PeriSystem, Vec);
 PETSC_EXTERN PetscErrorCode PeriOperatorMemoryMB(PeriSystem, PeriOperator, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriOperatorScaleBond(PeriSystem, PetscInt, PetscInt, PetscReal, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriOperatorScaled(PeriSystem);
