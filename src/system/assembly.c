@@ -96,6 +96,7 @@ static void StateFamilyBlock(PeriModel m, PetscInt n, const PeriBondGeometry fam
     m->ops.bond_state(m, &fam[t], &G[(t + 1) * bs], gj);
     for (PetscInt c = 0; c < bs; c++) G[c] -= G[(t + 1) * bs + c];
   }
+  if (!Ke) return; /* the gradient only */
   for (PetscInt a = 0; a < N; a++)
     for (PetscInt c = 0; c < N; c++) Ke[a * N + c] = A * G[a] * G[c];
 }
@@ -477,6 +478,105 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, const BondFilter *f, Mat *K)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The rows of a family model's measures (the interaction terms as linear maps of the DOFs): one
+ * per owned particle, its state's gradient G_q (StateFamilyBlock), and one per live bond of an
+ * owned row, sqrt(k) n . (u_j - u_i) (the spring). K = B^T diag(A_q, 1) B. */
+static PetscErrorCode StateMeasures(PeriSystem sys, Mat *B, Vec *D)
+{
+  PeriModel         m  = sys->model;
+  const PeriBonds  *b  = &sys->disc.bonds;
+  const PetscInt    bs = m->dofs, nown = b->rend - b->rstart, nmax = PeriSystemMaxFamily(sys), *G = sys->disc.particles.global;
+  PetscInt          nrow = nown, row0, *dnz, *onz, *cols, r = 0;
+  PetscReal        *vals, *work, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PeriBondGeometry *fam, g;
+  PetscScalar      *d;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) nrow += b->live[k] && b->j[k] != i;
+  PetscCall(PetscMalloc2(nrow, &dnz, nrow, &onz));
+  PetscCall(PetscMalloc4(nmax, &fam, (nmax + 1) * bs, &cols, (nmax + 1) * bs, &vals, (nmax + 1) * bs, &work));
+  for (PetscInt i = b->rstart; i < b->rend; i++) { /* the state rows' columns, then the springs' */
+    PetscInt n;
+    PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
+    dnz[r] = bs;
+    for (PetscInt t = 0; t < n; t++) dnz[r] += fam[t].j < sys->disc.nowned ? bs : 0;
+    onz[r] = (n + 1) * bs - dnz[r];
+    r++;
+  }
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      if (b->live[k] && b->j[k] != i) {
+        dnz[r] = bs * (1 + (b->j[k] < sys->disc.nowned));
+        onz[r] = 2 * bs - dnz[r];
+        r++;
+      }
+  PetscCall(MatCreateAIJ(sys->comm, nrow, nown * bs, PETSC_DETERMINE, sys->disc.N * bs, 0, dnz, 0, onz, B));
+  PetscCall(MatSetBlockSizes(*B, 1, bs));
+  PetscCall(MatCreateVecs(*B, NULL, D));
+  PetscCall(MatGetOwnershipRange(*B, &row0, NULL));
+  PetscCall(VecGetArray(*D, &d));
+  r = row0;
+  for (PetscInt i = b->rstart; i < b->rend; i++, r++) {
+    PetscInt n;
+    PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
+    StateFamilyBlock(m, n, fam, vals, NULL);
+    for (PetscInt t = 0; t <= n; t++)
+      for (PetscInt c = 0; c < bs; c++) cols[t * bs + c] = G[t ? fam[t - 1].j : i] * bs + c;
+    PetscCall(MatSetValues(*B, 1, &r, (n + 1) * bs, cols, vals, ADD_VALUES)); /* periodic images repeat a column */
+    d[r - row0] = n ? m->ops.state_modulus(m, i) : 0;
+  }
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+      PetscReal kb = 0;
+      if (!b->live[k] || b->j[k] == i) continue;
+      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+      m->ops.bond_stiffness(m, &g, Ke);
+      for (PetscInt a = 0; a < bs; a++) kb += Ke[a * 2 * bs + a];
+      for (PetscInt c = 0; c < bs; c++) {
+        const PetscReal v = PetscSqrtReal(PetscMax(kb, 0)) * (c < m->dim ? g.xi[c] / g.length : 0);
+        cols[c]           = G[i] * bs + c;
+        cols[bs + c]      = G[g.j] * bs + c;
+        vals[c]           = -v;
+        vals[bs + c]      = v;
+      }
+      PetscCall(MatSetValues(*B, 1, &r, 2 * bs, cols, vals, ADD_VALUES));
+      d[r++ - row0] = 1;
+    }
+  PetscCall(VecRestoreArray(*D, &d));
+  PetscCall(MatAssemblyBegin(*B, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*B, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscFree4(fam, cols, vals, work));
+  PetscCall(PetscFree2(dnz, onz));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* K of a family model with states (ops.bond_state) as the sparse product B^T D B of its measures
+ * (StateMeasures): PETSc's sparse product finds the two-horizon pattern itself, where inserting
+ * every family's dense block took 15 s for 3,200 particles (13 times the product's time). AIJ,
+ * converted when the scene or -mat_type asks for another type. */
+static PetscErrorCode AssembleStates(PeriSystem sys, Mat *K)
+{
+  Mat       B, DB;
+  Vec       D;
+  char      type[PERI_NAME_LEN] = MATAIJ;
+  PetscBool set, aij;
+
+  PetscFunctionBeginUser;
+  PetscCall(StateMeasures(sys, &B, &D));
+  PetscCall(MatDuplicate(B, MAT_COPY_VALUES, &DB));
+  PetscCall(MatDiagonalScale(DB, D, NULL));
+  PetscCall(MatTransposeMatMult(B, DB, MAT_INITIAL_MATRIX, PETSC_DEFAULT, K));
+  PetscCall(MatDestroy(&B));
+  PetscCall(MatDestroy(&DB));
+  PetscCall(VecDestroy(&D));
+  if (sys->stiffness.mat_type[0]) PetscCall(PetscStrncpy(type, sys->stiffness.mat_type, sizeof(type)));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-mat_type", type, sizeof(type), &set));
+  PetscCall(PetscStrbeginswith(type, MATAIJ, &aij));
+  if (!aij) PetscCall(MatConvert(*K, type, MAT_INPLACE_MATRIX, K));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAssembleStiffness - assembles K = sum over live bonds of the model's bond blocks. The type is
   sys->stiffness.mat_type (BAIJ when unset) unless -mat_type says otherwise (sbaij stores the upper triangle
@@ -492,7 +592,9 @@ PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
-  if (PeriModelHasFamilies(sys->model))
+  if (sys->model->ops.bond_state)
+    PetscCall(AssembleStates(sys, K));
+  else if (sys->model->ops.family_stiffness)
     PetscCall(AssembleFamilies(sys, K));
   else
     PetscCall(AssembleBonds(sys, &all, K));
