@@ -10,7 +10,9 @@ Evaluates on the dump's lattice, with its displacement field:
              small-displacement code (perilin) computes;
 and prints the largest difference of each from the dump's theta and (fx, fy, fz), relative to
 the largest |theta| and the largest |f| of the dump. The nonlinear form should agree to
-roundoff (~1e-9 or better), the linear one to O(strain). Needs numpy (Debian's python3-numpy).
+roundoff (~1e-8, set by the absolute coordinates LAMMPS stores), the linear one to O(strain)
+(about 1.4 times the largest displacement gradient). With --pe (LAMMPS's thermo pe of the run)
+it also prints the energy sums that pe is compared with. Needs numpy (Debian's python3-numpy).
 """
 
 import argparse
@@ -77,7 +79,10 @@ def lps(X, U, a, delta, K, G, V, linear):
         bonds.append((s, d, r0, vfs, w, e, M))
     theta = 3.0 * tsum / m
     f = np.zeros(shape + (3,))
+    wdev = np.zeros(shape)
     for (s, d, r0, vfs, w, e, M) in bonds:
+        ed = e - theta[s] * r0 / 3.0
+        wdev[s] += 15.0 * G / (2.0 * m[s]) * w * ed * ed * V * vfs
         mi = m[s]
         mj = m[d]
         ti = theta[s]
@@ -85,7 +90,8 @@ def lps(X, U, a, delta, K, G, V, linear):
         # t[x_i]<xi> - t[x_j]<-xi>, both along M, with w(xi) = w(-xi)
         mag = V * vfs * w * ((3 * K - 5 * G) * (ti / mi + tj / mj) * r0 + 15 * G * (1 / mi + 1 / mj) * e)
         f[s] += mag[..., None] * M
-    return theta, f, m
+    # LPS strain energy density W_i = K theta^2 / 2 + (15 G / 2 m) sum w (e^d)^2 V vfs
+    return theta, f, m, 0.5 * K * theta * theta, wdev
 
 
 def main():
@@ -95,6 +101,7 @@ def main():
     p.add_argument("--nu", type=float, default=0.3)
     p.add_argument("--a", type=float, default=1e-3)
     p.add_argument("--m", type=float, default=3.015, help="horizon / a")
+    p.add_argument("--pe", type=float, help="LAMMPS's thermo pe of the same run, to compare")
     args = p.parse_args()
     d = read_dump(args.dump)
     a = args.a
@@ -119,15 +126,23 @@ def main():
     print("lattice %s, a = %g, delta = %g a, K = %.6g, G = %.6g, max |u| = %.3g m" %
           (shape, a, args.m, K, G, np.abs(U).max()))
     for linear in (False, True):
-        theta, f, m = lps(X, U, a, delta, K, G, V, linear)
+        theta, f, m, wvol, wdev = lps(X, U, a, delta, K, G, V, linear)
+        if not linear:
+            wv, wd = wvol.sum(), wdev.sum()
         dt = np.abs(theta - T).max() / np.abs(T).max()
         df = np.abs(f - F).max() / np.abs(F).max()
         print("  %-9s max |theta - lammps| / max |theta| = %.3e,  max |f - lammps| / max |f| = %.3e"
               % ("linear" if linear else "nonlinear", dt, df))
     interior = tuple(np.array(shape) // 2)
-    print("  m at an interior site = %.12g m^4 (%.12g a^4); at the corner = %.12g a^4" %
-          (m[interior], m[interior] / a ** 4, m[0, 0, 0] / a ** 4))
+    print("  m at the centre site %s = %.12g a^4; at the corner = %.12g a^4 (m in m^4; the full"
+          " family of 122 bonds, delta = 3.015a: 230.933410618 a^4)" %
+          (interior, m[interior] / a ** 4, m[0, 0, 0] / a ** 4))
     print("  max |f| = %.6g N/m^3, max |theta| = %.6g" % (np.abs(F).max(), np.abs(T).max()))
+    print("  sum_i W_i (LPS energy densities, J/m^3) = %.12g = %.12g (dilatational) + %.12g "
+          "(deviatoric); sum_i W_i V_i = %.6g J" % (wv + wd, wv, wd, (wv + wd) * V))
+    print("  sum of the dilatational part and half the deviatoric part = %.12g" % (wv + 0.5 * wd))
+    if args.pe is not None:
+        print("  LAMMPS pe = %.12g" % args.pe)
 
 
 if __name__ == "__main__":
