@@ -235,7 +235,16 @@ def main():
         workdir = args.keep
     else:
         workdir = tempfile.mkdtemp(prefix="ccx_free_bar_")
-    out = {"problem": {"box_m": [args.lx, args.ly, args.lz], "E_Pa": args.E, "rho_kg_m3": args.rho,
+    try:
+        ver = subprocess.run([args.ccx, "-v"], capture_output=True, text=True).stdout
+        ver = " ".join(ver.split())
+    except OSError:
+        ver = "?"
+    out = {"command": " ".join(["tests/reference/ccx_free_bar.py"] + sys.argv[1:]),
+           "ccx_version": ver,
+           "note": "rigid-body modes (6) dropped; frequencies in Hz as ccx prints them (7 digits); "
+                   "the finest mesh's values per nu, with the refinement history",
+           "problem": {"box_m": [args.lx, args.ly, args.lz], "E_Pa": args.E, "rho_kg_m3": args.rho,
                        "supports": "none (free-free)", "element": args.element,
                        "solver": "CalculiX ccx *FREQUENCY"},
            "tolerance": args.tol, "cases": {}}
@@ -255,7 +264,7 @@ def main():
                 history.append(r)
                 print("  mesh %dx%dx%d (%d nodes, %d dofs, %.1f s): max |rigid| %.3g Hz (signed sqrt of the eigenvalue / 2 pi)" %
                       (nx, ny, nz, r["nodes"], r["dofs"], r["wall_s"], max(map(abs, r["rigid_hz"]))))
-                print("    Hz: " + " ".join("%.6g" % v for v in f))
+                print("    Hz: " + " ".join("%.7g" % v for v in f))
                 if change is not None:
                     print("    max relative change from the previous mesh: %.3e" % change)
                 prev = f
@@ -264,7 +273,7 @@ def main():
             fin = history[-1]
             print("  lowest %d elastic modes on mesh %s:" % (args.nprint, "x".join(map(str, fin["mesh"]))))
             for m in range(args.nprint):
-                print("    %2d  %12.6g Hz  %s" % (m + 1, fin["freq_hz"][m], fin["types"][m]))
+                print("    %2d  %12.7g Hz  %s" % (m + 1, fin["freq_hz"][m], fin["types"][m]))
             out["cases"]["%g" % nu] = {
                 "nu": nu,
                 "mesh": fin["mesh"],
