@@ -282,33 +282,6 @@ static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
 
 /* omega_max^2 of M^-1 K from above (Gershgorin: every eigenvalue of M^-1 K lies within
  * max_i sum_j |K_ij| / m_i), and the explicit step's limit 2/omega_max. Collective. */
-/* Sum over c of |K_rc| for each owned row: from K's assembled rows (exact), or from the bonds'
- * blocks for a matrix-free K (an upper bound where a pair has several periodic images). */
-static PetscErrorCode RowSums(PeriAnalysis an, Vec rows)
-{
-  Mat          K = an->sys->stiffness.K;
-  PetscInt     rstart, rend;
-  PetscScalar *ra;
-
-  PetscFunctionBeginUser;
-  if (an->sys->stiffness.op) {
-    PetscCall(PeriOperatorRowSums(an->sys, rows));
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
-  PetscCall(VecGetArray(rows, &ra));
-  for (PetscInt r = rstart; r < rend; r++) {
-    const PetscScalar *v;
-    PetscInt           nc;
-    ra[r - rstart] = 0;
-    PetscCall(MatGetRow(K, r, &nc, NULL, &v));
-    for (PetscInt k = 0; k < nc; k++) ra[r - rstart] += PetscAbsScalar(v[k]);
-    PetscCall(MatRestoreRow(K, r, &nc, NULL, &v));
-  }
-  PetscCall(VecRestoreArray(rows, &ra));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 static PetscErrorCode StabilityBound(PeriAnalysis an)
 {
   Dynamic           *d = DYN(an);
@@ -320,7 +293,7 @@ static PetscErrorCode StabilityBound(PeriAnalysis an)
   PetscFunctionBeginUser;
   PetscCall(PeriMassGetDiagonal(an->sys, &m));
   PetscCall(VecDuplicate(m, &rows));
-  PetscCall(RowSums(an, rows));
+  PetscCall(PeriSystemStiffnessRowSums(an->sys, rows));
   PetscCall(VecGetLocalSize(m, &n));
   PetscCall(VecGetArrayRead(m, &ma));
   PetscCall(VecGetArrayRead(rows, &ra));
@@ -458,7 +431,7 @@ static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
 
   PetscFunctionBeginUser;
   (void)ts;
-  PetscCall(MatMult(an->sys->stiffness.K, q, dp));
+  PetscCall(PeriSystemInternalForce(an->sys, q, dp));
   PetscCall(LoadAt(an, t, 1, -1, dp));
   PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -495,7 +468,7 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
   (void)ts;
   (void)V;
   PetscCall(PeriMassGetDiagonal(sys, &m));
-  PetscCall(MatMult(sys->stiffness.K, U, F));
+  PetscCall(PeriSystemInternalForce(sys, U, F));
   PetscCall(VecPointwiseMult(DYN(an)->tmp, m, A));
   PetscCall(VecAXPY(F, 1, DYN(an)->tmp));
   PetscCall(LoadAt(an, t, -1, 1, F));
@@ -519,11 +492,13 @@ static PetscErrorCode I2Jacobian(TS ts, PetscReal t, Vec U, Vec V, Vec A, PetscR
   PeriAnalysis an  = (PeriAnalysis)ctx;
   PeriSystem   sys = an->sys;
   Vec          m;
+  Mat          K;
 
   PetscFunctionBeginUser;
   (void)ts, (void)t, (void)U, (void)V, (void)A, (void)shiftV, (void)J;
   PetscCall(PeriMassGetDiagonal(sys, &m));
-  PetscCall(MatCopy(sys->stiffness.K, P, SAME_NONZERO_PATTERN));
+  PetscCall(PeriSystemGetJacobian(sys, &K));
+  PetscCall(MatCopy(K, P, SAME_NONZERO_PATTERN));
   PetscCall(VecCopy(m, DYN(an)->tmp));
   PetscCall(VecScale(DYN(an)->tmp, shiftA));
   PetscCall(MatDiagonalSet(P, DYN(an)->tmp, ADD_VALUES));
@@ -565,7 +540,7 @@ static PetscErrorCode StrainEnergy(PeriAnalysis an, Vec q, PetscReal *E)
   PetscScalar e;
 
   PetscFunctionBeginUser;
-  PetscCall(MatMult(an->sys->stiffness.K, q, DYN(an)->tmp));
+  PetscCall(PeriSystemInternalForce(an->sys, q, DYN(an)->tmp));
   PetscCall(VecDot(q, DYN(an)->tmp, &e));
   *E = 0.5 * PetscRealPart(e);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -844,13 +819,15 @@ static PetscErrorCode CreateImplicit(PeriAnalysis an, Vec *U, Vec *V)
   SNES     snes;
   KSP      ksp;
   PC       pc;
+  Mat      K;
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(an->sys->fields.u, U));
   PetscCall(VecDuplicate(an->sys->fields.u, V));
   PetscCall(InitialDisplacement(an, *U));
   PetscCall(InitialVelocity(an, *V));
-  PetscCall(MatDuplicate(an->sys->stiffness.K, MAT_COPY_VALUES, &d->J));
+  PetscCall(PeriSystemGetJacobian(an->sys, &K));
+  PetscCall(MatDuplicate(K, MAT_COPY_VALUES, &d->J));
   PetscCall(PeriSetNearNullSpace(an->sys, d->J, NULL));
   PetscCall(TSSetType(d->ts, TSALPHA2));
   PetscCall(TSAlpha2SetRadius(d->ts, d->rho_inf));
@@ -1027,6 +1004,7 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
 {
   Dynamic       *d = DYN(an);
   Vec            U = NULL, V = NULL, q, p;
+  Mat            K;
   PetscLogDouble t0, t1;
   PetscReal      t;
 
@@ -1039,7 +1017,7 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   else
     PetscCall(PetscStrncpy(an->sys->stiffness.mat_type, MATBAIJ, sizeof(an->sys->stiffness.mat_type)));
   PetscCall(ChooseOperator(an));
-  if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(PeriSystemGetJacobian(an->sys, &K));
   PetscCall(PetscTime(&t0));
   PetscCall(StabilityBound(an));
   ChooseStep(d);

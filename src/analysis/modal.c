@@ -746,11 +746,12 @@ static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
 {
   ModalWork      w;
   PetscErrorCode ierr;
+  Mat            K;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrncpy(an->sys->stiffness.mat_type, MATAIJ, sizeof(an->sys->stiffness.mat_type)));
   PetscCall(ChooseEigensolver(an));
-  if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(PeriSystemGetJacobian(an->sys, &K));
   PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   /* a failed check may return from deep inside SLEPc: free everything, then pass the error on */

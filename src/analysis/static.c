@@ -13,6 +13,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   KSPConvergedReason reason;
   PetscLogDouble     t0, t1;
   PetscBool          released = PETSC_FALSE;
+  Mat                K;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Allreduce(&an->sys->conditions.nconstrained, &nc, 1, MPIU_INT, MPI_SUM, an->comm));
@@ -32,7 +33,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(PeriStaticDefaultMatType(an->sys->stiffness.mat_type, sizeof(an->sys->stiffness.mat_type)));
-  if (!an->sys->stiffness.K) PetscCall(PeriSystemAssemble(an->sys));
+  PetscCall(PeriSystemGetJacobian(an->sys, &K));
   PetscCall(PetscTime(&t0));
   PetscCall(VecDestroy(&an->sys->fields.u));
   {

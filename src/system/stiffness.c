@@ -182,6 +182,64 @@ PetscErrorCode PeriStiffnessScaled(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriSystemGetJacobian - the linearized operator of the system's interaction terms (bonds,
+  states): K, assembled or matrix-free as the scene and the analysis ask, built on first use. The
+  analyses solve and multiply with it, never with the terms' data. Collective on first use.
+@*/
+PetscErrorCode PeriSystemGetJacobian(PeriSystem sys, Mat *K)
+{
+  PetscFunctionBeginUser;
+  if (!sys->stiffness.K) PetscCall(PeriSystemAssemble(sys));
+  *K = sys->stiffness.K;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemInternalForce - f = K u, the force the interaction terms exert at the displacements u
+  (the linear models: their Jacobian times u; a term that is not linear, such as contact, adds
+  its own here). Collective.
+@*/
+PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
+{
+  Mat K;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemGetJacobian(sys, &K));
+  PetscCall(MatMult(K, u, f));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemStiffnessRowSums - the absolute row sums of K (Gershgorin's bound): from the rows of
+  an assembled K (exact), or from the terms of a matrix-free one (from above). Collective.
+@*/
+PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem sys, Vec rows)
+{
+  Mat          K;
+  PetscInt     rstart, rend;
+  PetscScalar *ra;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemGetJacobian(sys, &K));
+  if (sys->stiffness.op) {
+    PetscCall(PeriOperatorRowSums(sys, rows));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
+  PetscCall(VecGetArray(rows, &ra));
+  for (PetscInt r = rstart; r < rend; r++) {
+    const PetscScalar *v;
+    PetscInt           nc;
+    ra[r - rstart] = 0;
+    PetscCall(MatGetRow(K, r, &nc, NULL, &v));
+    for (PetscInt k = 0; k < nc; k++) ra[r - rstart] += PetscAbsScalar(v[k]);
+    PetscCall(MatRestoreRow(K, r, &nc, NULL, &v));
+  }
+  PetscCall(VecRestoreArray(rows, &ra));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Frees K, its preconditioning matrix and the matrix-free operator. */
 PetscErrorCode PeriStiffnessDestroy(PeriStiffness *S)
 {

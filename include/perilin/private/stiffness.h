@@ -82,6 +82,9 @@ typedef struct {
 } PeriStiffness;
 
 PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemGetJacobian(PeriSystem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriSystemInternalForce(PeriSystem, Vec, Vec);
+PETSC_EXTERN PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem, Vec);
 PETSC_EXTERN const char    *PeriMatrixFreeWhyNot(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriBondStiffness(PeriSystem, PetscInt, PetscInt, PetscReal, PeriBondGeometry *, PetscReal[]);
