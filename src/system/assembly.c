@@ -112,11 +112,13 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
   PeriElement       el;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc5(nmax, &fam, PetscSqr((nmax + 1) * bs), &Ke, 2 * (nmax + 1) * bs, &work, nmax + 1, &idx, nmax + 1, &gidx));
+  /* a rank-one block (states) keeps its gradient G in Ke, not the dense block */
+  PetscCall(PetscMalloc5(nmax, &fam, m->ops.bond_state ? (nmax + 1) * bs : PetscSqr((nmax + 1) * bs), &Ke, 2 * (nmax + 1) * bs, &work, nmax + 1, &idx, nmax + 1, &gidx));
   el.idx    = idx;
   el.gidx   = gidx;
   el.nshare = 1;
   el.K      = Ke;
+  el.G      = NULL;
   el.g      = fam;
   el.work   = work;
   for (PetscInt i = sys->disc.family.rstart; i < sys->disc.family.rend; i++) {
@@ -124,8 +126,12 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
     PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
     if (m->ops.family_stiffness)
       PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
-    else
-      StateFamilyBlock(m, n, fam, work, Ke);
+    else {
+      StateFamilyBlock(m, n, fam, Ke, NULL);
+      el.K = NULL;
+      el.G = Ke;
+      el.A = n ? m->ops.state_modulus(m, i) : 0;
+    }
     idx[0] = i;
     for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
     for (PetscInt t = 0; t <= n; t++) gidx[t] = sys->disc.particles.global[idx[t]];
@@ -145,7 +151,7 @@ static PetscErrorCode BondsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], work[4 * PERI_MAX_DOF];
   PetscInt         idx[2], gidx[2];
   PeriBondGeometry g;
-  PeriElement      el = {2, idx, gidx, 2, Ke, &g, work};
+  PeriElement      el = {2, idx, gidx, 2, Ke, NULL, 0, &g, work};
 
   PetscFunctionBeginUser;
   for (PetscInt i = b->rstart; i < b->rend; i++)
@@ -171,10 +177,29 @@ void PeriElementForces(PeriSystem sys, const PeriElement *el, const PetscScalar 
   PetscReal     *ue = el->work, *f = el->work + N;
   for (PetscInt t = 0; t < el->n; t++)
     for (PetscInt c = 0; c < bs; c++) ue[t * bs + c] = PetscRealPart(u[el->idx[t] * bs + c]);
+  if (el->G) { /* A G (G . u_e): O(N), not O(N^2) */
+    PetscReal s = 0;
+    for (PetscInt c = 0; c < N; c++) s += el->G[c] * ue[c];
+    for (PetscInt a = 0; a < N; a++) f[a] = el->A * s * el->G[a];
+    return;
+  }
   for (PetscInt a = 0; a < N; a++) {
     f[a] = 0;
     for (PetscInt c = 0; c < N; c++) f[a] += el->K[a * N + c] * ue[c];
   }
+}
+
+/* An element's energy u_e^T K_e u_e / 2 over its N DOFs ue. */
+PetscReal PeriElementEnergy(const PeriElement *el, PetscInt N, const PetscReal ue[])
+{
+  PetscReal e = 0;
+  if (el->G) {
+    for (PetscInt c = 0; c < N; c++) e += el->G[c] * ue[c];
+    return 0.5 * el->A * e * e;
+  }
+  for (PetscInt a = 0; a < N; a++)
+    for (PetscInt c = 0; c < N; c++) e += 0.5 * ue[a] * el->K[a * N + c] * ue[c];
+  return e;
 }
 
 /*@C

@@ -160,8 +160,7 @@ static PetscErrorCode ElementEnergy(PeriSystem sys, const PeriElement *el, void 
   PetscFunctionBeginUser;
   for (PetscInt c = 0; c < bs; c++)
     for (PetscInt t = 0; t < el->n; t++) ue[t * bs + c] = PetscRealPart(E->u[el->idx[t] * bs + c]);
-  for (PetscInt a = 0; a < N; a++)
-    for (PetscInt c = 0; c < N; c++) e += 0.5 * ue[a] * el->K[a * N + c] * ue[c];
+  e     = PeriElementEnergy(el, N, ue);
   share = e / el->nshare;
   for (PetscInt t = 0; t < el->nshare; t++) {
     PetscInt p = el->idx[t];

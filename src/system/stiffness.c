@@ -202,7 +202,7 @@ PetscErrorCode PeriSystemGetJacobian(PeriSystem sys, Mat *K)
 @*/
 PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
 {
-  Mat K;
+  Mat K = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemGetJacobian(sys, &K));
@@ -216,7 +216,7 @@ PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
 @*/
 PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem sys, Vec rows)
 {
-  Mat          K;
+  Mat          K = NULL;
   PetscInt     rstart, rend;
   PetscScalar *ra;
 

@@ -112,13 +112,16 @@ typedef struct {
   const PetscInt         *idx;    /* their local indices (the local view), the bond's or family's particle i first */
   const PetscInt         *gidx;   /* their global indices (matrix and vector rows) */
   PetscInt                nshare; /* idx[0..nshare-1] share its energy equally: a bond's 2 ends, a family's i */
-  const PetscReal        *K;      /* the ((n dofs)^2) stiffness block, row-major, DOFs in the order of idx */
-  const PeriBondGeometry *g;      /* the bond's geometry, or the family's n - 1 bonds */
-  PetscReal              *work;   /* scratch of 2 n dofs reals for the callback */
+  const PetscReal        *K;      /* the ((n dofs)^2) stiffness block, row-major, DOFs in the order of idx; NULL for a rank-one block: */
+  const PetscReal        *G;      /* K = A G G^T (a state's gradient over the family: ops.bond_state), else NULL */
+  PetscReal               A;
+  const PeriBondGeometry *g;    /* the bond's geometry, or the family's n - 1 bonds */
+  PetscReal              *work; /* scratch of 2 n dofs reals for the callback */
 } PeriElement;
 typedef PetscErrorCode (*PeriElementFn)(PeriSystem, const PeriElement *, void *);
 PETSC_EXTERN PetscErrorCode PeriElementsForEach(PeriSystem, PeriElementFn, void *);
 PETSC_EXTERN void           PeriElementForces(PeriSystem, const PeriElement *, const PetscScalar[]);
+PETSC_EXTERN PetscReal      PeriElementEnergy(const PeriElement *, PetscInt, const PetscReal[]);
 
 /* the matrix-free operator (src/system/operator.c) */
 
