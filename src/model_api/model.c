@@ -90,7 +90,7 @@ PetscErrorCode PeriModelCreate(const char type[], PetscInt dim, PetscBool plane_
  * "allowed here". */
 static const PeriKey material_keys[] = {
     {"E", PERI_KEY_REAL, NULL, "(0, inf)", "[stress]", NULL, "Young's modulus; give exactly one of E, K and mu"},
-    {"nu", PERI_KEY_REAL, "the model's fixed value", NULL, NULL, NULL, "Poisson ratio: pmb/npmb only 1/3 (plane stress) or 1/4 (plane strain, 3D); pds/mppd/gerstle in (-1, 1/2)"},
+    {"nu", PERI_KEY_REAL, "the model's fixed value", NULL, NULL, NULL, "Poisson ratio: pmb/npmb only 1/3 (plane stress) or 1/4 (plane strain, 3D); pds/mppd/gerstle (2D) and lps (2D, 3D) in (-1, 1/2)"},
     {"K", PERI_KEY_REAL, NULL, "(0, inf)", "[stress]", NULL, "3D bulk modulus, instead of E: E = 3 K (1 - 2 nu)"},
     {"mu", PERI_KEY_REAL, NULL, "(0, inf)", "[stress]", NULL, "shear modulus, instead of E: E = 2 mu (1 + nu) (the cross-section models need only mu)"},
     {"rho", PERI_KEY_REAL, "0", "[0, inf)", "[mass/volume]", NULL, "density; the modal analysis requires > 0"},
