@@ -221,6 +221,7 @@ static PyObject *Layout(PyObject *self, PyObject *args)
   Py_DECREF(ok);
   if (!(names = PyTuple_New(dofs))) return NULL;
   for (PetscInt c = 0; c < dofs; c++) PyTuple_SET_ITEM(names, c, PyUnicode_FromString(components[c]));
+  if (!nowned) x = (const PetscReal *)""; /* y# makes NULL None */
   return Py_BuildValue("(nnNnnny#)", (Py_ssize_t)dim, (Py_ssize_t)dofs, names, (Py_ssize_t)N, (Py_ssize_t)rstart, (Py_ssize_t)nowned, (const char *)x, (Py_ssize_t)(3 * nowned * sizeof(PetscReal)));
 }
 
@@ -264,6 +265,7 @@ static PyObject *Constraints(PyObject *self, PyObject *args)
   Begin();
   if (!(ok = End(PeriProblemGetConstraints(p, &n, &rows, &values)))) return NULL;
   Py_DECREF(ok);
+  if (!n) return Py_BuildValue("(y#y#n)", "", (Py_ssize_t)0, "", (Py_ssize_t)0, (Py_ssize_t)sizeof(PetscInt)); /* y# makes NULL None */
   return Py_BuildValue("(y#y#n)", (const char *)rows, (Py_ssize_t)(n * sizeof(PetscInt)), (const char *)values, (Py_ssize_t)(n * sizeof(PetscReal)), (Py_ssize_t)sizeof(PetscInt));
 }
 
