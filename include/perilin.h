@@ -9,7 +9,7 @@
  * include/perilin/private/. */
 #pragma once
 
-#include <petscsys.h>
+#include <petscmat.h>
 
 #if PETSC_VERSION_LT(3, 19, 0)
 #  define PETSC_SUCCESS 0
@@ -45,3 +45,17 @@ PETSC_EXTERN PetscErrorCode PeriProblemReport(PeriProblem);
 /* The signal (SIGINT, SIGTERM) that stopped the run early, or 0: the result is incomplete. */
 PETSC_EXTERN PetscErrorCode PeriProblemInterrupted(PeriProblem, int *);
 PETSC_EXTERN PetscErrorCode PeriProblemDestroy(PeriProblem *);
+
+/* Embedding (src/embed.c): perilin in another program's PETSc session, as the Python module
+ * (python/perilin_ext.c, docs/python.md) runs it. */
+PETSC_EXTERN PetscErrorCode PeriInitializeEmbedded(void);
+PETSC_EXTERN PetscErrorCode PeriProblemLoadOverrides(PeriProblem, const char[], PetscInt, const char *const[], const char *const[]);
+PETSC_EXTERN PetscErrorCode PeriProblemSetOutputDir(PeriProblem, const char[]);
+PETSC_EXTERN PetscErrorCode PeriProblemGetStiffness(PeriProblem, Mat *);
+PETSC_EXTERN PetscErrorCode PeriProblemGetLoads(PeriProblem, Vec *);
+PETSC_EXTERN PetscErrorCode PeriProblemGetMass(PeriProblem, Vec *);
+PETSC_EXTERN PetscErrorCode PeriProblemGetSolution(PeriProblem, Vec *, PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriProblemGetConstraints(PeriProblem, PetscInt *, const PetscInt *[], const PetscReal *[]);
+PETSC_EXTERN PetscErrorCode PeriProblemGetLayout(PeriProblem, PetscInt *, PetscInt *, const char *const **, PetscInt *, PetscInt *, PetscInt *, const PetscReal *[]);
+PETSC_EXTERN PetscErrorCode PeriProblemGetSummary(PeriProblem, char **);
+PETSC_EXTERN PetscErrorCode PeriProblemGetScene(PeriProblem, char **);

@@ -1,0 +1,229 @@
+"""perilin in-process: a scene as a Problem, its solution as numpy arrays, its operators as
+petsc4py objects (docs/python.md).
+
+    import perilin
+    p = perilin.Problem("examples/pmb/plate_traction.yaml", {"material.E": 2e9})
+    r = p.solve()            # r.x, r.u: particles x dim numpy arrays; r.summary: summary.json
+    K, f = p.stiffness(), p.rhs()
+
+PETSc and SLEPc are started by petsc4py and slepc4py (import them first to pass your own options:
+petsc4py.init(sys.argv)); perilin's input errors are raised as perilin.Error with the message the
+command line prints.
+"""
+import json
+import os
+import tempfile
+
+import numpy as np
+import petsc4py
+from petsc4py import PETSc
+import slepc4py
+from slepc4py import SLEPc  # noqa: F401 (starts SLEPc, which perilin's modal analysis uses)
+
+from . import _perilin
+from ._perilin import Error
+
+_perilin.initialize()
+__version__, petsc_version, slepc_version = _perilin.versions()
+
+__all__ = ["Problem", "Result", "Error", "__version__"]
+
+
+def _text(value):
+    """A Python value as the command line gives it (-material_E 2e9, -grid_upper 1,0.5)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return ",".join(_text(v) for v in value)
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    return str(value)
+
+
+def _typed(value):
+    """A scalar of the resolved scene as a number where it reads as one."""
+    if isinstance(value, str):
+        for kind in (int, float):
+            try:
+                return kind(value)
+            except ValueError:
+                pass
+    if isinstance(value, list):
+        return [_typed(v) for v in value]
+    if isinstance(value, dict):
+        return {k: _typed(v) for k, v in value.items()}
+    return value
+
+
+def _petsc_comm(comm):
+    if comm is None:
+        return PETSc.COMM_WORLD
+    if isinstance(comm, PETSc.Comm):
+        return comm
+    return PETSc.Comm(comm)  # an mpi4py communicator
+
+
+class Result:
+    """One solution: x (positions) and u (the DOFs, ux uy [uz] or the model's components) as
+    particles x dim and particles x dofs numpy arrays in the global particle order (the order of
+    particles.vtu; on several ranks, the pieces of particles.pvtu one after the other), on every
+    rank; components names u's columns; summary is the dict summary.json holds."""
+
+    def __init__(self, x, u, components, summary):
+        self.x, self.u, self.components, self.summary = x, u, components, summary
+
+    def __repr__(self):
+        return "perilin.Result(%d particles, components %s)" % (len(self.x), ", ".join(self.components))
+
+
+class Problem:
+    """A scene set up in this process: particles, bonds, model, conditions (perilin's set-up).
+
+    scene: a scene file, or a dict with the same schema (written to a temporary file; give paths in
+    it absolute). overrides: {'dotted.key': value}, as the command line's -dotted_key value.
+    comm: a petsc4py or mpi4py communicator (default PETSc.COMM_WORLD)."""
+
+    def __init__(self, scene, overrides=None, comm=None):
+        self._handle = None
+        self._tmp = None
+        self._result = None
+        self.comm = _petsc_comm(comm)
+        if isinstance(scene, dict):
+            fd, self._tmp = tempfile.mkstemp(prefix="perilin-scene-", suffix=".yaml")
+            with os.fdopen(fd, "w") as out:
+                json.dump(scene, out, indent=1)  # JSON is YAML: one key a line, for the messages
+            self.file = self._tmp
+        else:
+            self.file = os.path.abspath(os.fspath(scene))
+        self._overrides = dict(overrides or {})
+        try:
+            self._handle = self._build(self._overrides)
+        except BaseException:
+            self._remove_tmp()
+            raise
+
+    def _build(self, overrides):
+        keys = list(overrides)
+        return _perilin.create(self.file, keys, [_text(overrides[k]) for k in keys], self.comm)
+
+    def _remove_tmp(self):
+        if self._tmp:
+            try:
+                os.unlink(self._tmp)
+            except OSError:
+                pass
+            self._tmp = None
+
+    def close(self):
+        """Frees the problem (collective); the object is unusable after it."""
+        if self._handle is not None:
+            _perilin.destroy(self._handle)
+            self._handle = None
+        self._remove_tmp()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __del__(self):
+        try:
+            self._remove_tmp()
+        except Exception:
+            pass
+
+    @property
+    def overrides(self):
+        """The overrides in force (a copy)."""
+        return dict(self._overrides)
+
+    # scene keys
+    def scene(self):
+        """The resolved scene (what scene.yaml holds: every key read, with its value) as a dict."""
+        import yaml
+
+        return _typed(yaml.safe_load(_perilin.scene(self._handle)))
+
+    def get(self, key):
+        """The value the problem uses for the dotted key ('material.E', 'bc.0.region')."""
+        node = self.scene()
+        for part in key.split("."):
+            if isinstance(node, list) and part.isdigit() and int(part) < len(node):
+                node = node[int(part)]
+            elif isinstance(node, dict) and part in node:
+                node = node[part]
+            else:
+                raise Error("%s: no such key in the resolved scene of %s (docs/scene.md lists the keys)" % (key, self.file))
+        return node
+
+    def set(self, key, value):
+        """Sets the dotted key to value. At present the problem is set up again from the scene with
+        every override (particles and bonds included; docs/python.md); on an error the problem
+        stays as it was."""
+        overrides = dict(self._overrides)
+        overrides[key] = value
+        handle = self._build(overrides)
+        _perilin.destroy(self._handle)
+        self._handle, self._overrides, self._result = handle, overrides, None
+
+    # the run
+    def solve(self):
+        """Runs the scene's analysis (analysis.type) once and returns its Result (the same Result
+        again until a set())."""
+        if self._result is None:
+            _perilin.run(self._handle)
+            self._result = self._gather_result()
+        return self._result
+
+    run = solve
+
+    def _gather(self, local):
+        if self.comm.getSize() == 1:
+            return local
+        return np.concatenate(self.comm.tompi4py().allgather(local))
+
+    def _gather_result(self):
+        dim, dofs, components, n, rstart, nowned, xb = _perilin.layout(self._handle)
+        x = np.frombuffer(xb, dtype=np.float64).reshape(nowned, 3)[:, :dim].copy()
+        ub = _perilin.solution(self._handle)
+        u = None
+        if ub is not None:
+            u = np.frombuffer(ub, dtype=np.float64).reshape(-1, dofs).copy()
+            u = self._gather(u)
+        summary = json.loads(_perilin.summary(self._handle))
+        return Result(self._gather(x), u, components, summary)
+
+    def write(self, directory):
+        """The usual output set (summary.json, scene.yaml, particles.vtu, the analysis' files) in
+        directory, replaced as a whole. Collective."""
+        _perilin.write(self._handle, os.path.abspath(os.fspath(directory)))
+
+    # the operators
+    def stiffness(self):
+        """A new assembled stiffness K (petsc4py Mat) of the body, every DOF (particle-major: DOF d
+        of particle i is row i*dofs + d), before the conditions are applied."""
+        return _perilin.stiffness(self._handle)
+
+    def rhs(self):
+        """A new petsc4py Vec with the scene's loads f (load factor 1), in K's layout."""
+        return _perilin.loads(self._handle)
+
+    def mass(self):
+        """A new petsc4py Vec with the lumped mass per DOF (the diagonal of M), in K's layout."""
+        return _perilin.mass(self._handle)
+
+    def constraints(self):
+        """The prescribed DOFs (rows of K, sorted) and their values, as numpy arrays on every rank."""
+        rows, values, isize = _perilin.constraints(self._handle)
+        r = np.frombuffer(rows, dtype=np.int64 if isize == 8 else np.int32).astype(np.int64)
+        v = np.frombuffer(values, dtype=np.float64).copy()
+        return self._gather(r), self._gather(v)
+
+    def free_dofs(self):
+        """This rank's free DOFs (not prescribed) as a petsc4py IS, for K.createSubMatrix(is, is)."""
+        rows, _, isize = _perilin.constraints(self._handle)
+        held = np.frombuffer(rows, dtype=np.int64 if isize == 8 else np.int32)
+        start, end = self.rhs().getOwnershipRange()
+        free = np.setdiff1d(np.arange(start, end), held).astype(PETSc.IntType)
+        return PETSc.IS().createGeneral(free, comm=self.comm)

@@ -1,0 +1,421 @@
+/* perilin._perilin: the C half of the Python module perilin (python/perilin/__init__.py is the
+ * other): a PeriProblem behind a capsule, its operators as petsc4py objects (petsc4py's C API),
+ * every PETSc error raised as perilin.Error with perilin's message. PETSc and SLEPc are started
+ * by petsc4py and slepc4py, never here (docs/python.md). */
+#define PY_SSIZE_T_CLEAN
+#include <Python.h>
+#include <petsc4py/petsc4py.h>
+#include "perilin.h"
+#include <stdlib.h>
+#include <string.h>
+
+static PyObject *PerilinError; /* perilin.Error */
+
+/* The first error's message, as the command line prints it (src/main.c, CaptureError). */
+static char first_error[4096];
+
+static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
+{
+  (void)comm;
+  (void)ctx;
+  if (p == PETSC_ERROR_INITIAL && !first_error[0]) {
+    if (n == PETSC_ERR_USER_INPUT || n == PETSC_ERR_NOT_CONVERGED)
+      PetscSNPrintf(first_error, sizeof(first_error), "%s", mess ? mess : "invalid input");
+    else
+      PetscSNPrintf(first_error, sizeof(first_error), "%s (PETSc error %d in %s() at %s:%d)", mess ? mess : "error", (int)n, fun, file, line);
+  }
+  return n;
+}
+
+/* Calls into perilin run between Begin and End: the error handler returns the error to here. */
+static void Begin(void)
+{
+  first_error[0] = 0;
+  (void)PetscPushErrorHandler(CaptureError, NULL);
+}
+
+/* NULL with perilin.Error set when ierr, else Py_None (a new reference). */
+static PyObject *End(PetscErrorCode ierr)
+{
+  (void)PetscPopErrorHandler();
+  if (!ierr) Py_RETURN_NONE;
+  PyErr_SetString(PerilinError, first_error[0] ? first_error : "PETSc error");
+  return NULL;
+}
+
+#define CAPSULE "perilin.PeriProblem"
+
+/* What a capsule holds: the problem, NULL once destroyed. */
+typedef struct {
+  PeriProblem p;
+} Handle;
+
+static PeriProblem GetProblem(PyObject *cap)
+{
+  Handle *h = (Handle *)PyCapsule_GetPointer(cap, CAPSULE);
+  if (!h) return NULL;
+  if (!h->p) PyErr_SetString(PerilinError, "the problem was destroyed");
+  return h->p;
+}
+
+static void DestroyQuietly(PeriProblem *p)
+{
+  (void)PetscPushErrorHandler(PetscIgnoreErrorHandler, NULL);
+  (void)PeriProblemDestroy(p);
+  (void)PetscPopErrorHandler();
+}
+
+/* A problem dropped without destroy(): freed unless PETSc has ended (the interpreter's exit). */
+static void CapsuleFree(PyObject *cap)
+{
+  Handle *h = (Handle *)PyCapsule_GetPointer(cap, CAPSULE);
+  if (!h) {
+    PyErr_Clear();
+    return;
+  }
+  if (h->p && PetscInitializeCalled && !PetscFinalizeCalled) DestroyQuietly(&h->p);
+  free(h);
+}
+
+static PyObject *Initialize(PyObject *self, PyObject *args)
+{
+  (void)self;
+  (void)args;
+  if (!PetscInitializeCalled) {
+    PyErr_SetString(PerilinError, "PETSc is not initialized: import petsc4py.PETSc and slepc4py.SLEPc first");
+    return NULL;
+  }
+  Begin();
+  return End(PeriInitializeEmbedded());
+}
+
+static PyObject *Version(PyObject *self, PyObject *args)
+{
+  char           perilin[PERI_VERSION_LEN], petsc[PERI_VERSION_LEN], slepc[PERI_VERSION_LEN];
+  PetscErrorCode ierr;
+  PyObject      *ok;
+
+  (void)self;
+  (void)args;
+  Begin();
+  ierr = PeriGetVersions(perilin, petsc, slepc, PERI_VERSION_LEN);
+  if (!(ok = End(ierr))) return NULL;
+  Py_DECREF(ok);
+  return Py_BuildValue("(sss)", perilin, petsc, slepc);
+}
+
+static PetscErrorCode CreateProblem(MPI_Comm comm, const char file[], PetscInt n, const char *const keys[], const char *const values[], PeriProblem *p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriProblemCreate(comm, p));
+  PetscCall(PeriProblemLoadOverrides(*p, file, n, keys, values));
+  PetscCall(PeriProblemSetUp(*p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* create(file, keys, values, comm): a problem set up from the scene file with the overrides
+ * keys[k] = values[k] (strings), on comm (a petsc4py Comm, or None: PETSC_COMM_WORLD). */
+static PyObject *Create(PyObject *self, PyObject *args)
+{
+  const char    *file;
+  PyObject      *keys, *values, *comm_obj, *ok;
+  MPI_Comm       comm = PETSC_COMM_WORLD;
+  Py_ssize_t     n;
+  const char   **k = NULL, **v = NULL;
+  PeriProblem    p = NULL;
+  Handle        *h;
+  PyObject      *cap;
+  PetscErrorCode ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "sO!O!O", &file, &PyList_Type, &keys, &PyList_Type, &values, &comm_obj)) return NULL;
+  n = PyList_Size(keys);
+  if (PyList_Size(values) != n) {
+    PyErr_SetString(PyExc_ValueError, "keys and values differ in length");
+    return NULL;
+  }
+  if (comm_obj != Py_None) {
+    comm = PyPetscComm_Get(comm_obj);
+    if (PyErr_Occurred()) return NULL;
+  }
+  k = (const char **)calloc((size_t)n + 1, sizeof(*k));
+  v = (const char **)calloc((size_t)n + 1, sizeof(*v));
+  if (!k || !v) {
+    free(k);
+    free(v);
+    return PyErr_NoMemory();
+  }
+  for (Py_ssize_t i = 0; i < n; i++) {
+    k[i] = PyUnicode_AsUTF8(PyList_GetItem(keys, i));
+    v[i] = PyUnicode_AsUTF8(PyList_GetItem(values, i));
+    if (!k[i] || !v[i]) {
+      free(k);
+      free(v);
+      return NULL;
+    }
+  }
+  Begin();
+  Py_BEGIN_ALLOW_THREADS;
+  ierr = CreateProblem(comm, file, (PetscInt)n, k, v, &p);
+  Py_END_ALLOW_THREADS;
+  free(k);
+  free(v);
+  if (!(ok = End(ierr))) {
+    DestroyQuietly(&p);
+    return NULL;
+  }
+  Py_DECREF(ok);
+  if (!(h = (Handle *)malloc(sizeof(*h)))) {
+    DestroyQuietly(&p);
+    return PyErr_NoMemory();
+  }
+  h->p = p;
+  if (!(cap = PyCapsule_New(h, CAPSULE, CapsuleFree))) {
+    DestroyQuietly(&h->p);
+    free(h);
+  }
+  return cap;
+}
+
+static PyObject *Destroy(PyObject *self, PyObject *args)
+{
+  PyObject *cap;
+  Handle   *h;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(h = (Handle *)PyCapsule_GetPointer(cap, CAPSULE))) return NULL;
+  if (!h->p) Py_RETURN_NONE;
+  Begin();
+  return End(PeriProblemDestroy(&h->p));
+}
+
+static PyObject *Run(PyObject *self, PyObject *args)
+{
+  PyObject      *cap;
+  PeriProblem    p;
+  PetscErrorCode ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  Py_BEGIN_ALLOW_THREADS;
+  ierr = PeriProblemRun(p);
+  Py_END_ALLOW_THREADS;
+  return End(ierr);
+}
+
+/* layout(p): (dim, dofs, components, N, rstart, nowned, x): x the owned particles' positions as
+ * bytes of 3 doubles each. */
+static PyObject *Layout(PyObject *self, PyObject *args)
+{
+  PyObject          *cap, *ok, *names;
+  PeriProblem        p;
+  PetscInt           dim, dofs, N, rstart, nowned;
+  const char *const *components;
+  const PetscReal   *x;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  if (!(ok = End(PeriProblemGetLayout(p, &dim, &dofs, &components, &N, &rstart, &nowned, &x)))) return NULL;
+  Py_DECREF(ok);
+  if (!(names = PyTuple_New(dofs))) return NULL;
+  for (PetscInt c = 0; c < dofs; c++) PyTuple_SET_ITEM(names, c, PyUnicode_FromString(components[c]));
+  if (!nowned) x = (const PetscReal *)""; /* y# makes NULL None */
+  return Py_BuildValue("(nnNnnny#)", (Py_ssize_t)dim, (Py_ssize_t)dofs, names, (Py_ssize_t)N, (Py_ssize_t)rstart, (Py_ssize_t)nowned, (const char *)x, (Py_ssize_t)(3 * nowned * sizeof(PetscReal)));
+}
+
+/* solution(p): this rank's part of u as bytes of doubles, or None before a solution. */
+static PyObject *Solution(PyObject *self, PyObject *args)
+{
+  PyObject          *cap, *ok, *out;
+  PeriProblem        p;
+  Vec                u;
+  PetscBool          solved;
+  PetscInt           n = 0;
+  const PetscScalar *a = NULL;
+  PetscErrorCode     ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  ierr = PeriProblemGetSolution(p, &u, &solved);
+  if (!ierr && solved) ierr = VecGetLocalSize(u, &n);
+  if (!ierr && solved) ierr = VecGetArrayRead(u, &a);
+  if (!(ok = End(ierr))) return NULL;
+  Py_DECREF(ok);
+  if (!solved) Py_RETURN_NONE;
+  out = PyBytes_FromStringAndSize((const char *)a, (Py_ssize_t)(n * sizeof(PetscScalar)));
+  (void)VecRestoreArrayRead(u, &a);
+  return out;
+}
+
+/* constraints(p): (rows, values, sizeof(PetscInt)): this rank's prescribed global DOFs and values
+ * as bytes. */
+static PyObject *Constraints(PyObject *self, PyObject *args)
+{
+  PyObject        *cap, *ok;
+  PeriProblem      p;
+  PetscInt         n;
+  const PetscInt  *rows;
+  const PetscReal *values;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  if (!(ok = End(PeriProblemGetConstraints(p, &n, &rows, &values)))) return NULL;
+  Py_DECREF(ok);
+  if (!n) return Py_BuildValue("(y#y#n)", "", (Py_ssize_t)0, "", (Py_ssize_t)0, (Py_ssize_t)sizeof(PetscInt)); /* y# makes NULL None */
+  return Py_BuildValue("(y#y#n)", (const char *)rows, (Py_ssize_t)(n * sizeof(PetscInt)), (const char *)values, (Py_ssize_t)(n * sizeof(PetscReal)), (Py_ssize_t)sizeof(PetscInt));
+}
+
+static PyObject *Stiffness(PyObject *self, PyObject *args)
+{
+  PyObject      *cap, *ok, *out;
+  PeriProblem    p;
+  Mat            K = NULL;
+  PetscErrorCode ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  Py_BEGIN_ALLOW_THREADS;
+  ierr = PeriProblemGetStiffness(p, &K);
+  Py_END_ALLOW_THREADS;
+  if (!(ok = End(ierr))) return NULL;
+  Py_DECREF(ok);
+  out = PyPetscMat_New(K); /* takes its own reference */
+  (void)MatDestroy(&K);
+  return out;
+}
+
+static PyObject *VecResult(PeriProblem p, PetscErrorCode (*get)(PeriProblem, Vec *))
+{
+  PyObject *ok, *out;
+  Vec       v = NULL;
+
+  Begin();
+  if (!(ok = End(get(p, &v)))) return NULL;
+  Py_DECREF(ok);
+  out = PyPetscVec_New(v);
+  (void)VecDestroy(&v);
+  return out;
+}
+
+static PyObject *Loads(PyObject *self, PyObject *args)
+{
+  PyObject   *cap;
+  PeriProblem p;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  return VecResult(p, PeriProblemGetLoads);
+}
+
+static PyObject *Mass(PyObject *self, PyObject *args)
+{
+  PyObject   *cap;
+  PeriProblem p;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  return VecResult(p, PeriProblemGetMass);
+}
+
+static PyObject *TextResult(PeriProblem p, PetscErrorCode (*get)(PeriProblem, char **))
+{
+  PyObject      *ok, *out;
+  char          *text = NULL;
+  PetscErrorCode ierr;
+
+  Begin();
+  ierr = get(p, &text);
+  if (!(ok = End(ierr))) {
+    free(text);
+    return NULL;
+  }
+  Py_DECREF(ok);
+  out = PyUnicode_FromString(text ? text : "");
+  free(text);
+  return out;
+}
+
+static PyObject *Summary(PyObject *self, PyObject *args)
+{
+  PyObject   *cap;
+  PeriProblem p;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  return TextResult(p, PeriProblemGetSummary);
+}
+
+static PyObject *Scene(PyObject *self, PyObject *args)
+{
+  PyObject   *cap;
+  PeriProblem p;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  return TextResult(p, PeriProblemGetScene);
+}
+
+static PetscErrorCode WriteOutput(PeriProblem p, const char dir[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriProblemSetOutputDir(p, dir));
+  PetscCall(PeriProblemWriteOutput(p));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PyObject *Write(PyObject *self, PyObject *args)
+{
+  PyObject      *cap;
+  PeriProblem    p;
+  const char    *dir;
+  PetscErrorCode ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "Os", &cap, &dir) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  Py_BEGIN_ALLOW_THREADS;
+  ierr = WriteOutput(p, dir);
+  Py_END_ALLOW_THREADS;
+  return End(ierr);
+}
+
+static PyMethodDef methods[] = {
+    {"initialize", Initialize, METH_NOARGS, "perilin's registries in the PETSc session petsc4py and slepc4py started"},
+    {"versions", Version, METH_NOARGS, "(perilin, PETSc, SLEPc) versions"},
+    {"create", Create, METH_VARARGS, "create(file, keys, values, comm): a problem set up from the scene"},
+    {"destroy", Destroy, METH_VARARGS, "destroy(problem)"},
+    {"run", Run, METH_VARARGS, "run(problem): the scene's analysis"},
+    {"layout", Layout, METH_VARARGS, "layout(problem): (dim, dofs, components, N, rstart, nowned, x bytes)"},
+    {"solution", Solution, METH_VARARGS, "solution(problem): this rank's part of u as bytes, or None"},
+    {"constraints", Constraints, METH_VARARGS, "constraints(problem): (rows bytes, values bytes, sizeof(PetscInt))"},
+    {"stiffness", Stiffness, METH_VARARGS, "stiffness(problem): a new assembled K (petsc4py Mat)"},
+    {"loads", Loads, METH_VARARGS, "loads(problem): a new vector of the loads f (petsc4py Vec)"},
+    {"mass", Mass, METH_VARARGS, "mass(problem): a new vector of the lumped mass per DOF (petsc4py Vec)"},
+    {"summary", Summary, METH_VARARGS, "summary(problem): summary.json's text"},
+    {"scene", Scene, METH_VARARGS, "scene(problem): the resolved scene as YAML"},
+    {"write", Write, METH_VARARGS, "write(problem, dir): the output set into dir"},
+    {NULL, NULL, 0, NULL},
+};
+
+static struct PyModuleDef module = {PyModuleDef_HEAD_INIT, "_perilin", "the C half of perilin (docs/python.md)", -1, methods, NULL, NULL, NULL, NULL};
+
+PyMODINIT_FUNC PyInit__perilin(void)
+{
+  PyObject *m;
+
+  if (import_petsc4py() < 0) return NULL;
+  if (!(m = PyModule_Create(&module))) return NULL;
+  PerilinError = PyErr_NewExceptionWithDoc("perilin.Error", "an input error or a failed run, with perilin's message (what the command line prints after 'perilin: error: ')", NULL, NULL);
+  if (!PerilinError || PyModule_AddObject(m, "Error", PerilinError) < 0) {
+    Py_XDECREF(PerilinError);
+    Py_DECREF(m);
+    return NULL;
+  }
+  Py_INCREF(PerilinError);
+  return m;
+}

@@ -1,0 +1,149 @@
+"""The Python module perilin (issue 39, docs/python.md) against the command line and against
+petsc4py's own algebra, on one rank or several (mpiexec -n P /usr/bin/python3 python_api.py ...).
+
+usage: python_api.py REPO CLI_OUT VERSION_LINE TMPDIR
+  CLI_OUT: the output set of `perilin examples/pmb/plate_traction.yaml` on as many ranks as this
+  script runs on (particles.vtu or particles.pvtu; the same partition, so the same global order);
+  VERSION_LINE: the first line `perilin -version` prints.
+
+Checks, each with its number:
+  1. perilin.__version__ is what `perilin -version` prints;
+  2. the displacements solved in-process equal the command line's particles file to 1e-12 (relative
+     to the largest), the positions exactly, and the summary's counts and energy its summary.json's;
+  3. K u - f from stiffness() and rhs() (petsc4py) vanishes on the free DOFs (relative 1e-8), u
+     holds the prescribed values on the others, and an LU solve of the free block with petsc4py
+     gives solve()'s u to 1e-8;
+  4. a misspelt key and a bad value raise perilin.Error naming the key (and the file and line), and
+     the same process goes on to solve again with the same result;
+  5. set('material.E', 2 E) halves u (1e-10), a failing set() leaves the problem as it was;
+  6. a dict scene gives the file's result; write(dir) writes the output set with the same u.
+"""
+import json
+import os
+import sys
+
+import numpy as np
+from petsc4py import PETSc
+import yaml
+
+import perilin
+from vtkmodules.util.numpy_support import vtk_to_numpy
+from vtkmodules.vtkIOXML import vtkXMLPUnstructuredGridReader, vtkXMLUnstructuredGridReader
+
+repo, cli_out, version_line, tmpdir = sys.argv[1:5]
+comm = PETSc.COMM_WORLD
+rank, size = comm.getRank(), comm.getSize()
+failures = 0
+
+
+def check(ok, what):
+    global failures
+    if rank == 0:
+        print(("ok: " if ok else "FAIL: ") + what, flush=True)
+    failures += not ok
+
+
+def read_particles(out):
+    """positions and displacements of an output set, in the files' order."""
+    path = os.path.join(out, "particles.pvtu")
+    reader = vtkXMLPUnstructuredGridReader() if os.path.exists(path) else vtkXMLUnstructuredGridReader()
+    reader.SetFileName(path if os.path.exists(path) else os.path.join(out, "particles.vtu"))
+    reader.Update()
+    grid = reader.GetOutput()
+    return vtk_to_numpy(grid.GetPoints().GetData()), vtk_to_numpy(grid.GetPointData().GetArray("displacement"))
+
+
+plate = os.path.join(repo, "examples/pmb/plate_traction.yaml")
+
+# 1. the version
+check(version_line.split() == ["perilin", perilin.__version__], "__version__ %s is `perilin -version`'s (%s)" % (perilin.__version__, version_line))
+
+# 2. the in-process solve against the command line
+p = perilin.Problem(plate)
+r = p.solve()
+x_cli, u_cli = read_particles(cli_out)
+dim = r.x.shape[1]
+scale = np.abs(u_cli).max()
+check(r.x.shape == (5000, 2) and r.u.shape == (5000, 2) and r.components == ("ux", "uy"), "x, u are particles x dim: %s, %s, %s" % (r.x.shape, r.u.shape, r.components))
+check(np.array_equal(r.x, x_cli[:, :dim]), "the positions are the command line's, in its order")
+diff = np.abs(r.u - u_cli[:, :dim]).max() / scale
+check(diff <= 1e-12, "u equals the command line's to %.2g of max |u| = %.4g (<= 1e-12)" % (diff, scale))
+cli = json.load(open(os.path.join(cli_out, "summary.json")))
+s = r.summary
+check(all(s[k] == cli[k] for k in ("particles", "bonds", "dofs", "ranks", "model", "analysis")), "the summary's counts are summary.json's")
+check(abs(s["strain_energy"] - cli["strain_energy"]) <= 1e-12 * abs(cli["strain_energy"]), "strain energy %.15g, the command line's %.15g" % (s["strain_energy"], cli["strain_energy"]))
+
+# 3. K and f as petsc4py objects
+K, f = p.stiffness(), p.rhs()
+u = f.duplicate()
+lo, hi = u.getOwnershipRange()
+u.setValues(np.arange(lo, hi, dtype=PETSc.IntType), r.u.ravel()[lo:hi])
+u.assemble()
+res = K * u - f
+free = p.free_dofs()
+rf, ff = res.getSubVector(free), f.getSubVector(free)
+rel = rf.norm() / ff.norm()
+res.restoreSubVector(free, rf)
+f.restoreSubVector(free, ff)
+check(K.getSize() == (10000, 10000) and rel < 1e-8, "||K u - f|| / ||f|| on the free DOFs: %.2g (< 1e-8)" % rel)
+rows, values = p.constraints()
+check(len(rows) > 0 and np.array_equal(r.u.ravel()[rows], values), "u holds the %d prescribed values" % len(rows))
+Kff = K.createSubMatrix(free, free)
+b = f.getSubVector(free).copy()  # the prescribed values are 0 on this plate: no K_fc u_c term
+check(not np.any(values), "the plate's prescribed values are 0")
+ksp = PETSc.KSP().create(comm)
+ksp.setOperators(Kff)
+ksp.setType("preonly")
+ksp.getPC().setType("lu")
+if size > 1:
+    ksp.getPC().setFactorSolverType("mumps")
+x = b.duplicate()
+ksp.solve(b, x)
+uf = u.getSubVector(free)
+lu = (x - uf).norm(PETSc.NormType.INFINITY) / uf.norm(PETSc.NormType.INFINITY)
+u.restoreSubVector(free, uf)
+check(lu < 1e-8, "petsc4py's LU solve of the free block gives solve()'s u to %.2g (< 1e-8)" % lu)
+
+# 4. errors are perilin.Error, and the process goes on
+for overrides, words in (({"materal.E": 1e9}, ["materal", "did you mean -material_E"]), ({"material.E": -1}, ["material.E", "plate_traction.yaml", "(0, inf)"])):
+    try:
+        perilin.Problem(plate, overrides)
+        check(False, "%s raises perilin.Error" % overrides)
+    except perilin.Error as e:
+        check(all(w in str(e) for w in words), "%s raises perilin.Error: %s" % (overrides, e))
+try:
+    perilin.Problem(os.path.join(tmpdir, "no_such_scene.yaml"))
+    check(False, "a missing scene file raises perilin.Error")
+except perilin.Error as e:
+    check("no_such_scene.yaml" in str(e), "a missing scene file raises perilin.Error: %s" % e)
+again = perilin.Problem(plate).solve()
+check(np.array_equal(again.u, r.u), "after the errors, the same scene solves to the same u")
+
+# 5. set(): a new modulus
+E = p.get("material.E")
+check(E == 1e9, "get('material.E') = %g" % E)
+p.set("material.E", 2 * E)
+r2 = p.solve()
+half = np.abs(2 * r2.u - r.u).max() / scale
+check(p.get("material.E") == 2 * E and half <= 1e-10, "set('material.E', 2E) halves u: max |2 u' - u| / max |u| = %.2g (<= 1e-10)" % half)
+try:
+    p.set("material.nu", 0.2)
+    check(False, "set('material.nu', 0.2) on pmb raises perilin.Error")
+except perilin.Error as e:
+    check("material.nu" in str(e) and p.get("material.E") == 2 * E and p.solve() is r2, "a failing set() raises (%s) and leaves the problem as it was" % e)
+
+# 6. a dict scene, and write()
+scene = yaml.safe_load(open(plate))
+d = perilin.Problem(scene, comm=comm).solve()
+check(np.array_equal(d.u, r.u), "a dict scene solves to the file's u")
+out = os.path.join(tmpdir, "py-out")
+p.write(out)
+x_w, u_w = read_particles(out)
+written = json.load(open(os.path.join(out, "summary.json")))
+check(np.array_equal(u_w[:, :dim], r2.u) and written["material"]["E"] == 2 * E, "write(dir): particles file with u, summary.json with E = %g" % written["material"]["E"])
+p.close()
+
+failures = comm.tompi4py().allreduce(failures)
+if rank == 0:
+    print("%s: %d failure(s) on %d rank(s)" % ("FAIL" if failures else "ok", failures, size))
+sys.exit(1 if failures else 0)
