@@ -93,7 +93,7 @@ static const PeriKey dyn_pulse_keys[] = {
     {"center", PERI_KEY_REAL, "required", NULL, "[length]", NULL, "its position along axis"},
     {"width", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "its width w"},
     {"axis", PERI_KEY_STRING, "x", NULL, NULL, NULL, "the axis along which the pulse lies and displaces: x, y or z"},
-    {"direction", PERI_KEY_STRING, "axis", NULL, NULL, NULL, "the displacement's direction x, y or z when not along axis: across it, a shear wave"},
+    {"direction", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "the displacement's direction x, y or z when not along axis (absent: along axis): across it, a shear wave"},
     {"profile", PERI_KEY_CHOICE, "gaussian", NULL, NULL, dyn_profiles, "gaussian: amplitude exp(-((x - center)/width)^2); cosine: amplitude cos(pi (x - center)/width), a standing wave (with center 0 and width the bar's length, a free bar's lowest longitudinal mode)"},
     {NULL},
 };
