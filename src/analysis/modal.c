@@ -742,22 +742,59 @@ static PetscErrorCode ChooseEigensolver(PeriAnalysis an)
   asked for: else the run fails with PETSC_ERR_NOT_CONVERGED. Options: every -eps_* and -st_* option (e.g.
   -st_pc_factor_mat_solver_type, -eps_tol). SLEPc must be initialized. Collective.
 @*/
-static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
+/* One attempt with the chosen eigensolver: a failed check may return from deep inside SLEPc, so
+ * everything is freed before the error goes on. quiet: the error is returned without a message
+ * (PETSc keeps it, PetscErrorMessage), for the caller to retry or to raise. */
+static PetscErrorCode ModalAttempt(PeriAnalysis an, PetscBool quiet, PetscErrorCode *ierr)
 {
-  ModalWork      w;
-  PetscErrorCode ierr;
-  Mat            K;
+  ModalWork w;
+  Mat       K;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscStrncpy(an->sys->stiffness.mat_type, MATAIJ, sizeof(an->sys->stiffness.mat_type)));
-  PetscCall(ChooseEigensolver(an));
   PetscCall(PeriSystemGetJacobian(an->sys, &K));
   PetscCall(PetscMemzero(&w, sizeof(w)));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
-  /* a failed check may return from deep inside SLEPc: free everything, then pass the error on */
-  ierr = ModalSolve(an, Modal(an)->nev, Modal(an)->target_hz, &w);
+  if (quiet) PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  *ierr = ModalSolve(an, Modal(an)->nev, Modal(an)->target_hz, &w);
+  if (quiet) PetscCall(PetscPopErrorHandler());
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(ModalWorkDestroy(&w));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode PeriAnalysisRun_Modal(PeriAnalysis an)
+{
+  PeriModal       *md     = Modal(an);
+  PeriStiffness   *S      = &an->sys->stiffness;
+  const PetscBool  chosen = (PetscBool)(md->eigensolver == EIGENSOLVER_AUTO);
+  PeriOperatorKind kind   = S->operator_kind;
+  PetscBool        retry;
+  PetscErrorCode   ierr;
+  const char      *msg = NULL;
+  char             reason[512];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(S->mat_type, MATAIJ, sizeof(S->mat_type)));
+  PetscCall(ChooseEigensolver(an));
+  retry = (PetscBool)(chosen && md->eigensolver == EIGENSOLVER_LOBPCG);
+  PetscCall(ModalAttempt(an, retry, &ierr));
+  if (retry && ierr) {
+    PetscCall(PetscErrorMessage(ierr, NULL, (char **)&msg));
+    PetscCall(PetscStrncpy(reason, msg ? msg : "no message", sizeof(reason)));
+    /* auto's LOBPCG that does not converge gives way to the factorization: the default must not
+       fail where shift-and-invert succeeds (the mppd lamina at nu = -0.99 took LOBPCG 387
+       iterations on one machine and more than its 2,500 on another) */
+    PetscCheck(ierr == PETSC_ERR_NOT_CONVERGED, an->comm, ierr, "%s", reason);
+    PetscCall(PetscPrintf(an->comm, "perilin: note: LOBPCG did not converge (%s); retrying with shift-and-invert (analysis.eigensolver: shift_invert)\n", reason));
+    PetscCall(PetscFree(md->modes));
+    PetscCall(PetscFree(md->shapes));
+    md->nmodes = md->nshapes = 0;
+    md->eigensolver          = EIGENSOLVER_SHIFT_INVERT;
+    S->operator_kind         = kind;
+    S->needs.matrix_free     = PETSC_FALSE;
+    PetscCall(PeriSystemAssemble(an->sys));
+    PetscCall(ModalAttempt(an, PETSC_FALSE, &ierr));
+  }
   PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
