@@ -48,13 +48,13 @@ static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Any isotropic elasticity that is positive definite: -1 < nu < 1/2 (the strict bounds are
- * checked with the key named by the material reader). */
+/* Any isotropic elasticity that is positive definite: -1 < nu < 1/2 (the material reader refuses
+ * the bounds themselves, naming the key). */
 static void NuRange(PeriModel m, PetscReal *lo, PetscReal *hi)
 {
   (void)m;
-  *lo = -1 + 1e-12;
-  *hi = 0.5 - 1e-12;
+  *lo = -1;
+  *hi = 0.5;
 }
 
 /* omega of a bond, dimensionless; delta the bond's horizon */

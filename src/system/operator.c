@@ -609,20 +609,34 @@ static void FormDiagonal(const PeriOperator op, const PetscReal w[], PetscReal d
   }
 }
 
-/* The state term's diagonal, added to ya (the local form of ym): sum_q A_q (d theta_q / d u_p)^2.
- * A bond (i, j) adds p_i w to theta_i's gradient at j and -p_i w at i, p_j w to theta_j's at j and
- * -p_j w at i: the neighbours' terms go straight in, a particle's own gradient S_p is summed over
- * the ranks first (in xm's local form, scratch here). Collective. */
-static PetscErrorCode StateDiagonal(PeriOperator op, PetscScalar *ya)
+/* Ghost exchange of a ghosted vector: the ranks' partial sums to the owner, then back. */
+static PetscErrorCode GhostSum(Vec v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecGhostUpdateBegin(v, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateEnd(v, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(VecGhostUpdateBegin(v, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecGhostUpdateEnd(v, INSERT_VALUES, SCATTER_FORWARD));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Each particle's own state gradient S_p = d theta_p / d u_p = sum of -p_i w (bonds stored at p)
+ * and +p_j w (bonds toward p), bs per particle in xm's local form, summed over the ranks and copied
+ * to the ghosts; with T (theta's local form) also sum |p w_d| over p's bonds, ||G_p||_1 without
+ * S_p's own share. Scratch use of xm and theta. Collective. */
+static PetscErrorCode StateOwnGradients(PeriOperator op, PetscBool abs_sums)
 {
   const PetscInt bs = op->bs;
-  Vec            sl;
-  PetscScalar   *S;
+  Vec            sl, tl;
+  PetscScalar   *S, *T;
 
   PetscFunctionBeginUser;
   PetscCall(VecGhostGetLocalForm(op->xm, &sl));
+  PetscCall(VecGhostGetLocalForm(op->theta, &tl));
   PetscCall(VecSet(sl, 0));
+  PetscCall(VecSet(tl, 0));
   PetscCall(VecGetArray(sl, &S));
+  PetscCall(VecGetArray(tl, &T));
   for (PetscInt i = 0; i < op->nloc; i++)
     for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
       const PetscReal *w = op->w + bs * b, pi = op->p[2 * b], pj = op->p[2 * b + 1];
@@ -630,17 +644,38 @@ static PetscErrorCode StateDiagonal(PeriOperator op, PetscScalar *ya)
       for (PetscInt d = 0; d < bs; d++) {
         S[bs * i + d] -= pi * w[d];
         S[bs * j + d] += pj * w[d];
-        ya[bs * j + d] += op->A[i] * PetscSqr(pi * w[d]);
-        ya[bs * i + d] += op->A[j] * PetscSqr(pj * w[d]);
+        T[i] += PetscAbsReal(pi * w[d]);
+        T[j] += PetscAbsReal(pj * w[d]);
       }
     }
+  PetscCall(VecRestoreArray(tl, &T));
   PetscCall(VecRestoreArray(sl, &S));
+  PetscCall(VecGhostRestoreLocalForm(op->theta, &tl));
   PetscCall(VecGhostRestoreLocalForm(op->xm, &sl));
-  PetscCall(VecGhostUpdateBegin(op->xm, ADD_VALUES, SCATTER_REVERSE));
-  PetscCall(VecGhostUpdateEnd(op->xm, ADD_VALUES, SCATTER_REVERSE));
+  PetscCall(GhostSum(op->xm));
+  if (abs_sums) PetscCall(GhostSum(op->theta));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The state term's diagonal, added to ya (the local form of ym): sum_q A_q (d theta_q / d u_p)^2:
+ * a bond (i, j) adds p_i w to theta_i's gradient at j and p_j w to theta_j's at i; a particle's
+ * own gradient is S_p (StateOwnGradients). Collective. */
+static PetscErrorCode StateDiagonal(PeriOperator op, PetscScalar *ya)
+{
+  const PetscInt bs = op->bs;
+  PetscScalar   *S;
+
+  PetscFunctionBeginUser;
+  PetscCall(StateOwnGradients(op, PETSC_FALSE));
   PetscCall(VecGetArray(op->xm, &S));
-  for (PetscInt i = 0; i < op->nloc; i++)
+  for (PetscInt i = 0; i < op->nloc; i++) {
     for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += op->A[i] * PetscSqr(S[bs * i + d]);
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++)
+      for (PetscInt d = 0; d < bs; d++) {
+        ya[bs * op->jl[b] + d] += op->A[i] * PetscSqr(op->p[2 * b] * op->w[bs * b + d]);
+        ya[bs * i + d] += op->A[op->jl[b]] * PetscSqr(op->p[2 * b + 1] * op->w[bs * b + d]);
+      }
+  }
   PetscCall(VecRestoreArray(op->xm, &S));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -938,17 +973,6 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Ghost exchange of a ghosted vector: the ranks' partial sums to the owner, then back. */
-static PetscErrorCode GhostSum(Vec v)
-{
-  PetscFunctionBeginUser;
-  PetscCall(VecGhostUpdateBegin(v, ADD_VALUES, SCATTER_REVERSE));
-  PetscCall(VecGhostUpdateEnd(v, ADD_VALUES, SCATTER_REVERSE));
-  PetscCall(VecGhostUpdateBegin(v, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecGhostUpdateEnd(v, INSERT_VALUES, SCATTER_FORWARD));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The state term's share of the absolute row sums of K, from above: sum_q |A_q| |G_q,r| ||G_q||_1
  * with G_q the gradient of theta_q (StateDiagonal). Adds to ya (ym's local form, reduced by the
  * caller). Uses xm and theta as scratch. Collective. */
@@ -959,27 +983,9 @@ static PetscErrorCode StateRowSums(PeriOperator op, PetscScalar *ya)
   PetscScalar   *S, *T;
 
   PetscFunctionBeginUser;
+  PetscCall(StateOwnGradients(op, PETSC_TRUE));
   PetscCall(VecGhostGetLocalForm(op->xm, &sl));
   PetscCall(VecGhostGetLocalForm(op->theta, &tl));
-  PetscCall(VecSet(sl, 0));
-  PetscCall(VecSet(tl, 0));
-  PetscCall(VecGetArray(sl, &S));
-  PetscCall(VecGetArray(tl, &T));
-  for (PetscInt i = 0; i < op->nloc; i++)
-    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
-      const PetscReal *w = op->w + bs * b, pi = op->p[2 * b], pj = op->p[2 * b + 1];
-      const PetscInt   j = op->jl[b];
-      for (PetscInt d = 0; d < bs; d++) {
-        S[bs * i + d] -= pi * w[d];
-        S[bs * j + d] += pj * w[d];
-        T[i] += PetscAbsReal(pi * w[d]);
-        T[j] += PetscAbsReal(pj * w[d]);
-      }
-    }
-  PetscCall(VecRestoreArray(tl, &T));
-  PetscCall(VecRestoreArray(sl, &S));
-  PetscCall(GhostSum(op->xm));
-  PetscCall(GhostSum(op->theta));
   PetscCall(VecGetArray(sl, &S));
   PetscCall(VecGetArray(tl, &T));
   for (PetscInt i = 0; i < op->nloc + op->nghost; i++) { /* T becomes |A| ||G||_1 */
@@ -988,14 +994,11 @@ static PetscErrorCode StateRowSums(PeriOperator op, PetscScalar *ya)
   }
   for (PetscInt i = 0; i < op->nloc; i++) {
     for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += T[i] * PetscAbsScalar(S[bs * i + d]);
-    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
-      const PetscReal *w = op->w + bs * b;
-      const PetscInt   j = op->jl[b];
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++)
       for (PetscInt d = 0; d < bs; d++) {
-        ya[bs * j + d] += T[i] * PetscAbsReal(op->p[2 * b] * w[d]);
-        ya[bs * i + d] += T[j] * PetscAbsReal(op->p[2 * b + 1] * w[d]);
+        ya[bs * op->jl[b] + d] += T[i] * PetscAbsReal(op->p[2 * b] * op->w[bs * b + d]);
+        ya[bs * i + d] += T[op->jl[b]] * PetscAbsReal(op->p[2 * b + 1] * op->w[bs * b + d]);
       }
-    }
   }
   PetscCall(VecRestoreArray(tl, &T));
   PetscCall(VecRestoreArray(sl, &S));
