@@ -52,6 +52,24 @@ static PetscErrorCode ReadCheckpointOptions(PeriProblem p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* output.every in a scene whose analysis writes no series (static, modal): not read, but a value out
+ * of the declared range is refused all the same, naming the key (issue 40, item 6). Not collective. */
+static PetscErrorCode CheckUnreadEvery(PeriScene s)
+{
+  PeriNode          out = NULL, node = NULL;
+  const PeriSchema *sec;
+  const PeriKey    *decl;
+  PetscReal         v;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetMap(s, s->root, "output", PETSC_FALSE, &out));
+  if (out) PetscCall(PeriSceneGetNode(out, "every", &node));
+  if (!node) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneParseReal(s, node, &v));
+  PetscCall(PeriSceneFindKey(s, out, "every", &sec, &decl));
+  PetscCall(PeriSceneCheckRange(s, node, sec, decl, v, node->value));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 /* analysis.type, checked against the registered types; analysis.* against that analysis' schema
  * (p->scene->owners holds every plug-in's), then read by the analysis itself: every analysis key
  * is checked before any particle exists. */
@@ -80,7 +98,10 @@ static PetscErrorCode ReadAnalysis(PeriProblem p)
   PetscCall(PeriSceneCheckKeysSchema(s, a, "analysis", active));
   /* output.every: only the analyses that write series declare it, and only they read it (so that
      scene.yaml has it only for them) */
-  if (PeriSchemaFindKey(type->schema, "output", "every")) PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
+  if (PeriSchemaFindKey(type->schema, "output", "every"))
+    PetscCall(PeriSceneGetInt(s, s->root, "output.every", PETSC_FALSE, &p->output_every, NULL));
+  else
+    PetscCall(CheckUnreadEvery(s));
   PetscCall(PeriAnalysisCreate(p->comm, type, &p->analysis));
   PetscCall(PeriAnalysisSetFromScene(p->analysis, s));
   PetscCall(ReadCheckpointOptions(p));

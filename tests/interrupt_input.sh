@@ -20,7 +20,13 @@ for sig in TERM HUP; do
   writer=$!
   "$exe" "$tmp/scene.yaml" -output_dir "$tmp/out" > "$tmp/log" 2>&1 &
   pid=$!
-  sleep 2
+  # the signal once perilin reads the pipe (its start takes seconds under AddressSanitizer), and 1 s more
+  for _ in $(seq 100); do
+    ls -l "/proc/$pid/fd" 2> /dev/null | grep -q "$tmp/scene.yaml" && break
+    kill -0 "$pid" 2> /dev/null || break
+    sleep 0.2
+  done
+  sleep 1
   kill -0 "$pid" 2> /dev/null || fail "SIG$sig: perilin did not wait for the pipe"
   kill -s $sig "$pid"
   for _ in $(seq 50); do kill -0 "$pid" 2> /dev/null || break; sleep 0.2; done

@@ -14,9 +14,10 @@ typedef struct {
   PetscReal *paths; /* s1, s2 per path, in units of the criterion's limit */
   PetscReal *m;
   PetscInt   crit[3];
-  PetscReal *emax;     /* [crit][path][m], in % */
-  PetscReal *ratio;    /* [crit][path][m][orientation]: the lattice's failure load over the continuum's */
-  PetscReal *envelope; /* [crit][m][psi][3]: the continuum's failure load along psi, the lattice's smallest and largest over the orientations */
+  PetscReal *emax;                      /* [crit][path][m], in % */
+  PetscReal *ratio;                     /* [crit][path][m][orientation]: the lattice's failure load over the continuum's */
+  PetscReal *envelope;                  /* [crit][m][psi][3]: the continuum's failure load along psi, the lattice's smallest and largest over the orientations */
+  PetscInt   rows_done, envelopes_done; /* the rows of emax and ratio, and the envelopes, complete: a signal stops the run between them */
 } Anisotropy;
 
 #define AN(an)                    ((Anisotropy *)(an)->data)
@@ -73,17 +74,30 @@ static void Rotated(PetscInt k, PetscInt n, const PetscReal s[], PetscReal H[])
   H[3]        = sn * sn * s[0] + c * c * s[1];
 }
 
+/* Whether a signal (SIGINT, SIGTERM, SIGHUP) asks the run to stop: polled by every rank at the same
+ * points (each computes the whole study). Collective. */
+static PetscErrorCode Interrupted(PeriAnalysis an, PetscBool *stop)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
+  *stop = an->sys->run.interrupted ? PETSC_TRUE : PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* e_max (%) of one path (in units of s0t, scaled by unit) and m under the criterion now in
  * sys->bond_state.failure, and the ratio of the lattice's failure load to the continuum's at each
- * orientation (inf where nothing fails along the path). */
-static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal unit, PetscReal m, PetscReal ratio[])
+ * orientation (inf where nothing fails along the path); *stop when a signal came first. */
+static PetscErrorCode MaxError(PeriAnalysis an, const PetscReal path[], PetscReal unit, PetscReal m, PetscReal ratio[], PetscReal *emax, PetscBool *stop)
 {
   const PetscInt  n     = AN(an)->norient;
   const PetscReal s[2]  = {unit * path[0], unit * path[1]};
   PetscReal       worst = 0;
 
+  PetscFunctionBeginUser;
   for (PetscInt k = 0; k < n; k++) {
     PetscReal H[4], lat, cont;
+    PetscCall(Interrupted(an, stop));
+    if (*stop) PetscFunctionReturn(PETSC_SUCCESS);
     Rotated(k, n, s, H);
     lat      = LatticeLoad(an->sys, m, H);
     cont     = ContinuumLoad(an->sys, H);
@@ -92,20 +106,24 @@ static PetscReal MaxError(PeriAnalysis an, const PetscReal path[], PetscReal uni
     ratio[k] = lat / cont;
     worst    = PetscMax(worst, lat / cont - 1);
   }
-  return 100 * worst;
+  *emax = 100 * worst;
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The failure envelope of one m in the (s1, s2) plane under the criterion now in
  * sys->bond_state.failure: along each direction psi the load factor (in units of s0t) at which
  * the continuum fails (isotropic: at Theta = 0), and the smallest and largest over the lattice's
- * orientations. */
-static void Envelope(PeriAnalysis an, PetscReal unit, PetscReal m, PetscReal env[])
+ * orientations; *stop when a signal came first. */
+static PetscErrorCode Envelope(PeriAnalysis an, PetscReal unit, PetscReal m, PetscReal env[], PetscBool *stop)
 {
   const PetscInt n = AN(an)->norient;
 
+  PetscFunctionBeginUser;
   for (PetscInt d = 0; d < PERI_ENVELOPE_DIRECTIONS; d++) {
     const PetscReal psi = 2 * PETSC_PI * d / PERI_ENVELOPE_DIRECTIONS, s[2] = {unit * PetscCosReal(psi), unit * PetscSinReal(psi)};
     PetscReal       H[4], *e                                                = &env[3 * d];
+    PetscCall(Interrupted(an, stop));
+    if (*stop) PetscFunctionReturn(PETSC_SUCCESS);
     Rotated(0, n, s, H);
     e[0] = ContinuumLoad(an->sys, H);
     e[1] = PETSC_INFINITY;
@@ -120,6 +138,7 @@ static void Envelope(PeriAnalysis an, PetscReal unit, PetscReal m, PetscReal env
     for (PetscInt k = 0; k < 3; k++)
       if (e[k] > PERI_ENVELOPE_NEVER) e[k] = PETSC_INFINITY;
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* sys->bond_state.failure with only criterion c of the scene's (0 stretch: tension and compression, 1
@@ -179,9 +198,12 @@ static PetscErrorCode SetFromScene_Anisotropy(PeriAnalysis an, PeriScene s, Peri
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A signal stops the study between two orientations (or envelope directions): the rows and
+ * envelopes complete by then are written, summary.json says "complete": false. */
 static PetscErrorCode Run_Anisotropy(PeriAnalysis an)
 {
   Anisotropy       *A;
+  PetscBool         stop = PETSC_FALSE;
   const PeriFailure all  = an->sys->bond_state.failure;
   const PetscReal   unit = PeriFailureValue(&all, "critical_stretch") > 0 ? PeriFailureValue(&all, "critical_stretch") : 1;
 
@@ -189,14 +211,18 @@ static PetscErrorCode Run_Anisotropy(PeriAnalysis an)
   PetscCheck(an->sys->disc.particles.dim == 2, an->comm, PETSC_ERR_USER_INPUT, "%s: the anisotropy analysis studies the 2D square lattice: dim must be 2", an->sys->scene->file);
   A = AN(an);
   PetscCall(PetscMalloc3(A->ncrit * A->npaths * A->nm, &A->emax, A->ncrit * A->npaths * A->nm * A->norient, &A->ratio, A->ncrit * A->nm * PERI_ENVELOPE_DIRECTIONS * 3, &A->envelope));
-  for (PetscInt c = 0; c < A->ncrit; c++) {
+  for (PetscInt c = 0; c < A->ncrit && !stop; c++) {
     PetscCall(OnlyCriterion(an, A->crit[c]));
-    for (PetscInt p = 0; p < A->npaths; p++)
-      for (PetscInt k = 0; k < A->nm; k++) {
+    for (PetscInt p = 0; p < A->npaths && !stop; p++)
+      for (PetscInt k = 0; k < A->nm && !stop; k++) {
         const PetscInt row = (c * A->npaths + p) * A->nm + k;
-        A->emax[row]       = MaxError(an, &A->paths[2 * p], unit, A->m[k], &A->ratio[row * A->norient]);
+        PetscCall(MaxError(an, &A->paths[2 * p], unit, A->m[k], &A->ratio[row * A->norient], &A->emax[row], &stop));
+        if (!stop) A->rows_done = row + 1;
       }
-    for (PetscInt k = 0; k < A->nm; k++) Envelope(an, unit, A->m[k], &A->envelope[(c * A->nm + k) * PERI_ENVELOPE_DIRECTIONS * 3]);
+    for (PetscInt k = 0; k < A->nm && !stop; k++) {
+      PetscCall(Envelope(an, unit, A->m[k], &A->envelope[(c * A->nm + k) * PERI_ENVELOPE_DIRECTIONS * 3], &stop));
+      if (!stop) A->envelopes_done = c * A->nm + k + 1;
+    }
   }
   an->sys->bond_state.failure = all;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -224,14 +250,14 @@ static PetscErrorCode WriteCurves(PeriAnalysis an, const char dir[])
   for (PetscInt c = 0; c < A->ncrit; c++)
     for (PetscInt p = 0; p < A->npaths; p++)
       for (PetscInt k = 0; k < A->nm; k++)
-        for (PetscInt o = 0; o < A->norient; o++) bad |= fprintf(fp, "%s,%g,%g,%g,%.6g,%.8g\n", criteria[A->crit[c]], (double)A->paths[2 * p], (double)A->paths[2 * p + 1], (double)A->m[k], 90.0 * o / (A->norient - 1), CSVLoad(A->ratio[((c * A->npaths + p) * A->nm + k) * A->norient + o])) < 0;
+        for (PetscInt o = 0; o < A->norient && (c * A->npaths + p) * A->nm + k < A->rows_done; o++) bad |= fprintf(fp, "%s,%g,%g,%g,%.6g,%.8g\n", criteria[A->crit[c]], (double)A->paths[2 * p], (double)A->paths[2 * p + 1], (double)A->m[k], 90.0 * o / (A->norient - 1), CSVLoad(A->ratio[((c * A->npaths + p) * A->nm + k) * A->norient + o])) < 0;
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/anisotropy_envelope.csv", dir));
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "criterion,m,psi_deg,continuum,lattice_min,lattice_max\n") < 0;
   for (PetscInt c = 0; c < A->ncrit; c++)
     for (PetscInt k = 0; k < A->nm; k++)
-      for (PetscInt d = 0; d < PERI_ENVELOPE_DIRECTIONS; d++) {
+      for (PetscInt d = 0; d < PERI_ENVELOPE_DIRECTIONS && c * A->nm + k < A->envelopes_done; d++) {
         const PetscReal *e = &A->envelope[((c * A->nm + k) * PERI_ENVELOPE_DIRECTIONS + d) * 3];
         bad |= fprintf(fp, "%s,%g,%g,%.8g,%.8g,%.8g\n", criteria[A->crit[c]], (double)A->m[k], 360.0 * d / PERI_ENVELOPE_DIRECTIONS, CSVLoad(e[0]), CSVLoad(e[1]), CSVLoad(e[2])) < 0;
       }
@@ -256,7 +282,7 @@ static PetscErrorCode Files_Anisotropy(PeriAnalysis an, const char dir[])
   bad |= fprintf(fp, "criterion,s1,s2,m,e_max_percent\n") < 0;
   for (PetscInt c = 0; c < A->ncrit; c++)
     for (PetscInt p = 0; p < A->npaths; p++)
-      for (PetscInt k = 0; k < A->nm; k++) bad |= fprintf(fp, "%s,%g,%g,%g,%.4f\n", criteria[A->crit[c]], (double)A->paths[2 * p], (double)A->paths[2 * p + 1], (double)A->m[k], (double)A->emax[(c * A->npaths + p) * A->nm + k]) < 0;
+      for (PetscInt k = 0; k < A->nm && (c * A->npaths + p) * A->nm + k < A->rows_done; k++) bad |= fprintf(fp, "%s,%g,%g,%g,%.4f\n", criteria[A->crit[c]], (double)A->paths[2 * p], (double)A->paths[2 * p + 1], (double)A->m[k], (double)A->emax[(c * A->npaths + p) * A->nm + k]) < 0;
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
   PetscCall(PeriPlotsDraw(an->comm, dir, "anisotropy", NULL, &an->plots));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -269,9 +295,9 @@ static PetscErrorCode Summary_Anisotropy(PeriAnalysis an, PeriJSON j)
 
   PetscFunctionBeginUser;
   if (!A || !A->emax) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt k = 0; k < A->ncrit * A->npaths * A->nm; k++) worst = PetscMax(worst, A->emax[k]);
+  for (PetscInt k = 0; k < A->rows_done; k++) worst = PetscMax(worst, A->emax[k]);
   PetscCall(PeriJSONBeginObject(j, "anisotropy"));
-  PetscCall(PeriJSONInt(j, "rows", A->ncrit * A->npaths * A->nm));
+  PetscCall(PeriJSONInt(j, "rows", A->rows_done));
   PetscCall(PeriJSONInt(j, "orientations", A->norient));
   PetscCall(PeriJSONReal(j, "largest_e_max_percent", worst));
   PetscCall(PeriJSONEndObject(j));

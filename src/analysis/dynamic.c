@@ -785,9 +785,10 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
 /* Explicit: the state [q; p] of the owned DOFs, split for TSBASICSYMPLECTIC. */
 static PetscErrorCode CreateExplicit(PeriAnalysis an, Vec *U)
 {
-  Dynamic *d = DYN(an);
-  Vec      q;
-  PetscInt n, r0;
+  Dynamic       *d = DYN(an);
+  Vec            q;
+  PetscInt       n, r0;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(VecGetLocalSize(an->sys->fields.u, &n));
@@ -795,12 +796,15 @@ static PetscErrorCode CreateExplicit(PeriAnalysis an, Vec *U)
   PetscCall(VecGetOwnershipRange(*U, &r0, NULL));
   PetscCall(ISCreateStride(an->comm, n, r0, 1, &d->isq));
   PetscCall(ISCreateStride(an->comm, n, r0 + n, 1, &d->isp));
+  /* the parts go back to U even when the initial state is refused (analysis.initial): no leak */
   PetscCall(VecGetSubVector(*U, d->isq, &q));
-  PetscCall(InitialDisplacement(an, q));
+  ierr = InitialDisplacement(an, q);
   PetscCall(VecRestoreSubVector(*U, d->isq, &q));
+  PetscCall(ierr);
   PetscCall(VecGetSubVector(*U, d->isp, &q));
-  PetscCall(InitialVelocity(an, q));
+  ierr = InitialVelocity(an, q);
   PetscCall(VecRestoreSubVector(*U, d->isp, &q));
+  PetscCall(ierr);
   PetscCall(TSSetType(d->ts, TSBASICSYMPLECTIC));
   PetscCall(TSBasicSymplecticSetType(d->ts, TSBASICSYMPLECTICVELVERLET));
   PetscCall(TSSetRHSFunction(d->ts, NULL, RHSWhole, an));
@@ -1000,10 +1004,11 @@ static const char *DriftAdvice(const Dynamic *d)
   return advice;
 }
 
-static PetscErrorCode Run_Dynamic(PeriAnalysis an)
+/* Sets up the TS (its state in *U, and *V for the implicit integrator) and integrates to t_end. */
+static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
 {
   Dynamic       *d = DYN(an);
-  Vec            U = NULL, V = NULL, q, p;
+  Vec            q, p;
   Mat            K;
   PetscLogDouble t0, t1;
   PetscReal      t;
@@ -1026,10 +1031,10 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   PetscCall(VecDuplicate(an->sys->fields.u, &d->tmp));
   PetscCall(VecDuplicate(an->sys->fields.u, &d->uprev));
   PetscCall(LoadTerms(an));
-  PetscCall(SetUpTS(an, &U, &V));
-  PetscCall(GetState(an, U, &q, &p));
+  PetscCall(SetUpTS(an, U, V));
+  PetscCall(GetState(an, *U, &q, &p));
   PetscCall(VecCopy(q, d->uprev));
-  PetscCall(RestoreState(an, U, &q, &p));
+  PetscCall(RestoreState(an, *U, &q, &p));
   for (PetscInt k = 0; k < d->nterms; k++) d->term_prev[k] = PeriAmplitudeValue(d->term_amp[k], 0);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(TSSolve(d->ts, NULL));
@@ -1039,13 +1044,27 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   PetscCall(PetscTime(&t1));
   an->sys->run.log.solve_s = t1 - t0;
   PetscCall(RecordSolver(an));
-  PetscCall(GetState(an, U, &q, &p));
+  PetscCall(GetState(an, *U, &q, &p));
   PetscCall(VecCopy(q, an->sys->fields.u));
-  PetscCall(RestoreState(an, U, &q, &p));
+  PetscCall(RestoreState(an, *U, &q, &p));
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
   if (an->sys->bond_state.failure.active) PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The run: the integration (Integrate), whose state U (and V, implicit) is freed whether it ends
+ * or fails, then the energy balance's check. */
+static PetscErrorCode Run_Dynamic(PeriAnalysis an)
+{
+  Dynamic       *d = DYN(an);
+  Vec            U = NULL, V = NULL;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  ierr = Integrate(an, &U, &V);
   PetscCall(VecDestroy(&U));
   PetscCall(VecDestroy(&V));
+  PetscCall(ierr);
   PetscCheck(an->sys->run.interrupted || d->drift <= d->energy_tol, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the energy balance (kinetic + strain + dissipated - work of the loads) drifted by %.3g of the energy scale, above analysis.energy_tolerance %g: the run is not consistent; %s", an->sys->scene->file, (double)d->drift, (double)d->energy_tol, DriftAdvice(d));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

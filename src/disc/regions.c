@@ -185,6 +185,9 @@ PetscErrorCode PeriRegionsCreateFromScene(MPI_Comm comm, PeriScene scene, const 
   PetscCall(PeriSceneGetMap(scene, scene->root, "regions", PETSC_FALSE, &map));
   n = 1 + p->ngroups + (map ? map->n : 0);
   PetscCall(PetscCalloc1(n, &r));
+  /* the caller's from here: an input error below leaves the array to its destroy (no leak) */
+  *nregions = n;
+  *regions  = r;
   PetscCall(PetscStrncpy(r[0].name, "all", sizeof(r[0].name)));
   r[0].kind = PERI_REGION_ALL;
   for (PetscInt d = 0; d < 3; d++) {
@@ -199,8 +202,6 @@ PetscErrorCode PeriRegionsCreateFromScene(MPI_Comm comm, PeriScene scene, const 
     PetscCall(RegionFromScene(scene, node, p, delta, &r[k]));
   }
   PetscCall(RegionsCount(comm, scene, p, nowned, n, r, 1 + p->ngroups));
-  *nregions = n;
-  *regions  = r;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -5,6 +5,9 @@
 #if defined(__GLIBC__)
 #  include <malloc.h>
 #endif
+#if defined(PERI_ASAN)
+#  include <sanitizer/lsan_interface.h>
+#endif
 
 PetscLogEvent PERI_EVENT_Neighbors, PERI_EVENT_Partition, PERI_EVENT_Assembly, PERI_EVENT_Solve, PERI_EVENT_MatMultFree, PERI_EVENT_Mechanisms, PERI_EVENT_Multigrid;
 PetscLogStage PERI_STAGE_Setup, PERI_STAGE_Assembly, PERI_STAGE_Solve, PERI_STAGE_Output;
@@ -44,18 +47,41 @@ PetscReal PeriHeapInUseMB(void)
   the solver's smaller arrays split: 787 -> 718 MB on the 641,601-particle plate with the
   multigrid, for 4 % more wall time (page faults of the remapped arrays); arrays below 32 MiB
   (runs below about 10^5 particles) are not affected. 0 keeps the libraries' setting
-  (docs/performance.md, issue 29 item 3). Not collective.
+  (docs/performance.md, issue 29 item 3). Under AddressSanitizer (-DPERILIN_SANITIZE=ON), whose
+  allocator ignores mallopt, nothing is set: a note when the option is given. Not collective.
 @*/
 PetscErrorCode PeriMallocInitialize(void)
 {
-  PetscInt threshold = 32 << 20;
+  PetscInt  threshold = 32 << 20;
+  PetscBool set       = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_malloc_mmap_threshold", &threshold, NULL));
-#if defined(__GLIBC__)
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_malloc_mmap_threshold", &threshold, &set));
+#if defined(PERI_ASAN)
+  /* AddressSanitizer's allocator replaces glibc's and refuses every mallopt: nothing to set */
+  if (set && threshold > 0)
+    PetscCall(PetscPrintf(PETSC_COMM_WORLD, "perilin: note: -peri_malloc_mmap_threshold %" PetscInt_FMT " has no effect: this build runs under AddressSanitizer, whose allocator ignores mallopt\n", threshold));
+  else
+    PetscCall(PetscInfo(NULL, "AddressSanitizer build: the allocator settings (-peri_malloc_mmap_threshold) are not applied\n"));
+#elif defined(__GLIBC__)
   if (threshold > 0) {
     PetscCheck(mallopt(M_MMAP_MAX, 65536) && mallopt(M_MMAP_THRESHOLD, (int)threshold) && mallopt(M_TRIM_THRESHOLD, 2 * (int)threshold), PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "-peri_malloc_mmap_threshold %" PetscInt_FMT ": glibc takes at most 32 MiB", threshold);
   }
 #endif
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Allocations of this thread between PeriLeakCheckPause(PETSC_TRUE) and PeriLeakCheckPause(PETSC_FALSE)
+ * are not leaks to LeakSanitizer (MPI's start and end keep memory to the process's end); without
+ * AddressSanitizer nothing. Not collective. */
+void PeriLeakCheckPause(PetscBool pause)
+{
+#if defined(PERI_ASAN)
+  if (pause)
+    __lsan_disable();
+  else
+    __lsan_enable();
+#else
+  (void)pause;
+#endif
 }

@@ -42,28 +42,15 @@ static PetscErrorCode TableRow(PeriScene s, PeriNode node, const char path[], ch
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* amplitude.file: every rank reads it whole (a few rows), then parses it line by line. */
-static PetscErrorCode ReadTable(PeriScene s, PeriNode node, PeriAmplitude *a)
+/* The rows of amplitude.file's text (NUL-terminated, changed in place) appended to a. */
+static PetscErrorCode ParseTable(PeriScene s, PeriNode node, const char path[], char text[], PeriAmplitude *a)
 {
-  char      path[PETSC_MAX_PATH_LEN], *text, *line, *next;
-  FILE     *fp;
-  long      len;
+  char     *line, *next;
   PetscInt  lineno = 0, cap = 0;
   PetscReal row[2];
   PetscBool isrow, header = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetPath(s, node, "file", PETSC_TRUE, path, sizeof(path), NULL));
-  fp = fopen(path, "rb");
-  PeriInputCheck(fp, s, node, "file", "cannot read %s: %s", path, strerror(errno));
-  len = fseek(fp, 0, SEEK_END) ? -1 : ftell(fp);
-  if (len < 0 || fseek(fp, 0, SEEK_SET)) len = -1;
-  text = len >= 0 ? (char *)malloc((size_t)len + 1) : NULL;
-  if (text && fread(text, 1, (size_t)len, fp) != (size_t)len) len = -1;
-  (void)fclose(fp);
-  if (len < 0 || !text) free(text);
-  PeriInputCheck(len >= 0 && text, s, node, "file", "cannot read %s", path);
-  text[len] = 0;
   for (line = text; line && *line; line = next) {
     next = strchr(line, '\n');
     if (next) *next++ = 0;
@@ -78,7 +65,33 @@ static PetscErrorCode ReadTable(PeriScene s, PeriNode node, PeriAmplitude *a)
     a->t[a->n]   = row[0];
     a->a[a->n++] = row[1];
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* amplitude.file: every rank reads it whole (a few rows), then parses it line by line. */
+static PetscErrorCode ReadTable(PeriScene s, PeriNode node, PeriAmplitude *a)
+{
+  char           path[PETSC_MAX_PATH_LEN], *text;
+  FILE          *fp;
+  long           len;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetPath(s, node, "file", PETSC_TRUE, path, sizeof(path), NULL));
+  fp = fopen(path, "rb");
+  PeriInputCheck(fp, s, node, "file", "cannot read %s: %s", path, strerror(errno));
+  len = fseek(fp, 0, SEEK_END) ? -1 : ftell(fp);
+  if (len < 0 || fseek(fp, 0, SEEK_SET)) len = -1;
+  text = len >= 0 ? (char *)malloc((size_t)len + 1) : NULL;
+  if (text && fread(text, 1, (size_t)len, fp) != (size_t)len) len = -1;
+  (void)fclose(fp);
+  if (len < 0 || !text) free(text);
+  PeriInputCheck(len >= 0 && text, s, node, "file", "cannot read %s", path);
+  text[len] = 0;
+  /* the text is freed whether its rows parse or not (an input error) */
+  ierr = ParseTable(s, node, path, text, a);
   free(text);
+  PetscCall(ierr);
   PeriInputCheck(a->n >= 1, s, node, "file", "%s holds no 'time, amplitude' row", path);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -239,6 +239,25 @@ static PetscBool SegmentMeetsBox(const PetscReal s[], const PetscReal lo[], cons
   return t0 <= t1 ? PETSC_TRUE : PETSC_FALSE;
 }
 
+/* The segments of cracks: (list) into seg[4 k ..]: from, to. Not collective. */
+static PetscErrorCode ReadSegments(PeriSystem sys, PeriNode list, PetscReal seg[])
+{
+  PeriScene s = sys->scene;
+  PetscInt  n;
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < list->n; c++) {
+    PeriNode item = list->child[c];
+    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a crack is a segment {from: [x, y], to: [x, y]}");
+    PetscCall(PeriSceneCheckSection(s, item, "cracks.<k>"));
+    PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
+    PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
+    PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");
+    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], sys->disc.particles.lower, sys->disc.particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)sys->disc.particles.lower[0], (double)sys->disc.particles.upper[0], (double)sys->disc.particles.lower[1], (double)sys->disc.particles.upper[1]);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriCracksApply - reads cracks: (2D segments {from: [x, y], to: [x, y]}) and removes every bond
   that crosses one, before the family volumes and the calibration see the body. Collective.
@@ -248,7 +267,7 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
   PeriScene  s = sys->scene;
   PeriNode   list;
   PetscReal *seg;
-  PetscInt   cut, n;
+  PetscInt   cut;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "cracks", &list));
@@ -256,14 +275,11 @@ PetscErrorCode PeriCracksApply(PeriSystem sys)
   PeriInputCheck(list->kind == PERI_NODE_SEQ, s, list, NULL, "must be a list of segments, each {from: [x, y], to: [x, y]}");
   PeriInputCheck(sys->disc.particles.dim == 2, s, list, NULL, "cracks are 2D segments; 3D scenes cannot have them yet");
   PetscCall(PetscMalloc1(4 * list->n, &seg));
-  for (PetscInt c = 0; c < list->n; c++) {
-    PeriNode item = list->child[c];
-    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a crack is a segment {from: [x, y], to: [x, y]}");
-    PetscCall(PeriSceneCheckSection(s, item, "cracks.<k>"));
-    PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
-    PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
-    PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");
-    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], sys->disc.particles.lower, sys->disc.particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)sys->disc.particles.lower[0], (double)sys->disc.particles.upper[0], (double)sys->disc.particles.lower[1], (double)sys->disc.particles.upper[1]);
+  {
+    /* an input error frees the segments before it is passed on (LeakSanitizer) */
+    PetscErrorCode ierr = ReadSegments(sys, list, seg);
+    if (ierr) PetscCall(PetscFree(seg));
+    PetscCall(ierr);
   }
   cut = CutBonds(&sys->disc.particles, &sys->disc.bonds, list->n, seg);
   if (sys->disc.family.offset) CutBonds(&sys->disc.particles, &sys->disc.family, list->n, seg);

@@ -35,6 +35,9 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
     char pc[64] = PCGAMG;
     PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc, sizeof(pc), NULL));
     *mf = PeriOperatorServesPC(pc);
+    /* the patch calibration may make springs negative (an irregular family's correction), which
+       the operator cannot apply: auto takes K assembled (matrix_free still tries, and says so) */
+    if (sys->model->calibration == PERI_CALIBRATION_PATCH) *mf = PETSC_FALSE;
   }
   if (sys->stiffness.operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriSceneGetMap(sys->scene, sys->scene->root, "solver", PETSC_FALSE, &node));

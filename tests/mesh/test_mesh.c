@@ -42,6 +42,19 @@ static PetscErrorCode CountElements(const char mesh[], PetscInt dim, PetscInt *n
       if (on >= dim) (*left)++;
     }
   }
+  /* the arrays Gmsh's C API returns are the caller's */
+  for (size_t t = 0; t < ntypes; t++) {
+    gmshFree(et[t]);
+    gmshFree(nt[t]);
+  }
+  gmshFree(types);
+  gmshFree(et);
+  gmshFree(net);
+  gmshFree(nt);
+  gmshFree(nnt);
+  gmshFree(tags);
+  gmshFree(xyz);
+  gmshFree(par);
   gmshFinalize(&ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

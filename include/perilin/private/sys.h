@@ -22,6 +22,18 @@ PETSC_EXTERN const char    *PeriBuildVersion(void);
 PETSC_EXTERN PetscReal      PeriPeakMemoryMB(void);
 PETSC_EXTERN PetscReal      PeriHeapInUseMB(void);
 PETSC_EXTERN PetscErrorCode PeriMallocInitialize(void);
+/* PERI_ASAN: built with AddressSanitizer (-DPERILIN_SANITIZE=ON, tests/sanitize/run.sh): GCC's
+ * macro, clang's feature */
+#if defined(__SANITIZE_ADDRESS__)
+#  define PERI_ASAN 1
+#elif defined(__has_feature)
+#  if __has_feature(address_sanitizer)
+#    define PERI_ASAN 1
+#  endif
+#endif
+/* under LeakSanitizer, allocations between PeriLeakCheckPause(PETSC_TRUE) and (PETSC_FALSE), in
+ * this thread, are never reported as leaks (MPI's own, at start and end); elsewhere nothing */
+PETSC_EXTERN void PeriLeakCheckPause(PetscBool);
 
 /* the status line of a long run on a terminal (src/sys/progress.c): its slots, left to right */
 typedef enum {
