@@ -24,4 +24,8 @@ for name in plate_hole plate_hole_graded; do
   "$py" "$here/kt.py" "$out/continuum" || fail=1
   "$py" "$here/kt.py" "$out/lattice" "$out/lattice2" || fail=1
 done
+# lps at nu = 0.3 on the graded mesh: per-particle horizons, a state-based model (docs/models/lps.md)
+out=$tmp/lps_graded
+"$exe" "$ex/mesh/plate_hole_graded.yaml" "${opts[@]}" -model_type lps -material_nu 0.3 -corrections_surface none -output_dir "$out" > /dev/null || exit 1
+"$py" "$here/kt.py" "$out" || fail=1
 exit $fail
