@@ -3,7 +3,8 @@
 # concentration 3.03 within 8 % (tests/mesh/kt.py: Kt extrapolated to the hole's edge by a fit of
 # Kirsch's near field), with the continuum and the lattice calibration, from the bond-force and
 # the elastic stress; on 2 ranks the same Kt to 1e-6. Issue 27: the same for the graded mesh
-# (examples/mesh/plate_hole_graded.yaml, 44 % of the particles). Needs python3-vtk9 (else
+# (examples/mesh/plate_hole_graded.yaml, 44 % of the particles). Issue 37: lps at nu = 0.3 on the
+# graded mesh (per-particle horizons, a state-based model). Needs python3-vtk9 (else
 # skipped, exit 77).
 # Usage: kt.sh PERILIN EXAMPLES_DIR
 set -u
