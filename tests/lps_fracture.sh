@@ -5,7 +5,9 @@
 # 130.6 Pa does not depend on nu (docs/failure.md); lps with the critical stretch of Madenci &
 # Oterkus (docs/models/lps.md) gives, at this dx, 129.3 Pa at nu = 0.2 (-1.0 %) and 139.9 Pa at
 # nu = 0.45 (+7.2 %): both within 8 % of 130.6 Pa; and 2 ranks break the same bonds at the same
-# loads as 1.
+# loads as 1. And dynamic fracture (tests/scenes/dynamic_crack.yaml, explicit, nu = 0.3): bonds
+# break and the energy balance closes (drift < 1 %: the broken bonds' energy, states included, is
+# K's energy before and after).
 # Usage: lps_fracture.sh PERILIN REPO
 set -u
 exe=${1:?usage: lps_fracture.sh PERILIN REPO}
@@ -23,6 +25,7 @@ run() { # name, command...
 run nu20 "$exe" "${plate[@]}" -material_nu 0.2
 run nu45 "$exe" "${plate[@]}" -material_nu 0.45
 run nu45r2 mpiexec --oversubscribe -n 2 "$exe" "${plate[@]}" -material_nu 0.45
+run dyn "$exe" "$repo/tests/scenes/dynamic_crack.yaml" -model_type lps -material_nu 0.3
 [ $fail = 0 ] || exit 1
 python3 - "$tmp" << 'PY'
 import json, sys
@@ -37,5 +40,9 @@ for n, nu in (("nu20", 0.2), ("nu45", 0.45)):
 same = all(q["nu45"][k] == q["nu45r2"][k] for k in ("peak_load_factor", "critical_load_factor", "broken_bonds", "steps"))
 bad |= not same
 print(("ok: " if same else "FAIL: ") + f"lps nu = 0.45 on 2 ranks: the same loads and {q['nu45r2']['broken_bonds']} broken bonds as on 1")
+d = json.load(open(f"{tmp}/dyn/summary.json"))["dynamic"]
+ok = d["broken_bonds"] > 1000 and d["energy_drift"] < 0.01
+bad |= not ok
+print(("ok: " if ok else "FAIL: ") + f"lps dynamic crack: {d['broken_bonds']} bonds broken, energy drift {d['energy_drift']:.2g} (tolerance 0.01)")
 sys.exit(bad)
 PY
