@@ -46,6 +46,12 @@ PETSC_EXTERN PetscErrorCode PeriProblemReport(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriProblemInterrupted(PeriProblem, int *);
 PETSC_EXTERN PetscErrorCode PeriProblemDestroy(PeriProblem *);
 
+/* The first error's message as perilin states it (src/package.c): PeriErrorCapture is the error
+ * handler that keeps it. */
+PETSC_EXTERN PetscErrorCode PeriErrorCapture(MPI_Comm, int, const char *, const char *, PetscErrorCode, PetscErrorType, const char *, void *);
+PETSC_EXTERN const char    *PeriErrorFirst(void);
+PETSC_EXTERN void           PeriErrorReset(void);
+
 /* Embedding (src/embed.c): perilin in another program's PETSc session, as the Python module
  * (python/perilin_ext.c, docs/python.md) runs it. */
 PETSC_EXTERN PetscErrorCode PeriInitializeEmbedded(void);

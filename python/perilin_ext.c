@@ -11,27 +11,11 @@
 
 static PyObject *PerilinError; /* perilin.Error */
 
-/* The first error's message, as the command line prints it (src/main.c, CaptureError). */
-static char first_error[4096];
-
-static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
-{
-  (void)comm;
-  (void)ctx;
-  if (p == PETSC_ERROR_INITIAL && !first_error[0]) {
-    if (n == PETSC_ERR_USER_INPUT || n == PETSC_ERR_NOT_CONVERGED)
-      PetscSNPrintf(first_error, sizeof(first_error), "%s", mess ? mess : "invalid input");
-    else
-      PetscSNPrintf(first_error, sizeof(first_error), "%s (PETSc error %d in %s() at %s:%d)", mess ? mess : "error", (int)n, fun, file, line);
-  }
-  return n;
-}
-
 /* Calls into perilin run between Begin and End: the error handler returns the error to here. */
 static void Begin(void)
 {
-  first_error[0] = 0;
-  (void)PetscPushErrorHandler(CaptureError, NULL);
+  PeriErrorReset();
+  (void)PetscPushErrorHandler(PeriErrorCapture, NULL); /* the first error's message, as the command line prints it */
 }
 
 /* NULL with perilin.Error set when ierr, else Py_None (a new reference). */
@@ -39,7 +23,7 @@ static PyObject *End(PetscErrorCode ierr)
 {
   (void)PetscPopErrorHandler();
   if (!ierr) Py_RETURN_NONE;
-  PyErr_SetString(PerilinError, first_error[0] ? first_error : "PETSc error");
+  PyErr_SetString(PerilinError, PeriErrorFirst()[0] ? PeriErrorFirst() : "PETSc error");
   return NULL;
 }
 

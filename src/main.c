@@ -120,22 +120,6 @@ static PetscErrorCode CheckSceneFirst(int argc, char **argv)
   SETERRQ(PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "the scene file comes first, then the options: perilin %s", order);
 }
 
-/* The first error's message, printed once by main instead of PETSc's traceback. */
-static char first_error[4096];
-
-static PetscErrorCode CaptureError(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
-{
-  (void)comm;
-  (void)ctx;
-  if (p == PETSC_ERROR_INITIAL && !first_error[0]) {
-    if (n == PETSC_ERR_USER_INPUT || n == PETSC_ERR_NOT_CONVERGED)
-      PetscSNPrintf(first_error, sizeof(first_error), "%s", mess ? mess : "invalid input");
-    else
-      PetscSNPrintf(first_error, sizeof(first_error), "%s (PETSc error %d in %s() at %s:%d)", mess ? mess : "error", (int)n, fun, file, line);
-  }
-  return n;
-}
-
 /* -scene_doc_update FILE rewrites the key tables of docs/scene.md from the declared keys;
  * -scene_doc_check FILE fails when they are out of date (the scene_doc test). *done: either ran. */
 static PetscErrorCode SceneDoc(PetscBool *done)
@@ -217,7 +201,7 @@ int main(int argc, char **argv)
   if (mode == MODE_HELP_PETSC) PetscHelpPrintf = GatherPetscHelp;
   PetscCall(PeriInitialize(&argc, &argv, NULL)); /* the usage is perilin's help, PeriPrintHelp */
   PetscHelpPrintf = PetscHelpPrintfDefault;
-  PetscCall(PetscPushErrorHandler(CaptureError, NULL));
+  PetscCall(PetscPushErrorHandler(PeriErrorCapture, NULL)); /* the first error's message, printed once below instead of PETSc's traceback */
   ierr = Run(argc, argv, mode, &p, &status);
   PetscCall(PetscPopErrorHandler());
   if (ierr) {
@@ -227,7 +211,7 @@ int main(int argc, char **argv)
     if (rank == 0) PeriOutputSetDiscard(); /* the previous results stay as they were */
     all = size == 1 ? PETSC_TRUE : EveryRankFailed();
     /* through PETSc's printer, which first erases a status line on the terminal (src/sys/progress.c) */
-    if (rank == 0 || !all) (void)PetscFPrintf(PETSC_COMM_SELF, stderr, "perilin: error: %s\n", first_error[0] ? first_error : "unknown error");
+    if (rank == 0 || !all) (void)PetscFPrintf(PETSC_COMM_SELF, stderr, "perilin: error: %s\n", PeriErrorFirst()[0] ? PeriErrorFirst() : "unknown error");
     if (!all) MPI_Abort(PETSC_COMM_WORLD, 1);
     /* every rank is here: free what the run held, so that -malloc_dump shows real leaks only */
     PetscCall(PetscPushErrorHandler(PetscIgnoreErrorHandler, NULL));

@@ -247,3 +247,37 @@ PetscErrorCode PeriSceneDoc(MPI_Comm comm, const char file[], PetscBool check)
   PetscCall(PeriSceneDocUpdate(comm, file, check, n, owners));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The first error's message since PeriErrorReset, as perilin states it: input and convergence
+ * errors by their message alone, others with PETSc's code and place. */
+static char first_error[4096];
+
+/*@C
+  PeriErrorCapture - a PETSc error handler (PetscPushErrorHandler) that keeps the first error's
+  message for PeriErrorFirst and returns the error: the executable prints it once instead of
+  PETSc's traceback, the Python module raises it as perilin.Error. Not collective.
+@*/
+PetscErrorCode PeriErrorCapture(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
+{
+  (void)comm;
+  (void)ctx;
+  if (p == PETSC_ERROR_INITIAL && !first_error[0]) {
+    if (n == PETSC_ERR_USER_INPUT || n == PETSC_ERR_NOT_CONVERGED)
+      PetscSNPrintf(first_error, sizeof(first_error), "%s", mess ? mess : "invalid input");
+    else
+      PetscSNPrintf(first_error, sizeof(first_error), "%s (PETSc error %d in %s() at %s:%d)", mess ? mess : "error", (int)n, fun, file, line);
+  }
+  return n;
+}
+
+/* The message PeriErrorCapture kept ("" when none). */
+const char *PeriErrorFirst(void)
+{
+  return first_error;
+}
+
+/* Forgets the kept message: the next error's is kept. */
+void PeriErrorReset(void)
+{
+  first_error[0] = 0;
+}
