@@ -18,6 +18,7 @@ tests=(
   plate_traction plate_traction_2ranks             # static, matrix-free, 1 and 2 ranks
   affine_npmb_3d_2ranks                            # 3D, assembled, 2 ranks
   model_contract                                   # every model type
+  lammps_lps_2ranks affine_lps_2d_stress           # lps: the state term matrix-free and assembled (B^T D B), 2 ranks
   mesh_read_tet_2ranks mesh_import_inp_tri         # Gmsh meshes; meshio's readers (a child process)
   csv_particles_npmb_2ranks                        # CSV particles
   analysis_setup                                   # the setup analysis, 1 and 2 ranks
