@@ -716,14 +716,13 @@ static PetscErrorCode SetUpStates(PeriSystem sys, PeriOperator op)
 {
   Vec                al;
   const PetscScalar *a;
+  PetscScalar       *w;
 
   PetscFunctionBeginUser;
   PetscCall(VecCreateGhost(sys->comm, op->nloc, PETSC_DECIDE, op->nghost, op->ghost, &op->theta));
-  PetscCall(VecGhostGetLocalForm(op->theta, &al));
-  PetscCall(VecGetArray(al, (PetscScalar **)&a));
-  for (PetscInt i = 0; i < op->nloc; i++) ((PetscScalar *)a)[i] = sys->model->ops.state_modulus(sys->model, i);
-  PetscCall(VecRestoreArray(al, (PetscScalar **)&a));
-  PetscCall(VecGhostRestoreLocalForm(op->theta, &al));
+  PetscCall(VecGetArrayWrite(op->theta, &w));
+  for (PetscInt i = 0; i < op->nloc; i++) w[i] = sys->model->ops.state_modulus(sys->model, i);
+  PetscCall(VecRestoreArrayWrite(op->theta, &w));
   PetscCall(VecGhostUpdateBegin(op->theta, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGhostUpdateEnd(op->theta, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(PetscMalloc1(op->nloc + op->nghost, &op->A));
