@@ -2,7 +2,7 @@
 other outputs: summary.json, steps.csv, modes.csv; and a run on several ranks (VTK's parallel
 format, issue 17 item 4) against the same run on one.
 
-usage: vtk_read.py static|modal|quasistatic OUTPUT_DIR EVERY RANKS [ONE_RANK_OUTPUT_DIR]
+usage: vtk_read.py static|modal|quasistatic|dynamic OUTPUT_DIR EVERY RANKS [ONE_RANK_OUTPUT_DIR]
 
 VTK has no PVD reader outside ParaView (vtkPVDReader is ParaView's), so a .pvd collection is
 parsed with Python's xml module, as its format is plain XML, and every file it names is opened
@@ -38,7 +38,7 @@ CONDITIONS = ("fixed", "prescribed_displacement", "applied_force", "region_")
 # Modal: the shapes come from shift-and-invert solved by a direct factorization and converge to
 # SLEPc's default tolerance 1e-8 in the residual, which bounds a shape's error by about that over
 # the relative gap to the next frequency (a few per cent in lamina/modal.yaml): 1e-6.
-RTOL = {"static": 1e-8, "quasistatic": 1e-8, "modal": 1e-6}
+RTOL = {"static": 1e-8, "quasistatic": 1e-8, "modal": 1e-6, "dynamic": 1e-8}
 
 
 def check(ok, what):
@@ -198,11 +198,32 @@ def compare(out, ref, name, rtol):
     if bad:
         print("    beyond %g: %s" % (rtol, bad))
 
+def dynamic(out, summary):
+    """A transient run's series: a frame every EVERY steps and at the last (EVERY 0: perilin's
+    default of 25 frames over t_end), each frame's velocity against history.csv's kinetic energy
+    of its time (1/2 sum rho V |v|^2: the field is the state the energies describe), the last
+    frame equal to particles.vtu."""
+    with open(os.path.join(out, "history.csv")) as f:
+        hist = {float(r["time"]): float(r["kinetic"]) for r in csv.DictReader(f)}
+    steps, dt = summary["dynamic"]["steps"], summary["dynamic"]["dt"]
+    every = int(sys.argv[3]) or -(-steps // 25)
+    ks = list(range(0, steps + 1, every)) + ([steps] if steps % every else [])
+    frames = check_frames(out, "particles.pvd", [k * dt for k in ks], ["particles_%04d.%s" % (n, EXT) for n in range(len(ks))], summary, 1e-9)
+    rho = summary["material"]["rho"]
+    for t, f in frames:
+        g = read_vtu(os.path.join(out, f))
+        v, V = array(g, "velocity"), array(g, "volume")
+        T = 0.5 * rho * float((V * (v * v).sum(axis=1)).sum())
+        ref = min(hist, key=lambda h: abs(h - t))
+        check(close(T, hist[ref], 1e-8), "%s: 1/2 sum rho V |v|^2 = %.10g, history.csv kinetic at t = %g: %.10g" % (f, T, ref, hist[ref]))
+    end, last = read_vtu(os.path.join(out, "particles." + EXT)), read_vtu(os.path.join(out, frames[-1][1]))
+    check((array(end, "velocity") == array(last, "velocity")).all() and (array(end, "displacement") == array(last, "displacement")).all(), "the last frame shows particles.vtu's displacement and velocity")
+
 
 def compare_run(kind, out, ref, rtol):
     """The particle file and every frame of the run's series."""
     names = ["particles." + EXT]
-    pvd = {"modal": "modes.pvd", "quasistatic": "particles.pvd"}.get(kind)
+    pvd = {"modal": "modes.pvd", "quasistatic": "particles.pvd", "dynamic": "particles.pvd"}.get(kind)
     if pvd and os.path.exists(os.path.join(out, pvd)):
         names += [f for _, f in read_pvd(os.path.join(out, pvd)) if f not in names]
     for n in names:
@@ -218,7 +239,7 @@ def main():
         summary = json.load(f)
     other = os.path.join(out, "particles." + ("vtu" if RANKS > 1 else "pvtu"))
     check(not os.path.exists(other), "%d rank(s): no %s" % (RANKS, os.path.basename(other)))
-    {"static": static, "modal": modal, "quasistatic": quasistatic}[kind](out, summary)
+    {"static": static, "modal": modal, "quasistatic": quasistatic, "dynamic": dynamic}[kind](out, summary)
     if len(sys.argv) > 5:
         compare_run(kind, out, sys.argv[5], RTOL[kind])
     sys.exit(1 if failures else 0)

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # perilin's particles.vtu and .pvd series read by VTK's own Python readers (issue 16, item 7;
-# tests/vtk_read.py): a static, a modal and a quasi-static run, each checked against its
+# tests/vtk_read.py): a static, a modal, a quasi-static and a dynamic run, each checked against its
 # summary.json, modes.csv and steps.csv; then the same runs on 2 ranks (with MPIRUN), whose
 # particles.pvtu, mode_NN.pvtu and particles_NNNN.pvtu (one piece per rank, issue 17 item 4) are
 # read with VTK's parallel reader, checked the same way and against the one-rank run's arrays. A
@@ -46,4 +46,7 @@ run modal_target modal lamina/modal.yaml -analysis_target_hz 3000
 # (the peak and the state after its cascade) at nearly the same load factor
 every=3 compare=1 run quasistatic quasistatic fracture/edge_crack.yaml -grid_spacing 0.04 -quiet -output_every 3
 every=2 compare=1 run quasistatic_events quasistatic antiplane/cracked_bar.yaml -grid_spacing 0.04 -quiet -output_every 2 -analysis_stepping events
+# a transient run: 25 frames by default, each with its velocity (issue 38, item 5); then every 7
+every=0 compare=1 run dynamic dynamic dynamics/pulse.yaml -analysis_t_end 10 -output_vtk true
+every=7 run dynamic_every dynamic dynamics/pulse.yaml -analysis_t_end 10 -output_vtk true -output_every 7
 exit $fail

@@ -15,6 +15,7 @@ static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
 static const char *const dyn_profiles[]    = {"gaussian", "cosine", NULL};
 
 #define PERI_DYN_MAX_TERMS  16 /* load terms with amplitudes of their own, plus one */
+#define DYN_FRAMES          25 /* snapshots over t_end by default (output.every 0) */
 #define DYN_HISTORY_COLUMNS 11 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe, wave front, damage front */
 
 typedef struct {
@@ -55,6 +56,7 @@ typedef struct {
   PetscReal  wave_front, damage_front;                /* the farthest distance from the origin along the axis of a particle past them */
   PetscReal  t_prev, pulse_pos, probe_u;              /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
   PetscInt   nhist, cap, nsnap;
+  PetscInt   every;            /* a snapshot every k steps: output.every, or DYN_FRAMES over the run */
   PetscReal *hist, *snap_time; /* rank 0 keeps them; every rank counts */
   Vec        minv, uprev, tmp; /* 1/m per DOF (0 on held DOFs), the last step's u, work */
   Mat        J;                /* implicit: K + shift M with the held rows and columns eliminated */
@@ -116,7 +118,7 @@ static const PeriKey dyn_fronts_keys[] = {
 };
 /* output.every, which the snapshots follow (problem.c reads it with output.*) */
 static const PeriKey dyn_output_keys[] = {
-    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "also write particles_NNNN.vtu every k time steps, indexed by particles.pvd with the time (0: only the end)"},
+    {"every", PERI_KEY_INT, "0", "[0, inf)", NULL, NULL, "with output.vtk, also write particles_NNNN.vtu every k time steps and at the last, indexed by particles.pvd with the time (0: about 25 frames over t_end)"},
     {NULL},
 };
 static const PeriSchema dyn_schema[] = {
@@ -606,17 +608,18 @@ static PetscErrorCode PostStep(TS ts)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* particles_NNNN.vtu of the present state, through the problem's snapshot callback. */
-static PetscErrorCode WriteSnapshot(PeriAnalysis an, Vec q, PetscReal t)
+/* particles_NNNN.vtu of the present state (q, p), through the problem's snapshot callback. */
+static PetscErrorCode WriteSnapshot(PeriAnalysis an, Vec q, Vec p, PetscReal t)
 {
   Dynamic *d = DYN(an);
   char     name[64];
 
   PetscFunctionBeginUser;
+  if (!an->vtk || !an->snapshot) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecCopy(q, an->sys->fields.u));
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
+  PetscCall(PeriSystemKeepVelocity(an->sys, p));
   if (an->sys->bond_state.failure.active) PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
-  if (!an->vtk || !an->every || !an->snapshot) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscRealloc(sizeof(PetscReal) * (d->nsnap + 1), &d->snap_time));
   d->snap_time[d->nsnap] = t;
   PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT, d->nsnap++));
@@ -757,13 +760,15 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   Vec          q, p;
   PetscReal    balance;
   PetscInt     last;
+  PetscBool    snap;
 
   PetscFunctionBeginUser;
   PetscCall(GetState(an, U, &q, &p));
   PetscCall(Work(an, q, t));
   PetscCall(TSGetMaxSteps(ts, &last));
   d->nsteps = step;
-  if (step % d->energy_every && step < last) { /* not a step that checks the balance */
+  snap      = (PetscBool)(step % d->every == 0 || step >= last);
+  if (step % d->energy_every && step < last && !snap) { /* not a step that checks the balance */
     PetscCall(RestoreState(an, U, &q, &p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -778,7 +783,7 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   d->error = PetscMax(d->error, PetscAbsReal(balance - d->E0));
   d->drift = d->scale > 0 ? d->error / d->scale : 0;
   PetscCall(RecordHistory(d, t, balance));
-  if (an->every && step % an->every == 0) PetscCall(WriteSnapshot(an, q, t));
+  if (snap) PetscCall(WriteSnapshot(an, q, p, t));
   PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", t = %g of %g, %" PetscInt_FMT " bonds broken", step, (double)t, (double)d->t_end, d->broken));
   PetscCall(RestoreState(an, U, &q, &p));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -883,6 +888,8 @@ static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(TSGetTimeStep(d->ts, &d->dt));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
   if (!given) PetscCall(TSSetMaxSteps(d->ts, (PetscInt)PetscCeilReal(d->t_end / d->dt - 1e-9)));
+  PetscCall(TSGetMaxSteps(d->ts, &d->every));
+  d->every = an->every ? an->every : PetscMax(1, (d->every + DYN_FRAMES - 1) / DYN_FRAMES);
   PetscCall(PeriSceneGetNode(an->sys->scene->root, "analysis", &a));
   /* analysis.dt or -ts_dt, held to the limit before any step */
   PeriInputCheck(d->implicit || d->dt <= d->dt_limit, an->sys->scene, a, "dt", "%g (or -ts_dt) is above the explicit stability limit 2/omega_max = %g (omega_max^2 <= %g by Gershgorin's bound on M^-1 K): use dt <= %g, or integrator: implicit", (double)d->dt, (double)d->dt_limit, (double)d->omega2_max, (double)d->dt_limit);
@@ -1048,6 +1055,7 @@ static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(RecordSolver(an));
   PetscCall(GetState(an, *U, &q, &p));
   PetscCall(VecCopy(q, an->sys->fields.u));
+  PetscCall(PeriSystemKeepVelocity(an->sys, p));
   PetscCall(RestoreState(an, *U, &q, &p));
   PetscCall(PeriSystemEvaluateEnergy(an->sys));
   if (an->sys->bond_state.failure.active) PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));

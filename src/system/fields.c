@@ -225,21 +225,33 @@ static PetscErrorCode ShearStresses(PeriSystem sys, const PetscScalar u[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* sys->fields.u_owned: this rank's particles' DOFs, from the distributed sys->fields.u (no gather), so that its
- * piece of the output shows the state the other results describe. */
-static PetscErrorCode KeepOwnedSolution(PeriSystem sys)
+/* *owned: this rank's particles' DOFs of the distributed v (no gather), so that its piece of the
+ * output shows the state the other results describe. */
+static PetscErrorCode KeepOwned(PeriSystem sys, Vec v, PetscReal **owned)
 {
-  const PetscScalar *u;
+  const PetscScalar *a;
   PetscInt           nl;
 
   PetscFunctionBeginUser;
-  PetscCall(VecGetLocalSize(sys->fields.u, &nl));
-  PetscCheck(nl == (sys->disc.bonds.rend - sys->disc.bonds.rstart) * sys->model->dofs, PETSC_COMM_SELF, PETSC_ERR_PLIB, "The solution's local size %" PetscInt_FMT " is not the owned particles' DOFs", nl);
-  PetscCall(PetscFree(sys->fields.u_owned));
-  PetscCall(PetscMalloc1(nl, &sys->fields.u_owned));
-  PetscCall(VecGetArrayRead(sys->fields.u, &u));
-  for (PetscInt k = 0; k < nl; k++) sys->fields.u_owned[k] = PetscRealPart(u[k]);
-  PetscCall(VecRestoreArrayRead(sys->fields.u, &u));
+  PetscCall(VecGetLocalSize(v, &nl));
+  PetscCheck(nl == (sys->disc.bonds.rend - sys->disc.bonds.rstart) * sys->model->dofs, PETSC_COMM_SELF, PETSC_ERR_PLIB, "The state's local size %" PetscInt_FMT " is not the owned particles' DOFs", nl);
+  PetscCall(PetscFree(*owned));
+  PetscCall(PetscMalloc1(nl, owned));
+  PetscCall(VecGetArrayRead(v, &a));
+  for (PetscInt k = 0; k < nl; k++) (*owned)[k] = PetscRealPart(a[k]);
+  PetscCall(VecRestoreArrayRead(v, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemKeepVelocity - the velocities v (the layout of sys->fields.u) of the state the output
+  describes: particles.vtu's "velocity" (translations) and "velocity_<component>" (the others).
+  Not collective.
+@*/
+PetscErrorCode PeriSystemKeepVelocity(PeriSystem sys, Vec v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(KeepOwned(sys, v, &sys->fields.v_owned));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -280,7 +292,7 @@ PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem sys)
   PetscCallMPI(MPI_Allreduce(&E.energy, &sys->fields.strain_energy, 1, MPIU_REAL, MPI_SUM, sys->comm));
   if (PeriModelOutOfPlane(sys->model)) PetscCall(ShearStresses(sys, u));
   PetscCall(PeriSystemEvaluateStress(sys, u));
-  PetscCall(KeepOwnedSolution(sys));
+  PetscCall(KeepOwned(sys, sys->fields.u, &sys->fields.u_owned));
   PetscCall(ProbesEvaluate(sys, u));
   PetscCall(PeriTorsionEvaluate(sys));
   sys->fields.has_solution = PETSC_TRUE;
@@ -313,6 +325,7 @@ PetscErrorCode PeriSystemAddFields(PeriSystem sys, PeriFieldList fl)
   PetscCall(PeriFieldListAddInt(fl, "neighbors", sys->disc.neighbor_count));
   if (sys->disc.horizon) PetscCall(PeriFieldListAddReal(fl, "horizon", 1, sys->disc.horizon, 1, NULL)); /* per-particle horizons */
   PetscCall(PeriFieldListAddIntConstant(fl, "rank", sys->rank));
+  if (sys->fields.v_owned) PetscCall(PeriFieldListAddSolution(fl, "velocity", sys->model->dofs, sys->model->components, sys->model->axis, sys->fields.v_owned));
   if (sys->fields.W) PetscCall(PeriFieldListAddReal(fl, "strain_energy_density", 1, sys->fields.W, 1, NULL));
   if (sys->fields.tau) {
     const PetscInt tmap[3] = {0, 1, -1}, nmap = 2;
@@ -411,5 +424,6 @@ PetscErrorCode PeriFieldsDestroy(PeriFields *F)
   PetscCall(PetscFree(F->probes));
   PetscCall(PetscFree(F->W));
   PetscCall(PetscFree(F->u_owned));
+  PetscCall(PetscFree(F->v_owned));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

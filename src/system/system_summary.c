@@ -36,6 +36,7 @@ PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
   PetscCall(PeriJSONReal(j, "nu", m->material.nu));
   PetscCall(PeriJSONReal(j, "K", m->material.K));
   PetscCall(PeriJSONReal(j, "G", m->material.G));
+  if (m->material.rho > 0) PetscCall(PeriJSONReal(j, "rho", m->material.rho)); /* given: the mass of a transient or modal run */
   PetscCall(PeriJSONEndObject(j));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

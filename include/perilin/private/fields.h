@@ -41,6 +41,7 @@ typedef struct {
 typedef struct {
   Vec           u, f;                    /* the displacements (every DOF, global layout) and the reference loads */
   PetscReal    *u_owned;                 /* the same state's DOFs of the owned particles: this rank's piece of the output */
+  PetscReal    *v_owned;                 /* their velocities (transient analyses: PeriSystemKeepVelocity), else NULL */
   PetscBool     has_solution;            /* the fields below describe a solution */
   PetscReal    *W;                       /* strain energy density per owned particle, after the solve */
   PetscReal    *tau;                     /* antiplane models, per owned particle: tau_xz, tau_yz, |tau| after the solve */
@@ -56,6 +57,7 @@ typedef struct {
 } PeriFields;
 
 PETSC_EXTERN PetscErrorCode PeriSystemEvaluateEnergy(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemKeepVelocity(PeriSystem, Vec);
 PETSC_EXTERN PetscErrorCode PeriSystemLocalDOFs(PeriSystem, Vec, PetscScalar **);
 PETSC_EXTERN PetscErrorCode PeriSystemFindProbe(PeriSystem, const char[], PeriProbe **);
 PETSC_EXTERN PetscErrorCode PeriReadProbes(PeriSystem);
