@@ -63,6 +63,8 @@ check "$tmp/modal" "modes.png"
 run an examples/failure/anisotropy.yaml "${an_small[@]}"
 check "$tmp/an" "anisotropy_envelope.png anisotropy_polar.png"
 for f in anisotropy_polar.csv anisotropy_envelope.csv; do [ -s "$tmp/an/$f" ] || bad "no $f"; done
+run dyn examples/dynamics/pulse.yaml -analysis_t_end 5 -output_vtk true
+check "$tmp/dyn" "dynamics.png"
 
 # 2. two ranks: rank 0 draws the shapes from the pieces
 if [ ${#mpirun[@]} -gt 0 ]; then

@@ -1104,7 +1104,21 @@ static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* history.csv, and with snapshots particles.pvd over the physical time. */
+/* dynamics.png from history.csv and particles.vtu (output.plots). */
+static PetscErrorCode DrawPlots(PeriAnalysis an, const char dir[])
+{
+  Dynamic    *d = DYN(an);
+  char        arg[2][64];
+  const char *args[3] = {arg[0], arg[1], NULL};
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(arg[0], sizeof(arg[0]), "integrator=%s", d->implicit ? "implicit" : "explicit"));
+  PetscCall(PetscSNPrintf(arg[1], sizeof(arg[1]), "drift=%.2g", (double)d->drift));
+  PetscCall(PeriPlotsDraw(an->comm, dir, "dynamic", args, &an->plots));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* history.csv, dynamics.png, and with snapshots particles.pvd over the physical time. */
 static PetscErrorCode Files_Dynamic(PeriAnalysis an, const char dir[])
 {
   Dynamic *d = DYN(an);
@@ -1113,6 +1127,7 @@ static PetscErrorCode Files_Dynamic(PeriAnalysis an, const char dir[])
   PetscFunctionBeginUser;
   if (!d->started) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(WriteHistory(an, dir));
+  PetscCall(DrawPlots(an, dir));
   if (!d->nsnap || an->rank) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc1(d->nsnap, &files));
   for (PetscInt k = 0; k < d->nsnap; k++) {
@@ -1211,7 +1226,7 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static const char *const dyn_files[] = {"history.csv", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", NULL};
+static const char *const dyn_files[] = {"history.csv", "dynamics.png", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", NULL};
 
 /* K is assembled, or matrix-free for the explicit integrator (solver.operator: matrix_free); the
    implicit step copies it into J. */

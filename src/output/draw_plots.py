@@ -3,8 +3,9 @@
 
     draw_plots.py KIND SETDIR OUTDIR [key=value ...]
 
-KIND is quasistatic, modal or anisotropy. The script reads the output set's own files in SETDIR
-(steps.csv; modes.csv and particles.vtu or .pvtu; anisotropy_polar.csv and anisotropy_envelope.csv)
+KIND is quasistatic, modal, anisotropy or dynamic. The script reads the output set's own files in
+SETDIR (steps.csv; modes.csv and particles.vtu or .pvtu; anisotropy_polar.csv and
+anisotropy_envelope.csv; history.csv and particles.vtu)
 and writes PNG files of SIZE pixels into OUTDIR; perilin moves them into the set only when this
 exits 0. key=value: facts summary.json will hold, which is written after the pictures. matplotlib's
 Agg backend: no display is needed. docs/summary.md lists the files."""
@@ -160,6 +161,51 @@ def modal(setdir, outdir, facts):
     save(fig, os.path.join(outdir, "modes.png"))
 
 
+# --------------------------------------------------------------------- dynamic
+def dynamic(setdir, outdir, facts):
+    """The energies against time, the fronts (history.csv has them with analysis.fronts), and the
+    last state: its damage where the scene has failure, else its speed |v|."""
+    rows = rows_of(os.path.join(setdir, "history.csv"))
+    if not rows:
+        sys.exit("history.csv has no rows")
+    plt = pyplot()
+    fig = figure(plt)
+    t = [float(r["time"]) for r in rows]
+    fronts = "wave_front" in rows[0]
+    P = read_particles(setdir, ["damage", "velocity"])
+    field = "damage" if P and "damage" in P else ("velocity" if P and "velocity" in P else None)
+    n = 1 + fronts + (field is not None)
+    ax = fig.add_subplot(n, 1, 1)
+    for col in ("kinetic", "strain", "dissipated", "work"):
+        ax.plot(t, [float(r[col]) for r in rows], label=col)
+    E0 = float(rows[0]["balance"])
+    ax.plot(t, [float(r["balance"]) - E0 for r in rows], "k--", label="balance - balance(0)")
+    ax.set_xlabel("time")
+    ax.set_ylabel("energy")
+    ax.set_title("%s dynamics: energy drift %s, %s bonds broken" % (facts.get("integrator", "?"), facts.get("drift", "?"), rows[-1]["broken"]), fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(True, alpha=0.3)
+    if fronts:
+        ax = fig.add_subplot(n, 1, 2)
+        for col in ("wave_front", "damage_front"):
+            ax.plot(t, [float(r[col]) for r in rows], label=col)
+        ax.set_xlabel("time")
+        ax.set_ylabel("distance from the origin")
+        ax.legend(fontsize=7)
+        ax.grid(True, alpha=0.3)
+    if field:
+        ax = fig.add_subplot(n, 1, n)
+        X = P["Points"]
+        c = [v[0] for v in P[field]] if field == "damage" else [math.sqrt(sum(x * x for x in v)) for v in P[field]]
+        step = max(1, len(X) // 40000)
+        sc = ax.scatter([x[0] for x in X[::step]], [x[1] for x in X[::step]], c=c[::step], s=1, lw=0, cmap="viridis")
+        fig.colorbar(sc, ax=ax)
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title("t = %g: %s (x, y; a 3D body seen along z)" % (t[-1], field if field == "damage" else "|velocity|"), fontsize=8)
+    fig.tight_layout()
+    save(fig, os.path.join(outdir, "dynamics.png"))
+
+
 # ------------------------------------------------------------------ anisotropy
 def anisotropy(setdir, outdir, facts):
     plt = pyplot()
@@ -226,7 +272,7 @@ def line(ax, rows, col, style):
 
 
 def main():
-    if len(sys.argv) < 4 or sys.argv[1] not in ("quasistatic", "modal", "anisotropy"):
+    if len(sys.argv) < 4 or sys.argv[1] not in ("quasistatic", "modal", "anisotropy", "dynamic"):
         sys.exit(__doc__)
     facts = dict(a.split("=", 1) for a in sys.argv[4:])
     globals()[sys.argv[1]](sys.argv[2], sys.argv[3], facts)
