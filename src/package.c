@@ -90,6 +90,7 @@ static const PeriSchemaOwner core_owners[] = {
     {"core", "reference", PeriReferenceSchema},
     {"core", "layers", PeriLayersSchema},
     {"core", "failure", PeriFailureSchema},
+    {"core", "contact", PeriContactSchema},
 };
 
 /* The problem's keys, read by src/problem.c: the root keys, in the order "allowed here" lists
@@ -114,6 +115,8 @@ static const PeriKey root_keys[] = {
     {"torsion", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the twist of a bar (cross-section models)"},
     {"failure", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "bond failure criteria"},
     {"cracks", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "pre-existing cracks"},
+    {"contact", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "contact between particles without a bond, in time ({} for the defaults; docs/contact.md)"},
+    {"impactors", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "rigid bodies in penalty contact with the body, in time"},
     {"solver", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "checks of the linear solves"},
     {NULL},
 };

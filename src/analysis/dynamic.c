@@ -14,9 +14,11 @@
 static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
 static const char *const dyn_profiles[]    = {"gaussian", "cosine", NULL};
 
-#define PERI_DYN_MAX_TERMS  16 /* load terms with amplitudes of their own, plus one */
-#define DYN_FRAMES          25 /* snapshots over t_end by default (output.every 0) */
-#define DYN_HISTORY_COLUMNS 11 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe, wave front, damage front */
+#define PERI_DYN_MAX_TERMS   16 /* load terms with amplitudes of their own, plus one */
+#define DYN_FRAMES           25 /* snapshots over t_end by default (output.every 0) */
+#define DYN_HISTORY_COLUMNS  11 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe, wave front, damage front */
+#define DYN_IMPACTOR_COLUMNS 9  /* per impactor: its centre, velocity and the particles' force on it */
+#define DYN_ROW(d)           (DYN_HISTORY_COLUMNS + DYN_IMPACTOR_COLUMNS * (d)->nimpactors)
 
 typedef struct {
   /* analysis.* */
@@ -45,23 +47,24 @@ typedef struct {
   Vec                  *term_f;
   PetscReal            *term_prev; /* a_k at the last step, for the work */
   /* the run */
-  PetscBool  started;
-  PetscReal  omega2_max, dt_limit; /* Gershgorin's bound of M^-1 K, and 2/omega_max */
-  PetscInt   nsteps, broken, snes_its, ksp_its;
-  PetscReal  worst;                                                      /* implicit: the largest relative residual a step ended with */
-  PetscReal  kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
-  PetscBool  fronts;                                                     /* analysis.fronts given */
-  PetscInt   front_axis;
-  PetscReal  front_origin, front_speed, front_damage; /* origin along the axis; the thresholds of speed and damage */
-  PetscReal  wave_front, damage_front;                /* the farthest distance from the origin along the axis of a particle past them */
-  PetscReal  t_prev, pulse_pos, probe_u;              /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
-  PetscInt   nhist, cap, nsnap;
-  PetscInt   every;            /* a snapshot every k steps: output.every, or DYN_FRAMES over the run */
-  PetscReal *hist, *snap_time; /* rank 0 keeps them; every rank counts */
-  Vec        minv, uprev, tmp; /* 1/m per DOF (0 on held DOFs), the last step's u, work */
-  Mat        J;                /* implicit: K + shift M with the held rows and columns eliminated */
-  IS         isq, isp;         /* explicit: positions and velocities in the state [q; p] */
-  TS         ts;
+  PetscBool          started;
+  PetscReal          omega2_max, dt_limit; /* Gershgorin's bound of M^-1 K, and 2/omega_max */
+  PetscInt           nsteps, broken, snes_its, ksp_its;
+  PetscReal          worst;                                                      /* implicit: the largest relative residual a step ended with */
+  PetscReal          kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
+  PetscBool          fronts;                                                     /* analysis.fronts given */
+  PetscInt           front_axis;
+  PetscReal          front_origin, front_speed, front_damage; /* origin along the axis; the thresholds of speed and damage */
+  PetscReal          wave_front, damage_front;                /* the farthest distance from the origin along the axis of a particle past them */
+  PetscReal          t_prev, pulse_pos, probe_u;              /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
+  PetscInt           nhist, cap, nsnap, nimpactors;           /* history rows (DYN_ROW reals each), their room, snapshots; impactors */
+  PetscInt           every;                                   /* a snapshot every k steps: output.every, or DYN_FRAMES over the run */
+  PetscReal         *hist, *snap_time;                        /* rank 0 keeps them; every rank counts */
+  Vec                minv, uprev, tmp;                        /* 1/m per DOF (0 on held DOFs), the last step's u, work */
+  Mat                J;                                       /* implicit: K + shift M with the held rows and columns eliminated */
+  const PeriContact *contact;                                 /* the system's, for the impactors' history */
+  IS                 isq, isp;                                /* explicit: positions and velocities in the state [q; p] */
+  TS                 ts;
 } Dynamic;
 
 static inline Dynamic *DYN(PeriAnalysis an)
@@ -279,6 +282,7 @@ static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
   PeriInputCheck(!d->pulse || d->pulse_axis < an->sys->disc.particles.dim, s, s->root, "analysis.pulse.axis", "the body is %" PetscInt_FMT "D", an->sys->disc.particles.dim);
   PeriInputCheck(!d->pulse || PeriModelTranslation(an->sys->model, d->pulse_dir) >= 0, s, s->root, d->pulse_dir == d->pulse_axis ? "analysis.pulse.axis" : "analysis.pulse.direction", "model %s does not translate along this axis", an->sys->model->type);
   PetscCall(PeriMassSetUp(an->sys));
+  PeriInputCheck(!d->implicit || !an->sys->contact.nimpactors, s, s->root, "impactors", "impactors move with the explicit integrator (analysis.integrator: explicit)");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -433,6 +437,7 @@ static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
 
   PetscFunctionBeginUser;
   (void)ts;
+  PetscCall(PeriContactSetTime(an->sys, t, PETSC_TRUE)); /* the step's one force: the impactors' kick */
   PetscCall(PeriSystemInternalForce(an->sys, q, dp));
   PetscCall(LoadAt(an, t, 1, -1, dp));
   PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
@@ -470,6 +475,7 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
   (void)ts;
   (void)V;
   PetscCall(PeriMassGetDiagonal(sys, &m));
+  PetscCall(PeriContactSetTime(sys, t, PETSC_FALSE));
   PetscCall(PeriSystemInternalForce(sys, U, F));
   PetscCall(VecPointwiseMult(DYN(an)->tmp, m, A));
   PetscCall(VecAXPY(F, 1, DYN(an)->tmp));
@@ -536,15 +542,11 @@ static PetscErrorCode RestoreState(PeriAnalysis an, Vec U, Vec *q, Vec *p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* 1/2 q^T K q with the present bonds. */
+/* 1/2 q^T K q with the present bonds, and the energy of contact. */
 static PetscErrorCode StrainEnergy(PeriAnalysis an, Vec q, PetscReal *E)
 {
-  PetscScalar e;
-
   PetscFunctionBeginUser;
-  PetscCall(PeriSystemInternalForce(an->sys, q, DYN(an)->tmp));
-  PetscCall(VecDot(q, DYN(an)->tmp, &e));
-  *E = 0.5 * PetscRealPart(e);
+  PetscCall(PeriSystemStrainEnergy(an->sys, q, DYN(an)->tmp, E));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -567,7 +569,7 @@ static PetscErrorCode PostStep(TS ts)
   Dynamic     *d;
   Vec          U, q, p;
   PetscInt     nb = 0;
-  PetscReal    before, after = 0, released;
+  PetscReal    before, after = 0, released, t;
   PetscBool    bybond;
 
   PetscFunctionBeginUser;
@@ -576,9 +578,12 @@ static PetscErrorCode PostStep(TS ts)
      share of each state the bond carried, which is measured as K's energy before and after */
   bybond = (PetscBool)(an->sys->model->ops.bond_stiffness && !an->sys->model->ops.bond_state);
   d      = DYN(an);
+  PetscCall(TSGetSolution(ts, &U));
+  PetscCall(GetState(an, U, &q, &p));
+  PetscCall(TSGetTime(ts, &t));
+  PetscCall(PeriImpactorsAdvance(an->sys, t));
+  PetscCall(PeriContactCheckReach(an->sys, q));
   if (an->sys->bond_state.failure.active) {
-    PetscCall(TSGetSolution(ts, &U));
-    PetscCall(GetState(an, U, &q, &p));
     PetscCall(VecCopy(q, an->sys->fields.u));
     if (bybond)
       PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, &nb, &released));
@@ -591,8 +596,8 @@ static PetscErrorCode PostStep(TS ts)
     }
     d->dissipated += released;
     d->broken += nb;
-    PetscCall(RestoreState(an, U, &q, &p));
   }
+  PetscCall(RestoreState(an, U, &q, &p));
   /* a signal ends the run after this step (TSStep resets the reason, so a monitor could not) */
   PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
   if (an->sys->run.interrupted) PetscCall(TSSetConvergedReason(ts, TS_CONVERGED_USER));
@@ -631,13 +636,21 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an, Vec q, Vec p, PetscReal t)
 static PetscErrorCode RecordHistory(Dynamic *d, PetscReal t, PetscReal balance)
 {
   const PetscReal row[DYN_HISTORY_COLUMNS] = {t, d->kinetic, d->strain, d->dissipated, d->work, balance, (PetscReal)d->broken, d->pulse_pos, d->probe_u, d->wave_front, d->damage_front};
+  PetscReal      *r;
 
   PetscFunctionBeginUser;
   if (d->nhist == d->cap) {
     d->cap = PetscMax(256, 2 * d->cap);
-    PetscCall(PetscRealloc(sizeof(PetscReal) * DYN_HISTORY_COLUMNS * d->cap, &d->hist));
+    PetscCall(PetscRealloc(sizeof(PetscReal) * DYN_ROW(d) * d->cap, &d->hist));
   }
-  PetscCall(PetscArraycpy(&d->hist[DYN_HISTORY_COLUMNS * d->nhist++], row, DYN_HISTORY_COLUMNS));
+  r = &d->hist[DYN_ROW(d) * d->nhist++];
+  PetscCall(PetscArraycpy(r, row, DYN_HISTORY_COLUMNS));
+  for (PetscInt k = 0; k < d->nimpactors; k++) {
+    const PeriImpactor *imp = &d->contact->impactors[k];
+    PetscCall(PetscArraycpy(&r[DYN_HISTORY_COLUMNS + DYN_IMPACTOR_COLUMNS * k], imp->x, 3));
+    PetscCall(PetscArraycpy(&r[DYN_HISTORY_COLUMNS + DYN_IMPACTOR_COLUMNS * k + 3], imp->v, 3));
+    PetscCall(PetscArraycpy(&r[DYN_HISTORY_COLUMNS + DYN_IMPACTOR_COLUMNS * k + 6], imp->force, 3));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -652,7 +665,7 @@ static PetscErrorCode Energies(PeriAnalysis an, Vec q, Vec p)
   PetscCall(PeriMassGetDiagonal(an->sys, &m));
   PetscCall(VecPointwiseMult(d->tmp, p, p));
   PetscCall(VecDot(d->tmp, m, &e));
-  d->kinetic = 0.5 * PetscRealPart(e);
+  d->kinetic = 0.5 * PetscRealPart(e) + PeriImpactorsKinetic(an->sys);
   PetscCall(StrainEnergy(an, q, &d->strain));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -772,6 +785,7 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
     PetscCall(RestoreState(an, U, &q, &p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
+  PetscCall(PeriContactSetTime(an->sys, t, PETSC_FALSE)); /* the impactors where they are at t */
   PetscCall(Energies(an, q, p));
   PetscCall(PulsePosition(an, q));
   PetscCall(ProbeDisplacement(an, q));
@@ -860,6 +874,26 @@ static PetscErrorCode CreateImplicit(PeriAnalysis an, Vec *U, Vec *V)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Impactors move by PETSc's velocity Verlet of the particles (PeriImpactorsAdvance): another -ts_type
+ * or -ts_basicsymplectic_type would integrate the two differently. */
+static PetscErrorCode CheckImpactorScheme(PeriAnalysis an)
+{
+  TSType    type;
+  PetscBool ok;
+
+  PetscFunctionBeginUser;
+  if (!an->sys->contact.nimpactors) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(TSGetType(DYN(an)->ts, &type));
+  PetscCall(PetscStrcmp(type, TSBASICSYMPLECTIC, &ok));
+  if (ok) {
+    TSBasicSymplecticType bt;
+    PetscCall(TSBasicSymplecticGetType(DYN(an)->ts, &bt));
+    PetscCall(PetscStrcmp(bt, TSBASICSYMPLECTICVELVERLET, &ok));
+  }
+  PetscCheck(ok, an->comm, PETSC_ERR_USER_INPUT, "%s: impactors move with the particles' velocity Verlet (-ts_type basicsymplectic -ts_basicsymplectic_type velverlet, the default): drop the -ts_type or -ts_basicsymplectic_type option", an->sys->scene->file);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The TS of the run, set from the options after perilin's defaults. */
 static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
 {
@@ -885,6 +919,7 @@ static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(TSSetPostStep(d->ts, PostStep));
   PetscCall(TSSetErrorIfStepFails(d->ts, PETSC_FALSE)); /* a failed step is perilin's message (CheckSteps) */
   PetscCall(TSSetFromOptions(d->ts));
+  PetscCall(CheckImpactorScheme(an));
   PetscCall(TSGetTimeStep(d->ts, &d->dt));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
   if (!given) PetscCall(TSSetMaxSteps(d->ts, (PetscInt)PetscCeilReal(d->t_end / d->dt - 1e-9)));
@@ -1023,7 +1058,9 @@ static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
   PetscReal      t;
 
   PetscFunctionBeginUser;
-  d->started = PETSC_TRUE;
+  d->started    = PETSC_TRUE;
+  d->contact    = &an->sys->contact;
+  d->nimpactors = an->sys->contact.nimpactors;
   /* the explicit step only multiplies by K: BAIJ's blocks make the product about 1.6x faster than
      AIJ's (tests/perf/dynamic_lammps.sh); the implicit solve takes the static solver's type */
   if (d->implicit)
@@ -1053,6 +1090,7 @@ static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(PetscTime(&t1));
   an->sys->run.log.solve_s = t1 - t0;
   PetscCall(RecordSolver(an));
+  PetscCall(PeriContactTally(an->sys));
   PetscCall(GetState(an, *U, &q, &p));
   PetscCall(VecCopy(q, an->sys->fields.u));
   PetscCall(PeriSystemKeepVelocity(an->sys, p));
@@ -1082,22 +1120,29 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
 /* history.csv: one row per step. Rank 0 writes (temporary name, then rename). */
 static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
 {
-  Dynamic *d = DYN(an);
-  char     path[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
-  FILE    *fp;
-  int      bad = 0;
+  Dynamic       *d   = DYN(an);
+  const PetscInt dim = an->sys->disc.particles.dim;
+  char           path[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
+  FILE          *fp;
+  int            bad = 0;
 
   PetscFunctionBeginUser;
   if (an->rank) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/history.csv", dir));
   PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s%s%s\n", d->pulse ? ",pulse_position" : "", an->sys->fields.nprobes ? ",probe_u" : "", d->fronts ? ",wave_front,damage_front" : "") < 0;
+  bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s%s%s", d->pulse ? ",pulse_position" : "", an->sys->fields.nprobes ? ",probe_u" : "", d->fronts ? ",wave_front,damage_front" : "") < 0;
+  for (PetscInt m = 0; m < d->nimpactors; m++)
+    for (PetscInt c = 0; c < DYN_IMPACTOR_COLUMNS; c++)
+      if (c % 3 < dim) bad |= fprintf(fp, ",impactor%" PetscInt_FMT "_%s%c", m + 1, c < 3 ? "" : (c < 6 ? "v" : "f"), (char)('x' + c % 3)) < 0;
+  bad |= fprintf(fp, "\n") < 0;
   for (PetscInt k = 0; k < d->nhist; k++) {
-    const PetscReal *r = &d->hist[DYN_HISTORY_COLUMNS * k];
+    const PetscReal *r = &d->hist[DYN_ROW(d) * k];
     bad |= fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%" PetscInt_FMT, (double)r[0], (double)r[1], (double)r[2], (double)r[3], (double)r[4], (double)r[5], (PetscInt)r[6]) < 0;
     if (d->pulse) bad |= fprintf(fp, ",%.10g", (double)r[7]) < 0;
     if (an->sys->fields.nprobes) bad |= fprintf(fp, ",%.17g", (double)r[8]) < 0;
     if (d->fronts) bad |= fprintf(fp, ",%.10g,%.10g", (double)r[9], (double)r[10]) < 0;
+    for (PetscInt c = DYN_HISTORY_COLUMNS; c < DYN_ROW(d); c++)
+      if ((c - DYN_HISTORY_COLUMNS) % 3 < dim) bad |= fprintf(fp, ",%.17g", (double)r[c]) < 0;
     bad |= fprintf(fp, "\n") < 0;
   }
   PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
@@ -1148,9 +1193,9 @@ static PetscReal FrontSpeed(const Dynamic *d, PetscInt col)
 {
   PetscReal n = 0, st = 0, sx = 0, stt = 0, stx = 0, last = 0;
 
-  for (PetscInt k = 0; k < d->nhist; k++) last = PetscMax(last, d->hist[DYN_HISTORY_COLUMNS * k + col]);
+  for (PetscInt k = 0; k < d->nhist; k++) last = PetscMax(last, d->hist[DYN_ROW(d) * k + col]);
   for (PetscInt k = 0; k < d->nhist; k++) {
-    const PetscReal t = d->hist[DYN_HISTORY_COLUMNS * k], x = d->hist[DYN_HISTORY_COLUMNS * k + col];
+    const PetscReal t = d->hist[DYN_ROW(d) * k], x = d->hist[DYN_ROW(d) * k + col];
     if (x <= 0 || x >= last) continue;
     n += 1, st += t, sx += x, stt += t * t, stx += t * x;
   }
@@ -1178,6 +1223,7 @@ static PetscErrorCode Summary_Dynamic(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONReal(j, "energy_drift", d->drift));
   PetscCall(PeriJSONReal(j, "energy_tolerance", d->energy_tol));
   PetscCall(PeriJSONInt(j, "broken_bonds", d->broken));
+  PetscCall(PeriContactSummary(an->sys, j));
   if (d->implicit) {
     PetscCall(PeriJSONInt(j, "ksp_iterations", d->ksp_its));
     PetscCall(PeriJSONReal(j, "rho_infinity", d->rho_inf));

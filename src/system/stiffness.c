@@ -210,6 +210,26 @@ PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
   PetscFunctionBeginUser;
   PetscCall(PeriSystemGetJacobian(sys, &K));
   PetscCall(MatMult(K, u, f));
+  PetscCall(PeriContactAddForce(sys, u, f));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemStrainEnergy - the energy the interaction terms hold at u: (1/2) u^T K u of the linear
+  ones and the energy of contact; work is a vector of u's layout. Collective.
+@*/
+PetscErrorCode PeriSystemStrainEnergy(PeriSystem sys, Vec u, Vec work, PetscReal *E)
+{
+  Mat         K = NULL;
+  PetscScalar e;
+  PetscReal   ec;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemGetJacobian(sys, &K));
+  PetscCall(MatMult(K, u, work));
+  PetscCall(VecDot(u, work, &e));
+  PetscCall(PeriContactEnergy(sys, u, &ec));
+  *E = 0.5 * PetscRealPart(e) + ec;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -227,6 +247,7 @@ PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem sys, Vec rows)
   PetscCall(PeriSystemGetJacobian(sys, &K));
   if (sys->stiffness.op) {
     PetscCall(PeriOperatorRowSums(sys, rows));
+    PetscCall(PeriContactAddRowSums(sys, rows));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
@@ -240,6 +261,7 @@ PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem sys, Vec rows)
     PetscCall(MatRestoreRow(K, r, &nc, NULL, &v));
   }
   PetscCall(VecRestoreArray(rows, &ra));
+  PetscCall(PeriContactAddRowSums(sys, rows));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -529,6 +529,7 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PeriReferenceSetUp(sys));
   PetscCall(PeriBoundarySetUp(sys));
   PetscCall(PeriLayersSetUp(sys));
+  PetscCall(PeriContactSetUp(sys));
   /* the loads too, so that a bad load is reported before any solve */
   PetscCall(PeriSystemCreateVec(sys, &sys->fields.f));
   PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
@@ -561,6 +562,7 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PeriMassDestroy(&sys->mass));
   PetscCall(PeriFieldsDestroy(&sys->fields));
   PetscCall(PeriBondStateDestroy(&sys->bond_state));
+  PetscCall(PeriContactDestroy(&sys->contact));
   PetscCall(PeriConditionsDestroy(&sys->conditions));
   PetscCall(PeriModelDestroy(&sys->model));
   PetscCall(PeriDiscDestroy(&sys->disc));

@@ -13,6 +13,7 @@
 #include "perilin/private/conditions.h"
 #include "perilin/private/stiffness.h"
 #include "perilin/private/bondstate.h"
+#include "perilin/private/contact.h"
 
 typedef struct _p_PeriSystem *PeriSystem;
 
@@ -76,6 +77,7 @@ struct _p_PeriSystem {
   PeriStiffness  stiffness;  /* K, matrix-free K, preconditioning matrix, solves (stiffness.h) */
   PeriMass       mass;       /* densities and lumped mass, on request (mass.h) */
   PeriBondState  bond_state; /* failure criteria, damage, breaking, checkpoints (bondstate.h) */
+  PeriContact    contact;    /* contact between particles and rigid impactors (contact.h) */
   PeriFields     fields;     /* the present state and what is derived from it (fields.h) */
   PeriReference  reference;  /* an exact field to compare with */
   PeriRun        run;        /* cost, progress, interruption */
