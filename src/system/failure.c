@@ -193,7 +193,7 @@ PetscErrorCode PeriFailureView(const PeriFailure *F, PeriModel m, MPI_Comm comm)
 static PetscErrorCode CheckHits(PeriSystem sys, PeriNode list, const PetscInt hits[])
 {
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < list->n; k++) PeriInputCheck(hits[k] > 0, sys->scene, list->child[k], NULL, "the crack cuts no bond (it lies between two bonds' ends, or along a row of particles: place it a fraction of a spacing off)");
+  for (PetscInt k = 0; k < list->n; k++) PeriInputCheck(hits[k] > 0, sys->scene, list->child[k], NULL, "the crack cuts no bond (it is smaller than the bonds' spacing, or lies on a face of the body)");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
