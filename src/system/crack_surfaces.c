@@ -51,7 +51,7 @@ static PetscErrorCode AddFacet(PeriCrackSet *s, PeriCrackKind kind, PetscInt ite
 PetscErrorCode PeriCrackAddSegment(PeriCrackSet *s, PetscInt item, const PetscReal a[], const PetscReal b[])
 {
   PetscReal       x[6] = {a[0], a[1], 0, b[0], b[1], 0};
-  PeriCrackFacet *f = NULL;
+  PeriCrackFacet *f    = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(AddFacet(s, PERI_CRACK_SEGMENT, item, 2, x, &f));
@@ -143,7 +143,7 @@ PetscErrorCode PeriCrackAddPolygon(PeriCrackSet *s, PetscInt item, PetscInt n, c
 PetscErrorCode PeriCrackAddDisc(PeriCrackSet *s, PetscInt item, const PetscReal c[], const PetscReal nrm[], PetscReal r, const char **problem)
 {
   PetscReal       len = PetscSqrtReal(Dot(nrm, nrm));
-  PeriCrackFacet *f = NULL;
+  PeriCrackFacet *f   = NULL;
 
   PetscFunctionBeginUser;
   *problem = !(len > 0) ? "the normal is zero" : !(r > 0) ? "the radius must be positive"
