@@ -582,3 +582,60 @@ PetscErrorCode PeriMeshGroupsDestroy(PetscInt *ngroups, PeriMeshGroup **groups)
   *ngroups = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The corners of the surface elements e holds (triangles; a quadrangle gives two) into tri[9 k ..]. */
+static PetscErrorCode SurfaceCorners(const MeshNodes *nodes, const MeshElements *e, PetscInt *ntri, PetscReal **tri)
+{
+  PetscInt  ed, ec, n = 0;
+  PetscBool simplex;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(18 * e->count + 1, tri));
+  for (size_t t = 0; t < e->ntypes; t++) {
+    ElementShape(e->types[t], &ed, &ec, &simplex);
+    if (ed != 2 || !ec) continue;
+    for (size_t k = 0; k < e->netags[t]; k++) {
+      PetscReal X[8][3];
+      ElementCorners(nodes, &e->ntags[t][k * (e->nntags[t] / e->netags[t])], ec, X);
+      for (PetscInt h = 0; h + 2 < ec; h++) { /* a fan about the first corner */
+        for (PetscInt r = 0; r < 3; r++) {
+          (*tri)[9 * n + r]     = X[0][r];
+          (*tri)[9 * n + 3 + r] = X[h + 1][r];
+          (*tri)[9 * n + 6 + r] = X[h + 2][r];
+        }
+        n++;
+      }
+    }
+  }
+  *ntri = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriMeshSurfaceRead - the triangles of a surface file (path, already resolved; map.key names it in
+  errors) that Gmsh reads: a .msh surface mesh, or an STL file (ASCII or binary). tri gets 9
+  coordinates per triangle (PetscFree); a quadrangle gives two. Not collective: every rank reads it.
+@*/
+PetscErrorCode PeriMeshSurfaceRead(PeriScene scene, PeriNode map, const char key[], const char path[], PetscInt *ntri, PetscReal **tri)
+{
+  char         msg[256] = "";
+  int          ierr     = 0;
+  MeshNodes    nodes;
+  MeshElements e;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(access(path, R_OK) == 0, scene, map, key, "cannot read %s: %s", path, strerror(errno));
+  PetscCall(GmshStart(PETSC_FALSE));
+  gmshOpen(path, &ierr);
+  if (ierr) PeriGmshLastError(msg, sizeof(msg));
+  PeriInputCheck(!ierr, scene, map, key, "Gmsh cannot read %s: %s", path, msg);
+  PetscCall(NodesGet(&nodes));
+  PetscCall(ElementsGet(2, -1, &e));
+  PetscCall(SurfaceCorners(&nodes, &e, ntri, tri));
+  ElementsFree(&e);
+  PetscCall(NodesDestroy(&nodes));
+  gmshClear(&ierr);
+  if (!*ntri) PetscCall(PetscFree(*tri));
+  PeriInputCheck(*ntri > 0, scene, map, key, "%s holds no triangles", path);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -3,6 +3,7 @@
  * Schweitzer (critical stretch from G), Diana & Casolo eqs. 44-58 (tension, compression, sliding,
  * friction), Oterkus & Madenci eqs. 70, 78-79 (critical shear angle, damage). docs/failure.md. */
 #include "perilin/private/system.h"
+#include "perilin/private/crack_surfaces.h"
 
 const char *const PeriFailureCauses[] = {"crack", "tension", "compression", "sliding", "shear_angle", NULL};
 
@@ -16,11 +17,6 @@ static const PeriCriterionType *const criteria[] = {
 #undef PERI_CRITERION
 };
 
-static const PeriKey crack_keys[] = {
-    {"from", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "a pre-existing crack, a 2D segment: its first end [x, y]; bonds crossing it are removed before the first step"},
-    {"to", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "its other end"},
-    {NULL},
-};
 /* failure: is the union of the criteria's keys, in the order of the list, their softening keys
  * last; then cracks.<k>. */
 const PeriSchema PeriFailureSchema[] = {
@@ -30,7 +26,8 @@ const PeriSchema PeriFailureSchema[] = {
 #define PERI_CRITERION(id) {"failure", PeriCriterion_##id.softening_keys},
 #include "criterion_list.h"
 #undef PERI_CRITERION
-    {"cracks.<k>", crack_keys},
+    {"cracks.<k>", PeriCrackKeys},
+    {"cracks.<k>.disc", PeriCrackDiscKeys},
     {NULL},
 };
 
@@ -191,101 +188,44 @@ PetscErrorCode PeriFailureView(const PeriFailure *F, PeriModel m, MPI_Comm comm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Do the open segments P0P1 and Q0Q1 cross (a touch at an end point does not count)? */
-static PetscBool SegmentsCross(const PetscReal P0[], const PetscReal P1[], const PetscReal Q0[], const PetscReal Q1[])
+/* Every crack item must cut a bond somewhere (hits: per item, over all ranks): one that cuts none
+   is almost always a mistake of units or coordinates, or a crack along a row of particles. */
+static PetscErrorCode CheckHits(PeriSystem sys, PeriNode list, const PetscInt hits[])
 {
-  PetscReal d1 = (P1[0] - P0[0]) * (Q0[1] - P0[1]) - (P1[1] - P0[1]) * (Q0[0] - P0[0]);
-  PetscReal d2 = (P1[0] - P0[0]) * (Q1[1] - P0[1]) - (P1[1] - P0[1]) * (Q1[0] - P0[0]);
-  PetscReal d3 = (Q1[0] - Q0[0]) * (P0[1] - Q0[1]) - (Q1[1] - Q0[1]) * (P0[0] - Q0[0]);
-  PetscReal d4 = (Q1[0] - Q0[0]) * (P1[1] - Q0[1]) - (Q1[1] - Q0[1]) * (P1[0] - Q0[0]);
-  return (PetscBool)(d1 * d2 < 0 && d3 * d4 < 0);
-}
-
-static PetscInt CutBonds(const PeriParticles *pt, PeriBonds *b, PetscInt nc, const PetscReal seg[])
-{
-  PetscInt cut = 0;
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscReal X1[2] = {pt->x[3 * i] + b->xi[3 * k], pt->x[3 * i + 1] + b->xi[3 * k + 1]};
-      for (PetscInt c = 0; c < nc && b->live[k]; c++)
-        if (SegmentsCross(&pt->x[3 * i], X1, &seg[4 * c], &seg[4 * c + 2])) {
-          b->live[k] = 0;
-          cut++;
-        }
-    }
-  return cut;
-}
-
-/* Whether the 2D segment s = (x0, y0, x1, y1) meets the box [lo, hi] (Liang-Barsky clipping). A
-   crack that misses the body entirely cuts nothing, which is almost always a mistake of units or
-   coordinates, so it is reported rather than ignored. */
-static PetscBool SegmentMeetsBox(const PetscReal s[], const PetscReal lo[], const PetscReal hi[])
-{
-  PetscReal t0 = 0, t1 = 1;
-  for (PetscInt d = 0; d < 2; d++) {
-    PetscReal dx = s[2 + d] - s[d], tol = 1e-9 * (hi[d] - lo[d]);
-    PetscReal pq[2][2] = {
-        {-dx, s[d] - (lo[d] - tol)},
-        {dx, (hi[d] + tol) - s[d]}};
-    for (PetscInt k = 0; k < 2; k++) {
-      if (pq[k][0] == 0) {
-        if (pq[k][1] < 0) return PETSC_FALSE;
-      } else if (pq[k][0] < 0)
-        t0 = PetscMax(t0, pq[k][1] / pq[k][0]);
-      else
-        t1 = PetscMin(t1, pq[k][1] / pq[k][0]);
-    }
-  }
-  return t0 <= t1 ? PETSC_TRUE : PETSC_FALSE;
-}
-
-/* The segments of cracks: (list) into seg[4 k ..]: from, to. Not collective. */
-static PetscErrorCode ReadSegments(PeriSystem sys, PeriNode list, PetscReal seg[])
-{
-  PeriScene s = sys->scene;
-  PetscInt  n;
-
   PetscFunctionBeginUser;
-  for (PetscInt c = 0; c < list->n; c++) {
-    PeriNode item = list->child[c];
-    PeriInputCheck(item->kind == PERI_NODE_MAP, s, item, NULL, "a crack is a segment {from: [x, y], to: [x, y]}");
-    PetscCall(PeriSceneCheckSection(s, item, "cracks.<k>"));
-    PetscCall(PeriSceneGetRealArray(s, item, "from", PETSC_TRUE, 2, 2, &seg[4 * c], &n));
-    PetscCall(PeriSceneGetRealArray(s, item, "to", PETSC_TRUE, 2, 2, &seg[4 * c + 2], &n));
-    PeriInputCheck(seg[4 * c] != seg[4 * c + 2] || seg[4 * c + 1] != seg[4 * c + 3], s, item, "to", "the segment has zero length");
-    PeriInputCheck(SegmentMeetsBox(&seg[4 * c], sys->disc.particles.lower, sys->disc.particles.upper), s, item, NULL, "the segment from (%g, %g) to (%g, %g) lies outside the body [%g, %g] x [%g, %g]: it would cut no bond", (double)seg[4 * c], (double)seg[4 * c + 1], (double)seg[4 * c + 2], (double)seg[4 * c + 3], (double)sys->disc.particles.lower[0], (double)sys->disc.particles.upper[0], (double)sys->disc.particles.lower[1], (double)sys->disc.particles.upper[1]);
-  }
+  for (PetscInt k = 0; k < list->n; k++) PeriInputCheck(hits[k] > 0, sys->scene, list->child[k], NULL, "the crack cuts no bond (it is smaller than the bonds' spacing, or lies on a face of the body)");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
-  PeriCracksApply - reads cracks: (2D segments {from: [x, y], to: [x, y]}) and removes every bond
-  that crosses one, before the family volumes and the calibration see the body. Collective.
+  PeriCracksApply - reads cracks: (2D segments {from: [x, y], to: [x, y]}; 3D polygons, discs and
+  surface files: src/system/cracks.c) and removes every bond that crosses one, before the family
+  volumes and the calibration see the body. Each crack must cut a bond. Collective.
 @*/
 PetscErrorCode PeriCracksApply(PeriSystem sys)
 {
-  PeriScene  s = sys->scene;
-  PeriNode   list;
-  PetscReal *seg;
-  PetscInt   cut;
+  PeriScene      s   = sys->scene;
+  PeriCrackSet   set = {0};
+  PeriNode       list;
+  PetscInt       cut, *hits;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "cracks", &list));
   if (!list) PetscFunctionReturn(PETSC_SUCCESS);
-  PeriInputCheck(list->kind == PERI_NODE_SEQ, s, list, NULL, "must be a list of segments, each {from: [x, y], to: [x, y]}");
-  PeriInputCheck(sys->disc.particles.dim == 2, s, list, NULL, "cracks are 2D segments; 3D scenes cannot have them yet");
-  PetscCall(PetscMalloc1(4 * list->n, &seg));
-  {
-    /* an input error frees the segments before it is passed on (LeakSanitizer) */
-    PetscErrorCode ierr = ReadSegments(sys, list, seg);
-    if (ierr) PetscCall(PetscFree(seg));
-    PetscCall(ierr);
-  }
-  cut = CutBonds(&sys->disc.particles, &sys->disc.bonds, list->n, seg);
-  if (sys->disc.family.offset) CutBonds(&sys->disc.particles, &sys->disc.family, list->n, seg);
-  PetscCall(PetscFree(seg));
+  PeriInputCheck(list->kind == PERI_NODE_SEQ, s, list, NULL, "must be a list of segments, each {from: [x, y], to: [x, y]} (2D), or of polygon, disc and surface items (3D)");
+  PetscCall(PeriCracksRead(sys, list, &set));
+  PetscCall(PetscCalloc1(list->n, &hits));
+  cut = PeriCracksCut(&sys->disc.particles, &sys->disc.bonds, &set, hits);
+  if (sys->disc.family.offset) PeriCracksCut(&sys->disc.particles, &sys->disc.family, &set, NULL);
+  PetscCall(PeriCrackSetDestroy(&set));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &cut, 1, MPIU_INT, MPI_SUM, sys->comm));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, hits, (PetscMPIInt)list->n, MPIU_INT, MPI_SUM, sys->comm));
+  ierr = CheckHits(sys, list, hits);
+  PetscCall(PetscFree(hits)); /* before an input error is passed on (LeakSanitizer) */
+  PetscCall(ierr);
   sys->bond_state.failure.precracked_bonds = cut;
+  sys->bond_state.failure.ncracks          = list->n;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -576,6 +516,8 @@ PetscErrorCode PeriFailureAddFields(PeriSystem sys, PeriFieldList fl)
   const PetscInt     map0   = 0;
 
   PetscFunctionBeginUser;
+  /* a pre-cracked body shows its cracks in every analysis, with failure: or without */
+  if (!sys->bond_state.damage && F->precracked_bonds > 0) PetscCall(PeriDamage(sys, &sys->bond_state.damage));
   if (!sys->bond_state.damage) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt i = 0; i < F->ncriteria; i++)
     if (F->criterion[i].active) causes |= F->criterion[i].causes;

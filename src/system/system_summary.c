@@ -24,6 +24,7 @@ PetscErrorCode PeriSystemSummaryDiscretization(PeriSystem sys, PeriJSON j)
   PetscFunctionBeginUser;
   PetscCall(PeriJSONInt(j, "particles", sys->disc.N));
   PetscCall(PeriJSONInt(j, "bonds", sys->run.log.nbonds_total));
+  if (sys->bond_state.failure.ncracks) PetscCall(PeriJSONInt(j, "precracked_bonds", sys->bond_state.failure.precracked_bonds)); /* cracks: */
   PetscCall(PeriJSONInt(j, "dofs", sys->disc.N * m->dofs));
   PetscCall(PeriJSONInt(j, "ranks", sys->size));
   PetscCall(PeriJSONInt(j, "edge_cut", sys->run.log.edge_cut));

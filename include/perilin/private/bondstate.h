@@ -88,6 +88,7 @@ typedef struct {
   PetscInt      ncriteria;
   PeriCriterion criterion[PERI_MAX_CRITERIA]; /* in the order of src/system/criterion_list.h */
   PetscInt      precracked_bonds;             /* bonds the scene's cracks removed */
+  PetscInt      ncracks;                      /* the items of cracks: */
 } PeriFailure;
 
 /* The bond state's part of the system. */
@@ -108,7 +109,11 @@ typedef struct {
 PETSC_EXTERN PetscErrorCode PeriFailureSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriFailureCacheBonds(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriBondsCount(PeriSystem, PetscInt *, PetscInt *);
+struct _PeriCrackSet; /* the cracks' geometry: perilin/private/crack_surfaces.h */
+PETSC_EXTERN const PeriKey  PeriCrackKeys[], PeriCrackDiscKeys[];
 PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriCracksRead(PeriSystem, PeriNode, struct _PeriCrackSet *);
+PETSC_EXTERN PetscInt       PeriCracksCut(const PeriParticles *, PeriBonds *, const struct _PeriCrackSet *, PetscInt[]);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
 PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriSystem, const PetscReal[]);

@@ -65,6 +65,7 @@ typedef struct _n_PeriMeshGroup {
 PETSC_EXTERN void           PeriGmshLastError(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriMeshGenerateIsolated(const char[], PetscInt, PetscReal, PetscBool *, char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriMeshRead(PeriScene, PeriNode, PetscInt, PetscReal, PetscInt *, PetscReal **, PetscReal **, PetscInt *, PeriMeshGroup **, PetscReal[6]);
+PETSC_EXTERN PetscErrorCode PeriMeshSurfaceRead(PeriScene, PeriNode, const char[], const char[], PetscInt *, PetscReal **);
 PETSC_EXTERN PetscErrorCode PeriParticlesReadPeriodic(PeriScene, PeriNode, PeriParticles *);
 PETSC_EXTERN void           PeriParticlesPeriodicBox(PeriParticles *, const PetscReal[6]);
 PETSC_EXTERN PetscErrorCode PeriMeshGroupsDestroy(PetscInt *, PeriMeshGroup **);
