@@ -99,21 +99,26 @@ static PetscErrorCode ReadPiece(const char path[], PeriVTUData *d)
   char       *buf, val[32];
   size_t      len;
   const char *app, *data, *tag;
-  PetscInt    n, before = d->narrays;
+  PetscInt       n, before = d->narrays;
+  PetscErrorCode ierr = PETSC_SUCCESS;
 
   PetscFunctionBeginUser;
   PetscCall(Slurp(path, &buf, &len));
   Attribute(buf + (strstr(buf, "<VTKFile") ? strstr(buf, "<VTKFile") - buf : 0), "header_type", val, sizeof(val));
   app = strstr(buf, "<AppendedData encoding=\"raw\">");
-  if (!app || strcmp(val, "UInt64") || !strstr(buf, "byte_order=\"LittleEndian\"") || !(tag = strstr(buf, "<Piece NumberOfPoints="))) {
+  /* the data start after the '_' that follows the tag (none: the file was cut there; found by
+     tests/fuzz/fuzz_vtu.c) */
+  data = app ? strchr(app, '_') : NULL;
+  if (!data || strcmp(val, "UInt64") || !strstr(buf, "byte_order=\"LittleEndian\"") || !(tag = strstr(buf, "<Piece NumberOfPoints="))) {
     PetscCall(PetscFree(buf));
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s is not a .vtu perilin wrote (raw appended data, UInt64 headers, little-endian): give perilin's own file, not one re-saved by another program", path);
   }
   Attribute(tag, "NumberOfPoints", val, sizeof(val));
   n    = (PetscInt)strtol(val, NULL, 10);
-  data = strchr(app, '_') + 1;
-  for (tag = strstr(buf, "<DataArray"); tag && tag < app; tag = strstr(tag + 1, "<DataArray")) PetscCall(ReadArray(path, tag, data, len - (size_t)(data - buf), n, d));
-  PetscCall(PetscFree(buf));
+  data++;
+  for (tag = strstr(buf, "<DataArray"); tag && tag < app && !ierr; tag = strstr(tag + 1, "<DataArray")) ierr = ReadArray(path, tag, data, len - (size_t)(data - buf), n, d);
+  PetscCall(PetscFree(buf)); /* a bad array too */
+  PetscCall(ierr);
   PetscCheck(d->n == 0 || d->narrays == before, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s has arrays the earlier pieces lack", path);
   d->n += n;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -135,13 +140,15 @@ PetscErrorCode PeriReadParticles(const char path[], PeriVTUData *d)
     size_t      blen;
     const char *tag, *slash = strrchr(path, '/');
     PetscCall(PetscSNPrintf(dir, sizeof(dir), "%.*s", slash ? (int)(slash - path + 1) : 0, path));
+    PetscErrorCode ierr = PETSC_SUCCESS;
     PetscCall(Slurp(path, &buf, &blen));
-    for (tag = strstr(buf, "<Piece Source="); tag; tag = strstr(tag + 1, "<Piece Source=")) {
+    for (tag = strstr(buf, "<Piece Source="); tag && !ierr; tag = strstr(tag + 1, "<Piece Source=")) {
       Attribute(tag, "Source", src, sizeof(src));
-      PetscCall(PetscSNPrintf(piece, sizeof(piece), "%s%s", src[0] == '/' ? "" : dir, src));
-      PetscCall(ReadPiece(piece, d));
+      ierr = PetscSNPrintf(piece, sizeof(piece), "%s%s", src[0] == '/' ? "" : dir, src);
+      if (!ierr) ierr = ReadPiece(piece, d);
     }
-    PetscCall(PetscFree(buf));
+    PetscCall(PetscFree(buf)); /* a bad piece too: the index is freed (found by tests/fuzz/fuzz_vtu.c) */
+    PetscCall(ierr);
   } else
     PetscCall(ReadPiece(path, d));
   PetscCheck(d->n > 0 && d->points, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s holds no points", path);
