@@ -7,6 +7,9 @@
  * DOFs); the analysis writes its own state after it, then the system's (PeriCheckpointView). */
 #include "perilin/private/analysis.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #define PERI_CHECKPOINT_MAGIC   0x50455249 /* "PERI" */
 #define PERI_CHECKPOINT_VERSION 2          /* 2: each step carries its attempts */
 #define PERI_CHECKPOINT_FILE    "checkpoint/state.bin"
@@ -149,5 +152,26 @@ PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis an, PetscViewer *v, char fi
   ierr = CheckHeader(an, *v, file, &run);
   if (ierr) PetscCall(PetscViewerDestroy(v));
   PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisCheckpointFits - refuses a count read from the checkpoint open in v when n items of
+  each bytes cannot be in what is left of the file (or n < 0): a damaged count would otherwise size
+  an allocation. Collective.
+@*/
+PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis an, PetscViewer v, PetscInt n, size_t each)
+{
+  int         fd;
+  struct stat st;
+  off_t       at;
+  PetscInt    bad = n < 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerBinaryGetDescriptor(v, &fd));
+  /* the rank that reads the file (rank 0) knows its size; the others agree with it */
+  if (!bad && fd >= 0 && !fstat(fd, &st) && (at = lseek(fd, 0, SEEK_CUR)) >= 0) bad = (double)n * (double)each > (double)(st.st_size - at);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, an->comm));
+  PetscCheck(!bad, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: it counts %" PetscInt_FMT " items where the rest of the file holds fewer: restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, n);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -644,6 +644,11 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
     PetscCall(PetscViewerBinaryRead(v, r, 2, NULL, PETSC_REAL));
     PetscCall(PetscViewerBinaryRead(v, n, 5, NULL, PETSC_INT));
     PetscCheck(n[4] == w && n[0] > 0, an->comm, PETSC_ERR_FILE_UNEXPECTED, "-restart: the checkpoint's steps do not fit this scene's reaction regions");
+    /* counts and the load factor from the file, checked before they size anything (found by
+       tests/fuzz/fuzz_checkpoint.c: a count of 2^62 steps) */
+    PetscCall(PeriAnalysisCheckpointFits(an, v, n[0], (PERI_STEP_REALS + w) * sizeof(PetscReal) + PERI_STEP_INTS * sizeof(PetscInt)));
+    PetscCall(PeriAnalysisCheckpointFits(an, v, n[3], sizeof(PetscInt)));
+    PetscCheck(n[3] >= 0 && n[1] >= 0 && n[2] >= 0 && r[0] >= 0 && r[0] <= ST(an)->max && r[1] > 0 && r[1] <= ST(an)->max, an->comm, PETSC_ERR_USER_INPUT, "-restart: the checkpoint is damaged (its counts or its load factor %g and step %g are out of range for load_factor_max %g): restart from an undamaged checkpoint, or run the scene from the start", (double)r[0], (double)r[1], (double)ST(an)->max);
     PetscCall(StepsAllocate(an, n[0], n[3]));
     *lambda = r[0], *dl = r[1];
     q->nsteps = n[0], q->pc_setups = n[1], q->solves = n[2], data->nsnaps = n[3];

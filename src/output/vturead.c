@@ -39,7 +39,7 @@ static void Attribute(const char *tag, const char name[], char value[], size_t l
 
   value[0] = 0;
   while ((p = strstr(p, name)) && (!end || p < end)) {
-    if (p[-1] == ' ' && p[nl] == '=' && p[nl + 1] == '"') {
+    if (p > tag && p[-1] == ' ' && p[nl] == '=' && p[nl + 1] == '"') {
       const char *q = strchr(p + nl + 2, '"');
       size_t      k = q ? (size_t)(q - (p + nl + 2)) : 0;
       if (k >= len) k = len - 1;
@@ -69,9 +69,12 @@ static PetscErrorCode ReadArray(const char path[], const char *tag, const char *
   PetscCheck(off[0], PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s is not in appended data: not a file perilin wrote", path, name);
   nc = (PetscInt)strtol(comp[0] ? comp : "1", NULL, 10);
   o  = (size_t)strtoull(off, NULL, 10);
-  PetscCheck(o + 8 <= avail, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s lies past the end of the file", path, name);
+  /* every count from the file is checked against the bytes it has before it sizes anything, without
+     overflow (found by tests/fuzz/fuzz_vtu.c: offsets near 2^64, 2^60 points) */
+  PetscCheck(avail >= 8 && o <= avail - 8, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s lies past the end of the file", path, name);
   memcpy(&nbytes, data + o, 8);
-  PetscCheck(nbytes == (uint64_t)(8 * n * nc) && o + 8 + nbytes <= avail, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s holds %" PRIu64 " bytes, not %" PetscInt_FMT " points x %" PetscInt_FMT " components", path, name, nbytes, n, nc);
+  PetscCheck(nc >= 1 && nc <= 64 && (uint64_t)n <= (avail - 8 - o) / 8 / (size_t)nc && nbytes == (uint64_t)(8 * n * nc), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s holds %" PRIu64 " bytes, not %" PetscInt_FMT " points x %" PetscInt_FMT " components", path, name, nbytes, n, nc);
+  if (!n) PetscFunctionReturn(PETSC_SUCCESS); /* an empty piece (a rank without particles) */
   if (!strcmp(name, "Points")) {
     PetscCheck(nc == 3, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: Points with %" PetscInt_FMT " components", path, nc);
     PetscCall(PetscRealloc(sizeof(PetscReal) * 3 * (d->n + n), &d->points));
@@ -115,6 +118,10 @@ static PetscErrorCode ReadPiece(const char path[], PeriVTUData *d)
   }
   Attribute(tag, "NumberOfPoints", val, sizeof(val));
   n    = (PetscInt)strtol(val, NULL, 10);
+  if (n < 0) {
+    PetscCall(PetscFree(buf));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: NumberOfPoints %" PetscInt_FMT " is negative", path, n);
+  }
   data++;
   for (tag = strstr(buf, "<DataArray"); tag && tag < app && !ierr; tag = strstr(tag + 1, "<DataArray")) ierr = ReadArray(path, tag, data, len - (size_t)(data - buf), n, d);
   PetscCall(PetscFree(buf)); /* a bad array too */
