@@ -99,9 +99,9 @@ static PetscErrorCode ReadArray(const char path[], const char *tag, const char *
 /* Appends the points and arrays of one .vtu to d. */
 static PetscErrorCode ReadPiece(const char path[], PeriVTUData *d)
 {
-  char       *buf, val[32];
-  size_t      len;
-  const char *app, *data, *tag;
+  char          *buf, val[32];
+  size_t         len;
+  const char    *app, *data, *tag;
   PetscInt       n, before = d->narrays;
   PetscErrorCode ierr = PETSC_SUCCESS;
 
@@ -117,7 +117,7 @@ static PetscErrorCode ReadPiece(const char path[], PeriVTUData *d)
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s is not a .vtu perilin wrote (raw appended data, UInt64 headers, little-endian): give perilin's own file, not one re-saved by another program", path);
   }
   Attribute(tag, "NumberOfPoints", val, sizeof(val));
-  n    = (PetscInt)strtol(val, NULL, 10);
+  n = (PetscInt)strtol(val, NULL, 10);
   if (n < 0) {
     PetscCall(PetscFree(buf));
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: NumberOfPoints %" PetscInt_FMT " is negative", path, n);

@@ -19,7 +19,7 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
 /* Reads every value the reader says it holds, as the dynamic analysis may (src/system/readback.c):
  * ASan reports an array shorter than its count. */
 static volatile PetscReal sink;
-static void Touch(const PeriVTUData *d)
+static void               Touch(const PeriVTUData *d)
 {
   PetscReal sum = 0;
 
