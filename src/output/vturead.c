@@ -9,16 +9,24 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* The whole file, NUL-terminated (the XML part is searched as a string; the appended part is
  * read by offsets and may hold NULs). */
 static PetscErrorCode Slurp(const char path[], char **buf, size_t *len)
 {
-  FILE *fp = fopen(path, "rb");
-  long  n;
+  FILE       *fp = fopen(path, "rb");
+  long        n;
+  struct stat st;
 
   PetscFunctionBeginUser;
   PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot open %s: %s", path, strerror(errno));
+  /* a directory opens too, and its "size" is LONG_MAX (found by tests/fuzz/fuzz_vtu.c: a .pvtu
+     piece with an empty Source, the .pvtu's own directory); a FIFO or a device never ends */
+  if (fstat(fileno(fp), &st) || !S_ISREG(st.st_mode)) {
+    (void)fclose(fp);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s is no regular file", path);
+  }
   if (fseek(fp, 0, SEEK_END) || (n = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET)) {
     (void)fclose(fp);
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "Cannot read %s: %s", path, strerror(errno));
