@@ -133,14 +133,13 @@ static PetscErrorCode ReadOutput(PeriProblem p, const char file[])
 }
 
 /*@C
-  PeriProblemSetUp - the system (particles, bonds, model, conditions) with every input check, and
-  the output set, opened before any large computation so that a bad output.dir costs nothing.
-  Collective.
+  PeriProblemSetFromScene - the first part of PeriProblemSetUp: the root, output, analysis and
+  model keys checked and read, the system created, no particle yet (the scene fuzzer,
+  tests/fuzz/fuzz_scene.c, stops here). Collective.
 @*/
-PetscErrorCode PeriProblemSetUp(PeriProblem p)
+PetscErrorCode PeriProblemSetFromScene(PeriProblem p)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
   PetscCall(PeriSceneCheckSection(p->scene, p->scene->root, ""));
   /* the output and the analysis first: their keys are checked before any particle exists */
   PetscCall(ReadOutput(p, p->scene->file));
@@ -149,6 +148,19 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PeriSystemSetNeeds(p->sys, &p->analysis->type->needs));
   PetscCall(PeriProgressUpdate(p->sys->run.progress, PERI_PROGRESS_PHASE, "setup"));
   PetscCall(PeriSystemSetFromScene(p->sys));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriProblemSetUp - the system (particles, bonds, model, conditions) with every input check, and
+  the output set, opened before any large computation so that a bad output.dir costs nothing.
+  Collective.
+@*/
+PetscErrorCode PeriProblemSetUp(PeriProblem p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
+  PetscCall(PeriProblemSetFromScene(p));
   if (p->write_output) PetscCall(PeriOutputSetOpen(p->comm, p->output_dir, sizeof(p->output_dir), p->staging_dir, sizeof(p->staging_dir)));
   PetscCall(PeriSystemSetUp(p->sys));
   PetscCall(PeriAnalysisSetUp(p->analysis, p->sys));

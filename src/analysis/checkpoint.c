@@ -7,6 +7,9 @@
  * DOFs); the analysis writes its own state after it, then the system's (PeriCheckpointView). */
 #include "perilin/private/analysis.h"
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #define PERI_CHECKPOINT_MAGIC   0x50455249 /* "PERI" */
 #define PERI_CHECKPOINT_VERSION 2          /* 2: each step carries its attempts */
 #define PERI_CHECKPOINT_FILE    "checkpoint/state.bin"
@@ -109,6 +112,27 @@ PetscErrorCode PeriAnalysisCheckpointEnd(PeriAnalysis an, PetscViewer *v, const 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The header of the checkpoint open in v, checked against this run's: the same analysis, ranks,
+ * particles, bonds and scene, each refused with what to do. */
+static PetscErrorCode CheckHeader(PeriAnalysis an, PetscViewer v, const char file[], const Header *run)
+{
+  Header h;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerBinaryRead(v, h.n, 6, NULL, PETSC_INT));
+  PetscCheck(h.n[0] == PERI_CHECKPOINT_MAGIC, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is no perilin checkpoint", file);
+  PetscCheck(h.n[1] == PERI_CHECKPOINT_VERSION, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s has format %" PetscInt_FMT ", this perilin reads %d: run the scene from the start", file, h.n[1], PERI_CHECKPOINT_VERSION);
+  PetscCall(PetscViewerBinaryRead(v, h.analysis, sizeof(h.analysis), NULL, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryRead(v, &h.fingerprint, 1, NULL, PETSC_INT64));
+  h.analysis[sizeof(h.analysis) - 1] = 0;
+  PetscCheck(!strcmp(h.analysis, run->analysis), an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is a checkpoint of a %s analysis, and this run's is %s", file, h.analysis, run->analysis);
+  PetscCheck(h.n[2] == run->n[2], an->comm, PETSC_ERR_USER_INPUT, "-restart: %s was written on %" PetscInt_FMT " ranks and this run has %" PetscInt_FMT ": restart on %" PetscInt_FMT " (each rank's bonds are kept as that rank held them)", file, h.n[2], run->n[2], h.n[2]);
+  PetscCheck(h.fingerprint == run->fingerprint && h.n[3] == run->n[3] && h.n[4] == run->n[4] && h.n[5] == run->n[5], an->comm, PETSC_ERR_USER_INPUT,
+             "-restart: %s was written by a run of another scene (%" PetscInt_FMT " particles, %" PetscInt_FMT " bonds; this one has %" PetscInt_FMT " and %" PetscInt_FMT "%s): give the scene and scene options of the run that wrote it, or its resolved scene: perilin %s/scene.yaml -restart %s",
+             file, h.n[3], h.n[4], run->n[3], run->n[4], h.n[3] == run->n[3] && h.n[4] == run->n[4] ? ", but the scenes' keys differ" : "", an->restart, an->restart);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAnalysisRestartBegin - opens -restart's checkpoint (its path in file) and checks its header
   against this run: the same analysis, ranks, particles, bonds and scene, each refused with what to
@@ -116,22 +140,38 @@ PetscErrorCode PeriAnalysisCheckpointEnd(PeriAnalysis an, PetscViewer *v, const 
 @*/
 PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis an, PetscViewer *v, char file[], size_t len)
 {
-  Header h, run;
+  Header         run;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(HeaderOfRun(an, &run));
   PetscCall(PetscSNPrintf(file, len, "%s/%s", an->restart, PERI_CHECKPOINT_FILE));
   PetscCall(OpenViewer(an->comm, file, FILE_MODE_READ, v));
-  PetscCall(PetscViewerBinaryRead(*v, h.n, 6, NULL, PETSC_INT));
-  PetscCheck(h.n[0] == PERI_CHECKPOINT_MAGIC, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is no perilin checkpoint", file);
-  PetscCheck(h.n[1] == PERI_CHECKPOINT_VERSION, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s has format %" PetscInt_FMT ", this perilin reads %d: run the scene from the start", file, h.n[1], PERI_CHECKPOINT_VERSION);
-  PetscCall(PetscViewerBinaryRead(*v, h.analysis, sizeof(h.analysis), NULL, PETSC_CHAR));
-  PetscCall(PetscViewerBinaryRead(*v, &h.fingerprint, 1, NULL, PETSC_INT64));
-  h.analysis[sizeof(h.analysis) - 1] = 0;
-  PetscCheck(!strcmp(h.analysis, run.analysis), an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is a checkpoint of a %s analysis, and this run's is %s", file, h.analysis, run.analysis);
-  PetscCheck(h.n[2] == run.n[2], an->comm, PETSC_ERR_USER_INPUT, "-restart: %s was written on %" PetscInt_FMT " ranks and this run has %" PetscInt_FMT ": restart on %" PetscInt_FMT " (each rank's bonds are kept as that rank held them)", file, h.n[2], run.n[2], h.n[2]);
-  PetscCheck(h.fingerprint == run.fingerprint && h.n[3] == run.n[3] && h.n[4] == run.n[4] && h.n[5] == run.n[5], an->comm, PETSC_ERR_USER_INPUT,
-             "-restart: %s was written by a run of another scene (%" PetscInt_FMT " particles, %" PetscInt_FMT " bonds; this one has %" PetscInt_FMT " and %" PetscInt_FMT "%s): give the scene and scene options of the run that wrote it, or its resolved scene: perilin %s/scene.yaml -restart %s",
-             file, h.n[3], h.n[4], run.n[3], run.n[4], h.n[3] == run.n[3] && h.n[4] == run.n[4] ? ", but the scenes' keys differ" : "", an->restart, an->restart);
+  /* a refused header closes the file: the caller has no viewer to destroy (found by
+     tests/fuzz/fuzz_checkpoint.c) */
+  ierr = CheckHeader(an, *v, file, &run);
+  if (ierr) PetscCall(PetscViewerDestroy(v));
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisCheckpointFits - refuses a count read from the checkpoint open in v when n items of
+  each bytes cannot be in what is left of the file (or n < 0): a damaged count would otherwise size
+  an allocation. Collective.
+@*/
+PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis an, PetscViewer v, PetscInt n, size_t each)
+{
+  int         fd;
+  struct stat st;
+  off_t       at;
+  PetscInt    bad = n < 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerBinaryGetDescriptor(v, &fd));
+  /* the rank that reads the file (rank 0) knows its size; the others agree with it */
+  if (!bad && fd >= 0 && !fstat(fd, &st) && (at = lseek(fd, 0, SEEK_CUR)) >= 0) bad = (double)n * (double)each > (double)(st.st_size - at);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, an->comm));
+  PetscCheck(!bad, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: it counts %" PetscInt_FMT " items where the rest of the file holds fewer: restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, n);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

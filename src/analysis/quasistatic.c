@@ -644,6 +644,11 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
     PetscCall(PetscViewerBinaryRead(v, r, 2, NULL, PETSC_REAL));
     PetscCall(PetscViewerBinaryRead(v, n, 5, NULL, PETSC_INT));
     PetscCheck(n[4] == w && n[0] > 0, an->comm, PETSC_ERR_FILE_UNEXPECTED, "-restart: the checkpoint's steps do not fit this scene's reaction regions");
+    /* counts and the load factor from the file, checked before they size anything (found by
+       tests/fuzz/fuzz_checkpoint.c: a count of 2^62 steps) */
+    PetscCall(PeriAnalysisCheckpointFits(an, v, n[0], (PERI_STEP_REALS + w) * sizeof(PetscReal) + PERI_STEP_INTS * sizeof(PetscInt)));
+    PetscCall(PeriAnalysisCheckpointFits(an, v, n[3], sizeof(PetscInt)));
+    PetscCheck(n[3] >= 0 && n[1] >= 0 && n[2] >= 0 && r[0] >= 0 && r[0] <= ST(an)->max && r[1] > 0 && r[1] <= ST(an)->max, an->comm, PETSC_ERR_USER_INPUT, "-restart: the checkpoint is damaged (its counts or its load factor %g and step %g are out of range for load_factor_max %g): restart from an undamaged checkpoint, or run the scene from the start", (double)r[0], (double)r[1], (double)ST(an)->max);
     PetscCall(StepsAllocate(an, n[0], n[3]));
     *lambda = r[0], *dl = r[1];
     q->nsteps = n[0], q->pc_setups = n[1], q->solves = n[2], data->nsnaps = n[3];
@@ -723,12 +728,14 @@ static PetscErrorCode Restart(PeriAnalysis an, Loop *L, PeriCheckpoint *eq, Pets
   PeriQuasistatic *q = QS(an);
   PetscViewer      v;
   char             file[PETSC_MAX_PATH_LEN + 32];
+  PetscErrorCode   ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PeriAnalysisRestartBegin(an, &v, file, sizeof(file)));
-  PetscCall(StateBinary(an, v, lambda, dl, PETSC_FALSE));
-  PetscCall(PeriCheckpointLoad(an->sys, eq, v, file));
-  PetscCall(PetscViewerDestroy(&v));
+  ierr = StateBinary(an, v, lambda, dl, PETSC_FALSE);
+  if (!ierr) ierr = PeriCheckpointLoad(an->sys, eq, v, file);
+  PetscCall(PetscViewerDestroy(&v)); /* a refused checkpoint too */
+  PetscCall(ierr);
   PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_TRUE, PETSC_TRUE));
   PetscCall(AdoptSnapshots(an));
   q->peak_load_factor = q->steps[q->nsteps - 1].lambda;
@@ -924,6 +931,7 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   Loop            L  = {0};
   PeriCheckpoint  eq = {0};
   PetscLogDouble  t0, t;
+  PetscErrorCode  ierr;
 
   PetscFunctionBeginUser;
   QS(an)->started = PETSC_TRUE;
@@ -935,13 +943,14 @@ static PetscErrorCode PeriAnalysisRun_Quasistatic(PeriAnalysis an)
   PetscCall(PetscTime(&t0));
   L.mark = t0;
   PetscCall(PrintCriteria(an, st));
-  if (st->events)
-    PetscCall(RunEvents(an, st, &L, &eq));
-  else
-    PetscCall(RunIncrements(an, st, &L, &eq));
+  /* the loop's solver and equilibrium are freed whatever the outcome: a refused -restart
+     checkpoint is an input error of a process that may go on (the Python module; found by
+     tests/fuzz/fuzz_checkpoint.c) */
+  ierr = st->events ? RunEvents(an, st, &L, &eq) : RunIncrements(an, st, &L, &eq);
   PetscCall(KSPDestroy(&L.ksp));
   PetscCall(PetscFree2(L.hold, L.held));
   PetscCall(PeriCheckpointDestroy(&eq));
+  PetscCall(ierr);
   PetscCall(PetscTime(&t));
   an->sys->run.log.solve_s    = t - t0;
   QS(an)->unfinished_s        = t - L.mark;

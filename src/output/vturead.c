@@ -9,16 +9,24 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
 
 /* The whole file, NUL-terminated (the XML part is searched as a string; the appended part is
  * read by offsets and may hold NULs). */
 static PetscErrorCode Slurp(const char path[], char **buf, size_t *len)
 {
-  FILE *fp = fopen(path, "rb");
-  long  n;
+  FILE       *fp = fopen(path, "rb");
+  long        n;
+  struct stat st;
 
   PetscFunctionBeginUser;
   PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot open %s: %s", path, strerror(errno));
+  /* a directory opens too, and its "size" is LONG_MAX (found by tests/fuzz/fuzz_vtu.c: a .pvtu
+     piece with an empty Source, the .pvtu's own directory); a FIFO or a device never ends */
+  if (fstat(fileno(fp), &st) || !S_ISREG(st.st_mode)) {
+    (void)fclose(fp);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s is no regular file", path);
+  }
   if (fseek(fp, 0, SEEK_END) || (n = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET)) {
     (void)fclose(fp);
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "Cannot read %s: %s", path, strerror(errno));
@@ -39,7 +47,7 @@ static void Attribute(const char *tag, const char name[], char value[], size_t l
 
   value[0] = 0;
   while ((p = strstr(p, name)) && (!end || p < end)) {
-    if (p[-1] == ' ' && p[nl] == '=' && p[nl + 1] == '"') {
+    if (p > tag && p[-1] == ' ' && p[nl] == '=' && p[nl + 1] == '"') {
       const char *q = strchr(p + nl + 2, '"');
       size_t      k = q ? (size_t)(q - (p + nl + 2)) : 0;
       if (k >= len) k = len - 1;
@@ -69,9 +77,12 @@ static PetscErrorCode ReadArray(const char path[], const char *tag, const char *
   PetscCheck(off[0], PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s is not in appended data: not a file perilin wrote", path, name);
   nc = (PetscInt)strtol(comp[0] ? comp : "1", NULL, 10);
   o  = (size_t)strtoull(off, NULL, 10);
-  PetscCheck(o + 8 <= avail, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s lies past the end of the file", path, name);
+  /* every count from the file is checked against the bytes it has before it sizes anything, without
+     overflow (found by tests/fuzz/fuzz_vtu.c: offsets near 2^64, 2^60 points) */
+  PetscCheck(avail >= 8 && o <= avail - 8, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s lies past the end of the file", path, name);
   memcpy(&nbytes, data + o, 8);
-  PetscCheck(nbytes == (uint64_t)(8 * n * nc) && o + 8 + nbytes <= avail, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s holds %" PRIu64 " bytes, not %" PetscInt_FMT " points x %" PetscInt_FMT " components", path, name, nbytes, n, nc);
+  PetscCheck(nc >= 1 && nc <= 64 && (uint64_t)n <= (avail - 8 - o) / 8 / (size_t)nc && nbytes == (uint64_t)(8 * n * nc), PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: array %s holds %" PRIu64 " bytes, not %" PetscInt_FMT " points x %" PetscInt_FMT " components", path, name, nbytes, n, nc);
+  if (!n) PetscFunctionReturn(PETSC_SUCCESS); /* an empty piece (a rank without particles) */
   if (!strcmp(name, "Points")) {
     PetscCheck(nc == 3, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: Points with %" PetscInt_FMT " components", path, nc);
     PetscCall(PetscRealloc(sizeof(PetscReal) * 3 * (d->n + n), &d->points));
@@ -96,24 +107,33 @@ static PetscErrorCode ReadArray(const char path[], const char *tag, const char *
 /* Appends the points and arrays of one .vtu to d. */
 static PetscErrorCode ReadPiece(const char path[], PeriVTUData *d)
 {
-  char       *buf, val[32];
-  size_t      len;
-  const char *app, *data, *tag;
-  PetscInt    n, before = d->narrays;
+  char          *buf, val[32];
+  size_t         len;
+  const char    *app, *data, *tag;
+  PetscInt       n, before = d->narrays;
+  PetscErrorCode ierr = PETSC_SUCCESS;
 
   PetscFunctionBeginUser;
   PetscCall(Slurp(path, &buf, &len));
   Attribute(buf + (strstr(buf, "<VTKFile") ? strstr(buf, "<VTKFile") - buf : 0), "header_type", val, sizeof(val));
   app = strstr(buf, "<AppendedData encoding=\"raw\">");
-  if (!app || strcmp(val, "UInt64") || !strstr(buf, "byte_order=\"LittleEndian\"") || !(tag = strstr(buf, "<Piece NumberOfPoints="))) {
+  /* the data start after the '_' that follows the tag (none: the file was cut there; found by
+     tests/fuzz/fuzz_vtu.c) */
+  data = app ? strchr(app, '_') : NULL;
+  if (!data || strcmp(val, "UInt64") || !strstr(buf, "byte_order=\"LittleEndian\"") || !(tag = strstr(buf, "<Piece NumberOfPoints="))) {
     PetscCall(PetscFree(buf));
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s is not a .vtu perilin wrote (raw appended data, UInt64 headers, little-endian): give perilin's own file, not one re-saved by another program", path);
   }
   Attribute(tag, "NumberOfPoints", val, sizeof(val));
-  n    = (PetscInt)strtol(val, NULL, 10);
-  data = strchr(app, '_') + 1;
-  for (tag = strstr(buf, "<DataArray"); tag && tag < app; tag = strstr(tag + 1, "<DataArray")) PetscCall(ReadArray(path, tag, data, len - (size_t)(data - buf), n, d));
-  PetscCall(PetscFree(buf));
+  n = (PetscInt)strtol(val, NULL, 10);
+  if (n < 0) {
+    PetscCall(PetscFree(buf));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s: NumberOfPoints %" PetscInt_FMT " is negative", path, n);
+  }
+  data++;
+  for (tag = strstr(buf, "<DataArray"); tag && tag < app && !ierr; tag = strstr(tag + 1, "<DataArray")) ierr = ReadArray(path, tag, data, len - (size_t)(data - buf), n, d);
+  PetscCall(PetscFree(buf)); /* a bad array too */
+  PetscCall(ierr);
   PetscCheck(d->n == 0 || d->narrays == before, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s has arrays the earlier pieces lack", path);
   d->n += n;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -135,13 +155,15 @@ PetscErrorCode PeriReadParticles(const char path[], PeriVTUData *d)
     size_t      blen;
     const char *tag, *slash = strrchr(path, '/');
     PetscCall(PetscSNPrintf(dir, sizeof(dir), "%.*s", slash ? (int)(slash - path + 1) : 0, path));
+    PetscErrorCode ierr = PETSC_SUCCESS;
     PetscCall(Slurp(path, &buf, &blen));
-    for (tag = strstr(buf, "<Piece Source="); tag; tag = strstr(tag + 1, "<Piece Source=")) {
+    for (tag = strstr(buf, "<Piece Source="); tag && !ierr; tag = strstr(tag + 1, "<Piece Source=")) {
       Attribute(tag, "Source", src, sizeof(src));
-      PetscCall(PetscSNPrintf(piece, sizeof(piece), "%s%s", src[0] == '/' ? "" : dir, src));
-      PetscCall(ReadPiece(piece, d));
+      ierr = PetscSNPrintf(piece, sizeof(piece), "%s%s", src[0] == '/' ? "" : dir, src);
+      if (!ierr) ierr = ReadPiece(piece, d);
     }
-    PetscCall(PetscFree(buf));
+    PetscCall(PetscFree(buf)); /* a bad piece too: the index is freed (found by tests/fuzz/fuzz_vtu.c) */
+    PetscCall(ierr);
   } else
     PetscCall(ReadPiece(path, d));
   PetscCheck(d->n > 0 && d->points, PETSC_COMM_SELF, PETSC_ERR_FILE_UNEXPECTED, "%s holds no points", path);

@@ -193,6 +193,28 @@ PetscErrorCode PeriCheckpointView(PeriSystem sys, const PeriCheckpoint *e, Petsc
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* What a checkpoint holds must be a state this run could have reached: flags 0 or 1, causes
+ * among PeriFailureCauses, shares in [0, 1], finite displacements, the solve's names ended. A
+ * damaged file is refused here, not met as a solver failure or an overrun later (found by
+ * tests/fuzz/fuzz_checkpoint.c). Collective. */
+static PetscErrorCode CheckLoaded(PeriSystem sys, PeriCheckpoint *e, const char file[])
+{
+  const PeriBonds *b   = &sys->disc.bonds;
+  PetscInt         bad = 0;
+  PetscReal        norm;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < b->nbonds && !bad; k++)
+    bad = (e->live[k] != 0 && e->live[k] != 1) || b->cause[k] < 0 || b->cause[k] >= PERI_NCAUSES || (e->intact && !(e->intact[k] >= 0 && e->intact[k] <= 1));
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, sys->comm));
+  PetscCall(VecNorm(e->u, NORM_INFINITY, &norm));
+  PetscCheck(!bad && PetscIsNormalReal(norm + 1), sys->comm, PETSC_ERR_USER_INPUT, "-restart: %s is damaged (a bond flag, cause or share out of its range, or displacements not finite): restart from an undamaged checkpoint, or run the scene from the start", file);
+  e->solve.ksp_type[sizeof(e->solve.ksp_type) - 1]                 = 0;
+  e->solve.pc_type[sizeof(e->solve.pc_type) - 1]                   = 0;
+  e->solve.converged_reason[sizeof(e->solve.converged_reason) - 1] = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriCheckpointLoad - reads what PeriCheckpointView wrote into e (created by PeriCheckpointCreate)
   and the causes into sys; PeriCheckpointRestore then makes it the system's state. The bond counts
@@ -213,6 +235,7 @@ PetscErrorCode PeriCheckpointLoad(PeriSystem sys, PeriCheckpoint *e, PetscViewer
   if (e->intact) PetscCall(PetscViewerBinaryReadAll(v, e->intact, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_REAL));
   PetscCall(SolveInfoBinary(v, &e->solve, PETSC_FALSE));
   PetscCall(VecLoad(e->u, v));
+  PetscCall(CheckLoaded(sys, e, file));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -9,7 +9,8 @@
 #                          temporary directory holds both and is removed at the end)
 #   # ranks: N             run under mpiexec -n N
 #   # exit: STATUS         the exact exit status expected
-#   # setup: COMMAND       run by bash before perilin, with $out the output directory
+#   # setup: COMMAND       run by bash before perilin, with $out the output directory ($perilin and
+#                          $scene: the executable and the case, to make a checkpoint of it)
 #   # keep: FILE...        the outputs the case may leave (paths relative to $out, globs allowed)
 #   # signal: SIG DELAY [rank|group]   send SIG after DELAY s to perilin (or mpiexec), to one rank,
 #                          or to the process group; then the run must write summary.json marked
@@ -111,7 +112,7 @@ for scene in "${scenes[@]}"; do
   problem=""
   if [ -z "$expect" ]; then problem="no '# expect:' line"; fi
   if [ -z "$problem" ] && [ -n "$setup" ]; then
-    if ! out="$out" bash -c "$setup" > "$tmp/setup.log" 2>&1 < /dev/null; then
+    if ! out="$out" perilin="$perilin" scene="$scene" bash -c "$setup" > "$tmp/setup.log" 2>&1 < /dev/null; then
       problem="setup failed: $(head -c 200 "$tmp/setup.log")"
     fi
   fi

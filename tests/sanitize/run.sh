@@ -43,7 +43,7 @@ scenarios=(
 # clang (Debian's clang, .ci/install): its runtime holds both sanitizers, and writes UBSan's reports to
 # log_path too; with gcc's separate libubsan they go to stderr, where a test may not look.
 if [ -f "$build/CMakeCache.txt" ] && ! grep -q '^CMAKE_C_COMPILER:.*clang' "$build/CMakeCache.txt"; then rm -rf "$build"; fi
-cmake -S "$repo" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPERILIN_SANITIZE=ON > /dev/null
+cmake -S "$repo" -B "$build" -DCMAKE_C_COMPILER=clang -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPERILIN_SANITIZE=ON -DPERILIN_FUZZ=ON > /dev/null
 cmake --build "$build" -j 2 > "$build/build.log" 2>&1 || {
   tail -50 "$build/build.log"
   exit 1

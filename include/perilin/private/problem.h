@@ -23,6 +23,8 @@ struct _p_PeriProblem {
   PetscLogDouble t_start;
 };
 
+/* The keys of the root, output, analysis and model read, no particle yet (PeriProblemSetUp's start). */
+PETSC_EXTERN PetscErrorCode PeriProblemSetFromScene(PeriProblem);
 PETSC_EXTERN PetscErrorCode PeriWriteSummary(PeriProblem, const char[]);
 PETSC_EXTERN PetscErrorCode PeriWriteScene(PeriProblem, const char[]);
 
