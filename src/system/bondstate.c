@@ -205,7 +205,7 @@ static PetscErrorCode CheckLoaded(PeriSystem sys, PeriCheckpoint *e, const char 
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < b->nbonds && !bad; k++)
-    bad = (e->live[k] != 0 && e->live[k] != 1) || b->cause[k] < 0 || b->cause[k] >= PERI_NCAUSES || (e->intact && !(e->intact[k] >= 0 && e->intact[k] <= 1));
+    bad = (e->live[k] != 0 && e->live[k] != 1) || b->cause[k] >= PERI_NCAUSES || (e->intact && !(e->intact[k] >= 0 && e->intact[k] <= 1));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, sys->comm));
   PetscCall(VecNorm(e->u, NORM_INFINITY, &norm));
   PetscCheck(!bad && PetscIsNormalReal(norm + 1), sys->comm, PETSC_ERR_USER_INPUT, "-restart: %s is damaged (a bond flag, cause or share out of its range, or displacements not finite): restart from an undamaged checkpoint, or run the scene from the start", file);
