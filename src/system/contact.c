@@ -133,15 +133,37 @@ static int CompareCells(const void *a, const void *b)
   return x->i < y->i ? -1 : (x->i > y->i);
 }
 
-static PetscErrorCode AddPair(PeriContact *C, PetscInt i, PetscInt j)
+/* The bond joining owned i and local j, or -1: while it lives they interact through it, not by
+ * contact. A bond lives in the row of its smaller global index: a ghost's own row is on its rank,
+ * and such a pair counts as unbonded (its contact force acts only past 10 % compression). */
+static PetscInt BondOf(const PeriSystem sys, PetscInt i, PetscInt j)
 {
+  const PeriBonds *b = &sys->disc.bonds;
+  const PetscInt  *g = sys->disc.particles.global;
+  PetscInt         row = i, other = j;
+
+  if (g ? g[j] < g[i] : j < i) {
+    if (j >= sys->disc.nowned) return -1;
+    row = j, other = i;
+  }
+  for (PetscInt k = b->offset[row - b->rstart]; k < b->offset[row - b->rstart + 1]; k++)
+    if (b->j[k] == other) return k;
+  return -1;
+}
+
+/* Appends the candidate (i, j) with the bond that joins them (-1: none). */
+static PetscErrorCode AddPair(PeriSystem sys, PetscInt i, PetscInt j)
+{
+  PeriContact *C = &sys->contact;
+
   PetscFunctionBeginUser;
   if (C->npairs == C->cap) {
     C->cap = PetscMax(1024, 2 * C->cap);
-    PetscCall(PetscRealloc(sizeof(PetscInt) * 2 * C->cap, &C->pair));
+    PetscCall(PetscRealloc(sizeof(PetscInt) * 3 * C->cap, &C->pair));
   }
-  C->pair[2 * C->npairs]     = i;
-  C->pair[2 * C->npairs + 1] = j;
+  C->pair[3 * C->npairs]     = i;
+  C->pair[3 * C->npairs + 1] = j;
+  C->pair[3 * C->npairs + 2] = BondOf(sys, i, j);
   C->npairs++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -149,7 +171,6 @@ static PetscErrorCode AddPair(PeriContact *C, PetscInt i, PetscInt j)
 /* The candidates of owned i among the sorted cells (keys[], idx[]): its own and the adjacent ones. */
 static PetscErrorCode CandidatesOf(PeriSystem sys, PetscInt i, const PetscReal *y, const PetscReal lo[3], PetscReal h, const PetscInt64 n[3], PetscInt nl, const PetscInt64 keys[], const PetscInt idx[])
 {
-  PeriContact   *C  = &sys->contact;
   const PetscInt zr = sys->disc.particles.dim == 3 ? 1 : 0;
 
   PetscFunctionBeginUser;
@@ -172,7 +193,7 @@ static PetscErrorCode CandidatesOf(PeriSystem sys, PetscInt i, const PetscReal *
           PetscReal      r2 = 0;
           if (j == i) continue;
           for (PetscInt d = 0; d < 3; d++) r2 += PetscSqr(y[3 * j + d] - y[3 * i + d]);
-          if (r2 < h * h) PetscCall(AddPair(C, i, j));
+          if (r2 < h * h) PetscCall(AddPair(sys, i, j));
         }
       }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -235,10 +256,11 @@ static PetscBool Moved(PeriSystem sys, const PetscScalar ul[])
 static PetscReal PairTerm(PeriSystem sys, const PetscScalar ul[], PetscInt p, PetscReal g[3])
 {
   const PeriContact *C = &sys->contact;
-  const PetscInt     i = C->pair[2 * p], j = C->pair[2 * p + 1];
+  const PetscInt     i = C->pair[3 * p], j = C->pair[3 * p + 1], bond = C->pair[3 * p + 2];
   const PetscReal   *X = sys->disc.particles.x, *V = sys->disc.particles.volume;
   PetscReal          ui[3], uj[3], e[3], r2 = 0, X2 = 0, r, d, k;
 
+  if (bond >= 0 && sys->disc.bonds.live[bond]) return 0; /* the bond acts */
   Translation(sys, ul, i, ui);
   Translation(sys, ul, j, uj);
   for (PetscInt a = 0; a < 3; a++) {
@@ -273,7 +295,7 @@ static PetscReal Evaluate(PeriSystem sys, const PetscScalar ul[], PetscScalar fa
 
   for (PetscInt p = 0; C->on && p < C->npairs; p++) {
     PetscReal      g[3] = {0, 0, 0};
-    const PetscInt i    = C->pair[2 * p];
+    const PetscInt i    = C->pair[3 * p];
     E += 0.5 * PairTerm(sys, ul, p, g);
     for (PetscInt d = 0; fa && d < sys->disc.particles.dim; d++) {
       const PetscInt c = PeriModelTranslation(sys->model, d);

@@ -5,8 +5,8 @@
  * Contact between particles: every pair closer than d_ij = min(0.9 |X_j - X_i|, r_c) in the
  * deformed body repels with the short-range force of LAMMPS's peri pair styles and Peridigm's
  * short-range force, k V_i V_j (d_ij - r)/delta, from the energy k V_i V_j (d_ij - r)^2/(2 delta).
- * Bonded pairs feel it only when compressed below 0.9 of their length; in practice it acts between
- * particles without a bond: fragments, the faces of a crack, separate bodies. Candidate pairs
+ * It acts between particles without a live bond: fragments, the faces of a crack, separate bodies
+ * (a pair whose bond only the other rank holds is kept, and feels it only past 10 % compression). Candidate pairs
  * come from cells over the deformed positions with a skin, rebuilt when a particle has moved more
  * than half the skin since the last build.
  *
@@ -45,10 +45,10 @@ typedef struct {
   PetscBool      on;                 /* contact: given */
   PetscReal      radius, k, skin;    /* r_c, the stiffness k, the skin of the candidate list */
   PetscReal      delta;              /* the horizon the force is scaled by */
-  PetscInt       npairs, cap, *pair; /* candidates: (i owned, j local) */
+  PetscInt       npairs, cap, *pair; /* candidates: (i owned, j local, the bond joining them or -1) */
   PetscReal     *ubuild;             /* the local translations at the last build (3 per particle) */
   PetscInt       builds;             /* candidate lists built */
-  PetscReal      reach;              /* several ranks: the ghosts cover pairs while max |u| stays below this */
+  PetscReal      reach;              /* several ranks: the ghosts hold every pair while the spread of u stays below this */
   PetscReal      t;                  /* the time of the next evaluation (the impactors' positions) */
   PetscBool      record;             /* the next evaluation is the step's force: keep the impactors' */
   PetscReal      fstep[12];          /* this rank's share of each impactor's force in the step */
