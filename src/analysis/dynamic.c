@@ -52,6 +52,7 @@ typedef struct {
   PetscInt           nsteps, broken, snes_its, ksp_its;
   PetscReal          worst;                                                      /* implicit: the largest relative residual a step ended with */
   PetscReal          kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
+  PetscReal          work_bc; /* this rank's work of the moving boundaries since the last Work */
   PetscBool          fronts;                                                     /* analysis.fronts given */
   PetscInt           front_axis;
   PetscReal          front_origin, front_speed, front_damage; /* origin along the axis; the thresholds of speed and damage */
@@ -283,6 +284,7 @@ static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
   PeriInputCheck(!d->pulse || PeriModelTranslation(an->sys->model, d->pulse_dir) >= 0, s, s->root, d->pulse_dir == d->pulse_axis ? "analysis.pulse.axis" : "analysis.pulse.direction", "model %s does not translate along this axis", an->sys->model->type);
   PetscCall(PeriMassSetUp(an->sys));
   PeriInputCheck(!d->implicit || !an->sys->contact.nimpactors, s, s->root, "impactors", "impactors move with the explicit integrator (analysis.integrator: explicit)");
+  PeriInputCheck(!d->implicit || !an->sys->conditions.moving, s, s->root, "bc", "a bc velocity moves with the explicit integrator (analysis.integrator: explicit)");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -388,6 +390,15 @@ static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
   PetscCall(VecSet(v, 0));
   PetscCall(AddRegionValue(an, DYN(an)->vnode, DYN(an)->velocity, v));
   PetscCall(ZeroHeld(an, v));
+  if (an->sys->conditions.constrained_velocity) { /* the moving boundaries: held, at their velocity (owned rows) */
+    const PeriConditions *C = &an->sys->conditions;
+    PetscScalar          *a;
+    PetscInt              r0;
+    PetscCall(VecGetOwnershipRange(v, &r0, NULL));
+    PetscCall(VecGetArray(v, &a));
+    for (PetscInt k = 0; k < C->nconstrained; k++) a[C->constrained[k] - r0] = C->constrained_velocity[k];
+    PetscCall(VecRestoreArray(v, &a));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -430,6 +441,24 @@ static PetscErrorCode LoadAt(PeriAnalysis an, PetscReal t, PetscReal sign, Petsc
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The work of the moving boundaries (bc.<k>.velocity) in the step whose one force evaluation (half
+ * a step in: PETSc's velocity Verlet) left r = f - K q: the supports push the held DOFs with -r
+ * while they move by w dt. This rank's share, summed in Work. */
+static PetscErrorCode BoundaryWork(PeriAnalysis an, Vec r)
+{
+  const PeriConditions *C = &an->sys->conditions;
+  const PetscScalar    *a;
+  PetscInt              r0;
+
+  PetscFunctionBeginUser;
+  if (!C->constrained_velocity) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecGetOwnershipRange(r, &r0, NULL));
+  PetscCall(VecGetArrayRead(r, &a));
+  for (PetscInt k = 0; k < C->nconstrained; k++) DYN(an)->work_bc -= PetscRealPart(a[C->constrained[k] - r0]) * C->constrained_velocity[k] * DYN(an)->dt;
+  PetscCall(VecRestoreArrayRead(r, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Explicit, momentum split: dp/dt = M^-1 (a(t) f - K q), 0 on the held DOFs. */
 static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
 {
@@ -440,6 +469,7 @@ static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
   PetscCall(PeriContactSetTime(an->sys, t, PETSC_TRUE)); /* the step's one force: the impactors' kick */
   PetscCall(PeriSystemInternalForce(an->sys, q, dp));
   PetscCall(LoadAt(an, t, 1, -1, dp));
+  PetscCall(BoundaryWork(an, dp));
   PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -685,7 +715,10 @@ static PetscErrorCode Work(PeriAnalysis an, Vec q, PetscReal t)
     d->term_prev[k] = a;
   }
   PetscCall(VecCopy(q, d->uprev));
-  d->t_prev = t;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &d->work_bc, 1, MPIU_REAL, MPI_SUM, an->comm));
+  d->work += d->work_bc; /* the moving boundaries' */
+  d->work_bc = 0;
+  d->t_prev  = t;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -882,7 +915,7 @@ static PetscErrorCode CheckImpactorScheme(PeriAnalysis an)
   PetscBool ok;
 
   PetscFunctionBeginUser;
-  if (!an->sys->contact.nimpactors) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!an->sys->contact.nimpactors && !an->sys->conditions.moving) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(TSGetType(DYN(an)->ts, &type));
   PetscCall(PetscStrcmp(type, TSBASICSYMPLECTIC, &ok));
   if (ok) {
@@ -890,7 +923,7 @@ static PetscErrorCode CheckImpactorScheme(PeriAnalysis an)
     PetscCall(TSBasicSymplecticGetType(DYN(an)->ts, &bt));
     PetscCall(PetscStrcmp(bt, TSBASICSYMPLECTICVELVERLET, &ok));
   }
-  PetscCheck(ok, an->comm, PETSC_ERR_USER_INPUT, "%s: impactors move with the particles' velocity Verlet (-ts_type basicsymplectic -ts_basicsymplectic_type velverlet, the default): drop the -ts_type or -ts_basicsymplectic_type option", an->sys->scene->file);
+  PetscCheck(ok, an->comm, PETSC_ERR_USER_INPUT, "%s: impactors and bc velocities move with the particles' velocity Verlet (-ts_type basicsymplectic -ts_basicsymplectic_type velverlet, the default): drop the -ts_type or -ts_basicsymplectic_type option", an->sys->scene->file);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -37,6 +37,7 @@ static const PeriKey bc_keys[] = {
     {"fix", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "components held at zero, e.g. [ux, uy]"},
     {"value", PERI_KEY_MAP, NULL, NULL, "[length] (theta: radians)", NULL, "map component -> prescribed value, e.g. {ux: 0.001}"},
     {"affine", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the prescribed field u = A X + b at the reference positions X: {A: [[..],..], b: [..]}; every translational component, never theta"},
+    {"velocity", PERI_KEY_REALS, NULL, NULL, "[length/time]", NULL, "a dynamic analysis (explicit): the translations move at this velocity from rest, u = v t; one number per dimension"},
     {"optional", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "skip the components of fix and value the model lacks (one scene for several models)"},
     {"override", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "this item wins where an earlier item holds the same component of the same particle with another value (else that is an input error; equal values are always fine)"},
     {NULL},
@@ -84,7 +85,7 @@ PetscErrorCode PeriBoundaryParseAffine(PeriSystem sys, PeriNode node, const char
 
 /* The owned DOFs' prescribed values as the bc items build them, item by item. */
 typedef struct {
-  PetscReal *value;
+  PetscReal *value, *velocity; /* u = value + velocity t */
   PetscBool *set;
   PetscInt  *region; /* the condition's region, for its reaction (-1: none) */
   PetscInt  *item;   /* the bc item that set the value (-1: none) */
@@ -126,6 +127,29 @@ static PetscErrorCode ReportConflict(PeriSystem sys, PeriNode bc, PetscInt k, co
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* bc.<k>.velocity: every translation held at 0 from rest and moving at its velocity w (a dynamic
+ * analysis; its explicit integrator). */
+static PetscErrorCode ReadVelocity(PeriSystem sys, PeriNode item, PetscBool use[], PetscReal v[], PetscReal w[])
+{
+  PeriScene      s   = sys->scene;
+  const PetscInt dim = sys->disc.particles.dim;
+  PetscReal      vel[3];
+  PetscInt       n;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(sys->stiffness.needs.transient, s, item, "velocity", "a boundary moves in time in a dynamic analysis; a quasi-static one scales value by its load factor instead");
+  PetscCall(PeriSceneGetRealArray(s, item, "velocity", PETSC_TRUE, dim, dim, vel, &n));
+  for (PetscInt a = 0; a < dim; a++) {
+    PetscInt c;
+    PetscCall(AxisComponent(sys->model, a, &c));
+    PeriInputCheck(c >= 0, s, item, "velocity", "model %s has no displacement along axis %c", sys->model->type, (char)('x' + a));
+    use[c] = PETSC_TRUE;
+    v[c]   = 0;
+    w[c]   = vel[a];
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* bc item k into P over the owned DOFs. Where an earlier item holds a component of a particle,
  * a different value is an input error unless this item says override: true (then it wins).
  * Collective. */
@@ -138,8 +162,8 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
   PeriModel      m    = sys->model;
   const PetscInt bs = m->dofs, dim = sys->disc.particles.dim;
   PeriRegion    *r;
-  PeriNode       fix, val, aff;
-  PetscReal      v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0};
+  PeriNode       fix, val, aff, vel;
+  PetscReal      v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0}, w[PERI_MAX_DOF] = {0};
   PetscBool      use[PERI_MAX_DOF] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
   PetscInt       axis_comp[3]      = {-1, -1, -1};
   PetscBool      optional          = PETSC_FALSE;
@@ -153,7 +177,9 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
   PetscCall(PeriSceneGetNode(item, "fix", &fix));
   PetscCall(PeriSceneGetNode(item, "value", &val));
   PetscCall(PeriSceneGetNode(item, "affine", &aff));
-  PeriInputCheck((fix ? 1 : 0) + (val ? 1 : 0) + (aff ? 1 : 0) == 1, s, item, NULL, "give exactly one of fix, value, affine");
+  PetscCall(PeriSceneGetNode(item, "velocity", &vel));
+  PeriInputCheck((fix ? 1 : 0) + (val ? 1 : 0) + (aff ? 1 : 0) + (vel ? 1 : 0) == 1, s, item, NULL, "give exactly one of fix, value, affine, velocity");
+  if (vel) PetscCall(ReadVelocity(sys, item, use, v, w));
   if (fix) {
     PeriInputCheck(fix->kind == PERI_NODE_SEQ && fix->n > 0, s, fix, NULL, "must be a list of components, e.g. [ux, uy]");
     for (PetscInt k = 0; k < fix->n; k++) {
@@ -175,7 +201,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
       PetscCall(PeriSceneGetReal(s, val, val->child[k]->key, PETSC_TRUE, &v[c], NULL));
       use[c] = PETSC_TRUE;
     }
-  } else {
+  } else if (aff) {
     PetscCall(PeriBoundaryParseAffine(sys, aff, "bc.<k>.affine", A, b0));
     for (PetscInt a = 0; a < dim; a++) {
       PetscCall(AxisComponent(m, a, &axis_comp[a]));
@@ -194,16 +220,26 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
     for (PetscInt c = 0; c < bs; c++) {
       const PetscInt d = (i - sys->disc.bonds.rstart) * bs + c;
       if (!use[c]) continue;
-      if (P->set[d] && !over && x.j < 0 && !SameValue(P->value[d], v[c])) {
-        x = (Conflict){P->item[d], c, P->value[d], v[c], {X[0], X[1], X[2]}};
+      if (P->set[d] && !over && x.j < 0 && (!SameValue(P->value[d], v[c]) || !SameValue(P->velocity[d], w[c]))) {
+        x = (Conflict){P->item[d], c, P->value[d] + P->velocity[d], v[c] + w[c], {X[0], X[1], X[2]}};
       }
-      P->value[d]  = v[c];
+      P->value[d]    = v[c];
+      P->velocity[d] = w[c];
       P->set[d]    = PETSC_TRUE;
       P->region[d] = (PetscInt)(r - sys->disc.regions);
       P->item[d]   = k;
     }
   }
   PetscCall(ReportConflict(sys, bc, k, &x));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The velocity of the k-th constrained DOF, in conditions.constrained_velocity (made on the first). */
+static PetscErrorCode KeepVelocity(PeriSystem sys, PetscInt k, PetscReal w)
+{
+  PetscFunctionBeginUser;
+  if (!sys->conditions.constrained_velocity) PetscCall(PetscCalloc1(sys->conditions.nconstrained, &sys->conditions.constrained_velocity));
+  sys->conditions.constrained_velocity[k] = w;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -224,7 +260,7 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "bc", &bc));
   PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
-  PetscCall(PetscCalloc4(nloc, &P.value, nloc, &P.set, nloc, &P.region, nloc, &P.item));
+  PetscCall(PetscCalloc5(nloc, &P.value, nloc, &P.velocity, nloc, &P.set, nloc, &P.region, nloc, &P.item));
   value = P.value, set = P.set, region = P.region;
   for (PetscInt k = 0; k < nloc; k++) region[k] = P.item[k] = -1; /* held by no bc item (an inactive component) */
   /* a bad condition is an input error, not an exit: free the work arrays before passing it on */
@@ -250,9 +286,12 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
       sys->conditions.constrained[n]        = sys->disc.rstart * bs + k;
       sys->conditions.constrained_value[n]  = value[k];
       sys->conditions.constrained_region[n] = region[k];
+      if (P.velocity[k] != 0) PetscCall(KeepVelocity(sys, n, P.velocity[k]));
       n++;
     }
-  PetscCall(PetscFree4(P.value, P.set, P.region, P.item));
+  PetscCall(PetscFree5(P.value, P.velocity, P.set, P.region, P.item));
+  sys->conditions.moving = (PetscBool)(sys->conditions.constrained_velocity != NULL);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sys->conditions.moving, 1, MPIU_BOOL, MPI_LOR, sys->comm));
   PetscCall(PeriReactionsSetUp(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -543,6 +582,7 @@ PetscErrorCode PeriConditionsDestroy(PeriConditions *C)
   PetscCall(PetscFree(C->constrained));
   PetscCall(PetscFree(C->constrained_value));
   PetscCall(PetscFree(C->constrained_region));
+  PetscCall(PetscFree(C->constrained_velocity));
   PetscCall(PeriReactionsDestroy(&C->reactions));
   PetscCall(PeriConditionFieldsDestroy(&C->fields));
   PetscFunctionReturn(PETSC_SUCCESS);
