@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #define PERI_CHECKPOINT_MAGIC   0x50455249 /* "PERI" */
-#define PERI_CHECKPOINT_VERSION 2          /* 2: each step carries its attempts */
+#define PERI_CHECKPOINT_VERSION 3          /* 2: each step carries its attempts; 3: bond flags only with failure, dynamic runs */
 #define PERI_CHECKPOINT_FILE    "checkpoint/state.bin"
 
 /* What ties a checkpoint to a run. */
@@ -173,5 +173,35 @@ PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis an, PetscViewer v, PetscI
   if (!bad && fd >= 0 && !fstat(fd, &st) && (at = lseek(fd, 0, SEEK_CUR)) >= 0) bad = (double)n * (double)each > (double)(st.st_size - at);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, an->comm));
   PetscCheck(!bad, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: it counts %" PetscInt_FMT " items where the rest of the file holds fewer: restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, n);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisAdoptSnapshots - the snapshots of the checkpoint's run (particles_NNNN, NNNN = idx[k],
+  k < *n: particles.pvd's frames so far), taken from -restart's directory into this run's output
+  set; one that is gone leaves the series, and idx (and times, when given) keep the others. Collective.
+@*/
+PetscErrorCode PeriAnalysisAdoptSnapshots(PeriAnalysis an, PetscInt *n, PetscInt idx[], PetscReal times[])
+{
+  const char *dir;
+  PetscInt    kept = 0;
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(an->comm, &size));
+  PetscCall(an->outputdir(an->snapshotctx, &dir));
+  for (PetscInt k = 0; k < *n; k++) {
+    char      base[32], file[40];
+    PetscBool found, pieces = PETSC_TRUE;
+    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, idx[k]));
+    PetscCall(PeriParticlesFileName(an->comm, base, file, sizeof(file)));
+    PetscCall(PeriOutputSetAdopt(an->comm, an->restart, dir, file, &found));
+    if (found && size > 1) PetscCall(PeriOutputSetAdopt(an->comm, an->restart, dir, base, &pieces)); /* base/piece_RRRR.vtu */
+    if (!found || !pieces) continue;
+    if (times) times[kept] = times[k];
+    idx[kept++] = idx[k];
+  }
+  if (kept < *n) PetscCall(PetscPrintf(an->comm, "perilin: note: %" PetscInt_FMT " of the %" PetscInt_FMT " snapshots of %s are gone: particles.pvd lists the others\n", *n - kept, *n, an->restart));
+  *n = kept;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

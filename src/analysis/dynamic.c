@@ -10,6 +10,7 @@
  * loads) must close to analysis.energy_tolerance, or the run fails. */
 #include "perilin/private/analysis.h"
 #include <petscts.h>
+#include <signal.h>
 
 static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
 static const char *const dyn_profiles[]    = {"gaussian", "cosine", NULL};
@@ -52,7 +53,7 @@ typedef struct {
   PetscInt           nsteps, broken, snes_its, ksp_its;
   PetscReal          worst;                                                      /* implicit: the largest relative residual a step ended with */
   PetscReal          kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
-  PetscReal          work_bc; /* this rank's work of the moving boundaries since the last Work */
+  PetscReal          work_bc;                                                    /* this rank's work of the moving boundaries since the last Work */
   PetscBool          fronts;                                                     /* analysis.fronts given */
   PetscInt           front_axis;
   PetscReal          front_origin, front_speed, front_damage; /* origin along the axis; the thresholds of speed and damage */
@@ -61,6 +62,10 @@ typedef struct {
   PetscInt           nhist, cap, nsnap, nimpactors;           /* history rows (DYN_ROW reals each), their room, snapshots; impactors */
   PetscInt           every;                                   /* a snapshot every k steps: output.every, or DYN_FRAMES over the run */
   PetscReal         *hist, *snap_time;                        /* rank 0 keeps them; every rank counts */
+  PetscInt          *snap_idx, next_frame;                    /* each frame's NNNN (particles_NNNN), and the next one's */
+  PetscInt           checkpoints, restart_step;               /* checkpoints written; the step -restart continued from (0: none) */
+  PetscInt           stop_after;                              /* -peri_stop_after_step: stop after this step as a SIGINT would (0: never) */
+  PetscBool          resumed;                                 /* -restart: the first monitor call is the checkpoint's step, recorded already */
   Vec                minv, uprev, tmp;                        /* 1/m per DOF (0 on held DOFs), the last step's u, work */
   Mat                J;                                       /* implicit: K + shift M with the held rows and columns eliminated */
   const PeriContact *contact;                                 /* the system's, for the impactors' history */
@@ -269,6 +274,7 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
   if (amp) PetscCall(CheckOwnSection(s, amp, "analysis.amplitude"));
   PetscCall(PeriAmplitudeFromScene(s, amp, &d->amp));
   PetscCall(ReadLoadAmplitudes(d, s));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_stop_after_step", &d->stop_after, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -600,6 +606,7 @@ static PetscErrorCode PostStep(TS ts)
   Vec          U, q, p;
   PetscInt     nb = 0;
   PetscReal    before, after = 0, released, t;
+  PetscInt     step;
   PetscBool    bybond;
 
   PetscFunctionBeginUser;
@@ -629,6 +636,8 @@ static PetscErrorCode PostStep(TS ts)
   }
   PetscCall(RestoreState(an, U, &q, &p));
   /* a signal ends the run after this step (TSStep resets the reason, so a monitor could not) */
+  PetscCall(TSGetStepNumber(ts, &step));
+  if (step == d->stop_after) PeriSignalSimulate(SIGINT);
   PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
   if (an->sys->run.interrupted) PetscCall(TSSetConvergedReason(ts, TS_CONVERGED_USER));
   if (d->implicit) {
@@ -656,8 +665,10 @@ static PetscErrorCode WriteSnapshot(PeriAnalysis an, Vec q, Vec p, PetscReal t)
   PetscCall(PeriSystemKeepVelocity(an->sys, p));
   if (an->sys->bond_state.failure.active) PetscCall(PeriDamage(an->sys, &an->sys->bond_state.damage));
   PetscCall(PetscRealloc(sizeof(PetscReal) * (d->nsnap + 1), &d->snap_time));
-  d->snap_time[d->nsnap] = t;
-  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT, d->nsnap++));
+  PetscCall(PetscRealloc(sizeof(PetscInt) * (d->nsnap + 1), &d->snap_idx));
+  d->snap_time[d->nsnap]  = t;
+  d->snap_idx[d->nsnap++] = d->next_frame;
+  PetscCall(PetscSNPrintf(name, sizeof(name), "particles_%04" PetscInt_FMT, d->next_frame++));
   PetscCall(an->snapshot(an->snapshotctx, name));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -798,6 +809,129 @@ static PetscErrorCode ProbeDisplacement(PeriAnalysis an, Vec q)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Refuses a checkpoint whose counts or step do not fit this run, before they size anything. */
+static PetscErrorCode CheckState(PeriAnalysis an, PetscViewer v, const PetscInt n[], const PetscReal r[])
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  PetscCheck(n[4] == DYN_ROW(d) && n[5] == d->nterms && n[6] == d->nimpactors, an->comm, PETSC_ERR_USER_INPUT, "-restart: the checkpoint's history, loads or impactors do not fit this scene: restart with the scene of the run that wrote it");
+  PetscCheck(r[9] == d->dt, an->comm, PETSC_ERR_USER_INPUT, "-restart: the checkpoint's run stepped by dt = %g and this one by %g: restart with the options of the run that wrote it", (double)r[9], (double)d->dt);
+  PetscCheck(n[0] >= 0 && n[1] >= 0 && n[3] >= 0 && r[0] >= 0 && r[0] <= d->t_end && PetscIsNormalReal(r[4] + r[1] + 1), an->comm, PETSC_ERR_USER_INPUT, "-restart: the checkpoint is damaged (its step, time %g or energies out of range): restart from an undamaged checkpoint, or run the scene from the start", (double)r[0]);
+  PetscCall(PeriAnalysisCheckpointFits(an, v, n[2], DYN_ROW(d) * sizeof(PetscReal)));
+  PetscCall(PeriAnalysisCheckpointFits(an, v, n[3], sizeof(PetscReal) + sizeof(PetscInt)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The run's state at a step, besides the bonds and u (PeriCheckpointView) and the velocities: the
+ * step and time, the energies and counters, history.csv's rows, the frames written, the loads'
+ * last amplitudes and the impactors. write: into v, else from v. Collective. */
+static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *t, PetscBool write)
+{
+  Dynamic     *d     = DYN(an);
+  PeriContact *C     = &an->sys->contact;
+  PetscInt     n[8]  = {d->nsteps, d->broken, d->nhist, d->nsnap, DYN_ROW(d), d->nterms, d->nimpactors, d->next_frame};
+  PetscReal    r[10] = {*t, d->kinetic, d->strain, d->dissipated, d->work, d->E0, d->scale, d->error, d->drift, d->dt}, imp[40];
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; write && k < PetscMin(d->nimpactors, 4); k++) {
+    PetscCall(PetscArraycpy(&imp[10 * k], C->impactors[k].x, 3));
+    PetscCall(PetscArraycpy(&imp[10 * k + 3], C->impactors[k].v, 3));
+    PetscCall(PetscArraycpy(&imp[10 * k + 6], C->impactors[k].force, 3));
+    imp[10 * k + 9] = C->impactors[k].t;
+  }
+  if (write) {
+    PetscCall(PetscViewerBinaryWrite(v, n, 8, PETSC_INT));
+    PetscCall(PetscViewerBinaryWrite(v, r, 10, PETSC_REAL));
+  } else {
+    PetscCall(PetscViewerBinaryRead(v, n, 8, NULL, PETSC_INT));
+    PetscCall(PetscViewerBinaryRead(v, r, 10, NULL, PETSC_REAL));
+    PetscCall(CheckState(an, v, n, r));
+    d->nsteps = n[0], d->broken = n[1], d->nhist = d->cap = n[2], d->nsnap = n[3], d->next_frame = n[7];
+    *t = r[0], d->kinetic = r[1], d->strain = r[2], d->dissipated = r[3], d->work = r[4], d->E0 = r[5], d->scale = r[6], d->error = r[7], d->drift = r[8];
+    PetscCall(PetscMalloc1(DYN_ROW(d) * PetscMax(1, d->nhist), &d->hist));
+    PetscCall(PetscMalloc1(PetscMax(1, d->nsnap), &d->snap_time)); /* apart: WriteSnapshot grows each */
+    PetscCall(PetscMalloc1(PetscMax(1, d->nsnap), &d->snap_idx));
+  }
+  if (write) {
+    PetscCall(PetscViewerBinaryWrite(v, d->term_prev, d->nterms, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, imp, 10 * d->nimpactors, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, d->hist, DYN_ROW(d) * d->nhist, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, d->snap_time, d->nsnap, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, d->snap_idx, d->nsnap, PETSC_INT));
+  } else {
+    PetscCall(PetscViewerBinaryRead(v, d->term_prev, d->nterms, NULL, PETSC_REAL));
+    PetscCall(PetscViewerBinaryRead(v, imp, 10 * d->nimpactors, NULL, PETSC_REAL));
+    PetscCall(PetscViewerBinaryRead(v, d->hist, DYN_ROW(d) * d->nhist, NULL, PETSC_REAL));
+    PetscCall(PetscViewerBinaryRead(v, d->snap_time, d->nsnap, NULL, PETSC_REAL));
+    PetscCall(PetscViewerBinaryRead(v, d->snap_idx, d->nsnap, NULL, PETSC_INT));
+  }
+  for (PetscInt k = 0; !write && k < PetscMin(d->nimpactors, 4); k++) {
+    PetscCall(PetscArraycpy(C->impactors[k].x, &imp[10 * k], 3));
+    PetscCall(PetscArraycpy(C->impactors[k].v, &imp[10 * k + 3], 3));
+    PetscCall(PetscArraycpy(C->impactors[k].force, &imp[10 * k + 6], 3));
+    C->impactors[k].t = imp[10 * k + 9];
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* checkpoint/state.bin of the state (q, p) after the step to t: the run's state, the bonds and u,
+ * then the velocities (src/analysis/checkpoint.c). Collective. */
+static PetscErrorCode WriteCheckpoint(PeriAnalysis an, Vec q, Vec p, PetscReal t)
+{
+  PeriSystem     sys = an->sys;
+  PeriCheckpoint eq  = {q, sys->disc.bonds.live, sys->disc.bonds.intact, sys->fields.solve};
+  PetscViewer    v;
+  char           tmp[PETSC_MAX_PATH_LEN + 32];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriAnalysisCheckpointBegin(an, &v, tmp, sizeof(tmp)));
+  PetscCall(StateBinary(an, v, &t, PETSC_TRUE));
+  PetscCall(PeriCheckpointView(sys, &eq, v));
+  PetscCall(VecView(p, v));
+  PetscCall(PeriAnalysisCheckpointEnd(an, &v, tmp));
+  DYN(an)->checkpoints++;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -restart: the run's state, the bonds, u and the velocities of the checkpoint into the TS's state
+ * U, K for those bonds, and the frames of the stopped run adopted. The step goes on from there
+ * as the stopped run's did: the same dt (from the same pristine body), the same operations. */
+static PetscErrorCode Restart(PeriAnalysis an, Vec U, Vec V)
+{
+  Dynamic       *d = DYN(an);
+  PeriCheckpoint eq;
+  PetscViewer    v;
+  char           file[PETSC_MAX_PATH_LEN + 32];
+  Vec            q, p;
+  PetscReal      t = 0;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(d->hist));
+  PetscCall(PeriCheckpointCreate(an->sys, &eq));
+  PetscCall(PeriAnalysisRestartBegin(an, &v, file, sizeof(file)));
+  PetscCall(GetState(an, U, &q, &p));
+  ierr = StateBinary(an, v, &t, PETSC_FALSE);
+  if (!ierr) ierr = PeriCheckpointLoad(an->sys, &eq, v, file);
+  if (!ierr) ierr = VecLoad(d->implicit ? V : p, v);
+  PetscCall(PetscViewerDestroy(&v)); /* a refused checkpoint too */
+  if (!ierr) ierr = VecCopy(eq.u, q);
+  if (!ierr) ierr = VecCopy(eq.u, d->uprev);
+  PetscCall(RestoreState(an, U, &q, &p));
+  if (!ierr) ierr = PeriCheckpointRestore(an->sys, &eq, PETSC_TRUE, PETSC_TRUE);
+  PetscCall(PeriCheckpointDestroy(&eq));
+  PetscCall(ierr);
+  PetscCall(TSSetTime(d->ts, t));
+  PetscCall(TSSetStepNumber(d->ts, d->nsteps));
+  PetscCall(PeriAnalysisAdoptSnapshots(an, &d->nsnap, d->snap_idx, d->snap_time));
+  d->restart_step = d->nsteps;
+  d->resumed      = PETSC_TRUE;
+  d->t_prev       = t;
+  PetscCall(PetscPrintf(an->comm, "perilin: restarted from %s: step %" PetscInt_FMT " at t = %g, %" PetscInt_FMT " bonds broken\n", file, d->nsteps, (double)t, d->broken));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* After each step (and at t = 0): energies, the balance, history, snapshots, signals. */
 static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ctx)
 {
@@ -806,15 +940,20 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   Vec          q, p;
   PetscReal    balance;
   PetscInt     last;
-  PetscBool    snap;
+  PetscBool    snap, ckpt;
 
   PetscFunctionBeginUser;
+  if (d->resumed) { /* -restart: this step's row, frame and checkpoint are the stopped run's */
+    d->resumed = PETSC_FALSE;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(GetState(an, U, &q, &p));
   PetscCall(Work(an, q, t));
   PetscCall(TSGetMaxSteps(ts, &last));
   d->nsteps = step;
   snap      = (PetscBool)(step % d->every == 0 || step >= last);
-  if (step % d->energy_every && step < last && !snap) { /* not a step that checks the balance */
+  ckpt      = (PetscBool)(an->sys->run.interrupted || (an->checkpoint_every && step % an->checkpoint_every == 0 && step < last && step > 0));
+  if (step % d->energy_every && step < last && !snap && !ckpt) { /* not a step that checks the balance */
     PetscCall(RestoreState(an, U, &q, &p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -831,6 +970,7 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   d->drift = d->scale > 0 ? d->error / d->scale : 0;
   PetscCall(RecordHistory(d, t, balance));
   if (snap) PetscCall(WriteSnapshot(an, q, p, t));
+  if (ckpt) PetscCall(WriteCheckpoint(an, q, p, t));
   PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_ANALYSIS, "step %" PetscInt_FMT ", t = %g of %g, %" PetscInt_FMT " bonds broken", step, (double)t, (double)d->t_end, d->broken));
   PetscCall(RestoreState(an, U, &q, &p));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -1081,6 +1221,18 @@ static const char *DriftAdvice(const Dynamic *d)
   return advice;
 }
 
+/* -peri_checkpoint_every N: a checkpoint every N steps; without the option, at the frames' cadence
+ * (about 25 over the run): a checkpoint holds the whole state, too much to write every step. */
+static PetscErrorCode CheckpointCadence(PeriAnalysis an)
+{
+  PetscBool given;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-peri_checkpoint_every", &given));
+  if (!given) an->checkpoint_every = DYN(an)->every;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Sets up the TS (its state in *U, and *V for the implicit integrator) and integrates to t_end. */
 static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
 {
@@ -1115,6 +1267,8 @@ static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(VecCopy(q, d->uprev));
   PetscCall(RestoreState(an, *U, &q, &p));
   for (PetscInt k = 0; k < d->nterms; k++) d->term_prev[k] = PeriAmplitudeValue(d->term_amp[k], 0);
+  PetscCall(CheckpointCadence(an));
+  if (an->restart[0]) PetscCall(Restart(an, *U, d->implicit ? *V : NULL));
   PetscCall(PetscLogEventBegin(PERI_EVENT_Solve, 0, 0, 0, 0));
   PetscCall(TSSolve(d->ts, NULL));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Solve, 0, 0, 0, 0));
@@ -1209,7 +1363,7 @@ static PetscErrorCode Files_Dynamic(PeriAnalysis an, const char dir[])
   if (!d->nsnap || an->rank) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc1(d->nsnap, &files));
   for (PetscInt k = 0; k < d->nsnap; k++) {
-    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, k));
+    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, d->snap_idx[k]));
     PetscCall(PetscMalloc1(40, &files[k]));
     PetscCall(PeriParticlesFileName(an->comm, base, files[k], 40));
   }
@@ -1256,6 +1410,9 @@ static PetscErrorCode Summary_Dynamic(PeriAnalysis an, PeriJSON j)
   PetscCall(PeriJSONReal(j, "energy_drift", d->drift));
   PetscCall(PeriJSONReal(j, "energy_tolerance", d->energy_tol));
   PetscCall(PeriJSONInt(j, "broken_bonds", d->broken));
+  PetscCall(PeriJSONInt(j, "checkpoints", d->checkpoints));
+  if (d->restart_step) PetscCall(PeriJSONString(j, "restarted_from", an->restart));
+  if (d->restart_step) PetscCall(PeriJSONInt(j, "restart_step", d->restart_step));
   PetscCall(PeriContactSummary(an->sys, j));
   if (d->implicit) {
     PetscCall(PeriJSONInt(j, "ksp_iterations", d->ksp_its));
@@ -1297,6 +1454,7 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscCall(VecDestroy(&d->tmp));
   PetscCall(PetscFree(d->hist));
   PetscCall(PetscFree(d->snap_time));
+  PetscCall(PetscFree(d->snap_idx));
   for (PetscInt k = 0; k < d->nterms; k++) PetscCall(VecDestroy(&d->term_f[k]));
   PetscCall(PetscFree3(d->term_amp, d->term_f, d->term_prev));
   for (PetscInt k = 0; k < d->nloads; k++) PetscCall(PeriAmplitudeDestroy(&d->load_amp[k]));
@@ -1305,7 +1463,7 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static const char *const dyn_files[] = {"history.csv", "dynamics.png", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", NULL};
+static const char *const dyn_files[] = {"history.csv", "dynamics.png", "checkpoint", "particles.pvd", "particles_#.vtu", "particles_#.pvtu", "particles_#", NULL};
 
 /* K is assembled, or matrix-free for the explicit integrator (solver.operator: matrix_free); the
    implicit step copies it into J. */
@@ -1316,5 +1474,6 @@ const PeriAnalysisType PeriAnalysis_Dynamic = {
     .option_prefix = "",
     .files         = dyn_files,
     .needs         = {.matrix_free = PETSC_TRUE, .static_solver = PETSC_TRUE, .matrix_copies = 1, .transient = PETSC_TRUE},
+    .checkpoints   = PETSC_TRUE,
     .ops           = {.setfromscene = SetFromScene_Dynamic, .setup = SetUp_Dynamic, .run = Run_Dynamic, .files = Files_Dynamic, .summary = Summary_Dynamic, .report = Report_Dynamic, .destroy = Destroy_Dynamic},
 };

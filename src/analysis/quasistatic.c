@@ -693,32 +693,6 @@ static PetscErrorCode WriteCheckpoint(PeriAnalysis an, const PeriCheckpoint *eq,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The snapshots of the checkpoint's run (particles.pvd's frames so far), taken from -restart's
- * directory into this run's output set; one that is gone leaves the series. Collective. */
-static PetscErrorCode AdoptSnapshots(PeriAnalysis an)
-{
-  QSData     *data = (QSData *)an->data;
-  const char *dir;
-  PetscInt    n = 0;
-  PetscMPIInt size;
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_size(an->comm, &size));
-  PetscCall(an->outputdir(an->snapshotctx, &dir));
-  for (PetscInt k = 0; k < data->nsnaps; k++) {
-    char      base[32], file[40];
-    PetscBool found, pieces = PETSC_TRUE;
-    PetscCall(PetscSNPrintf(base, sizeof(base), "particles_%04" PetscInt_FMT, data->snaps[k]));
-    PetscCall(PeriParticlesFileName(an->comm, base, file, sizeof(file)));
-    PetscCall(PeriOutputSetAdopt(an->comm, an->restart, dir, file, &found));
-    if (found && size > 1) PetscCall(PeriOutputSetAdopt(an->comm, an->restart, dir, base, &pieces)); /* base/piece_RRRR.vtu */
-    if (found && pieces) data->snaps[n++] = data->snaps[k];
-  }
-  if (n < data->nsnaps) PetscCall(PetscPrintf(an->comm, "perilin: note: %" PetscInt_FMT " of the %" PetscInt_FMT " snapshots of %s are gone: particles.pvd lists the others\n", data->nsnaps - n, data->nsnaps, an->restart));
-  data->nsnaps = n;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* -restart: the loop's state, the bonds and u of the checkpoint, K assembled for those bonds, and a
  * KSP that starts from u, as the interrupted run's next solve did. Its preconditioner is built
  * anew (the interrupted run's came from an earlier K): the next solves agree with the interrupted
@@ -737,7 +711,7 @@ static PetscErrorCode Restart(PeriAnalysis an, Loop *L, PeriCheckpoint *eq, Pets
   PetscCall(PetscViewerDestroy(&v)); /* a refused checkpoint too */
   PetscCall(ierr);
   PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_TRUE, PETSC_TRUE));
-  PetscCall(AdoptSnapshots(an));
+  PetscCall(PeriAnalysisAdoptSnapshots(an, &((QSData *)an->data)->nsnaps, ((QSData *)an->data)->snaps, NULL));
   q->peak_load_factor = q->steps[q->nsteps - 1].lambda;
   q->broken_bonds     = q->steps[q->nsteps - 1].broken_total;
   q->restart_step     = q->nsteps;

@@ -96,8 +96,11 @@ PetscErrorCode PeriCheckpointCreate(PeriSystem sys, PeriCheckpoint *e)
 {
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(sys->stiffness.K, &e->u, NULL)); /* lambda = 0: no displacement */
-  PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &e->live));
-  PetscCall(PetscArraycpy(e->live, sys->disc.bonds.live, sys->disc.bonds.nbonds));
+  e->live = NULL;                                          /* a scene without failure has no flags */
+  if (sys->disc.bonds.live) {
+    PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &e->live));
+    PetscCall(PetscArraycpy(e->live, sys->disc.bonds.live, sys->disc.bonds.nbonds));
+  }
   e->intact = NULL;
   if (sys->disc.bonds.intact) {
     PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &e->intact));
@@ -111,7 +114,7 @@ PetscErrorCode PeriCheckpointSave(PeriSystem sys, PeriCheckpoint *e)
   PetscFunctionBeginUser;
   PetscCall(VecCopy(sys->fields.u, e->u));
   e->solve = sys->fields.solve;
-  PetscCall(PetscArraycpy(e->live, sys->disc.bonds.live, sys->disc.bonds.nbonds));
+  if (e->live) PetscCall(PetscArraycpy(e->live, sys->disc.bonds.live, sys->disc.bonds.nbonds));
   if (e->intact) PetscCall(PetscArraycpy(e->intact, sys->disc.bonds.intact, sys->disc.bonds.nbonds));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -121,7 +124,7 @@ PetscErrorCode PeriCheckpointSave(PeriSystem sys, PeriCheckpoint *e)
 PetscErrorCode PeriCheckpointRestore(PeriSystem sys, PeriCheckpoint *e, PetscBool reassemble, PetscBool restore_u)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscArraycpy(sys->disc.bonds.live, e->live, sys->disc.bonds.nbonds));
+  if (e->live) PetscCall(PetscArraycpy(sys->disc.bonds.live, e->live, sys->disc.bonds.nbonds));
   if (e->intact) PetscCall(PetscArraycpy(sys->disc.bonds.intact, e->intact, sys->disc.bonds.nbonds));
   PetscCall(PeriFamilySync(sys));
   if (reassemble) {
@@ -180,13 +183,15 @@ static PetscErrorCode SolveInfoBinary(PetscViewer v, PeriSolveInfo *s, PetscBool
 @*/
 PetscErrorCode PeriCheckpointView(PeriSystem sys, const PeriCheckpoint *e, PetscViewer v)
 {
-  const PeriBonds *b = &sys->disc.bonds;
-  PeriSolveInfo    s = e->solve;
+  const PeriBonds *b     = &sys->disc.bonds;
+  PeriSolveInfo    s     = e->solve;
+  PetscInt         flags = b->cause && e->live ? 1 : 0; /* a scene without failure breaks no bond: no flags */
 
   PetscFunctionBeginUser;
   PetscCall(PetscViewerBinaryWriteAll(v, &b->nbonds, 1, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_INT));
-  PetscCall(PetscViewerBinaryWriteAll(v, e->live, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
-  PetscCall(PetscViewerBinaryWriteAll(v, b->cause, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryWrite(v, &flags, 1, PETSC_INT));
+  if (flags) PetscCall(PetscViewerBinaryWriteAll(v, e->live, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  if (flags) PetscCall(PetscViewerBinaryWriteAll(v, b->cause, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
   if (e->intact) PetscCall(PetscViewerBinaryWriteAll(v, e->intact, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_REAL));
   PetscCall(SolveInfoBinary(v, &s, PETSC_TRUE));
   PetscCall(VecView(e->u, v));
@@ -204,7 +209,7 @@ static PetscErrorCode CheckLoaded(PeriSystem sys, PeriCheckpoint *e, const char 
   PetscReal        norm;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < b->nbonds && !bad; k++)
+  for (PetscInt k = 0; b->cause && e->live && k < b->nbonds && !bad; k++)
     bad = (e->live[k] != 0 && e->live[k] != 1) || b->cause[k] >= PERI_NCAUSES || (e->intact && !(e->intact[k] >= 0 && e->intact[k] <= 1));
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, sys->comm));
   PetscCall(VecNorm(e->u, NORM_INFINITY, &norm));
@@ -223,15 +228,17 @@ static PetscErrorCode CheckLoaded(PeriSystem sys, PeriCheckpoint *e, const char 
 PetscErrorCode PeriCheckpointLoad(PeriSystem sys, PeriCheckpoint *e, PetscViewer v, const char file[])
 {
   PeriBonds *b = &sys->disc.bonds;
-  PetscInt   n, bad;
+  PetscInt   n, bad, flags;
 
   PetscFunctionBeginUser;
   PetscCall(PetscViewerBinaryReadAll(v, &n, 1, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_INT));
   bad = n != b->nbonds;
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, sys->comm));
   PetscCheck(!bad, sys->comm, PETSC_ERR_USER_INPUT, "%s: its bonds are not shared out between the ranks as in this run (was it written by another perilin or with another -peri_partition?): restart with the options of the run that wrote it", file);
-  PetscCall(PetscViewerBinaryReadAll(v, e->live, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
-  PetscCall(PetscViewerBinaryReadAll(v, b->cause, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  PetscCall(PetscViewerBinaryRead(v, &flags, 1, NULL, PETSC_INT));
+  PetscCheck(flags == (b->cause && e->live ? 1 : 0), sys->comm, PETSC_ERR_USER_INPUT, "-restart: %s is damaged (its bond flags are %s, and this scene's bonds %s)", file, flags ? "there" : "absent", b->cause ? "break" : "do not");
+  if (flags) PetscCall(PetscViewerBinaryReadAll(v, e->live, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
+  if (flags) PetscCall(PetscViewerBinaryReadAll(v, b->cause, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_CHAR));
   if (e->intact) PetscCall(PetscViewerBinaryReadAll(v, e->intact, b->nbonds, PETSC_DETERMINE, PETSC_DETERMINE, PETSC_REAL));
   PetscCall(SolveInfoBinary(v, &e->solve, PETSC_FALSE));
   PetscCall(VecLoad(e->u, v));

@@ -225,9 +225,9 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
       }
       P->value[d]    = v[c];
       P->velocity[d] = w[c];
-      P->set[d]    = PETSC_TRUE;
-      P->region[d] = (PetscInt)(r - sys->disc.regions);
-      P->item[d]   = k;
+      P->set[d]      = PETSC_TRUE;
+      P->region[d]   = (PetscInt)(r - sys->disc.regions);
+      P->item[d]     = k;
     }
   }
   PetscCall(ReportConflict(sys, bc, k, &x));

@@ -138,8 +138,8 @@ static int CompareCells(const void *a, const void *b)
  * and such a pair counts as unbonded (its contact force acts only past 10 % compression). */
 static PetscInt BondOf(const PeriSystem sys, PetscInt i, PetscInt j)
 {
-  const PeriBonds *b = &sys->disc.bonds;
-  const PetscInt  *g = sys->disc.particles.global;
+  const PeriBonds *b   = &sys->disc.bonds;
+  const PetscInt  *g   = sys->disc.particles.global;
   PetscInt         row = i, other = j;
 
   if (g ? g[j] < g[i] : j < i) {

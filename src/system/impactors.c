@@ -85,29 +85,48 @@ static PetscErrorCode ReadImpactor(PeriSystem sys, PeriNode item, PeriImpactor *
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* How deep the point y lies inside imp at its present position, and the outward normal there (from
- * the impactor into the body); 0 outside. */
+/* The depth p of a point inside a solid and the normal n of the nearest face, given the depths
+ * below each face (p_k > 0 inside) and the faces' normals: the smallest depth wins, so that p falls
+ * continuously to 0 at every face and a particle is pushed out through the nearest one. */
+static PetscReal Nearest(PetscInt nf, const PetscReal depth[], const PetscReal normal[][3], PetscReal n[3])
+{
+  PetscInt best = 0;
+
+  for (PetscInt k = 0; k < nf; k++) {
+    if (depth[k] <= 0) return 0;
+    if (depth[k] < depth[best]) best = k;
+  }
+  for (PetscInt d = 0; d < 3; d++) n[d] = normal[best][d];
+  return depth[best];
+}
+
+/* How deep the point y lies inside imp (centre x), and the normal of the face it is pushed out
+ * through (from the impactor into the body); 0 outside. A punch is a solid cylinder (a rectangle
+ * in 2D) of the face's radius behind the face, one radius deep; a cylinder has its end caps. */
 static PetscReal Depth(const PeriImpactor *imp, const PetscReal x[3], const PetscReal y[3], PetscReal n[3])
 {
-  PetscReal w[3], s, r;
+  PetscReal w[3], s = 0, r, depth[3], normal[3][3];
+  PetscInt  nf = 1;
 
   for (PetscInt d = 0; d < 3; d++) w[d] = y[d] - x[d];
-  if (imp->shape == PERI_IMPACTOR_PUNCH) {
+  if (imp->shape != PERI_IMPACTOR_SPHERE) {
     s = Dot(w, imp->axis);
     for (PetscInt d = 0; d < 3; d++) w[d] -= s * imp->axis[d];
-    if (s >= 0 || s < -imp->radius || Dot(w, w) >= imp->radius * imp->radius) return 0;
-    for (PetscInt d = 0; d < 3; d++) n[d] = imp->axis[d];
-    return -s;
   }
-  if (imp->shape == PERI_IMPACTOR_CYLINDER) {
-    s = Dot(w, imp->axis);
-    if (PetscAbsReal(s) > 0.5 * imp->length) return 0;
-    for (PetscInt d = 0; d < 3; d++) w[d] -= s * imp->axis[d];
+  r        = PetscSqrtReal(Dot(w, w));
+  depth[0] = imp->radius - r; /* the round face (sphere, cylinder) or the side (punch) */
+  for (PetscInt d = 0; d < 3; d++) normal[0][d] = r > 0 ? w[d] / r : 0;
+  if (imp->shape == PERI_IMPACTOR_PUNCH) { /* its face at s = 0, its back one radius behind */
+    depth[nf] = -s, depth[nf + 1] = imp->radius + s;
+    for (PetscInt d = 0; d < 3; d++) normal[nf][d] = imp->axis[d], normal[nf + 1][d] = -imp->axis[d];
+    nf += 2;
+  } else if (imp->shape == PERI_IMPACTOR_CYLINDER) { /* its end caps */
+    depth[nf] = 0.5 * imp->length - PetscAbsReal(s);
+    for (PetscInt d = 0; d < 3; d++) normal[nf][d] = s >= 0 ? imp->axis[d] : -imp->axis[d];
+    nf++;
   }
-  r = PetscSqrtReal(Dot(w, w));
-  if (r >= imp->radius || r == 0) return 0;
-  for (PetscInt d = 0; d < 3; d++) n[d] = w[d] / r;
-  return imp->radius - r;
+  if (r == 0 && depth[0] < PetscMin(depth[nf - 1], nf > 1 ? depth[1] : PETSC_MAX_REAL)) return 0; /* on the axis: no direction */
+  return Nearest(nf, depth, (const PetscReal(*)[3])normal, n);
 }
 
 /* The impactor's centre at time t >= imp->t: it drifts with its velocity until the step's kick. */

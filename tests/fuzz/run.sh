@@ -9,10 +9,10 @@
 # has 2 cores); any finding (a crash, a sanitizer report, a leak, a timeout of 10 s on one input,
 # more than 2 GB) fails the stage, its input kept in BUILD/fuzz/findings (docs/reliability.md
 # "Fuzzing": each finding becomes a bad-input case and a fix).
-# Usage: tests/fuzz/run.sh [--long SECONDS] [BUILD_DIR]   (default: 55 s per harness, build-san)
+# Usage: tests/fuzz/run.sh [--long SECONDS] [BUILD_DIR]   (default: 60 s per harness, build-san)
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
-seconds=55
+seconds=60
 if [ "${1:-}" = --long ]; then
   seconds=${2:?--long needs a number of seconds per harness}
   shift 2

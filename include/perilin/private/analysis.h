@@ -133,6 +133,7 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointBegin(PeriAnalysis, PetscViewe
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointEnd(PeriAnalysis, PetscViewer *, const char[]);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis, PetscViewer *, char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis, PetscViewer, PetscInt, size_t);
+PETSC_EXTERN PetscErrorCode PeriAnalysisAdoptSnapshots(PeriAnalysis, PetscInt *, PetscInt[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 /* perilin's LOBPCG as a SLEPc eigensolver type (src/analysis/lobpcg.c) */
 #define PERI_EPSLOBPCG "perilin_lobpcg"

@@ -71,10 +71,10 @@ typedef struct {
 typedef struct {
   PeriLayers          layers;
   PeriTorsion         torsion;
-  PetscInt            nconstrained;       /* owned constrained DOFs */
-  PetscInt           *constrained;        /* their global rows, sorted */
-  PetscReal          *constrained_value;  /* their values at load factor 1 */
-  PetscInt           *constrained_region; /* the region (index of disc.regions) of the bc item that set each, or -1 */
+  PetscInt            nconstrained;         /* owned constrained DOFs */
+  PetscInt           *constrained;          /* their global rows, sorted */
+  PetscReal          *constrained_value;    /* their values at load factor 1 */
+  PetscInt           *constrained_region;   /* the region (index of disc.regions) of the bc item that set each, or -1 */
   PetscReal          *constrained_velocity; /* bc.<k>.velocity: their velocity (u = value + velocity t), or NULL when none of this rank's moves */
   PetscBool           moving;               /* a bc velocity moves DOFs on some rank */
   PeriReactions       reactions;
