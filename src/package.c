@@ -170,7 +170,7 @@ static const char *const own_options[][2] = {
     {"-progress <bool>", "the status line on or off (default: on when stdout is a terminal, outside mpiexec)"},
     {"-output_dir DIR", "the output directory (the scene key output.dir; default SCENE-out)"},
     {"-restart DIR", "quasistatic: continue the run whose output directory is DIR from its checkpoint (DIR/checkpoint/state.bin), same scene and ranks"},
-    {"-peri_checkpoint_every N", "quasistatic: write the checkpoint every N equilibria; 0 writes none; default 1"},
+    {"-peri_checkpoint_every N", "quasistatic: write the checkpoint every N equilibria (default 1); dynamic: every N time steps (default: at the frames, about 25 over the run); 0 writes none"},
     {"-peri_stop_after_step K", "quasistatic: stop after equilibrium K, dynamic: after time step K, as a SIGINT would (to test restarts)"},
     {"-options_unused_ok", "options that nothing reads are warnings, not errors"},
     {"-peri_partition TYPE", "how the particles are shared out on several ranks: geometric (default), metis, ptscotch"},

@@ -64,12 +64,12 @@ PetscErrorCode PeriAnalysisCheckpointSetFromOptions(PeriAnalysis an)
   an->checkpoint_every = 1;
   PetscCall(PetscOptionsGetString(NULL, NULL, "-restart", an->restart, sizeof(an->restart), &given));
   PetscCall(PetscOptionsGetInt(NULL, NULL, "-peri_checkpoint_every", &an->checkpoint_every, NULL));
-  PetscCheck(an->checkpoint_every >= 0, an->comm, PETSC_ERR_USER_INPUT, "-peri_checkpoint_every %" PetscInt_FMT ": give a number of equilibria >= 1, or 0 for no checkpoints", an->checkpoint_every);
+  PetscCheck(an->checkpoint_every >= 0, an->comm, PETSC_ERR_USER_INPUT, "-peri_checkpoint_every %" PetscInt_FMT ": give a number of equilibria or time steps >= 1, or 0 for no checkpoints", an->checkpoint_every);
   if (!given) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(an->restart[0], an->comm, PETSC_ERR_USER_INPUT, "-restart needs a directory: -restart DIR, the output directory of the run to continue");
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/%s", an->restart, PERI_CHECKPOINT_FILE));
   PetscCall(PetscTestFile(path, 'r', &found));
-  PetscCheck(found, an->comm, PETSC_ERR_USER_INPUT, "-restart %s: no checkpoint there (%s): give the output directory of a %s run that reached an equilibrium with checkpoints on (-peri_checkpoint_every, default 1); a run killed by SIGKILL left its own in %s.partial-XXXXXX", an->restart, path, an->type->name, an->restart);
+  PetscCheck(found, an->comm, PETSC_ERR_USER_INPUT, "-restart %s: no checkpoint there (%s): give the output directory of a %s run that wrote one (an equilibrium, or a dynamic run's step, with -peri_checkpoint_every not 0); a run killed by SIGKILL left its own in %s.partial-XXXXXX", an->restart, path, an->type->name, an->restart);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
