@@ -19,7 +19,7 @@ declare -A allow=(
   [src/main]="perilin.h perilin/private/output.h perilin/private/sys.h"
   [src]="perilin.h perilin/private/problem.h perilin/private/analysis.h perilin/private/system.h perilin/private/scene_file.h perilin/private/model_registry.h perilin/private/sys.h"
   [src/analysis]="perilin/private/analysis.h perilin/private/system.h analysis_list.h"
-  [src/system]="perilin/private/system.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/disc.h perilin/private/model_registry.h perilin/private/output.h perilin/private/scene_file.h perilin/private/sys.h"
+  [src/system]="perilin/private/system.h perilin/private/contact.h perilin/private/crack_surfaces.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/disc.h perilin/private/model_registry.h perilin/private/output.h perilin/private/scene_file.h perilin/private/sys.h"
   [src/disc]="perilin/private/disc.h perilin/private/sys.h perilin/private/gmsh_api.h"
   [src/model_api]="perilin/private/model_registry.h perilin/private/sys.h ../../models/model_list.h"
   [models]="perilin/model.h"
@@ -27,10 +27,10 @@ declare -A allow=(
   [src/output]="perilin/private/output.h perilin/private/sys.h"
   [src/sys]="perilin/private/sys.h"
   [include/perilin]="perilin/types.h perilin/scene.h"
-  [include/perilin/private]="perilin/types.h perilin/scene.h perilin/model.h perilin.h perilin/private/sys.h perilin/private/scene_file.h perilin/private/output.h perilin/private/disc.h perilin/private/model_registry.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/system.h perilin/private/analysis.h"
+  [include/perilin/private]="perilin/types.h perilin/scene.h perilin/model.h perilin.h perilin/private/sys.h perilin/private/scene_file.h perilin/private/output.h perilin/private/disc.h perilin/private/model_registry.h perilin/private/mass.h perilin/private/fields.h perilin/private/conditions.h perilin/private/stiffness.h perilin/private/bondstate.h perilin/private/crack_surfaces.h perilin/private/contact.h perilin/private/system.h perilin/private/analysis.h"
 )
 # Within include/perilin/private, a header may include only those listed before it here.
-hdr_order=(sys scene_file output disc model_registry mass fields conditions stiffness bondstate system analysis problem)
+hdr_order=(sys scene_file output disc model_registry mass fields conditions stiffness bondstate crack_surfaces contact system analysis problem)
 
 folder_of() { # a source path relative to the repo -> its folder key
   case $1 in

@@ -2,6 +2,7 @@
 # The repository holds no run outputs, and no two files share a name (issue 25): output directories (*-out, *.partial-* staging
 # sets), particle files (.vtu, .pvtu, .pvd), summary.json and scene.yaml belong under /tmp, never in git.
 # The golden expectations (tests/golden/expected) are normalized extracts, not run outputs.
+# The bad-input corpus (tests/bad_input) holds hand-made damaged particle files, not run outputs.
 # Usage: tree_clean.sh REPO
 set -euo pipefail
 cd "${1:?usage: tree_clean.sh REPO}"
@@ -10,7 +11,7 @@ if git rev-parse --is-inside-work-tree > /dev/null 2>&1; then
 else
   files=$(find . -path ./build -prune -o -type f -print | sed 's|^\./||')
 fi
-bad=$(printf '%s\n' "$files" | grep -E '(^|/)[^/]*(-out|\.partial-[^/]*)/|\.(vtu|pvtu|pvd)$|(^|/)(summary\.json|scene\.yaml)$|(^|/)steps\.csv$|(^|/)modes\.csv$' | grep -v '^tests/golden/expected/' || true)
+bad=$(printf '%s\n' "$files" | grep -E '(^|/)[^/]*(-out|\.partial-[^/]*)/|\.(vtu|pvtu|pvd)$|(^|/)(summary\.json|scene\.yaml)$|(^|/)steps\.csv$|(^|/)modes\.csv$' | grep -v '^tests/golden/expected/' | grep -v '^tests/bad_input/' || true)
 if [ -n "$bad" ]; then
   echo "tree_clean: run outputs are in the repository (write them under /tmp with -output_dir, then git rm them):"
   printf '%s\n' "$bad" | head -20

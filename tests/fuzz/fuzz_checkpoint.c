@@ -4,7 +4,7 @@
  * tests/fuzz/checkpoint.yaml with -restart DIR, as `perilin checkpoint.yaml -restart DIR` would:
  * set-up, the header's checks, the loop's state, the bonds and u, then the rest of the loop from
  * there. The seed is the checkpoint of that scene run to its end
- * (tests/fuzz/run.sh); its header matches, so that mutations reach what follows it. A refused
+ * (tests/fuzz/fuzz_stage.sh); its header matches, so that mutations reach what follows it. A refused
  * checkpoint is a normal outcome; a crash, a sanitizer report or a hang is a finding. */
 #include "fuzz.h"
 

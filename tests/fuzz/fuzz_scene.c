@@ -2,7 +2,7 @@
  * (libyaml into the scene tree, option overrides) and checked as far as the keys go before any
  * particle exists (the root, output, analysis and model keys against their schemas,
  * PeriProblemSetFromScene). A refused scene is a normal outcome; a crash, a sanitizer report or a
- * hang is a finding (tests/fuzz/run.sh, docs/reliability.md "Fuzzing"). */
+ * hang is a finding (tests/fuzz/fuzz_stage.sh, docs/reliability.md "Fuzzing"). */
 #include "fuzz.h"
 
 #include "perilin/private/problem.h"

@@ -9,7 +9,7 @@
 # has 2 cores); any finding (a crash, a sanitizer report, a leak, a timeout of 10 s on one input,
 # more than 2 GB) fails the stage, its input kept in BUILD/fuzz/findings (docs/reliability.md
 # "Fuzzing": each finding becomes a bad-input case and a fix).
-# Usage: tests/fuzz/run.sh [--long SECONDS] [BUILD_DIR]   (default: 60 s per harness, build-san)
+# Usage: tests/fuzz/fuzz_stage.sh [--long SECONDS] [BUILD_DIR]   (default: 60 s per harness, build-san)
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/../.." && pwd)
 seconds=60
@@ -38,8 +38,8 @@ rm -rf "$work/seeds" "$work/runs" "$findings"
 mkdir -p "$work/seeds" "$work/runs" "$findings"
 for h in "${harnesses[@]}"; do mkdir -p "$work/seeds/$h" "$work/corpus/$h"; done
 
-# one file: LSan reads a single suppressions file (Open MPI's, then PETSc's of tests/fuzz/lsan.supp)
-cat "$repo/tests/sanitize/lsan.supp" "$repo/tests/fuzz/lsan.supp" > "$work/lsan.supp"
+# one file: LSan reads a single suppressions file (Open MPI's, then PETSc's of tests/fuzz/fuzz_lsan.supp)
+cat "$repo/tests/sanitize/lsan.supp" "$repo/tests/fuzz/fuzz_lsan.supp" > "$work/lsan.supp"
 export ASAN_OPTIONS="detect_leaks=1"
 export LSAN_OPTIONS="suppressions=$work/lsan.supp:print_suppressions=0"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
