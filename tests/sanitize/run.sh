@@ -23,6 +23,7 @@ tests=(
   csv_particles_npmb_2ranks                        # CSV particles
   analysis_setup                                   # the setup analysis, 1 and 2 ranks
   interrupt interrupt_input                        # SIGINT, SIGTERM, SIGHUP (and the signals cases below)
+  contact                                          # contact, impactors, bc velocity; 1 and 2 ranks
   bad_input_syntax bad_input_filesystem            # the error paths of the readers and the output
 )
 ex=$repo/examples
@@ -38,6 +39,8 @@ scenarios=(
   "anisotropy 0 1 $ex/failure/anisotropy.yaml -analysis_m 2 -analysis_orientations 11 -analysis_criteria stretch,sliding"
   "tune 0 1 $ex/tuning/plate_tune.yaml -grid_spacing 0.02 -analysis_repeat 1"
   "mesh_2ranks 0 2 $ex/mesh/bar_tet.yaml"
+  "dynamic_stop 130 2 $ex/dynamics/kalthoff_winkler.yaml -grid_spacing 4e-3 -quiet -peri_stop_after_step 40"
+  "dynamic_restart 0 2 $ex/dynamics/kalthoff_winkler.yaml -grid_spacing 4e-3 -quiet -restart @dynamic_stop"
 )
 
 # clang (Debian's clang, .ci/install): its runtime holds both sanitizers, and writes UBSan's reports to
