@@ -18,6 +18,12 @@ usage: contact.py PERILIN SCENES_DIR TMP [MPIRUN...]
    the grip has moved by v t exactly (1e-12); behind the wave front (c = 1) the particles move at
    v within 2 %, ahead of it (x > 40 at t = 30) they are at rest (|v| < 1 % of v); the balance,
    with the supports' work, closes within 1 %. On 2 ranks the same field to 1e-12.
+4. Kalthoff-Winkler at dx = 2 mm (examples/dynamics/kalthoff_winkler.yaml, coarse): no bc, so the
+   plate's and the punch's momentum stays the punch's M v0 (1e-12); the setup is symmetric about
+   y = 0, so the two cracks leave their notch tips at angles within 3 degrees of each other, and
+   forward (between 20 and 80 degrees from the notch; the experiment's is about 70, perilin's 44:
+   docs/contact.md says why that is a miss); the balance within its default 1 % (the run fails
+   otherwise).
 """
 import json
 import os
@@ -123,12 +129,25 @@ def pulled(exe, scenes, tmp, mpirun):
         check(np.abs(vel[a] - vel2[b]).max() < 1e-12, "pulled on 2 ranks: the velocities equal 1 rank's to %.2g" % np.abs(vel[a] - vel2[b]).max())
 
 
+def kalthoff(exe, repo, tmp):
+    out = os.path.join(tmp, "kw")
+    s = run(exe, os.path.join(repo, "examples", "dynamics", "kalthoff_winkler.yaml"), out, (), "-grid_spacing", "2e-3")
+    imp = s["dynamic"]["impactors"][0]
+    p = momentum(out, s["material"]["rho"])[:2] + imp["mass"] * np.array(imp["velocity"])
+    p0 = np.array([imp["mass"] * 32.0, 0.0])
+    check(np.abs(p - p0).max() < 1e-12 * p0[0], "kalthoff: plate's + punch's momentum %s, M v0 %s" % (p, p0))
+    r = subprocess.run([sys.executable, os.path.join(repo, "docs", "tools", "kw_angle.py"), out], cwd=repo, stdout=subprocess.PIPE, text=True)
+    angles = [float(line.split()[-2]) for line in r.stdout.splitlines() if "angle" in line]
+    check(len(angles) == 2 and abs(angles[0] - angles[1]) < 3 and all(20 < a < 80 for a in angles), "kalthoff: crack angles %s (symmetric within 3 degrees, forward)" % angles)
+
+
 def main():
     exe, scenes, tmp = sys.argv[1:4]
     mpirun = sys.argv[4:]
     impact(exe, scenes, tmp)
     bars(exe, scenes, tmp, mpirun)
     pulled(exe, scenes, tmp, mpirun)
+    kalthoff(exe, os.path.dirname(os.path.dirname(os.path.abspath(scenes))), tmp)
     sys.exit(1 if failures else 0)
 
 

@@ -19,6 +19,6 @@ static PetscErrorCode Report_Setup(PeriAnalysis an)
 const PeriAnalysisType PeriAnalysis_Setup = {
     .name  = "setup",
     .help  = "set up the system and stop: check a scene, size a run",
-    .needs = {.static_solver = PETSC_TRUE},
+    .needs = {.static_solver = PETSC_TRUE, .dry_run = PETSC_TRUE},
     .ops   = {.report = Report_Setup},
 };

@@ -137,7 +137,7 @@ static PetscErrorCode ReadVelocity(PeriSystem sys, PeriNode item, PetscBool use[
   PetscInt       n;
 
   PetscFunctionBeginUser;
-  PeriInputCheck(sys->stiffness.needs.transient, s, item, "velocity", "a boundary moves in time in a dynamic analysis; a quasi-static one scales value by its load factor instead");
+  PeriInputCheck(sys->stiffness.needs.transient || sys->stiffness.needs.dry_run, s, item, "velocity", "a boundary moves in time in a dynamic analysis; a quasi-static one scales value by its load factor instead");
   PetscCall(PeriSceneGetRealArray(s, item, "velocity", PETSC_TRUE, dim, dim, vel, &n));
   for (PetscInt a = 0; a < dim; a++) {
     PetscInt c;
@@ -317,7 +317,7 @@ static PetscErrorCode AddLoad(PeriSystem sys, PeriNode item, PetscScalar *a)
   PetscCall(PeriSceneGetNode(item, "body_force", &body));
   PetscCall(PeriSceneGetNode(item, "traction_field", &field));
   PetscCall(PeriSceneGetNode(item, "amplitude", &amp));
-  PeriInputCheck(!amp || sys->stiffness.needs.transient, s, item, "amplitude", "only a transient analysis (analysis.type: dynamic) has time");
+  PeriInputCheck(!amp || sys->stiffness.needs.transient || sys->stiffness.needs.dry_run, s, item, "amplitude", "only a transient analysis (analysis.type: dynamic) has time");
   PeriInputCheck((force ? 1 : 0) + (traction ? 1 : 0) + (body ? 1 : 0) + (field ? 1 : 0) == 1, s, item, NULL, "give exactly one of force, traction, body_force, traction_field");
   if (field)
     PetscCall(PeriBoundaryParseAffine(sys, field, "loads.<k>.traction_field", A, F));

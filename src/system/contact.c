@@ -71,7 +71,7 @@ PetscErrorCode PeriContactSetUp(PeriSystem sys)
   PetscCall(PeriSceneGetNode(s->root, "contact", &node));
   PetscCall(PeriSceneGetNode(s->root, "impactors", &imp));
   if (!node && !imp) PetscFunctionReturn(PETSC_SUCCESS);
-  PeriInputCheck(sys->stiffness.needs.transient, s, node ? node : imp, NULL, "contact and impactors act in time: analysis.type dynamic");
+  PeriInputCheck(sys->stiffness.needs.transient || sys->stiffness.needs.dry_run, s, node ? node : imp, NULL, "contact and impactors act in time: analysis.type dynamic");
   for (PetscInt d = 0; d < 3; d++) PeriInputCheck(!sys->disc.particles.periodic[d], s, node ? node : imp, NULL, "contact and impactors need a body without periodic axes");
   C->k     = CONTACT_FACTOR * Micromodulus(sys);
   C->delta = sys->disc.delta;

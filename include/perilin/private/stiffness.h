@@ -57,6 +57,7 @@ typedef struct {
   PetscReal factor_fill;    /* a direct factorization of K, its fill in matrices per log2(particles) (nested dissection measured 0.45), or 0 */
   PetscReal iterative_dofs; /* from this many DOFs on it solves iteratively by default (no factorization, K matrix-free where the operator applies), or 0 */
   PetscBool transient;      /* runs in time: loads may carry an amplitude (loads.<k>.amplitude) */
+  PetscBool dry_run;        /* checks any analysis' scene (setup): what only time uses is read and checked, not refused */
 } PeriSystemNeeds;
 
 /* How the geometric multigrid (src/system/multigrid.c) gets the coarse levels of a system: the
