@@ -52,3 +52,29 @@ PetscErrorCode PeriModelGetTypes(PetscInt *n, const PeriModelType *const **types
   *types = builtin;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriModelAnyComponent - whether name is a component of some built-in model in 2D or 3D (bc's
+  optional: true skips the components of other models, never a misspelt one). A model that refuses
+  a dimension (pds in 3D) is passed over silently. Not collective.
+@*/
+PetscErrorCode PeriModelAnyComponent(const char name[], PetscBool *found)
+{
+  PetscInt                    n;
+  const PeriModelType *const *types;
+
+  PetscFunctionBeginUser;
+  *found = PETSC_FALSE;
+  PetscCall(PeriModelGetTypes(&n, &types));
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  for (PetscInt k = 0; k < n && !*found; k++)
+    for (PetscInt dim = 2; dim <= 3 && !*found; dim++) {
+      PeriModel m = NULL;
+      PetscInt  c = -1;
+      if (PeriModelCreate(types[k]->name, dim, PETSC_FALSE, &m)) continue;
+      if (!PeriModelComponentIndex(m, name, &c) && c >= 0) *found = PETSC_TRUE;
+      if (PeriModelDestroy(&m)) break;
+    }
+  PetscCall(PetscPopErrorHandler());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -20,6 +20,17 @@ static PetscErrorCode ComponentList(PeriModel m, char buf[], size_t len)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* optional: true skips a component of other models, never a name no model has (a misspelling). */
+static PetscErrorCode CheckOptional(PeriSystem sys, PeriNode node, const char name[])
+{
+  PetscBool known;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriModelAnyComponent(name, &known));
+  PeriInputCheck(known, sys->scene, node, NULL, "'%s' is a component of no model: optional: true skips only the components of other models (ux, uy, uz, theta, ...)", name);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode ComponentFromNode(PeriSystem sys, PeriNode node, const char name[], PetscInt *c)
 {
   char list[128];
@@ -186,7 +197,10 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
       PetscInt c;
       PeriInputCheck(fix->child[k]->kind == PERI_NODE_SCALAR, s, fix->child[k], NULL, "must be a component name");
       PetscCall(PeriModelComponentIndex(m, fix->child[k]->value, &c));
-      if (c < 0 && optional) continue;
+      if (c < 0 && optional) {
+        PetscCall(CheckOptional(sys, fix->child[k], fix->child[k]->value));
+        continue;
+      }
       PetscCall(ComponentFromNode(sys, fix->child[k], fix->child[k]->value, &c));
       use[c] = PETSC_TRUE;
       v[c]   = 0;
@@ -196,7 +210,10 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
     for (PetscInt k = 0; k < val->n; k++) {
       PetscInt c;
       PetscCall(PeriModelComponentIndex(m, val->child[k]->key, &c));
-      if (c < 0 && optional) continue;
+      if (c < 0 && optional) {
+        PetscCall(CheckOptional(sys, val->child[k], val->child[k]->key));
+        continue;
+      }
       PetscCall(ComponentFromNode(sys, val->child[k], val->child[k]->key, &c));
       PetscCall(PeriSceneGetReal(s, val, val->child[k]->key, PETSC_TRUE, &v[c], NULL));
       use[c] = PETSC_TRUE;

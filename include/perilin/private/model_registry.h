@@ -13,6 +13,7 @@ PETSC_EXTERN PetscErrorCode PeriModelListTypes(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriModelTypeRegistered(const char[], PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriModelDestroy(PeriModel *);
 PETSC_EXTERN PetscErrorCode PeriModelTypeGet(const char[], const PeriModelType **);
+PETSC_EXTERN PetscErrorCode PeriModelAnyComponent(const char[], PetscBool *);
 
 /* material.*, declared next to PeriModelSetFromScene (src/package.c hands it to the scene layer). */
 PETSC_EXTERN const PeriSchema PeriMaterialSchema[];
