@@ -357,7 +357,8 @@ PetscErrorCode PeriProblemReport(PeriProblem p)
   PetscFunctionBeginUser;
   PetscCall(PetscPrintf(p->comm, "perilin: %s, model %s, %" PetscInt_FMT " particles, %" PetscInt_FMT " bonds, %" PetscInt_FMT " dofs on %d rank(s)\n", p->analysis_type, sys->model->type, sys->disc.N, sys->run.log.nbonds_total, sys->disc.N * sys->model->dofs, p->size));
   if (sys->fields.solve.ksp_type[0])
-    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s%s, %" PetscInt_FMT " iterations, %s, true relative residual %.2g), peak memory %.1f MB\n", sys->run.log.neighbors_s, sys->run.log.assembly_s, sys->run.log.solve_s, sys->fields.solve.ksp_type, sys->fields.solve.pc_type, sys->stiffness.op ? " matrix-free" : "", sys->fields.solve.iterations, sys->fields.solve.converged_reason, (double)sys->fields.solve.residual_norm, sys->run.log.memory_mb));
+    PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, assembly %.3f s, solve %.3f s (%s/%s%s, %" PetscInt_FMT " iterations, %s, %s %.2g), peak memory %.1f MB\n", sys->run.log.neighbors_s, sys->run.log.assembly_s, sys->run.log.solve_s, sys->fields.solve.ksp_type, sys->fields.solve.pc_type, sys->stiffness.op ? " matrix-free" : "", sys->fields.solve.iterations, sys->fields.solve.converged_reason, sys->fields.solve.checked[0] ? sys->fields.solve.checked : "true relative residual",
+                          (double)(sys->fields.solve.checked[0] ? sys->fields.solve.checked_value : sys->fields.solve.residual_norm), sys->run.log.memory_mb));
   else
     PetscCall(PetscPrintf(p->comm, "perilin: neighbours %.3f s, no solve, peak memory %.1f MB\n", sys->run.log.neighbors_s, sys->run.log.memory_mb));
   if (sys->run.interrupted) {

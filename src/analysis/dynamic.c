@@ -1130,6 +1130,8 @@ static PetscErrorCode RecordSolver(PeriAnalysis an)
   PetscCall(PetscStrncpy(an->sys->fields.solve.converged_reason, an->sys->run.interrupted ? "INTERRUPTED" : "TS_CONVERGED_TIME", sizeof(an->sys->fields.solve.converged_reason)));
   an->sys->fields.solve.iterations    = d->nsteps;
   an->sys->fields.solve.residual_norm = d->worst; /* explicit: no solve, 0 */
+  PetscCall(PetscStrncpy(an->sys->fields.solve.checked, "energy drift", sizeof(an->sys->fields.solve.checked)));
+  an->sys->fields.solve.checked_value = d->drift;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -469,6 +469,9 @@ static PetscErrorCode CheckModes(PeriAnalysis an, PetscReal eps_tol)
   PetscInt         nbad = 0, first = -1;
 
   PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(an->sys->fields.solve.checked, "worst mode residual", sizeof(an->sys->fields.solve.checked)));
+  an->sys->fields.solve.checked_value = 0;
+  for (PetscInt k = 0; k < md->nmodes; k++) an->sys->fields.solve.checked_value = PetscMax(an->sys->fields.solve.checked_value, md->modes[k].residual);
   for (PetscInt k = 0; k < md->nmodes; k++)
     if (!(md->modes[k].residual <= tol)) {
       nbad++;

@@ -35,6 +35,8 @@ typedef struct {
   PetscReal load_imbalance;       /* share of the load along those motions, removed */
   PetscReal rhs_norm;             /* ||b|| of the last solve in the scene's units (the residual's scale) */
   PetscReal load_factor;          /* the load factor it was solved at */
+  char      checked[48];          /* what the status line reports instead of residual_norm when the run solved no static system (modal: the worst mode residual; dynamic: the energy drift), "" otherwise */
+  PetscReal checked_value;
 } PeriSolveInfo;
 
 /* The present state and what is derived from it. */
