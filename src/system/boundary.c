@@ -161,6 +161,49 @@ static PetscErrorCode ReadVelocity(PeriSystem sys, PeriNode item, PetscBool use[
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* bc.<k>.fix: the components held at 0 (optional: those of other models skipped). */
+static PetscErrorCode ReadFix(PeriSystem sys, PeriNode fix, PetscBool optional, PetscBool use[], PetscReal v[])
+{
+  PeriScene s = sys->scene;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(fix->kind == PERI_NODE_SEQ && fix->n > 0, s, fix, NULL, "must be a list of components, e.g. [ux, uy]");
+  for (PetscInt k = 0; k < fix->n; k++) {
+    PetscInt c;
+    PeriInputCheck(fix->child[k]->kind == PERI_NODE_SCALAR, s, fix->child[k], NULL, "must be a component name");
+    PetscCall(PeriModelComponentIndex(sys->model, fix->child[k]->value, &c));
+    if (c < 0 && optional) {
+      PetscCall(CheckOptional(sys, fix->child[k], fix->child[k]->value));
+      continue;
+    }
+    PetscCall(ComponentFromNode(sys, fix->child[k], fix->child[k]->value, &c));
+    use[c] = PETSC_TRUE;
+    v[c]   = 0;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* bc.<k>.value: component -> prescribed value (optional: those of other models skipped). */
+static PetscErrorCode ReadValue(PeriSystem sys, PeriNode val, PetscBool optional, PetscBool use[], PetscReal v[])
+{
+  PeriScene s = sys->scene;
+
+  PetscFunctionBeginUser;
+  PeriInputCheck(val->kind == PERI_NODE_MAP && val->n > 0, s, val, NULL, "must map components to values, e.g. {ux: 0.001}");
+  for (PetscInt k = 0; k < val->n; k++) {
+    PetscInt c;
+    PetscCall(PeriModelComponentIndex(sys->model, val->child[k]->key, &c));
+    if (c < 0 && optional) {
+      PetscCall(CheckOptional(sys, val->child[k], val->child[k]->key));
+      continue;
+    }
+    PetscCall(ComponentFromNode(sys, val->child[k], val->child[k]->key, &c));
+    PetscCall(PeriSceneGetReal(s, val, val->child[k]->key, PETSC_TRUE, &v[c], NULL));
+    use[c] = PETSC_TRUE;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* bc item k into P over the owned DOFs. Where an earlier item holds a component of a particle,
  * a different value is an input error unless this item says override: true (then it wins).
  * Collective. */
@@ -191,34 +234,11 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
   PetscCall(PeriSceneGetNode(item, "velocity", &vel));
   PeriInputCheck((fix ? 1 : 0) + (val ? 1 : 0) + (aff ? 1 : 0) + (vel ? 1 : 0) == 1, s, item, NULL, "give exactly one of fix, value, affine, velocity");
   if (vel) PetscCall(ReadVelocity(sys, item, use, v, w));
-  if (fix) {
-    PeriInputCheck(fix->kind == PERI_NODE_SEQ && fix->n > 0, s, fix, NULL, "must be a list of components, e.g. [ux, uy]");
-    for (PetscInt k = 0; k < fix->n; k++) {
-      PetscInt c;
-      PeriInputCheck(fix->child[k]->kind == PERI_NODE_SCALAR, s, fix->child[k], NULL, "must be a component name");
-      PetscCall(PeriModelComponentIndex(m, fix->child[k]->value, &c));
-      if (c < 0 && optional) {
-        PetscCall(CheckOptional(sys, fix->child[k], fix->child[k]->value));
-        continue;
-      }
-      PetscCall(ComponentFromNode(sys, fix->child[k], fix->child[k]->value, &c));
-      use[c] = PETSC_TRUE;
-      v[c]   = 0;
-    }
-  } else if (val) {
-    PeriInputCheck(val->kind == PERI_NODE_MAP && val->n > 0, s, val, NULL, "must map components to values, e.g. {ux: 0.001}");
-    for (PetscInt k = 0; k < val->n; k++) {
-      PetscInt c;
-      PetscCall(PeriModelComponentIndex(m, val->child[k]->key, &c));
-      if (c < 0 && optional) {
-        PetscCall(CheckOptional(sys, val->child[k], val->child[k]->key));
-        continue;
-      }
-      PetscCall(ComponentFromNode(sys, val->child[k], val->child[k]->key, &c));
-      PetscCall(PeriSceneGetReal(s, val, val->child[k]->key, PETSC_TRUE, &v[c], NULL));
-      use[c] = PETSC_TRUE;
-    }
-  } else if (aff) {
+  if (fix)
+    PetscCall(ReadFix(sys, fix, optional, use, v));
+  else if (val)
+    PetscCall(ReadValue(sys, val, optional, use, v));
+  else if (aff) {
     PetscCall(PeriBoundaryParseAffine(sys, aff, "bc.<k>.affine", A, b0));
     for (PetscInt a = 0; a < dim; a++) {
       PetscCall(AxisComponent(m, a, &axis_comp[a]));
