@@ -14,6 +14,7 @@
 
 static const char *const dyn_integrators[] = {"explicit", "implicit", NULL};
 static const char *const dyn_profiles[]    = {"gaussian", "cosine", NULL};
+static const char *const dyn_directions[]  = {"both", "positive", "negative", NULL};
 
 #define PERI_DYN_MAX_TERMS   16 /* load terms with amplitudes of their own, plus one */
 #define DYN_FRAMES           25 /* snapshots over t_end by default (output.every 0) */
@@ -55,21 +56,21 @@ typedef struct {
   PetscReal          kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
   PetscReal          work_bc;                                                    /* this rank's work of the moving boundaries since the last Work */
   PetscBool          fronts;                                                     /* analysis.fronts given */
-  PetscInt           front_axis;
-  PetscReal          front_origin, front_speed, front_damage; /* origin along the axis; the thresholds of speed and damage */
-  PetscReal          wave_front, damage_front;                /* the farthest distance from the origin along the axis of a particle past them */
-  PetscReal          t_prev, pulse_pos, probe_u;              /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
-  PetscInt           nhist, cap, nsnap, nimpactors;           /* history rows (DYN_ROW reals each), their room, snapshots; impactors */
-  PetscInt           every;                                   /* a snapshot every k steps: output.every, or DYN_FRAMES over the run */
-  PetscReal         *hist, *snap_time;                        /* rank 0 keeps them; every rank counts */
-  PetscInt          *snap_idx, next_frame;                    /* each frame's NNNN (particles_NNNN), and the next one's */
-  PetscInt           checkpoints, restart_step;               /* checkpoints written; the step -restart continued from (0: none) */
-  PetscInt           stop_after;                              /* -peri_stop_after_step: stop after this step as a SIGINT would (0: never) */
-  PetscBool          resumed;                                 /* -restart: the first monitor call is the checkpoint's step, recorded already */
-  Vec                minv, uprev, tmp;                        /* 1/m per DOF (0 on held DOFs), the last step's u, work */
-  Mat                J;                                       /* implicit: K + shift M with the held rows and columns eliminated */
-  const PeriContact *contact;                                 /* the system's, for the impactors' history */
-  IS                 isq, isp;                                /* explicit: positions and velocities in the state [q; p] */
+  PetscInt           front_axis, front_dir;                                      /* front_dir: 0 both sides of the origin, 1 only beyond it (+axis), 2 only before it */
+  PetscReal          front_origin, front_speed, front_damage;                    /* origin along the axis; the thresholds of speed and damage */
+  PetscReal          wave_front, damage_front;                                   /* the farthest distance from the origin along the axis of a particle past them */
+  PetscReal          t_prev, pulse_pos, probe_u;                                 /* probe_u: the first probe's displacement along the pulse axis (x without a pulse) */
+  PetscInt           nhist, cap, nsnap, nimpactors;                              /* history rows (DYN_ROW reals each), their room, snapshots; impactors */
+  PetscInt           every;                                                      /* a snapshot every k steps: output.every, or DYN_FRAMES over the run */
+  PetscReal         *hist, *snap_time;                                           /* rank 0 keeps them; every rank counts */
+  PetscInt          *snap_idx, next_frame;                                       /* each frame's NNNN (particles_NNNN), and the next one's */
+  PetscInt           checkpoints, restart_step;                                  /* checkpoints written; the step -restart continued from (0: none) */
+  PetscInt           stop_after;                                                 /* -peri_stop_after_step: stop after this step as a SIGINT would (0: never) */
+  PetscBool          resumed;                                                    /* -restart: the first monitor call is the checkpoint's step, recorded already */
+  Vec                minv, uprev, tmp;                                           /* 1/m per DOF (0 on held DOFs), the last step's u, work */
+  Mat                J;                                                          /* implicit: K + shift M with the held rows and columns eliminated */
+  const PeriContact *contact;                                                    /* the system's, for the impactors' history */
+  IS                 isq, isp;                                                   /* explicit: positions and velocities in the state [q; p] */
   TS                 ts;
 } Dynamic;
 
@@ -123,6 +124,7 @@ static const PeriKey dyn_fronts_keys[] = {
     {"origin", PERI_KEY_REAL, "0", NULL, "[length]", NULL, "where they start along it: a front is the farthest distance from here"},
     {"speed", PERI_KEY_REAL, "required", "(0, inf)", "[length/time]", NULL, "the wave front: particles moving faster than this"},
     {"damage", PERI_KEY_REAL, "0.5", "(0, 1)", NULL, NULL, "the damage front: particles damaged more than this (scenes with failure)"},
+    {"direction", PERI_KEY_CHOICE, "both", NULL, NULL, dyn_directions, "both: the distance |x - origin| on either side; positive: only particles at or beyond origin along +axis (a pre-crack's damage behind its tip is not counted); negative: only those before it"},
     {NULL},
 };
 /* output.every, which the snapshots follow (problem.c reads it with output.*) */
@@ -173,6 +175,7 @@ static PetscErrorCode ReadFronts(Dynamic *d, PeriScene s, PeriNode a)
   PetscCall(PeriSceneGetReal(s, f, "origin", PETSC_FALSE, &d->front_origin, NULL));
   PetscCall(PeriSceneGetReal(s, f, "speed", PETSC_TRUE, &d->front_speed, NULL));
   PetscCall(PeriSceneGetReal(s, f, "damage", PETSC_FALSE, &d->front_damage, NULL));
+  PetscCall(PeriSceneGetChoice(s, f, "direction", dyn_directions, &d->front_dir, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -775,8 +778,10 @@ static PetscErrorCode Fronts(PeriAnalysis an, Vec p)
   if (sys->bond_state.failure.active) PetscCall(PeriDamage(sys, &sys->bond_state.damage));
   PetscCall(VecGetArrayRead(p, &v));
   for (PetscInt i = 0; i < nloc; i++) {
-    const PetscReal x      = PetscAbsReal(sys->disc.particles.x[3 * i + d->front_axis] - d->front_origin);
+    const PetscReal dx     = sys->disc.particles.x[3 * i + d->front_axis] - d->front_origin;
+    const PetscReal x      = PetscAbsReal(dx);
     PetscReal       speed2 = 0;
+    if ((d->front_dir == 1 && dx < 0) || (d->front_dir == 2 && dx > 0)) continue;
     for (PetscInt c = 0; c < bs; c++)
       if (sys->model->axis[c] >= 0) speed2 += PetscSqr(PetscRealPart(v[i * bs + c]));
     if (speed2 > PetscSqr(d->front_speed)) far[0] = PetscMax(far[0], x);
