@@ -56,6 +56,6 @@ case_run kw 100 env -- "${kw[@]}"
 # contact between particles on 2 ranks stops once the struck zone has moved farther than the
 # ghosts reach (docs/contact.md): the 2-rank case keeps the impactor and the breaking bonds
 grep -v '^contact:' "$repo/examples/dynamics/kalthoff_winkler.yaml" > "$tmp/kw_no_contact.yaml"
-[ ${#mpirun[@]} -gt 0 ] && case_run kw_2ranks 100 "${mpirun[@]}" -- "$tmp/kw_no_contact.yaml" -grid_spacing 2e-3
-case_run pulse_implicit 20 env -- "$repo/examples/dynamics/pulse.yaml" -analysis_integrator implicit -analysis_dt 0.4 -analysis_t_end 20 -output_vtk true
+[ ${#mpirun[@]} -gt 0 ] && case_run kw_2ranks 60 "${mpirun[@]}" -- "$tmp/kw_no_contact.yaml" -grid_spacing 2.5e-3
+case_run pulse_implicit 8 env -- "$repo/examples/dynamics/pulse.yaml" -analysis_integrator implicit -analysis_dt 0.4 -analysis_t_end 6 -output_vtk true
 exit $fail
