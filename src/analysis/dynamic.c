@@ -18,6 +18,7 @@ static const char *const dyn_directions[]  = {"both", "positive", "negative", NU
 
 #define PERI_DYN_MAX_TERMS   16 /* load terms with amplitudes of their own, plus one */
 #define DYN_FRAMES           25 /* snapshots over t_end by default (output.every 0) */
+#define DYN_JACOBI_RATIO     20 /* implicit: CG with Jacobi up to dt = 20 explicit limits, GAMG beyond (ChooseImplicitPC) */
 #define DYN_HISTORY_COLUMNS  11 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe, wave front, damage front */
 #define DYN_IMPACTOR_COLUMNS 9  /* per impactor: its centre, velocity and the particles' force on it */
 #define DYN_ROW(d)           (DYN_HISTORY_COLUMNS + DYN_IMPACTOR_COLUMNS * (d)->nimpactors)
@@ -645,11 +646,9 @@ static PetscErrorCode PostStep(TS ts)
   if (an->sys->run.interrupted) PetscCall(TSSetConvergedReason(ts, TS_CONVERGED_USER));
   if (d->implicit) {
     SNES snes;
-    KSP  ksp;
     /* K changed: the next step sets up a new preconditioner, later steps keep it */
     PetscCall(TSGetSNES(ts, &snes));
-    PetscCall(SNESGetKSP(snes, &ksp));
-    PetscCall(KSPSetReusePreconditioner(ksp, nb ? PETSC_FALSE : PETSC_TRUE));
+    if (nb) PetscCall(SNESSetLagPreconditioner(snes, -2));
     PetscCall(WorstResidual(d, snes));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -1043,12 +1042,37 @@ static PetscErrorCode CreateImplicit(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(SNESSetTolerances(snes, PETSC_DEFAULT, 1e-8, PETSC_DEFAULT, 10, PETSC_DEFAULT));
   PetscCall(SNESSetConvergenceHistory(snes, NULL, NULL, 16, PETSC_TRUE));
   PetscCall(SNESGetKSP(snes, &ksp));
-  /* J follows K and the step's shift; its preconditioner is kept until bonds break (PostStep) */
-  PetscCall(KSPSetReusePreconditioner(ksp, PETSC_TRUE));
+  /* J follows K and the step's shift: its preconditioner is built once and kept until bonds break
+     (PostStep); SNES's lag decides, since SNES resets KSP's reuse flag at each Jacobian */
+  PetscCall(SNESSetLagPreconditioner(snes, -2));
   PetscCall(KSPSetType(ksp, KSPCG));
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCGAMG));
+  PetscCall(PCSetType(pc, PCGAMG)); /* ChooseImplicitPC may take Jacobi once dt is known */
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, 10000));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The implicit step's preconditioner when no -pc_type names one. Its matrix K + M/(beta dt^2) is
+ * dominated by the mass term up to dt of some 20 explicit limits (Jacobi's condition number is about
+ * 1 + (dt/dt_limit)^2): there CG with Jacobi costs fewer operator products than GAMG's set-up and
+ * V-cycles; beyond, GAMG. The ratio 20 is measured on the pulse (docs/dynamics.md, 'The implicit
+ * step's preconditioner'). */
+static PetscErrorCode ChooseImplicitPC(PeriAnalysis an)
+{
+  Dynamic  *d = DYN(an);
+  PetscBool given;
+  SNES      snes;
+  KSP       ksp;
+  PC        pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-pc_type", &given));
+  if (given || d->dt > DYN_JACOBI_RATIO * d->dt_limit) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(TSGetSNES(d->ts, &snes));
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCJACOBI));
+  PetscCall(PCSetFromOptions(pc)); /* -pc_jacobi_* */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1099,6 +1123,7 @@ static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(TSSetFromOptions(d->ts));
   PetscCall(CheckImpactorScheme(an));
   PetscCall(TSGetTimeStep(d->ts, &d->dt));
+  if (d->implicit) PetscCall(ChooseImplicitPC(an));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
   if (!given) PetscCall(TSSetMaxSteps(d->ts, (PetscInt)PetscCeilReal(d->t_end / d->dt - 1e-9)));
   PetscCall(TSGetMaxSteps(d->ts, &d->every));
@@ -1199,6 +1224,7 @@ static PetscErrorCode CheckSteps(PeriAnalysis an)
   KSPConvergedReason  kr;
   PCType              pctype;
   PetscReal           t;
+  PetscBool           jacobi;
 
   PetscFunctionBeginUser;
   PetscCall(TSGetConvergedReason(d->ts, &reason));
@@ -1211,7 +1237,9 @@ static PetscErrorCode CheckSteps(PeriAnalysis an)
   PetscCall(KSPGetConvergedReason(ksp, &kr));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCGetType(pc, &pctype));
-  SETERRQ(an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the implicit step after t = %g failed: %s, its linear solve %s (PC %s, after %" PetscInt_FMT " bonds broke): the run is no result; try -pc_type jacobi (slower, always valid for the step's symmetric positive definite matrix K + M/(beta dt^2)), a smaller dt, or the explicit integrator", an->sys->scene->file, (double)t, SNESConvergedReasons[sr], KSPConvergedReasons[kr], pctype ? pctype : "none", d->broken);
+  PetscCall(PetscStrcmp(pctype, PCJACOBI, &jacobi));
+  SETERRQ(an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the implicit step after t = %g failed: %s, its linear solve %s (PC %s, after %" PetscInt_FMT " bonds broke): the run is no result; try %s a smaller dt, or the explicit integrator", an->sys->scene->file, (double)t, SNESConvergedReasons[sr], KSPConvergedReasons[kr], pctype ? pctype : "none", d->broken,
+          jacobi ? "a larger -ksp_max_it (CG with Jacobi converges on the step's symmetric positive definite matrix K + M/(beta dt^2), slowly when dt is many explicit limits)," : "-pc_type jacobi (slower, always valid for the step's symmetric positive definite matrix K + M/(beta dt^2)),");
 }
 
 /* What to try when the energy balance drifts. */
