@@ -43,7 +43,7 @@ for sig in TERM HUP; do
   rm -rf "$work/int" "$work/int".partial-*
   setsid "$perilin" "$repo/examples/failure/anisotropy.yaml" -output_dir "$work/int" > "$work/int.log" 2>&1 < /dev/null &
   pid=$!
-  sleep 3
+  sleep 1
   kill -s "$sig" "$pid"
   waited=0
   while kill -0 "$pid" 2> /dev/null && [ $waited -lt 10 ]; do
