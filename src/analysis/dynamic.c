@@ -56,6 +56,7 @@ typedef struct {
   PetscReal          worst;                                                      /* implicit: the largest relative residual a step ended with */
   PetscReal          kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
   PetscReal          work_bc;                                                    /* this rank's work of the moving boundaries since the last Work */
+  PetscReal         *reaction;                                                   /* implicit, moving boundaries: K u - f on this rank's held DOFs at t_prev (NULL until known) */
   PetscBool          fronts;                                                     /* analysis.fronts given */
   PetscInt           front_axis, front_dir;                                      /* front_dir: 0 both sides of the origin, 1 only beyond it (+axis), 2 only before it */
   PetscReal          front_origin, front_speed, front_damage;                    /* origin along the axis; the thresholds of speed and damage */
@@ -294,7 +295,6 @@ static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
   PeriInputCheck(!d->pulse || PeriModelTranslation(an->sys->model, d->pulse_dir) >= 0, s, s->root, d->pulse_dir == d->pulse_axis ? "analysis.pulse.axis" : "analysis.pulse.direction", "model %s does not translate along this axis", an->sys->model->type);
   PetscCall(PeriMassSetUp(an->sys));
   PeriInputCheck(!d->implicit || !an->sys->contact.nimpactors, s, s->root, "impactors", "impactors move with the explicit integrator (analysis.integrator: explicit)");
-  PeriInputCheck(!d->implicit || !an->sys->conditions.moving, s, s->root, "bc", "a bc velocity moves with the explicit integrator (analysis.integrator: explicit)");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -504,7 +504,49 @@ static PetscErrorCode RHSWhole(TS ts, PetscReal t, Vec U, Vec F, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Implicit: F = M A + K U - a(t) f, and U - g on the held DOFs. */
+/* The held DOFs' reactions K q - f(t) (the supports' force on the body; their acceleration is 0,
+ * as they move at constant velocity) on this rank, into R. One product with K. */
+static PetscErrorCode Reactions(PeriAnalysis an, Vec q, PetscReal t, PetscReal R[])
+{
+  const PeriConditions *C = &an->sys->conditions;
+  const PetscScalar    *a;
+  PetscInt              r0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemInternalForce(an->sys, q, DYN(an)->tmp));
+  PetscCall(LoadAt(an, t, -1, 1, DYN(an)->tmp));
+  PetscCall(VecGetOwnershipRange(q, &r0, NULL));
+  PetscCall(VecGetArrayRead(DYN(an)->tmp, &a));
+  for (PetscInt k = 0; k < C->nconstrained; k++) R[k] = PetscRealPart(a[C->constrained[k] - r0]);
+  PetscCall(VecRestoreArrayRead(DYN(an)->tmp, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit: the moving boundaries' work from t_prev to t, the trapezoid of their reactions times
+ * w (t - t_prev): with Newmark's average acceleration the balance then closes to round-off on a
+ * linear body, since the held DOFs move linearly in time and the scheme integrates them exactly.
+ * The reactions at t_prev come from the last step, or (first step, after -restart) from uprev. */
+static PetscErrorCode ImplicitBoundaryWork(PeriAnalysis an, Vec q, PetscReal t)
+{
+  Dynamic              *d = DYN(an);
+  const PeriConditions *C = &an->sys->conditions;
+  PetscReal            *R;
+
+  PetscFunctionBeginUser;
+  if (!d->implicit || !C->moving) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!d->reaction) {
+    PetscCall(PetscMalloc1(C->nconstrained + 1, &d->reaction));
+    PetscCall(Reactions(an, d->uprev, d->t_prev, d->reaction));
+  }
+  PetscCall(PetscMalloc1(C->nconstrained + 1, &R));
+  PetscCall(Reactions(an, q, t, R));
+  for (PetscInt k = 0; C->constrained_velocity && k < C->nconstrained; k++) d->work_bc += 0.5 * (R[k] + d->reaction[k]) * C->constrained_velocity[k] * (t - d->t_prev);
+  PetscCall(PetscFree(d->reaction));
+  d->reaction = R;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit: F = M A + K U - a(t) f, and U - g(t) on the held DOFs (g = value + w t). */
 static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F, void *ctx)
 {
   PeriAnalysis an  = (PeriAnalysis)ctx;
@@ -527,7 +569,10 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
     PetscCall(VecGetOwnershipRange(F, &r0, NULL));
     PetscCall(VecGetArrayRead(U, &u));
     PetscCall(VecGetArray(F, &f));
-    for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) f[sys->conditions.constrained[k] - r0] = u[sys->conditions.constrained[k] - r0] - sys->conditions.constrained_value[k];
+    for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) {
+      const PetscReal w                      = sys->conditions.constrained_velocity ? sys->conditions.constrained_velocity[k] : 0;
+      f[sys->conditions.constrained[k] - r0] = u[sys->conditions.constrained[k] - r0] - (sys->conditions.constrained_value[k] + w * t);
+    }
     PetscCall(VecRestoreArray(F, &f));
     PetscCall(VecRestoreArrayRead(U, &u));
   }
@@ -720,6 +765,7 @@ static PetscErrorCode Work(PeriAnalysis an, Vec q, PetscReal t)
   PetscScalar w[PERI_DYN_MAX_TERMS];
 
   PetscFunctionBeginUser;
+  PetscCall(ImplicitBoundaryWork(an, q, t));
   PetscCall(VecWAXPY(d->tmp, -1, d->uprev, q));
   PetscCall(VecMDot(d->tmp, d->nterms, d->term_f, w));
   for (PetscInt k = 0; k < d->nterms; k++) {
@@ -1084,7 +1130,7 @@ static PetscErrorCode CheckImpactorScheme(PeriAnalysis an)
   PetscBool ok;
 
   PetscFunctionBeginUser;
-  if (!an->sys->contact.nimpactors && !an->sys->conditions.moving) PetscFunctionReturn(PETSC_SUCCESS);
+  if (DYN(an)->implicit || (!an->sys->contact.nimpactors && !an->sys->conditions.moving)) PetscFunctionReturn(PETSC_SUCCESS); /* implicit: g(t) in the residual */
   PetscCall(TSGetType(DYN(an)->ts, &type));
   PetscCall(PetscStrcmp(type, TSBASICSYMPLECTIC, &ok));
   if (ok) {
@@ -1486,6 +1532,7 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscCall(ISDestroy(&d->isp));
   PetscCall(VecDestroy(&d->minv));
   PetscCall(VecDestroy(&d->uprev));
+  PetscCall(PetscFree(d->reaction));
   PetscCall(VecDestroy(&d->tmp));
   PetscCall(PetscFree(d->hist));
   PetscCall(PetscFree(d->snap_time));

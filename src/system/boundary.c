@@ -48,7 +48,7 @@ static const PeriKey bc_keys[] = {
     {"fix", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "components held at zero, e.g. [ux, uy]"},
     {"value", PERI_KEY_MAP, NULL, NULL, "[length] (theta: radians)", NULL, "map component -> prescribed value, e.g. {ux: 0.001}"},
     {"affine", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the prescribed field u = A X + b at the reference positions X: {A: [[..],..], b: [..]}; every translational component, never theta"},
-    {"velocity", PERI_KEY_REALS, NULL, NULL, "[length/time]", NULL, "a dynamic analysis (explicit): the translations move at this velocity from rest, u = v t; one number per dimension"},
+    {"velocity", PERI_KEY_REALS, NULL, NULL, "[length/time]", NULL, "a dynamic analysis (explicit or implicit): the translations move at this velocity from rest, u = v t; one number per dimension"},
     {"optional", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "skip the components of fix and value the model lacks (one scene for several models)"},
     {"override", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "this item wins where an earlier item holds the same component of the same particle with another value (else that is an input error; equal values are always fine)"},
     {NULL},
