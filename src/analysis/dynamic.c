@@ -56,7 +56,7 @@ typedef struct {
   PetscReal          worst;                                                      /* implicit: the largest relative residual a step ended with */
   PetscReal          kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
   PetscReal          work_bc;                                                    /* this rank's work of the moving boundaries since the last Work */
-  PetscReal         *reaction;                                                   /* implicit, moving boundaries: K u - f on this rank's held DOFs at t_prev (NULL until known) */
+  PetscReal         *reaction, ke_held;                                          /* implicit, moving boundaries: K u - f on this rank's held DOFs at t_prev (NULL until known), and their kinetic energy */
   PetscBool          fronts;                                                     /* analysis.fronts given */
   PetscInt           front_axis, front_dir;                                      /* front_dir: 0 both sides of the origin, 1 only beyond it (+axis), 2 only before it */
   PetscReal          front_origin, front_speed, front_damage;                    /* origin along the axis; the thresholds of speed and damage */
@@ -393,7 +393,7 @@ static PetscErrorCode ZeroHeld(PeriAnalysis an, Vec v)
 }
 
 /* The initial velocities: analysis.velocity on its region's particles (translations only), 0
- * elsewhere and on the held DOFs. */
+ * elsewhere and on the held DOFs but the moving ones (w a(0)). */
 static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
 {
   PetscFunctionBeginUser;
@@ -406,7 +406,7 @@ static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
     PetscInt              r0;
     PetscCall(VecGetOwnershipRange(v, &r0, NULL));
     PetscCall(VecGetArray(v, &a));
-    for (PetscInt k = 0; k < C->nconstrained; k++) a[C->constrained[k] - r0] = C->constrained_velocity[k];
+    for (PetscInt k = 0; k < C->nconstrained; k++) PeriConditionsMotion(C, k, 0, NULL, &a[C->constrained[k] - r0], NULL);
     PetscCall(VecRestoreArray(v, &a));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -451,21 +451,49 @@ static PetscErrorCode LoadAt(PeriAnalysis an, PetscReal t, PetscReal sign, Petsc
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The work of the moving boundaries (bc.<k>.velocity) in the step whose one force evaluation (half
- * a step in: PETSc's velocity Verlet) left r = f - K q: the supports push the held DOFs with -r
- * while they move by w dt. This rank's share, summed in Work. */
-static PetscErrorCode BoundaryWork(PeriAnalysis an, Vec r)
+/* The work of the moving boundaries (bc.<k>.velocity) in the step whose one force evaluation (at
+ * t, half a step in: PETSc's velocity Verlet) left r = f - K q: the supports push the held DOFs
+ * with m w a'(t) - r (what accelerates them, less what the body pulls) while they move by
+ * w a(t) dt. This rank's share, summed in Work. */
+static PetscErrorCode BoundaryWork(PeriAnalysis an, Vec r, PetscReal t)
 {
   const PeriConditions *C = &an->sys->conditions;
-  const PetscScalar    *a;
+  const PetscScalar    *a, *m;
+  PetscInt              r0;
+  Vec                   mass;
+
+  PetscFunctionBeginUser;
+  if (!C->constrained_velocity) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriMassGetDiagonal(an->sys, &mass));
+  PetscCall(VecGetOwnershipRange(r, &r0, NULL));
+  PetscCall(VecGetArrayRead(r, &a));
+  PetscCall(VecGetArrayRead(mass, &m));
+  for (PetscInt k = 0; k < C->nconstrained; k++) {
+    const PetscInt row = C->constrained[k] - r0;
+    PetscReal      v, acc;
+    PeriConditionsMotion(C, k, t, NULL, &v, &acc);
+    DYN(an)->work_bc += (PetscRealPart(m[row]) * acc - PetscRealPart(a[row])) * v * DYN(an)->dt;
+  }
+  PetscCall(VecRestoreArrayRead(mass, &m));
+  PetscCall(VecRestoreArrayRead(r, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The moving boundaries' acceleration w a'(t) on their rows of dp (0 there from 1/m = 0): the kick
+ * of velocity Verlet then gives them their velocity w a(t), to second order in dt (exactly for a
+ * ramp or a step). */
+static PetscErrorCode BoundaryAcceleration(PeriAnalysis an, Vec dp, PetscReal t)
+{
+  const PeriConditions *C = &an->sys->conditions;
+  PetscScalar          *a;
   PetscInt              r0;
 
   PetscFunctionBeginUser;
   if (!C->constrained_velocity) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(VecGetOwnershipRange(r, &r0, NULL));
-  PetscCall(VecGetArrayRead(r, &a));
-  for (PetscInt k = 0; k < C->nconstrained; k++) DYN(an)->work_bc -= PetscRealPart(a[C->constrained[k] - r0]) * C->constrained_velocity[k] * DYN(an)->dt;
-  PetscCall(VecRestoreArrayRead(r, &a));
+  PetscCall(VecGetOwnershipRange(dp, &r0, NULL));
+  PetscCall(VecGetArray(dp, &a));
+  for (PetscInt k = 0; k < C->nconstrained; k++) PeriConditionsMotion(C, k, t, NULL, NULL, &a[C->constrained[k] - r0]);
+  PetscCall(VecRestoreArray(dp, &a));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -479,8 +507,9 @@ static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
   PetscCall(PeriContactSetTime(an->sys, t, PETSC_TRUE)); /* the step's one force: the impactors' kick */
   PetscCall(PeriSystemInternalForce(an->sys, q, dp));
   PetscCall(LoadAt(an, t, 1, -1, dp));
-  PetscCall(BoundaryWork(an, dp));
+  PetscCall(BoundaryWork(an, dp, t));
   PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
+  PetscCall(BoundaryAcceleration(an, dp, t));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -504,49 +533,98 @@ static PetscErrorCode RHSWhole(TS ts, PetscReal t, Vec U, Vec F, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The held DOFs' reactions K q - f(t) (the supports' force on the body; their acceleration is 0,
- * as they move at constant velocity) on this rank, into R. One product with K. */
-static PetscErrorCode Reactions(PeriAnalysis an, Vec q, PetscReal t, PetscReal R[])
+/* The held DOFs' reactions from the body, K q - f(t), on this rank into R, and this rank's
+ * kinetic energy of the held DOFs, ke. One product with K. */
+static PetscErrorCode Reactions(PeriAnalysis an, Vec q, Vec p, PetscReal t, PetscReal R[], PetscReal *ke)
 {
   const PeriConditions *C = &an->sys->conditions;
-  const PetscScalar    *a;
+  const PetscScalar    *a, *m, *v;
   PetscInt              r0;
+  Vec                   mass;
 
   PetscFunctionBeginUser;
+  PetscCall(PeriMassGetDiagonal(an->sys, &mass));
   PetscCall(PeriSystemInternalForce(an->sys, q, DYN(an)->tmp));
   PetscCall(LoadAt(an, t, -1, 1, DYN(an)->tmp));
   PetscCall(VecGetOwnershipRange(q, &r0, NULL));
   PetscCall(VecGetArrayRead(DYN(an)->tmp, &a));
-  for (PetscInt k = 0; k < C->nconstrained; k++) R[k] = PetscRealPart(a[C->constrained[k] - r0]);
+  PetscCall(VecGetArrayRead(mass, &m));
+  PetscCall(VecGetArrayRead(p, &v));
+  *ke = 0;
+  for (PetscInt k = 0; k < C->nconstrained; k++) {
+    const PetscInt row = C->constrained[k] - r0;
+    R[k]               = PetscRealPart(a[row]);
+    *ke += 0.5 * PetscRealPart(m[row] * v[row] * v[row]);
+  }
+  PetscCall(VecRestoreArrayRead(p, &v));
+  PetscCall(VecRestoreArrayRead(mass, &m));
   PetscCall(VecRestoreArrayRead(DYN(an)->tmp, &a));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Implicit: the moving boundaries' work from t_prev to t, the trapezoid of their reactions times
- * w (t - t_prev): with Newmark's average acceleration the balance then closes to round-off on a
- * linear body, since the held DOFs move linearly in time and the scheme integrates them exactly.
- * The reactions at t_prev come from the last step, or (first step, after -restart) from uprev. */
-static PetscErrorCode ImplicitBoundaryWork(PeriAnalysis an, Vec q, PetscReal t)
+/* Implicit: the moving boundaries' work from t_prev to t (this rank's share, into work_bc): what
+ * accelerated the held DOFs, the change of their kinetic energy (with Newmark's trapezoidal rule,
+ * m (a_n + a_n+1)/2 . du is exactly that), plus the trapezoid of the body's pull on them,
+ * (R_n + R_n+1)/2 . du, du = w (I(t) - I(t_prev)). With average acceleration the balance then
+ * closes to round-off on a linear body. The first call (step 0, or the step -restart resumed)
+ * only records R and the kinetic energy. Collective. */
+static PetscErrorCode ImplicitBoundaryWork(PeriAnalysis an, Vec q, Vec p, PetscReal t)
 {
   Dynamic              *d = DYN(an);
   const PeriConditions *C = &an->sys->conditions;
-  PetscReal            *R;
+  PetscReal            *R, ke = 0;
 
   PetscFunctionBeginUser;
   if (!d->implicit || !C->moving) PetscFunctionReturn(PETSC_SUCCESS);
-  if (!d->reaction) {
-    PetscCall(PetscMalloc1(C->nconstrained + 1, &d->reaction));
-    PetscCall(Reactions(an, d->uprev, d->t_prev, d->reaction));
-  }
   PetscCall(PetscMalloc1(C->nconstrained + 1, &R));
-  PetscCall(Reactions(an, q, t, R));
-  for (PetscInt k = 0; C->constrained_velocity && k < C->nconstrained; k++) d->work_bc += 0.5 * (R[k] + d->reaction[k]) * C->constrained_velocity[k] * (t - d->t_prev);
+  PetscCall(Reactions(an, q, p, t, R, &ke));
+  if (d->reaction) {
+    d->work_bc += ke - d->ke_held;
+    for (PetscInt k = 0; k < C->nconstrained; k++) {
+      PetscReal u, u0;
+      PeriConditionsMotion(C, k, t, &u, NULL, NULL);
+      PeriConditionsMotion(C, k, d->t_prev, &u0, NULL, NULL);
+      d->work_bc += 0.5 * (R[k] + d->reaction[k]) * (u - u0);
+    }
+  }
   PetscCall(PetscFree(d->reaction));
   d->reaction = R;
+  d->ke_held  = ke;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Implicit: F = M A + K U - a(t) f, and U - g(t) on the held DOFs (g = value + w t). */
+/* Implicit: U - g on the held DOFs' rows of F, g = value + w I(t) (bc.<k>.velocity). The
+ * generalized-alpha residual comes at t_n + alpha_f dt with U interpolated linearly over the step,
+ * so g is too: then U_n+1 = g(t_n+1) exactly, and the scheme's velocities follow the prescribed
+ * motion (exactly for a ramp whose rise is a whole number of steps) instead of oscillating about
+ * it, as U_af = g(t_af) would make them for a motion not linear in time. */
+static PetscErrorCode HeldResidual(PeriAnalysis an, TS ts, PetscReal t, Vec U, Vec F)
+{
+  const PeriConditions *C = &an->sys->conditions;
+  const PetscScalar    *u;
+  PetscScalar          *f;
+  PetscReal             tn, h, th;
+  PetscInt              r0;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetTime(ts, &tn)); /* the step's start during the step's solve */
+  PetscCall(TSGetTimeStep(ts, &h));
+  th = h > 0 ? (t - tn) / h : 0;
+  PetscCall(VecGetOwnershipRange(F, &r0, NULL));
+  PetscCall(VecGetArrayRead(U, &u));
+  PetscCall(VecGetArray(F, &f));
+  for (PetscInt k = 0; k < C->nconstrained; k++) {
+    PetscReal g0, g1;
+    PeriConditionsMotion(C, k, tn, &g0, NULL, NULL);
+    PeriConditionsMotion(C, k, tn + h, &g1, NULL, NULL);
+    f[C->constrained[k] - r0] = u[C->constrained[k] - r0] - (C->constrained_value[k] + g0 + th * (g1 - g0));
+  }
+  PetscCall(VecRestoreArray(F, &f));
+  PetscCall(VecRestoreArrayRead(U, &u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit: F = M A + K U - a(t) f, and U - g(t) on the held DOFs (HeldResidual). */
 static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F, void *ctx)
 {
   PeriAnalysis an  = (PeriAnalysis)ctx;
@@ -554,7 +632,6 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
   Vec          m;
 
   PetscFunctionBeginUser;
-  (void)ts;
   (void)V;
   PetscCall(PeriMassGetDiagonal(sys, &m));
   PetscCall(PeriContactSetTime(sys, t, PETSC_FALSE));
@@ -562,20 +639,7 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
   PetscCall(VecPointwiseMult(DYN(an)->tmp, m, A));
   PetscCall(VecAXPY(F, 1, DYN(an)->tmp));
   PetscCall(LoadAt(an, t, -1, 1, F));
-  if (sys->conditions.nconstrained) {
-    const PetscScalar *u;
-    PetscScalar       *f;
-    PetscInt           r0;
-    PetscCall(VecGetOwnershipRange(F, &r0, NULL));
-    PetscCall(VecGetArrayRead(U, &u));
-    PetscCall(VecGetArray(F, &f));
-    for (PetscInt k = 0; k < sys->conditions.nconstrained; k++) {
-      const PetscReal w                      = sys->conditions.constrained_velocity ? sys->conditions.constrained_velocity[k] : 0;
-      f[sys->conditions.constrained[k] - r0] = u[sys->conditions.constrained[k] - r0] - (sys->conditions.constrained_value[k] + w * t);
-    }
-    PetscCall(VecRestoreArray(F, &f));
-    PetscCall(VecRestoreArrayRead(U, &u));
-  }
+  PetscCall(HeldResidual(an, ts, t, U, F));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -759,13 +823,13 @@ static PetscErrorCode Energies(PeriAnalysis an, Vec q, Vec p)
 }
 
 /* The loads' work since the last step (trapezoidal in time): every step, a dot product. */
-static PetscErrorCode Work(PeriAnalysis an, Vec q, PetscReal t)
+static PetscErrorCode Work(PeriAnalysis an, Vec q, Vec p, PetscReal t)
 {
   Dynamic    *d = DYN(an);
   PetscScalar w[PERI_DYN_MAX_TERMS];
 
   PetscFunctionBeginUser;
-  PetscCall(ImplicitBoundaryWork(an, q, t));
+  PetscCall(ImplicitBoundaryWork(an, q, p, t));
   PetscCall(VecWAXPY(d->tmp, -1, d->uprev, q));
   PetscCall(VecMDot(d->tmp, d->nterms, d->term_f, w));
   for (PetscInt k = 0; k < d->nterms; k++) {
@@ -995,10 +1059,13 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   PetscFunctionBeginUser;
   if (d->resumed) { /* -restart: this step's row, frame and checkpoint are the stopped run's */
     d->resumed = PETSC_FALSE;
+    PetscCall(GetState(an, U, &q, &p));
+    PetscCall(ImplicitBoundaryWork(an, q, p, t)); /* its reactions, for the next step's work */
+    PetscCall(RestoreState(an, U, &q, &p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(GetState(an, U, &q, &p));
-  PetscCall(Work(an, q, t));
+  PetscCall(Work(an, q, p, t));
   PetscCall(TSGetMaxSteps(ts, &last));
   d->nsteps = step;
   snap      = (PetscBool)(step % d->every == 0 || step >= last);

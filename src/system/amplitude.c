@@ -1,5 +1,6 @@
 /* Amplitudes in time, a(t), for the loads of a transient analysis: analysis.amplitude (every load)
- * and loads.<k>.amplitude (that load). step, ramp, sine, or a table read from a two-column CSV
+ * and loads.<k>.amplitude (that load); bc.<k>.amplitude scales a moving boundary's velocity, which
+ * needs a's rate and integral too. step, ramp, sine, or a table read from a two-column CSV
  * (time, amplitude) and interpolated linearly, constant beyond its ends. */
 #include "perilin/private/system.h"
 
@@ -140,6 +141,56 @@ PetscReal PeriAmplitudeValue(const PeriAmplitude *a, PetscReal t)
     return a->a[lo] + (a->a[hi] - a->a[lo]) * (t - a->t[lo]) / (a->t[hi] - a->t[lo]);
   default:
     return 1;
+  }
+}
+
+/* a'(t) (the slope of the table's segment; 0 beyond its ends and after a ramp's rise). */
+PetscReal PeriAmplitudeRate(const PeriAmplitude *a, PetscReal t)
+{
+  PetscInt k = 0;
+
+  switch (a->shape) {
+  case PERI_AMPLITUDE_RAMP:
+    return t < a->rise ? 1 / a->rise : 0;
+  case PERI_AMPLITUDE_SINE:
+    return 2 * PETSC_PI / a->period * PetscCosReal(2 * PETSC_PI * t / a->period);
+  case PERI_AMPLITUDE_TABLE:
+    if (t < a->t[0] || t >= a->t[a->n - 1]) return 0;
+    while (a->t[k + 1] <= t) k++;
+    return (a->a[k + 1] - a->a[k]) / (a->t[k + 1] - a->t[k]);
+  default:
+    return 0;
+  }
+}
+
+/* The table's integral from 0 to t: the trapezoids of its segments clipped to [0, t], its end
+ * values beyond them. */
+static PetscReal TableIntegral(const PeriAmplitude *a, PetscReal t)
+{
+  PetscReal sum = 0, lo, hi;
+
+  if (t <= 0) return 0;
+  if (a->t[0] > 0) sum += a->a[0] * PetscMin(t, a->t[0]);
+  for (PetscInt k = 0; k + 1 < a->n; k++) {
+    lo = PetscMax(0, a->t[k]), hi = PetscMin(t, a->t[k + 1]);
+    if (hi > lo) sum += 0.5 * (PeriAmplitudeValue(a, lo) + PeriAmplitudeValue(a, hi)) * (hi - lo);
+  }
+  if (t > a->t[a->n - 1]) sum += a->a[a->n - 1] * (t - PetscMax(0, a->t[a->n - 1]));
+  return sum;
+}
+
+/* The integral of a from 0 to t (a moving boundary's displacement per unit velocity). */
+PetscReal PeriAmplitudeIntegral(const PeriAmplitude *a, PetscReal t)
+{
+  switch (a->shape) {
+  case PERI_AMPLITUDE_RAMP:
+    return t < a->rise ? 0.5 * t * t / a->rise : t - 0.5 * a->rise;
+  case PERI_AMPLITUDE_SINE:
+    return a->period / (2 * PETSC_PI) * (1 - PetscCosReal(2 * PETSC_PI * t / a->period));
+  case PERI_AMPLITUDE_TABLE:
+    return TableIntegral(a, t);
+  default:
+    return t;
   }
 }
 

@@ -48,7 +48,8 @@ static const PeriKey bc_keys[] = {
     {"fix", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "components held at zero, e.g. [ux, uy]"},
     {"value", PERI_KEY_MAP, NULL, NULL, "[length] (theta: radians)", NULL, "map component -> prescribed value, e.g. {ux: 0.001}"},
     {"affine", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the prescribed field u = A X + b at the reference positions X: {A: [[..],..], b: [..]}; every translational component, never theta"},
-    {"velocity", PERI_KEY_REALS, NULL, NULL, "[length/time]", NULL, "a dynamic analysis (explicit or implicit): the translations move at this velocity from rest, u = v t; one number per dimension"},
+    {"velocity", PERI_KEY_REALS, NULL, NULL, "[length/time]", NULL, "a dynamic analysis (explicit or implicit): the translations move at this velocity, u = v t (v a(t) under amplitude, u its integral); one number per dimension"},
+    {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "with velocity: its amplitude in time a(t) (default a step: v from t = 0; a ramp starts from rest)"},
     {"optional", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "skip the components of fix and value the model lacks (one scene for several models)"},
     {"override", PERI_KEY_BOOL, "false", NULL, NULL, NULL, "this item wins where an earlier item holds the same component of the same particle with another value (else that is an input error; equal values are always fine)"},
     {NULL},
@@ -70,6 +71,7 @@ static const PeriKey load_keys[] = {
 const PeriSchema PeriBoundarySchema[] = {
     {"bc.<k>", bc_keys},
     {"bc.<k>.affine", affine_keys},
+    {"bc.<k>.amplitude", PeriAmplitudeKeys},
     {"loads.<k>", load_keys},
     {"loads.<k>.traction_field", affine_keys},
     {"loads.<k>.amplitude", PeriAmplitudeKeys},
@@ -138,18 +140,21 @@ static PetscErrorCode ReportConflict(PeriSystem sys, PeriNode bc, PetscInt k, co
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* bc.<k>.velocity: every translation held at 0 from rest and moving at its velocity w (a dynamic
- * analysis; its explicit integrator). */
-static PetscErrorCode ReadVelocity(PeriSystem sys, PeriNode item, PetscBool use[], PetscReal v[], PetscReal w[])
+/* bc.<k>.velocity: every translation held at 0 and moving at its velocity w under the item's
+ * amplitude, into bc_amp[k] (a dynamic analysis). */
+static PetscErrorCode ReadVelocity(PeriSystem sys, PeriNode item, PetscInt k, PetscBool use[], PetscReal v[], PetscReal w[])
 {
   PeriScene      s   = sys->scene;
   const PetscInt dim = sys->disc.particles.dim;
+  PeriNode       amp;
   PetscReal      vel[3];
   PetscInt       n;
 
   PetscFunctionBeginUser;
   PeriInputCheck(sys->stiffness.needs.transient || sys->stiffness.needs.dry_run, s, item, "velocity", "a boundary moves in time in a dynamic analysis; a quasi-static one scales value by its load factor instead");
   PetscCall(PeriSceneGetRealArray(s, item, "velocity", PETSC_TRUE, dim, dim, vel, &n));
+  PetscCall(PeriSceneGetNode(item, "amplitude", &amp));
+  PetscCall(PeriAmplitudeFromScene(s, amp, &sys->conditions.bc_amp[k]));
   for (PetscInt a = 0; a < dim; a++) {
     PetscInt c;
     PetscCall(AxisComponent(sys->model, a, &c));
@@ -216,7 +221,7 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
   PeriModel      m    = sys->model;
   const PetscInt bs = m->dofs, dim = sys->disc.particles.dim;
   PeriRegion    *r;
-  PeriNode       fix, val, aff, vel;
+  PeriNode       fix, val, aff, vel, amp;
   PetscReal      v[PERI_MAX_DOF], A[3][3] = {{0}}, b0[3] = {0, 0, 0}, w[PERI_MAX_DOF] = {0};
   PetscBool      use[PERI_MAX_DOF] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
   PetscInt       axis_comp[3]      = {-1, -1, -1};
@@ -232,8 +237,10 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
   PetscCall(PeriSceneGetNode(item, "value", &val));
   PetscCall(PeriSceneGetNode(item, "affine", &aff));
   PetscCall(PeriSceneGetNode(item, "velocity", &vel));
+  PetscCall(PeriSceneGetNode(item, "amplitude", &amp));
   PeriInputCheck((fix ? 1 : 0) + (val ? 1 : 0) + (aff ? 1 : 0) + (vel ? 1 : 0) == 1, s, item, NULL, "give exactly one of fix, value, affine, velocity");
-  if (vel) PetscCall(ReadVelocity(sys, item, use, v, w));
+  if (vel) PetscCall(ReadVelocity(sys, item, k, use, v, w));
+  PeriInputCheck(vel || !amp, s, item, "amplitude", "moves a bc velocity in time; a held value has none");
   if (fix)
     PetscCall(ReadFix(sys, fix, optional, use, v));
   else if (val)
@@ -271,13 +278,32 @@ static PetscErrorCode ApplyCondition(PeriSystem sys, PeriNode bc, PetscInt k, Pr
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The velocity of the k-th constrained DOF, in conditions.constrained_velocity (made on the first). */
-static PetscErrorCode KeepVelocity(PeriSystem sys, PetscInt k, PetscReal w)
+/* The velocity of the k-th constrained DOF and the bc item whose amplitude moves it, in
+ * conditions.constrained_velocity and constrained_amp (made on the first). */
+static PetscErrorCode KeepVelocity(PeriSystem sys, PetscInt k, PetscReal w, PetscInt item)
 {
+  PeriConditions *C = &sys->conditions;
+
   PetscFunctionBeginUser;
-  if (!sys->conditions.constrained_velocity) PetscCall(PetscCalloc1(sys->conditions.nconstrained, &sys->conditions.constrained_velocity));
-  sys->conditions.constrained_velocity[k] = w;
+  if (!C->constrained_velocity) PetscCall(PetscCalloc2(C->nconstrained, &C->constrained_velocity, C->nconstrained, &C->constrained_amp));
+  C->constrained_velocity[k] = w;
+  C->constrained_amp[k]      = item;
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriConditionsMotion - the k-th constrained DOF's motion beyond its value at time t: displacement
+  w I(t), velocity w a(t) and acceleration w a'(t) (a the amplitude of its bc item, I its
+  integral from 0); all 0 for a DOF that does not move. Not collective.
+@*/
+void PeriConditionsMotion(const PeriConditions *C, PetscInt k, PetscReal t, PetscReal *u, PetscReal *v, PetscReal *a)
+{
+  const PetscReal      w   = C->constrained_velocity ? C->constrained_velocity[k] : 0;
+  const PeriAmplitude *amp = w != 0 ? &C->bc_amp[C->constrained_amp[k]] : NULL;
+
+  if (u) *u = amp ? w * PeriAmplitudeIntegral(amp, t) : 0;
+  if (v) *v = amp ? w * PeriAmplitudeValue(amp, t) : 0;
+  if (a) *a = amp ? w * PeriAmplitudeRate(amp, t) : 0;
 }
 
 /*@C
@@ -298,11 +324,13 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
   PetscCall(PeriSceneGetNode(s->root, "bc", &bc));
   PeriInputCheck(!bc || bc->kind == PERI_NODE_SEQ, s, bc, NULL, "must be a list of conditions, each {region: .., fix: [..]}");
   PetscCall(PetscCalloc5(nloc, &P.value, nloc, &P.velocity, nloc, &P.set, nloc, &P.region, nloc, &P.item));
+  sys->conditions.nbc_amp = bc ? bc->n : 0;
+  PetscCall(PetscCalloc1(sys->conditions.nbc_amp + 1, &sys->conditions.bc_amp)); /* step amplitudes (zeroed) */
   value = P.value, set = P.set, region = P.region;
   for (PetscInt k = 0; k < nloc; k++) region[k] = P.item[k] = -1; /* held by no bc item (an inactive component) */
   /* a bad condition is an input error, not an exit: free the work arrays before passing it on */
   for (PetscInt k = 0; bc && k < bc->n && !ierr; k++) ierr = ApplyCondition(sys, bc, k, &P);
-  if (ierr) PetscCall(PetscFree4(P.value, P.set, P.region, P.item));
+  if (ierr) PetscCall(PetscFree5(P.value, P.velocity, P.set, P.region, P.item));
   PetscCall(ierr);
   for (PetscInt c = 0; c < bs; c++) {
     if (!sys->model->inactive[c]) continue;
@@ -323,7 +351,7 @@ PetscErrorCode PeriBoundarySetUp(PeriSystem sys)
       sys->conditions.constrained[n]        = sys->disc.rstart * bs + k;
       sys->conditions.constrained_value[n]  = value[k];
       sys->conditions.constrained_region[n] = region[k];
-      if (P.velocity[k] != 0) PetscCall(KeepVelocity(sys, n, P.velocity[k]));
+      if (P.velocity[k] != 0) PetscCall(KeepVelocity(sys, n, P.velocity[k], P.item[k]));
       n++;
     }
   PetscCall(PetscFree5(P.value, P.velocity, P.set, P.region, P.item));
@@ -619,7 +647,9 @@ PetscErrorCode PeriConditionsDestroy(PeriConditions *C)
   PetscCall(PetscFree(C->constrained));
   PetscCall(PetscFree(C->constrained_value));
   PetscCall(PetscFree(C->constrained_region));
-  PetscCall(PetscFree(C->constrained_velocity));
+  PetscCall(PetscFree2(C->constrained_velocity, C->constrained_amp));
+  for (PetscInt k = 0; k < C->nbc_amp; k++) PetscCall(PeriAmplitudeDestroy(&C->bc_amp[k]));
+  PetscCall(PetscFree(C->bc_amp));
   PetscCall(PeriReactionsDestroy(&C->reactions));
   PetscCall(PeriConditionFieldsDestroy(&C->fields));
   PetscFunctionReturn(PETSC_SUCCESS);

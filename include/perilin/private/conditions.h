@@ -67,20 +67,6 @@ typedef struct {
   unsigned char *in_region;  /* [nregions][n]: 1 inside the region */
 } PeriConditionFields;
 
-/* Everything the scene prescribes or loads. */
-typedef struct {
-  PeriLayers          layers;
-  PeriTorsion         torsion;
-  PetscInt            nconstrained;         /* owned constrained DOFs */
-  PetscInt           *constrained;          /* their global rows, sorted */
-  PetscReal          *constrained_value;    /* their values at load factor 1 */
-  PetscInt           *constrained_region;   /* the region (index of disc.regions) of the bc item that set each, or -1 */
-  PetscReal          *constrained_velocity; /* bc.<k>.velocity: their velocity (u = value + velocity t), or NULL when none of this rank's moves */
-  PetscBool           moving;               /* a bc velocity moves DOFs on some rank */
-  PeriReactions       reactions;
-  PeriConditionFields fields;
-} PeriConditions;
-
 /* A load's amplitude in time (src/system/amplitude.c): loads.<k>.amplitude and
    analysis.amplitude of a transient analysis. */
 typedef enum {
@@ -95,9 +81,30 @@ typedef struct {
   PetscInt   n;            /* table: rows of (t, a) */
   PetscReal *t, *a;
 } PeriAmplitude;
+
+/* Everything the scene prescribes or loads. */
+typedef struct {
+  PeriLayers          layers;
+  PeriTorsion         torsion;
+  PetscInt            nconstrained;         /* owned constrained DOFs */
+  PetscInt           *constrained;          /* their global rows, sorted */
+  PetscReal          *constrained_value;    /* their values at load factor 1 */
+  PetscInt           *constrained_region;   /* the region (index of disc.regions) of the bc item that set each, or -1 */
+  PetscReal          *constrained_velocity; /* bc.<k>.velocity: their velocity w (u = value + w I(t), I the integral of the item's amplitude), or NULL when none of this rank's moves */
+  PetscInt           *constrained_amp;      /* with constrained_velocity: the index in bc_amp of the amplitude that moves each */
+  PetscInt            nbc_amp;              /* bc items */
+  PeriAmplitude      *bc_amp;               /* bc.<k>.amplitude of each bc item (a step where absent: the velocity from t = 0) */
+  PetscBool           moving;               /* a bc velocity moves DOFs on some rank */
+  PeriReactions       reactions;
+  PeriConditionFields fields;
+} PeriConditions;
+
 PETSC_EXTERN const PeriKey  PeriAmplitudeKeys[];
 PETSC_EXTERN PetscErrorCode PeriAmplitudeFromScene(PeriScene, PeriNode, PeriAmplitude *);
 PETSC_EXTERN PetscReal      PeriAmplitudeValue(const PeriAmplitude *, PetscReal);
+PETSC_EXTERN PetscReal      PeriAmplitudeRate(const PeriAmplitude *, PetscReal);
+PETSC_EXTERN PetscReal      PeriAmplitudeIntegral(const PeriAmplitude *, PetscReal);
+PETSC_EXTERN void           PeriConditionsMotion(const PeriConditions *, PetscInt, PetscReal, PetscReal *, PetscReal *, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriAmplitudeDestroy(PeriAmplitude *);
 
 PETSC_EXTERN PetscErrorCode PeriBoundarySetUp(PeriSystem);
