@@ -57,9 +57,17 @@ static PetscErrorCode ReadContact(PeriSystem sys, PeriNode node)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscErrorCode ContactAddForce(PeriSystem, Vec, Vec);
+static PetscErrorCode ContactEnergy(PeriSystem, Vec, PetscReal *);
+static PetscErrorCode ContactAddRowSums(PeriSystem, Vec);
+
+/* Contact and the impactors as one interaction term of the system (PeriTermOps). */
+static const PeriTermOps contact_term = {"contact", ContactAddForce, ContactEnergy, ContactAddRowSums};
+
 /*@C
-  PeriContactSetUp - reads contact and impactors (a transient analysis only; none: nothing) and
-  checks the impactors clear of the body at t = 0. Collective.
+  PeriContactSetUp - reads contact and impactors (a transient analysis only; none: nothing),
+  checks the impactors clear of the body at t = 0, and adds the contact term to the system's.
+  Collective.
 @*/
 PetscErrorCode PeriContactSetUp(PeriSystem sys)
 {
@@ -77,6 +85,7 @@ PetscErrorCode PeriContactSetUp(PeriSystem sys)
   C->delta = sys->disc.delta;
   if (node) PetscCall(ReadContact(sys, node));
   if (imp) PetscCall(PeriImpactorsSetUp(sys));
+  PetscCall(PeriSystemAddTerm(sys, &contact_term));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -310,11 +319,9 @@ static PetscReal Evaluate(PeriSystem sys, const PetscScalar ul[], PetscScalar fa
   return E + Ei;
 }
 
-/*@C
-  PeriContactAddForce - f += the contact and impactor forces at u (internal: the gradient of their
-  energy), at the time PeriContactSetTime set. Collective (the ghosts' DOFs).
-@*/
-PetscErrorCode PeriContactAddForce(PeriSystem sys, Vec u, Vec f)
+/* ContactAddForce - f += the contact and impactor forces at u (internal: the gradient of their
+ * energy), at the time PeriContactSetTime set. Collective (the ghosts' DOFs). */
+static PetscErrorCode ContactAddForce(PeriSystem sys, Vec u, Vec f)
 {
   PetscScalar   *ul, *fa;
   PetscLogDouble t0, t1;
@@ -332,10 +339,8 @@ PetscErrorCode PeriContactAddForce(PeriSystem sys, Vec u, Vec f)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriContactEnergy - the energy of the contact pairs and the impactors' penalty at u. Collective.
-@*/
-PetscErrorCode PeriContactEnergy(PeriSystem sys, Vec u, PetscReal *E)
+/* ContactEnergy - the energy of the contact pairs and the impactors' penalty at u. Collective. */
+static PetscErrorCode ContactEnergy(PeriSystem sys, Vec u, PetscReal *E)
 {
   PetscScalar *ul;
   PetscReal    e;
@@ -350,14 +355,12 @@ PetscErrorCode PeriContactEnergy(PeriSystem sys, Vec u, PetscReal *E)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriContactAddRowSums - adds to Gershgorin's row sums what contact can add to a row of the
-  Jacobian: k V_i V_max/delta for each particle a particle can touch across a face (3 in 2D, 5 in
-  3D: the one opposite and its lattice neighbours within r_c), and the impactors' penalty
-  k V_i^2/delta. Bonded pairs would add more only when compressed by 10 %, beyond what a linear
-  model describes. Not collective.
-@*/
-PetscErrorCode PeriContactAddRowSums(PeriSystem sys, Vec rows)
+/* ContactAddRowSums - adds to Gershgorin's row sums what contact can add to a row of the
+ * Jacobian: k V_i V_max/delta for each particle a particle can touch across a face (3 in 2D, 5 in
+ * 3D: the one opposite and its lattice neighbours within r_c), and the impactors' penalty
+ * k V_i^2/delta. Bonded pairs would add more only when compressed by 10 %, beyond what a linear
+ * model describes. Not collective. */
+static PetscErrorCode ContactAddRowSums(PeriSystem sys, Vec rows)
 {
   PeriContact    *C     = &sys->contact;
   const PetscInt  bs    = sys->model->dofs;

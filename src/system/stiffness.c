@@ -199,9 +199,23 @@ PetscErrorCode PeriSystemGetJacobian(PeriSystem sys, Mat *K)
 }
 
 /*@C
-  PeriSystemInternalForce - f = K u, the force the interaction terms exert at the displacements u
-  (the linear models: their Jacobian times u; a term that is not linear, such as contact, adds
-  its own here). Collective.
+  PeriSystemAddTerm - adds an interaction term to those the system applies besides the bonds
+  (PeriTermOps). Not collective: every rank adds the same terms in the same order.
+@*/
+PetscErrorCode PeriSystemAddTerm(PeriSystem sys, const PeriTermOps *term)
+{
+  PeriStiffness *S = &sys->stiffness;
+
+  PetscFunctionBeginUser;
+  PetscCheck(S->nterms < PERI_MAX_TERMS, PETSC_COMM_SELF, PETSC_ERR_PLIB, "at most %d interaction terms besides the bonds (PERI_MAX_TERMS): %s is one too many", PERI_MAX_TERMS, term->name);
+  S->terms[S->nterms++] = term;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemInternalForce - f = K u + the terms' forces: the force the interactions exert at the
+  displacements u (the bonds of the linear models: their Jacobian times u; the terms, such as
+  contact, that are not linear add their own). Collective.
 @*/
 PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
 {
@@ -210,13 +224,23 @@ PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
   PetscFunctionBeginUser;
   PetscCall(PeriSystemGetJacobian(sys, &K));
   PetscCall(MatMult(K, u, f));
-  PetscCall(PeriContactAddForce(sys, u, f));
+  for (PetscInt k = 0; k < sys->stiffness.nterms; k++)
+    if (sys->stiffness.terms[k]->add_force) PetscCall(sys->stiffness.terms[k]->add_force(sys, u, f));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* rows += the terms' bounds of their row sums. */
+static PetscErrorCode TermsRowSums(PeriSystem sys, Vec rows)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < sys->stiffness.nterms; k++)
+    if (sys->stiffness.terms[k]->add_row_sums) PetscCall(sys->stiffness.terms[k]->add_row_sums(sys, rows));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /*@C
-  PeriSystemStrainEnergy - the energy the interaction terms hold at u: (1/2) u^T K u of the linear
-  ones and the energy of contact; work is a vector of u's layout. Collective.
+  PeriSystemStrainEnergy - the energy the interactions hold at u: (1/2) u^T K u of the bonds and
+  the terms' own (contact); work is a vector of u's layout. Collective.
 @*/
 PetscErrorCode PeriSystemStrainEnergy(PeriSystem sys, Vec u, Vec work, PetscReal *E)
 {
@@ -228,8 +252,12 @@ PetscErrorCode PeriSystemStrainEnergy(PeriSystem sys, Vec u, Vec work, PetscReal
   PetscCall(PeriSystemGetJacobian(sys, &K));
   PetscCall(MatMult(K, u, work));
   PetscCall(VecDot(u, work, &e));
-  PetscCall(PeriContactEnergy(sys, u, &ec));
-  *E = 0.5 * PetscRealPart(e) + ec;
+  *E = 0.5 * PetscRealPart(e);
+  for (PetscInt k = 0; k < sys->stiffness.nterms; k++) {
+    if (!sys->stiffness.terms[k]->energy) continue;
+    PetscCall(sys->stiffness.terms[k]->energy(sys, u, &ec));
+    *E += ec;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -247,7 +275,7 @@ PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem sys, Vec rows)
   PetscCall(PeriSystemGetJacobian(sys, &K));
   if (sys->stiffness.op) {
     PetscCall(PeriOperatorRowSums(sys, rows));
-    PetscCall(PeriContactAddRowSums(sys, rows));
+    PetscCall(TermsRowSums(sys, rows));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(MatGetOwnershipRange(K, &rstart, &rend));
@@ -261,7 +289,7 @@ PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem sys, Vec rows)
     PetscCall(MatRestoreRow(K, r, &nc, NULL, &v));
   }
   PetscCall(VecRestoreArray(rows, &ra));
-  PetscCall(PeriContactAddRowSums(sys, rows));
+  PetscCall(TermsRowSums(sys, rows));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

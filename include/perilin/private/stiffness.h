@@ -68,18 +68,33 @@ typedef struct {
   PetscErrorCode (*destroy)(PeriSystem *);
 } PeriLevelFactory;
 
+/* An interaction term besides the model's bonds (contact today; docs/design.md, 'Interaction
+ * terms'): its force, energy and Gershgorin row sums at a displacement, which the system's
+ * PeriSystemInternalForce, PeriSystemStrainEnergy and PeriSystemStiffnessRowSums add to those of
+ * the bonds. A term registers itself at the system's set-up (PeriSystemAddTerm) when the scene
+ * turns it on; the analyses never call it by name. An op may be NULL. */
+typedef struct {
+  const char *name;
+  PetscErrorCode (*add_force)(PeriSystem, Vec u, Vec f);     /* f += the term's internal force at u */
+  PetscErrorCode (*energy)(PeriSystem, Vec u, PetscReal *E); /* its energy at u, summed over the ranks */
+  PetscErrorCode (*add_row_sums)(PeriSystem, Vec rows);      /* rows += a bound of its Jacobian's absolute row sums */
+} PeriTermOps;
+#define PERI_MAX_TERMS 4
+
 /* K and how it is applied and solved. */
 typedef struct {
-  Mat              K;                       /* stiffness: assembled, or a MATSHELL over op */
-  Mat              Kpc;                     /* with op: the assembled short-range stiffness that preconditions K */
-  PeriOperator     op;                      /* solver.operator: matrix_free, else NULL */
-  PeriOperatorKind operator_kind;           /* solver.operator */
-  PetscReal        pc_radius;               /* solver.pc_radius */
-  char             pc_default[16];          /* the static solve's PC unless -pc_type: gamg, or jacobi (matrix-free K on a small 3D body) */
-  char             mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
-  PeriSystemNeeds  needs;                   /* the analysis' (PeriSystemSetNeeds), before the set-up */
-  PetscReal        residual_tol;            /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
-  PeriLevelFactory levels;                  /* coarse versions of the system, for the geometric multigrid */
+  Mat                K;                       /* stiffness: assembled, or a MATSHELL over op */
+  Mat                Kpc;                     /* with op: the assembled short-range stiffness that preconditions K */
+  PeriOperator       op;                      /* solver.operator: matrix_free, else NULL */
+  PeriOperatorKind   operator_kind;           /* solver.operator */
+  PetscReal          pc_radius;               /* solver.pc_radius */
+  char               pc_default[16];          /* the static solve's PC unless -pc_type: gamg, or jacobi (matrix-free K on a small 3D body) */
+  char               mat_type[PERI_NAME_LEN]; /* default type of K, before -mat_type */
+  PeriSystemNeeds    needs;                   /* the analysis' (PeriSystemSetNeeds), before the set-up */
+  PetscReal          residual_tol;            /* solver.residual_tol: the largest true relative residual accepted (0: the default) */
+  PeriLevelFactory   levels;                  /* coarse versions of the system, for the geometric multigrid */
+  const PeriTermOps *terms[PERI_MAX_TERMS];   /* the interaction terms besides the bonds */
+  PetscInt           nterms;
 } PeriStiffness;
 
 PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
@@ -87,6 +102,7 @@ PETSC_EXTERN PetscErrorCode PeriSystemGetJacobian(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriSystemInternalForce(PeriSystem, Vec, Vec);
 PETSC_EXTERN PetscErrorCode PeriSystemStrainEnergy(PeriSystem, Vec, Vec, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem, Vec);
+PETSC_EXTERN PetscErrorCode PeriSystemAddTerm(PeriSystem, const PeriTermOps *);
 PETSC_EXTERN const char    *PeriMatrixFreeWhyNot(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriAssembleStiffness(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriBondStiffness(PeriSystem, PetscInt, PetscInt, PetscReal, PeriBondGeometry *, PetscReal[]);
