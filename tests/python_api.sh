@@ -25,7 +25,11 @@ for n in 1 2; do
   echo "== $n rank(s)"
   mkdir -p "$tmp/py$n"
   "${run[@]}" "$exe" "$plate" -quiet -output_dir "$tmp/cli$n" > "$tmp/log" 2>&1 || { cat "$tmp/log"; echo "FAIL: the command line's run on $n rank(s)"; status=1; continue; }
-  "${run[@]}" "$py" "$repo/tests/python_api.py" "$repo" "$tmp/cli$n" "$version" "$tmp/py$n" || status=1
+  # the small quasi-static and dynamic scenes of python_api.py's check 9, with its overrides
+  "${run[@]}" "$exe" "$repo/examples/antiplane/cracked_bar.yaml" -grid_spacing 0.025 -output_plots false -quiet -output_dir "$tmp/qs$n" > "$tmp/log" 2>&1 || { cat "$tmp/log"; echo "FAIL: the command line's quasi-static run on $n rank(s)"; status=1; continue; }
+  "${run[@]}" "$exe" "$repo/examples/dynamics/pulse.yaml" -grid_upper 100,4,4 -analysis_t_end 10 -output_plots false -quiet -output_dir "$tmp/dyn$n" > "$tmp/log" 2>&1 || { cat "$tmp/log"; echo "FAIL: the command line's dynamic run on $n rank(s)"; status=1; continue; }
+  "${run[@]}" "$py" "$repo/tests/python_api.py" "$repo" "$tmp/cli$n" "$version" "$tmp/py$n" "$tmp/qs$n" "$tmp/dyn$n" > "$tmp/pylog" 2>&1 || status=1
+  grep -E "^(ok|FAIL)" "$tmp/pylog" || cat "$tmp/pylog"
 done
 echo "== examples/python/slepc_modes.py"
 "$py" "$repo/examples/python/slepc_modes.py" "$repo/examples/lamina/modal.yaml" || status=1
