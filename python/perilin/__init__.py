@@ -155,10 +155,14 @@ class Problem:
             self._tmp = None
 
     def close(self):
-        """Frees the problem (collective); the object is unusable after it."""
+        """Frees the problem (collective); the object is unusable after it. Also frees the petsc4py
+        objects on the problem's communicator that Python dropped without destroy(): petsc4py 3.18
+        keeps a dropped parallel object (one on a communicator, as K, f, M are) in PETSc's garbage
+        until a collective PETSc.garbage_cleanup(), which this calls (docs/python.md, "Memory")."""
         if self._handle is not None:
             _perilin.destroy(self._handle)
             self._handle = None
+            PETSc.garbage_cleanup(self.comm)
         self._remove_tmp()
 
     def __enter__(self):
