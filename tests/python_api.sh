@@ -1,7 +1,8 @@
 #!/bin/bash
 # The Python module perilin (issue 39; tests/python_api.py says what is checked), on 1 and 2 ranks,
 # against the command line's run of the same scene on as many ranks; then the example
-# examples/python/slepc_modes.py (slepc4py on perilin's K and M gives perilin's frequencies).
+# examples/python/slepc_modes.py (slepc4py on perilin's K and M gives perilin's frequencies) and
+# examples/python/fit_modulus.py (scipy.optimize recovers E to 1e-6).
 # Debian's /usr/bin/python3, with the module from the build tree; skipped (77) without the module or
 # VTK's readers. usage: python_api.sh PERILIN REPO PYTHON_DIR
 set -u
@@ -33,4 +34,6 @@ for n in 1 2; do
 done
 echo "== examples/python/slepc_modes.py"
 "$py" "$repo/examples/python/slepc_modes.py" "$repo/examples/lamina/modal.yaml" || status=1
+echo "== examples/python/fit_modulus.py"
+"$py" "$repo/examples/python/fit_modulus.py" || status=1
 exit $status
