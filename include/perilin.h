@@ -65,3 +65,11 @@ PETSC_EXTERN PetscErrorCode PeriProblemGetConstraints(PeriProblem, PetscInt *, c
 PETSC_EXTERN PetscErrorCode PeriProblemGetLayout(PeriProblem, PetscInt *, PetscInt *, const char *const **, PetscInt *, PetscInt *, PetscInt *, const PetscReal *[]);
 PETSC_EXTERN PetscErrorCode PeriProblemGetSummary(PeriProblem, char **);
 PETSC_EXTERN PetscErrorCode PeriProblemGetScene(PeriProblem, char **);
+/* The body's K as a MATSHELL applied bond by bond (the matrix-free operator, no conditions). */
+PETSC_EXTERN PetscErrorCode PeriProblemGetOperator(PeriProblem, Mat *);
+/* A modal run's modes: their count and the shapes kept, then mode k's frequency (Hz), relative
+ * residual, kind and this rank's part of its shape (max |u| = 1). */
+PETSC_EXTERN PetscErrorCode PeriProblemGetModes(PeriProblem, PetscInt *, PetscInt *);
+PETSC_EXTERN PetscErrorCode PeriProblemGetMode(PeriProblem, PetscInt, PetscReal *, PetscReal *, const char **, const PetscReal **);
+/* The analysis' table of rows (steps.csv, history.csv): its file name and CSV text on every rank. */
+PETSC_EXTERN PetscErrorCode PeriProblemGetTable(PeriProblem, const char **, char **);

@@ -273,6 +273,92 @@ static PyObject *Stiffness(PyObject *self, PyObject *args)
   return out;
 }
 
+/* operator(p): the body's K as a petsc4py shell Mat (perilin's MATSHELL, applied bond by bond). */
+static PyObject *Operator(PyObject *self, PyObject *args)
+{
+  PyObject      *cap, *ok, *out;
+  PeriProblem    p;
+  Mat            A = NULL;
+  PetscErrorCode ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  Py_BEGIN_ALLOW_THREADS;
+  ierr = PeriProblemGetOperator(p, &A);
+  Py_END_ALLOW_THREADS;
+  if (!(ok = End(ierr))) return NULL;
+  Py_DECREF(ok);
+  out = PyPetscMat_New(A); /* takes its own reference */
+  (void)MatDestroy(&A);
+  return out;
+}
+
+/* One mode as (f_hz, residual, kind, shape bytes of this rank's DOFs or None). */
+static PyObject *ModeTuple(PeriProblem p, PetscInt k, Py_ssize_t nl)
+{
+  PetscReal        f, res;
+  const char      *kind;
+  const PetscReal *shape;
+  PyObject        *ok;
+
+  Begin();
+  if (!(ok = End(PeriProblemGetMode(p, k, &f, &res, &kind, &shape)))) return NULL;
+  Py_DECREF(ok);
+  if (!shape) return Py_BuildValue("(ddsO)", (double)f, (double)res, kind, Py_None);
+  if (!nl) shape = (const PetscReal *)""; /* y# makes NULL None */
+  return Py_BuildValue("(ddsy#)", (double)f, (double)res, kind, (const char *)shape, (Py_ssize_t)(nl * sizeof(PetscReal)));
+}
+
+/* modes(p, nlocal): a list of ModeTuple, nlocal the DOFs this rank owns. */
+static PyObject *Modes(PyObject *self, PyObject *args)
+{
+  PyObject   *cap, *ok, *list;
+  PeriProblem p;
+  PetscInt    n, nshapes;
+  Py_ssize_t  nl;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "On", &cap, &nl) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  if (!(ok = End(PeriProblemGetModes(p, &n, &nshapes)))) return NULL;
+  Py_DECREF(ok);
+  if (!(list = PyList_New(n))) return NULL;
+  for (PetscInt k = 0; k < n; k++) {
+    PyObject *t = ModeTuple(p, k, nl);
+    if (!t) {
+      Py_DECREF(list);
+      return NULL;
+    }
+    PyList_SET_ITEM(list, k, t);
+  }
+  return list;
+}
+
+/* table(p): (file name, CSV text) of the analysis' table, (None, None) without one, (name, None)
+ * before the run. Collective. */
+static PyObject *Table(PyObject *self, PyObject *args)
+{
+  PyObject      *cap, *ok, *out;
+  PeriProblem    p;
+  const char    *name = NULL;
+  char          *text = NULL;
+  PetscErrorCode ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  ierr = PeriProblemGetTable(p, &name, &text);
+  if (!(ok = End(ierr))) {
+    free(text);
+    return NULL;
+  }
+  Py_DECREF(ok);
+  out = Py_BuildValue("(zz)", name, text);
+  free(text);
+  return out;
+}
+
 static PyObject *VecResult(PeriProblem p, PetscErrorCode (*get)(PeriProblem, Vec *))
 {
   PyObject *ok, *out;
@@ -378,6 +464,9 @@ static PyMethodDef methods[] = {
     {"solution", Solution, METH_VARARGS, "solution(problem): this rank's part of u as bytes, or None"},
     {"constraints", Constraints, METH_VARARGS, "constraints(problem): (rows bytes, values bytes, sizeof(PetscInt))"},
     {"stiffness", Stiffness, METH_VARARGS, "stiffness(problem): a new assembled K (petsc4py Mat)"},
+    {"operator", Operator, METH_VARARGS, "operator(problem): the body's K as a new shell Mat, applied bond by bond (petsc4py Mat)"},
+    {"modes", Modes, METH_VARARGS, "modes(problem, nlocal): [(f_hz, residual, kind, shape bytes or None)] of a modal run"},
+    {"table", Table, METH_VARARGS, "table(problem): (file name, CSV text) of the analysis' table of rows"},
     {"loads", Loads, METH_VARARGS, "loads(problem): a new vector of the loads f (petsc4py Vec)"},
     {"mass", Mass, METH_VARARGS, "mass(problem): a new vector of the lumped mass per DOF (petsc4py Vec)"},
     {"summary", Summary, METH_VARARGS, "summary(problem): summary.json's text"},

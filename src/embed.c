@@ -285,3 +285,120 @@ PetscErrorCode PeriProblemGetScene(PeriProblem p, char **text)
   PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/*@C
+  PeriProblemGetOperator - a new MATSHELL applying the body's K (the live bonds) bond by bond, in
+  K's layout, without conditions: the run's matrix-free operator where it has one, else one built
+  from the bonds for this shell (which keeps it). MatMult equals PeriProblemGetStiffness's K times x
+  to round-off. An error for the models whose bonds the operator cannot apply (a family model, a
+  3D shear bond, the patch calibration's negative springs). Collective, after PeriProblemSetUp.
+@*/
+PetscErrorCode PeriProblemGetOperator(PeriProblem p, Mat *A)
+{
+  PeriOperator   op;
+  const char    *why;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCheck(p->sys, p->comm, PETSC_ERR_ORDER, "the operator of a problem before its set-up");
+  if (p->sys->stiffness.op) {
+    PetscCall(PeriOperatorCreateMat(p->sys, A));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  why = PeriOperatorWhyNotModel(p->sys->model);
+  if (!why && p->sys->model->calibration == PERI_CALIBRATION_PATCH) why = "the patch calibration may make springs negative, which the operator cannot apply";
+  PetscCheck(!why, p->comm, PETSC_ERR_SUP, "%s: no matrix-free operator for model %s: %s (stiffness() is the assembled K)", p->scene->file, p->sys->model->type, why);
+  PetscCall(PeriOperatorCreate(p->sys, p->sys->stiffness.pc_radius, &op));
+  /* PeriOperatorCreateMat takes the system's operator: lent for the call, so the run's choice of
+     K (solver.operator) stays as it was; the shell holds its own reference */
+  p->sys->stiffness.op = op;
+  ierr                 = PeriOperatorCreateMat(p->sys, A);
+  p->sys->stiffness.op = NULL;
+  PetscCall(PeriOperatorDestroy(&op));
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriProblemGetModes - the modes of a modal scene's run: their number (0 before the run) and how
+  many of the first have a shape (PeriProblemGetMode). An error for another analysis. Not
+  collective.
+@*/
+PetscErrorCode PeriProblemGetModes(PeriProblem p, PetscInt *n, PetscInt *nshapes)
+{
+  const PeriMode  *modes;
+  const PetscReal *shapes;
+
+  PetscFunctionBeginUser;
+  PetscCheck(p->analysis, PETSC_COMM_SELF, PETSC_ERR_ORDER, "the modes of a problem before its set-up");
+  PetscCall(PeriAnalysisGetModes(p->analysis, n, &modes, nshapes, &shapes));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriProblemGetMode - mode k (0-based, by rising frequency): its frequency in Hz, its relative
+  residual ||K x - omega^2 M x|| / (omega^2 ||M x||) on the free DOFs, its kind ("flexural", ...;
+  borrowed) and this rank's owned DOFs of its shape in K's layout, scaled to max |u| = 1 (borrowed;
+  NULL for the modes past the shapes kept). Not collective.
+@*/
+PetscErrorCode PeriProblemGetMode(PeriProblem p, PetscInt k, PetscReal *f_hz, PetscReal *residual, const char **kind, const PetscReal **shape)
+{
+  const PeriMode  *modes;
+  const PetscReal *shapes;
+  PetscInt         n, nshapes, nl;
+
+  PetscFunctionBeginUser;
+  PetscCheck(p->analysis, PETSC_COMM_SELF, PETSC_ERR_ORDER, "the modes of a problem before its set-up");
+  PetscCall(PeriAnalysisGetModes(p->analysis, &n, &modes, &nshapes, &shapes));
+  PetscCheck(k >= 0 && k < n, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "mode %" PetscInt_FMT " of %" PetscInt_FMT, k, n);
+  nl        = (p->sys->disc.bonds.rend - p->sys->disc.bonds.rstart) * p->sys->model->dofs;
+  *f_hz     = modes[k].f_hz;
+  *residual = modes[k].residual;
+  *kind     = modes[k].kind;
+  *shape    = k < nshapes ? &shapes[k * nl] : NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The analysis' table written by rank 0 into memory (NULL when it has none yet). */
+static PetscErrorCode TableText(PeriProblem p, char **text)
+{
+  size_t         len = 0;
+  FILE          *fp  = open_memstream(text, &len);
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_MEM, "cannot open a memory stream for the table");
+  ierr = p->analysis->type->ops.table(p->analysis, fp);
+  fclose(fp);
+  if (ierr || !len) {
+    free(*text);
+    *text = NULL;
+  }
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriProblemGetTable - the analysis' table of rows as the output set's CSV file holds it (steps.csv
+  of the quasi-static analysis, history.csv of the dynamic one): the file's name (NULL: the
+  analysis has no table) and its text on every rank (NULL before the run); free it with free().
+  Collective.
+@*/
+PetscErrorCode PeriProblemGetTable(PeriProblem p, const char **name, char **text)
+{
+  PetscErrorCode ierr = PETSC_SUCCESS;
+  PetscInt       has  = 0;
+
+  PetscFunctionBeginUser;
+  PetscCheck(p->analysis, p->comm, PETSC_ERR_ORDER, "the table of a problem before its set-up");
+  *name = p->analysis->type->ops.table ? p->analysis->type->table : NULL;
+  *text = NULL;
+  if (!*name) PetscFunctionReturn(PETSC_SUCCESS);
+  if (p->rank == 0) ierr = TableText(p, text);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &ierr, 1, MPI_INT, MPI_MAX, p->comm));
+  PetscCheck(!ierr, p->comm, ierr, "writing the table %s failed", *name);
+  has = *text != NULL;
+  PetscCallMPI(MPI_Bcast(&has, 1, MPIU_INT, 0, p->comm));
+  if (has) PetscCall(BcastText(p->comm, p->rank, text));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

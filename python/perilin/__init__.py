@@ -26,7 +26,24 @@ from ._perilin import Error
 _perilin.initialize()
 __version__, petsc_version, slepc_version = _perilin.versions()
 
-__all__ = ["Problem", "Result", "Error", "__version__"]
+__all__ = ["Problem", "Result", "Modes", "Error", "__version__"]
+
+# the columns of steps.csv and history.csv that count (int64 in Result.steps, Result.history);
+# every other column is float64
+_COUNT_COLUMNS = {"step", "broken", "broken_total", "softened", "equilibrium_iterations", "ksp_iterations", "attempts"}
+
+
+def _table(text):
+    """A CSV table (header line, then rows) as a dict column -> numpy array, in the file's column
+    order."""
+    lines = text.strip().split("\n")
+    names = lines[0].split(",")
+    rows = [line.split(",") for line in lines[1:]]
+    out = {}
+    for c, name in enumerate(names):
+        dtype = np.int64 if name in _COUNT_COLUMNS else np.float64
+        out[name] = np.array([float(r[c]) for r in rows], dtype=np.float64).astype(dtype)
+    return out
 
 
 def _text(value):
@@ -67,13 +84,36 @@ class Result:
     """One solution: x (positions) and u (the DOFs, ux uy [uz] or the model's components) as
     particles x dim and particles x dofs numpy arrays in the global particle order (the order of
     particles.vtu; on several ranks, the pieces of particles.pvtu one after the other), on every
-    rank; components names u's columns; summary is the dict summary.json holds."""
+    rank; components names u's columns; summary is the dict summary.json holds.
 
-    def __init__(self, x, u, components, summary):
+    steps (quasi-static runs) and history (dynamic runs): the rows of steps.csv and history.csv as
+    a dict column name -> numpy array (one entry per row; the counting columns int64, the others
+    float64), None for the other analyses."""
+
+    def __init__(self, x, u, components, summary, steps=None, history=None):
         self.x, self.u, self.components, self.summary = x, u, components, summary
+        self.steps, self.history = steps, history
 
     def __repr__(self):
         return "perilin.Result(%d particles, components %s)" % (len(self.x), ", ".join(self.components))
+
+
+class Modes:
+    """The modes of a modal run, by rising frequency: frequencies (Hz) and residuals (each pair's
+    ||K x - omega^2 M x|| / (omega^2 ||M x||) on the free DOFs) as numpy arrays of n; kinds (n
+    strings: flexural, longitudinal, ...); shapes, an nshapes x particles x dofs numpy array of the
+    first nshapes modes (at most 12: those perilin keeps for modes.pvd), in Result.u's global order
+    and columns (components), each scaled to max |translation| = 1, zero on the prescribed DOFs."""
+
+    def __init__(self, frequencies, residuals, kinds, shapes, components):
+        self.frequencies, self.residuals, self.kinds = frequencies, residuals, kinds
+        self.shapes, self.components = shapes, components
+
+    def __len__(self):
+        return len(self.frequencies)
+
+    def __repr__(self):
+        return "perilin.Modes(%d modes, %.6g to %.6g Hz, %d shapes)" % (len(self), self.frequencies[0], self.frequencies[-1], len(self.shapes))
 
 
 class Problem:
@@ -115,10 +155,14 @@ class Problem:
             self._tmp = None
 
     def close(self):
-        """Frees the problem (collective); the object is unusable after it."""
+        """Frees the problem (collective); the object is unusable after it. Also frees the petsc4py
+        objects on the problem's communicator that Python dropped without destroy(): petsc4py 3.18
+        keeps a dropped parallel object (one on a communicator, as K, f, M are) in PETSc's garbage
+        until a collective PETSc.garbage_cleanup(), which this calls (docs/python.md, "Memory")."""
         if self._handle is not None:
             _perilin.destroy(self._handle)
             self._handle = None
+            PETSc.garbage_cleanup(self.comm)
         self._remove_tmp()
 
     def __enter__(self):
@@ -192,7 +236,23 @@ class Problem:
             u = np.frombuffer(ub, dtype=np.float64).reshape(-1, dofs).copy()
             u = self._gather(u)
         summary = json.loads(_perilin.summary(self._handle))
-        return Result(self._gather(x), u, components, summary)
+        name, text = _perilin.table(self._handle)
+        table = _table(text) if text else None
+        return Result(self._gather(x), u, components, summary, steps=table if name == "steps.csv" else None, history=table if name == "history.csv" else None)
+
+    def modes(self):
+        """The modes of a modal scene (runs the analysis first if solve() has not): a Modes with
+        the frequencies in Hz, each pair's residual, and the shapes as numpy arrays in Result.u's
+        order. perilin.Error for another analysis."""
+        dim, dofs, components, n, rstart, nowned, _ = _perilin.layout(self._handle)
+        _perilin.modes(self._handle, nowned * dofs)  # raises for another analysis, before a run
+        self.solve()
+        got = _perilin.modes(self._handle, nowned * dofs)
+        f = np.array([m[0] for m in got])
+        res = np.array([m[1] for m in got])
+        shapes = [self._gather(np.frombuffer(m[3], dtype=np.float64).reshape(-1, dofs).copy()) for m in got if m[3] is not None]
+        shapes = np.array(shapes) if shapes else np.zeros((0, n, dofs))
+        return Modes(f, res, tuple(m[2] for m in got), shapes, components)
 
     def write(self, directory):
         """The usual output set (summary.json, scene.yaml, particles.vtu, the analysis' files) in
@@ -209,9 +269,25 @@ class Problem:
         """A new petsc4py Vec with the scene's loads f (load factor 1), in K's layout."""
         return _perilin.loads(self._handle)
 
-    def mass(self):
-        """A new petsc4py Vec with the lumped mass per DOF (the diagonal of M), in K's layout."""
-        return _perilin.mass(self._handle)
+    def mass(self, as_matrix=False):
+        """A new petsc4py Vec with the lumped mass per DOF (the diagonal of M), in K's layout; with
+        as_matrix=True, M itself as a new diagonal petsc4py Mat (AIJ, one entry a row) in that
+        layout, for SLEPc's K x = lambda M x."""
+        m = _perilin.mass(self._handle)
+        if not as_matrix:
+            return m
+        M = PETSc.Mat().createAIJ((m.getSizes(), m.getSizes()), nnz=(1, 0), comm=m.getComm())
+        M.setDiagonal(m)
+        M.assemble()
+        m.destroy()
+        return M
+
+    def operator(self):
+        """The body's K as a new petsc4py shell Mat applied bond by bond (perilin's matrix-free
+        operator, no matrix stored), in stiffness()'s layout and before the conditions: mult
+        equals stiffness() times x to round-off. perilin.Error for models whose bonds it cannot
+        apply (family models such as lps's, 3D shear bonds)."""
+        return _perilin.operator(self._handle)
 
     def constraints(self):
         """The prescribed DOFs (rows of K, sorted) and their values, as numpy arrays on every rank."""

@@ -1470,19 +1470,14 @@ static PetscErrorCode Run_Dynamic(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* history.csv: one row per step. Rank 0 writes (temporary name, then rename). */
-static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
+/* history.csv's text: the header, then one row per recorded step. Returns nonzero when a write
+ * failed. */
+static int HistoryRows(PeriAnalysis an, FILE *fp)
 {
   Dynamic       *d   = DYN(an);
   const PetscInt dim = an->sys->disc.particles.dim;
-  char           path[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
-  FILE          *fp;
   int            bad = 0;
 
-  PetscFunctionBeginUser;
-  if (an->rank) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/history.csv", dir));
-  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "time,kinetic,strain,dissipated,work,balance,broken%s%s%s", d->pulse ? ",pulse_position" : "", an->sys->fields.nprobes ? ",probe_u" : "", d->fronts ? ",wave_front,damage_front" : "") < 0;
   for (PetscInt m = 0; m < d->nimpactors; m++)
     for (PetscInt c = 0; c < DYN_IMPACTOR_COLUMNS; c++)
@@ -1498,7 +1493,29 @@ static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
       if ((c - DYN_HISTORY_COLUMNS) % 3 < dim) bad |= fprintf(fp, ",%.17g", (double)r[c]) < 0;
     bad |= fprintf(fp, "\n") < 0;
   }
-  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  return bad;
+}
+
+/* history.csv: one row per step. Rank 0 writes (temporary name, then rename). */
+static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
+{
+  char  path[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
+  FILE *fp;
+
+  PetscFunctionBeginUser;
+  if (an->rank) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/history.csv", dir));
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, HistoryRows(an, fp)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* history.csv's text into fp for the embedding (rank 0; nothing before the run began). */
+static PetscErrorCode Table_Dynamic(PeriAnalysis an, FILE *fp)
+{
+  PetscFunctionBeginUser;
+  if (an->rank || !DYN(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(!HistoryRows(an, fp), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing the history's table failed");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1640,7 +1657,8 @@ const PeriAnalysisType PeriAnalysis_Dynamic = {
     .schema        = dyn_schema,
     .option_prefix = "",
     .files         = dyn_files,
+    .table         = "history.csv",
     .needs         = {.matrix_free = PETSC_TRUE, .static_solver = PETSC_TRUE, .matrix_copies = 1, .transient = PETSC_TRUE},
     .checkpoints   = PETSC_TRUE,
-    .ops           = {.setfromscene = SetFromScene_Dynamic, .setup = SetUp_Dynamic, .run = Run_Dynamic, .files = Files_Dynamic, .summary = Summary_Dynamic, .report = Report_Dynamic, .destroy = Destroy_Dynamic},
+    .ops           = {.setfromscene = SetFromScene_Dynamic, .setup = SetUp_Dynamic, .run = Run_Dynamic, .files = Files_Dynamic, .summary = Summary_Dynamic, .report = Report_Dynamic, .table = Table_Dynamic, .destroy = Destroy_Dynamic},
 };

@@ -1006,3 +1006,22 @@ const PeriAnalysisType PeriAnalysis_Modal = {
     .needs         = {.factor_fill = 0.45, .iterative_dofs = MODAL_LOBPCG_MIN_DOFS},
     .ops           = {.setfromscene = SetFromScene_Modal, .setup = SetUp_Modal, .run = PeriAnalysisRun_Modal, .fields = ModalAddFields, .files = ModalFiles, .summary = ModalSummary, .report = ModalReport, .solvers_from_options = SolversFromOptions_Modal, .destroy = ModalDestroy},
 };
+
+/*@C
+  PeriAnalysisGetModes - a modal analysis' modes after its run (none before): their number and
+  data (borrowed), and the shapes kept of the first nshapes (at most PERI_MAX_VTU_MODES; this rank's
+  owned DOFs of each one after the other, in K's layout, scaled to max |u| = 1; borrowed). An error
+  for another analysis. Not collective.
+@*/
+PetscErrorCode PeriAnalysisGetModes(PeriAnalysis an, PetscInt *n, const PeriMode **modes, PetscInt *nshapes, const PetscReal **shapes)
+{
+  const PeriModal *md = Modal(an);
+
+  PetscFunctionBeginUser;
+  PetscCheck(an->type == &PeriAnalysis_Modal, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "modes of a %s analysis: only analysis.type modal computes modes", an->type->name);
+  *n       = md ? md->nmodes : 0;
+  *modes   = md ? md->modes : NULL;
+  *nshapes = md ? md->nshapes : 0;
+  *shapes  = md ? md->shapes : NULL;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

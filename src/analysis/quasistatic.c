@@ -964,18 +964,11 @@ static int ReactionColumns(PeriAnalysis an, FILE *fp, PetscInt k)
   return bad;
 }
 
-/*@C
-  PeriWriteStepsCSV - one row per load step. Rank 0 writes (temporary name, then rename). Collective.
-@*/
-static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
+/* steps.csv's text: the header, then one row per load step. Returns nonzero when a write failed. */
+static int StepsRows(PeriAnalysis an, FILE *fp)
 {
-  char  tmp[PETSC_MAX_PATH_LEN];
-  FILE *fp;
-  int   bad = 0;
+  int bad = 0;
 
-  PetscFunctionBeginUser;
-  if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
   bad |= fprintf(fp, "step,load_factor,control_u,broken,broken_total,softened,equilibrium_iterations,ksp_iterations,seconds,attempts") < 0;
   bad |= ReactionColumns(an, fp, -1);
   bad |= fprintf(fp, "\n") < 0;
@@ -985,7 +978,30 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
     bad |= ReactionColumns(an, fp, k);
     bad |= fprintf(fp, "\n") < 0;
   }
-  PetscCall(PeriFileCloseCommit(fp, tmp, path, bad));
+  return bad;
+}
+
+/*@C
+  PeriWriteStepsCSV - one row per load step. Rank 0 writes (temporary name, then rename). Collective.
+@*/
+static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
+{
+  char  tmp[PETSC_MAX_PATH_LEN];
+  FILE *fp;
+
+  PetscFunctionBeginUser;
+  if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
+  PetscCall(PeriFileCloseCommit(fp, tmp, path, StepsRows(an, fp)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* steps.csv's text into fp for the embedding (rank 0; nothing before the loop began). */
+static PetscErrorCode QSTable(PeriAnalysis an, FILE *fp)
+{
+  PetscFunctionBeginUser;
+  if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(!StepsRows(an, fp), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing the steps' table failed");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1148,7 +1164,8 @@ const PeriAnalysisType PeriAnalysis_Quasistatic = {
     .schema        = qs_schema,
     .option_prefix = "",
     .files         = qs_files,
+    .table         = "steps.csv",
     .needs         = {.matrix_free = PETSC_TRUE, .static_solver = PETSC_TRUE, .matrix_copies = 1},
     .checkpoints   = PETSC_TRUE,
-    .ops           = {.setfromscene = SetFromScene_Quasistatic, .setup = SetUp_Quasistatic, .run = PeriAnalysisRun_Quasistatic, .files = QSFiles, .summary = QSSummary, .destroy = QSDestroy},
+    .ops           = {.setfromscene = SetFromScene_Quasistatic, .setup = SetUp_Quasistatic, .run = PeriAnalysisRun_Quasistatic, .files = QSFiles, .summary = QSSummary, .table = QSTable, .destroy = QSDestroy},
 };

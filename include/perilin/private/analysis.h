@@ -85,6 +85,7 @@ typedef struct {
   PetscErrorCode (*files)(PeriAnalysis, const char[]);                          /* its files in the output set (the directory) */
   PetscErrorCode (*summary)(PeriAnalysis, PeriJSON);                            /* its object in summary.json */
   PetscErrorCode (*report)(PeriAnalysis);                                       /* its result line on stdout; NULL: the strain energy */
+  PetscErrorCode (*table)(PeriAnalysis, FILE *);                                /* its rows (PeriAnalysisType.table) as CSV text, header first, on rank 0; for the embedding, which hands them to Python */
   PetscErrorCode (*solvers_from_options)(MPI_Comm, const char[], const char[]); /* fresh solvers of the kinds it used (ksp and pc types, "" for the default) set from the options, for the unused-option check; NULL: a static KSP */
   PetscErrorCode (*destroy)(PeriAnalysis);
 } PeriAnalysisOps;
@@ -95,6 +96,7 @@ typedef struct {
   const PeriSchema  *schema;        /* its analysis.* keys besides type, ended by {NULL}; NULL: none */
   const char        *option_prefix; /* of its linear solvers' options ("st_" for an eigensolver's), NULL: none */
   const char *const *files;         /* the names of its files in the output set, NULL-terminated ('#': digits), or NULL */
+  const char        *table;         /* the file of its one table of rows (steps.csv, history.csv) that ops.table writes, or NULL */
   PeriSystemNeeds    needs;         /* what it asks of the system: K's kind and memory */
   PetscBool          checkpoints;   /* it writes checkpoints at its equilibria and continues from one (-restart; src/analysis/checkpoint.c) */
   PeriAnalysisOps    ops;
@@ -135,6 +137,7 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis, PetscViewer *
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis, PetscViewer, PetscInt, size_t);
 PETSC_EXTERN PetscErrorCode PeriAnalysisAdoptSnapshots(PeriAnalysis, PetscInt *, PetscInt[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
+PETSC_EXTERN PetscErrorCode PeriAnalysisGetModes(PeriAnalysis, PetscInt *, const PeriMode **, PetscInt *, const PetscReal **);
 /* perilin's LOBPCG as a SLEPc eigensolver type (src/analysis/lobpcg.c) */
 #define PERI_EPSLOBPCG "perilin_lobpcg"
 PETSC_EXTERN PetscErrorCode PeriEPSRegisterLOBPCG(void);
