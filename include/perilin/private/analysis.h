@@ -129,10 +129,10 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisSetUp(PeriAnalysis, PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun(PeriAnalysis);
 PETSC_EXTERN PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointSetFromOptions(PeriAnalysis);
-PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointBegin(PeriAnalysis, PetscViewer *, char[], size_t);
-PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointEnd(PeriAnalysis, PetscViewer *, const char[]);
+PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointWrite(PeriAnalysis, PetscErrorCode (*)(PeriAnalysis, PetscViewer, void *), void *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis, PetscViewer *, char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis, PetscViewer, PetscInt, size_t);
+PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointFinite(PeriAnalysis, const PetscReal[], PetscInt, Vec, const char[]);
 PETSC_EXTERN PetscErrorCode PeriAnalysisAdoptSnapshots(PeriAnalysis, PetscInt *, PetscInt[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRegisterAll(void);
 /* perilin's LOBPCG as a SLEPc eigensolver type (src/analysis/lobpcg.c) */
