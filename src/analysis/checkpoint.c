@@ -7,11 +7,12 @@
  * DOFs); the analysis writes its own state after it, then the system's (PeriCheckpointView). */
 #include "perilin/private/analysis.h"
 
+#include <errno.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #define PERI_CHECKPOINT_MAGIC   0x50455249 /* "PERI" */
-#define PERI_CHECKPOINT_VERSION 3          /* 2: each step carries its attempts; 3: bond flags only with failure, dynamic runs */
+#define PERI_CHECKPOINT_VERSION 4          /* 2: each step carries its attempts; 3: bond flags only with failure, dynamic runs; 4: an end mark */
 #define PERI_CHECKPOINT_FILE    "checkpoint/state.bin"
 
 /* What ties a checkpoint to a run. */
@@ -73,48 +74,80 @@ PetscErrorCode PeriAnalysisCheckpointSetFromOptions(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriAnalysisCheckpointBegin - opens the temporary checkpoint file tmp in the output set and
-  writes its header; the analysis then writes its state into v, and PeriAnalysisCheckpointEnd
-  renames the file into place. Collective.
-@*/
-PetscErrorCode PeriAnalysisCheckpointBegin(PeriAnalysis an, PetscViewer *v, char tmp[], size_t len)
+/* The file's last bytes: a file without them was cut short (a write that did not finish, a full
+ * disk, a copy that stopped), which a reader would otherwise meet as "Read past end of file". */
+static const char peri_checkpoint_end[12] = "perilin end\n";
+
+/* Rank 0's checkpoint file tmp: the header, the analysis' part (body) and the end mark. */
+static PetscErrorCode WriteFile(PeriAnalysis an, const char tmp[], PetscErrorCode (*body)(PeriAnalysis, PetscViewer, void *), void *ctx, PetscViewer *v)
 {
-  const char *dir;
-  char        sub[PETSC_MAX_PATH_LEN + 16];
-  Header      h;
+  Header h;
 
   PetscFunctionBeginUser;
   PetscCall(HeaderOfRun(an, &h));
-  PetscCall(an->outputdir(an->snapshotctx, &dir));
-  PetscCall(PetscSNPrintf(sub, sizeof(sub), "%s/checkpoint", dir));
-  if (!an->rank) PetscCall(PeriOutputDirCreate(sub)); /* rank 0 alone writes the file */
-  PetscCall(PetscSNPrintf(tmp, len, "%s/%s.tmp", dir, PERI_CHECKPOINT_FILE));
   PetscCall(OpenViewer(an->comm, tmp, FILE_MODE_WRITE, v));
   PetscCall(PetscViewerBinaryWrite(*v, h.n, 6, PETSC_INT));
   PetscCall(PetscViewerBinaryWrite(*v, h.analysis, sizeof(h.analysis), PETSC_CHAR));
   PetscCall(PetscViewerBinaryWrite(*v, &h.fingerprint, 1, PETSC_INT64));
+  PetscCall(body(an, *v, ctx));
+  PetscCall(PetscViewerBinaryWrite(*v, peri_checkpoint_end, sizeof(peri_checkpoint_end), PETSC_CHAR));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriAnalysisCheckpointEnd - closes v and renames tmp (…/state.bin.tmp) to state.bin. Collective.
-@*/
-PetscErrorCode PeriAnalysisCheckpointEnd(PeriAnalysis an, PetscViewer *v, const char tmp[])
+/* A checkpoint that could not be written (rank 0 writes: a full disk, a quota, an I/O error): its
+ * temporary file removed, the previous checkpoint and the staging directory it lies in kept for
+ * -restart (a failed run's set is otherwise discarded), and the cause said. */
+static PetscErrorCode WriteFailed(const char dir[], const char tmp[], int err)
 {
-  char final[PETSC_MAX_PATH_LEN + 32];
+  char      prev[PETSC_MAX_PATH_LEN + 32];
+  PetscBool found;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscViewerDestroy(v));
-  PetscCall(PetscStrncpy(final, tmp, sizeof(final)));
-  final[strlen(final) - 4] = 0; /* less ".tmp" */
-  if (!an->rank) PetscCall(PeriFileCommit(tmp, final));
+  (void)remove(tmp);
+  PetscCall(PetscSNPrintf(prev, sizeof(prev), "%s/%s", dir, PERI_CHECKPOINT_FILE));
+  PetscCall(PetscTestFile(prev, 'r', &found));
+  if (found) PeriOutputSetKeep();
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write the checkpoint %s: %s%s: %s; free space (or give -peri_checkpoint_every 0 for no checkpoints)%s%s", tmp, err ? strerror(err) : "a write failed", err == ENOSPC || err == EDQUOT ? " (the disk or the quota is full)" : "", found ? "the previous checkpoint is kept whole" : "there was no previous checkpoint", found ? ", then continue the run with -restart " : " and run the scene again", found ? dir : "");
+}
+
+/*@C
+  PeriAnalysisCheckpointWrite - checkpoint/state.bin of the output set: the header, then what
+  body(an, v, ctx) writes into v (the analysis' state), then an end mark; written under a
+  temporary name and renamed into place, so that the file is always one whole state. A write that
+  fails keeps the previous checkpoint (and its staging directory) and stops the run, saying the
+  file and the cause. Collective.
+@*/
+PetscErrorCode PeriAnalysisCheckpointWrite(PeriAnalysis an, PetscErrorCode (*body)(PeriAnalysis, PetscViewer, void *), void *ctx)
+{
+  const char    *dir;
+  char           sub[PETSC_MAX_PATH_LEN + 32], tmp[PETSC_MAX_PATH_LEN + 32];
+  PetscViewer    v = NULL;
+  PetscErrorCode ierr, cerr;
+  int            err;
+
+  PetscFunctionBeginUser;
+  PetscCall(an->outputdir(an->snapshotctx, &dir));
+  PetscCall(PetscSNPrintf(sub, sizeof(sub), "%s/checkpoint", dir));
+  if (!an->rank) PetscCall(PeriOutputDirCreate(sub)); /* rank 0 alone writes the file */
+  PetscCall(PetscSNPrintf(tmp, sizeof(tmp), "%s/%s.tmp", dir, PERI_CHECKPOINT_FILE));
+  /* PETSc's own message ("Error writing to file total size 6 err -1") names neither the file nor
+     the cause: its errors are taken here and said by WriteFailed */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  errno = 0;
+  ierr  = WriteFile(an, tmp, body, ctx, &v);
+  err   = errno;
+  cerr  = PetscViewerDestroy(&v); /* closes the file: a last failure may show here */
+  if (!ierr && cerr) ierr = cerr, err = errno;
+  PetscCall(PetscPopErrorHandler());
+  if (ierr) PetscCall(WriteFailed(dir, tmp, err));
+  PetscCall(PetscSNPrintf(sub, sizeof(sub), "%s/%s", dir, PERI_CHECKPOINT_FILE));
+  if (!an->rank) PetscCall(PeriFileCommit(tmp, sub));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The header of the checkpoint open in v, checked against this run's: the same analysis, ranks,
  * particles, bonds and scene, each refused with what to do. */
-static PetscErrorCode CheckHeader(PeriAnalysis an, PetscViewer v, const char file[], const Header *run)
+static PetscErrorCode CheckHeader(PeriAnalysis an, PetscViewer v, const char file[], const Header *run, PetscBool ends)
 {
   Header h;
 
@@ -122,6 +155,7 @@ static PetscErrorCode CheckHeader(PeriAnalysis an, PetscViewer v, const char fil
   PetscCall(PetscViewerBinaryRead(v, h.n, 6, NULL, PETSC_INT));
   PetscCheck(h.n[0] == PERI_CHECKPOINT_MAGIC, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is no perilin checkpoint", file);
   PetscCheck(h.n[1] == PERI_CHECKPOINT_VERSION, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s has format %" PetscInt_FMT ", this perilin reads %d: run the scene from the start", file, h.n[1], PERI_CHECKPOINT_VERSION);
+  PetscCheck(ends, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is cut short (truncated: it lacks the end of a whole checkpoint, as when its copy or its write stopped): restart from a whole checkpoint, or run the scene from the start", file);
   PetscCall(PetscViewerBinaryRead(v, h.analysis, sizeof(h.analysis), NULL, PETSC_CHAR));
   PetscCall(PetscViewerBinaryRead(v, &h.fingerprint, 1, NULL, PETSC_INT64));
   h.analysis[sizeof(h.analysis) - 1] = 0;
@@ -133,6 +167,30 @@ static PetscErrorCode CheckHeader(PeriAnalysis an, PetscViewer v, const char fil
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The size of the checkpoint file and whether it ends with the end mark, as rank 0 (which reads it)
+ * sees them. Collective. */
+static PetscErrorCode FileEnds(PeriAnalysis an, const char file[], PetscInt64 *size, PetscBool *ends)
+{
+  PetscInt64 r[2] = {0, 0}; /* size, ends */
+
+  PetscFunctionBeginUser;
+  if (!an->rank) {
+    FILE *fp = fopen(file, "rb");
+    char  tail[sizeof(peri_checkpoint_end)];
+    long  n;
+
+    if (fp && !fseek(fp, 0, SEEK_END) && (n = ftell(fp)) >= 0) {
+      r[0] = n;
+      r[1] = n >= (long)sizeof(tail) && !fseek(fp, -(long)sizeof(tail), SEEK_END) && fread(tail, 1, sizeof(tail), fp) == sizeof(tail) && !memcmp(tail, peri_checkpoint_end, sizeof(tail));
+    }
+    if (fp) (void)fclose(fp);
+  }
+  PetscCallMPI(MPI_Bcast(r, 2, MPIU_INT64, 0, an->comm));
+  *size = r[0];
+  *ends = r[1] ? PETSC_TRUE : PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriAnalysisRestartBegin - opens -restart's checkpoint (its path in file) and checks its header
   against this run: the same analysis, ranks, particles, bonds and scene, each refused with what to
@@ -141,15 +199,19 @@ static PetscErrorCode CheckHeader(PeriAnalysis an, PetscViewer v, const char fil
 PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis an, PetscViewer *v, char file[], size_t len)
 {
   Header         run;
+  PetscInt64     size;
+  PetscBool      ends;
   PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(HeaderOfRun(an, &run));
   PetscCall(PetscSNPrintf(file, len, "%s/%s", an->restart, PERI_CHECKPOINT_FILE));
+  PetscCall(FileEnds(an, file, &size, &ends));
+  PetscCheck(size >= (PetscInt64)(6 * sizeof(PetscInt) + sizeof(run.analysis) + sizeof(PetscInt64)), an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is cut short (truncated: %" PetscInt64_FMT " bytes, less than a checkpoint's header): restart from a whole checkpoint, or run the scene from the start", file, size);
   PetscCall(OpenViewer(an->comm, file, FILE_MODE_READ, v));
   /* a refused header closes the file: the caller has no viewer to destroy (found by
      tests/fuzz/fuzz_checkpoint.c) */
-  ierr = CheckHeader(an, *v, file, &run);
+  ierr = CheckHeader(an, *v, file, &run, ends);
   if (ierr) PetscCall(PetscViewerDestroy(v));
   PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -173,6 +235,25 @@ PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis an, PetscViewer v, PetscI
   if (!bad && fd >= 0 && !fstat(fd, &st) && (at = lseek(fd, 0, SEEK_CUR)) >= 0) bad = (double)n * (double)each > (double)(st.st_size - at);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, an->comm));
   PetscCheck(!bad, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: it counts %" PetscInt_FMT " items where the rest of the file holds fewer: restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, n);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriAnalysisCheckpointFinite - refuses the n reals x (or, with x NULL, the vector u) read from the
+  checkpoint when one is not finite: a NaN there would otherwise come out later as a solver's
+  failure (a singular operator) or in the results. what names them. Collective.
+@*/
+PetscErrorCode PeriAnalysisCheckpointFinite(PeriAnalysis an, const PetscReal x[], PetscInt n, Vec u, const char what[])
+{
+  PetscReal sum = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < n; k++) sum += PetscAbsReal(x[k]) * 0; /* 0 * inf and 0 * NaN are NaN */
+  if (u)
+    PetscCall(VecNorm(u, NORM_INFINITY, &sum)); /* collective: every rank gets the same */
+  else
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPIU_REAL, MPIU_SUM, an->comm));
+  PetscCheck(!PetscIsInfOrNanReal(sum), an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: its %s are not finite (NaN or inf): restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, what);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

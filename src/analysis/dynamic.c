@@ -964,6 +964,7 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *t, 
   } else {
     PetscCall(PetscViewerBinaryRead(v, n, 8, NULL, PETSC_INT));
     PetscCall(PetscViewerBinaryRead(v, r, 10, NULL, PETSC_REAL));
+    PetscCall(PeriAnalysisCheckpointFinite(an, r, 10, NULL, "time, energies and time step"));
     PetscCall(CheckState(an, v, n, r));
     d->nsteps = n[0], d->broken = n[1], d->nhist = d->cap = n[2], d->nsnap = n[3], d->next_frame = n[7];
     *t = r[0], d->kinetic = r[1], d->strain = r[2], d->dissipated = r[3], d->work = r[4], d->E0 = r[5], d->scale = r[6], d->error = r[7], d->drift = r[8];
@@ -983,6 +984,10 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *t, 
     PetscCall(PetscViewerBinaryRead(v, d->hist, DYN_ROW(d) * d->nhist, NULL, PETSC_REAL));
     PetscCall(PetscViewerBinaryRead(v, d->snap_time, d->nsnap, NULL, PETSC_REAL));
     PetscCall(PetscViewerBinaryRead(v, d->snap_idx, d->nsnap, NULL, PETSC_INT));
+    PetscCall(PeriAnalysisCheckpointFinite(an, d->term_prev, d->nterms, NULL, "loads' amplitudes"));
+    PetscCall(PeriAnalysisCheckpointFinite(an, imp, 10 * d->nimpactors, NULL, "impactors' positions, velocities and forces"));
+    PetscCall(PeriAnalysisCheckpointFinite(an, d->hist, DYN_ROW(d) * d->nhist, NULL, "history.csv rows"));
+    PetscCall(PeriAnalysisCheckpointFinite(an, d->snap_time, d->nsnap, NULL, "snapshot times"));
   }
   for (PetscInt k = 0; !write && k < PetscMin(d->nimpactors, 4); k++) {
     PetscCall(PetscArraycpy(C->impactors[k].x, &imp[10 * k], 3));
@@ -993,21 +998,33 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *t, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* What a checkpoint holds of the state (q, p) after the step to t. */
+typedef struct {
+  Vec       q, p;
+  PetscReal t;
+} CheckpointState;
+
+static PetscErrorCode CheckpointBody(PeriAnalysis an, PetscViewer v, void *ctx)
+{
+  CheckpointState *c   = (CheckpointState *)ctx;
+  PeriSystem       sys = an->sys;
+  PeriCheckpoint   eq  = {c->q, sys->disc.bonds.live, sys->disc.bonds.intact, sys->fields.solve};
+
+  PetscFunctionBeginUser;
+  PetscCall(StateBinary(an, v, &c->t, PETSC_TRUE));
+  PetscCall(PeriCheckpointView(sys, &eq, v));
+  PetscCall(VecView(c->p, v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* checkpoint/state.bin of the state (q, p) after the step to t: the run's state, the bonds and u,
  * then the velocities (src/analysis/checkpoint.c). Collective. */
 static PetscErrorCode WriteCheckpoint(PeriAnalysis an, Vec q, Vec p, PetscReal t)
 {
-  PeriSystem     sys = an->sys;
-  PeriCheckpoint eq  = {q, sys->disc.bonds.live, sys->disc.bonds.intact, sys->fields.solve};
-  PetscViewer    v;
-  char           tmp[PETSC_MAX_PATH_LEN + 32];
+  CheckpointState c = {q, p, t};
 
   PetscFunctionBeginUser;
-  PetscCall(PeriAnalysisCheckpointBegin(an, &v, tmp, sizeof(tmp)));
-  PetscCall(StateBinary(an, v, &t, PETSC_TRUE));
-  PetscCall(PeriCheckpointView(sys, &eq, v));
-  PetscCall(VecView(p, v));
-  PetscCall(PeriAnalysisCheckpointEnd(an, &v, tmp));
+  PetscCall(PeriAnalysisCheckpointWrite(an, CheckpointBody, &c));
   DYN(an)->checkpoints++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -1033,6 +1050,7 @@ static PetscErrorCode Restart(PeriAnalysis an, Vec U, Vec V)
   ierr = StateBinary(an, v, &t, PETSC_FALSE);
   if (!ierr) ierr = PeriCheckpointLoad(an->sys, &eq, v, file);
   if (!ierr) ierr = VecLoad(d->implicit ? V : p, v);
+  if (!ierr) ierr = PeriAnalysisCheckpointFinite(an, NULL, 0, d->implicit ? V : p, "velocities");
   PetscCall(PetscViewerDestroy(&v)); /* a refused checkpoint too */
   if (!ierr) ierr = VecCopy(eq.u, q);
   if (!ierr) ierr = VecCopy(eq.u, d->uprev);

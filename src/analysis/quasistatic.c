@@ -665,9 +665,27 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
     PetscCall(PetscViewerBinaryRead(v, si, q->nsteps * PERI_STEP_INTS, NULL, PETSC_INT));
     PetscCall(PetscViewerBinaryRead(v, q->reactions, q->nsteps * w, NULL, PETSC_REAL));
     PetscCall(PetscViewerBinaryRead(v, data->snaps, data->nsnaps, NULL, PETSC_INT));
+    PetscCall(PeriAnalysisCheckpointFinite(an, sr, q->nsteps * PERI_STEP_REALS, NULL, "steps' load factors, displacements and times"));
+    PetscCall(PeriAnalysisCheckpointFinite(an, q->reactions, q->nsteps * w, NULL, "steps' reactions"));
   }
   for (PetscInt k = 0; !write && k < q->nsteps; k++) StepUnpack(&sr[k * PERI_STEP_REALS], &si[k * PERI_STEP_INTS], &q->steps[k]);
   PetscCall(PetscFree2(sr, si));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What a checkpoint holds of the equilibrium eq from which the loop goes on at lambda with dl. */
+typedef struct {
+  const PeriCheckpoint *eq;
+  PetscReal             lambda, dl;
+} CheckpointState;
+
+static PetscErrorCode CheckpointBody(PeriAnalysis an, PetscViewer v, void *ctx)
+{
+  CheckpointState *c = (CheckpointState *)ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(StateBinary(an, v, &c->lambda, &c->dl, PETSC_TRUE));
+  PetscCall(PeriCheckpointView(an->sys, c->eq, v));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -676,17 +694,13 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
 static PetscErrorCode WriteCheckpoint(PeriAnalysis an, const PeriCheckpoint *eq, PetscReal lambda, PetscReal dl)
 {
   PeriQuasistatic *q = QS(an);
-  PetscViewer      v;
-  char             tmp[PETSC_MAX_PATH_LEN + 32];
+  CheckpointState  c = {eq, lambda, dl};
   PetscLogDouble   t0, t1;
 
   PetscFunctionBeginUser;
   if (!an->checkpoint_every || q->nsteps % an->checkpoint_every) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscTime(&t0));
-  PetscCall(PeriAnalysisCheckpointBegin(an, &v, tmp, sizeof(tmp)));
-  PetscCall(StateBinary(an, v, &lambda, &dl, PETSC_TRUE));
-  PetscCall(PeriCheckpointView(an->sys, eq, v));
-  PetscCall(PeriAnalysisCheckpointEnd(an, &v, tmp));
+  PetscCall(PeriAnalysisCheckpointWrite(an, CheckpointBody, &c));
   PetscCall(PetscTime(&t1));
   q->checkpoints++;
   q->checkpoint_s += t1 - t0;

@@ -332,6 +332,16 @@ void PeriOutputSetDiscard(void)
   peri_staging[0] = 0;
 }
 
+/*@C
+  PeriOutputSetKeep - a failed run's staging directory is kept by PeriOutputSetDiscard: it holds
+  the last checkpoint of a run whose next one could not be written (a full disk), which -restart
+  continues. Not collective: rank 0 discards.
+@*/
+void PeriOutputSetKeep(void)
+{
+  peri_staging[0] = 0;
+}
+
 /* dst as a hard link to src (the same file system: no copy), else a copy. Not collective. */
 static PetscErrorCode LinkOrCopy(const char src[], const char dst[])
 {
