@@ -113,6 +113,16 @@ def bars(exe, scenes, tmp, mpirun):
         run(exe, scene, os.path.join(tmp, "bars2"), mpirun)
         ql, qr = (momentum(os.path.join(tmp, "bars2"), 1, w)[0] for w in (left, right))
         check(abs(ql - pl) < 1e-10 and abs(qr - pr) < 1e-10, "bars on 2 ranks: %.12g, %.12g; 1 rank %.12g, %.12g" % (ql, qr, pl, pr))
+        # to t = 300 the bars move 2.6 apart, beyond the ghosts of the bonds' reach alone (a rank
+        # would miss pairs: refused, naming contact.ghosts) but within the default contact.ghosts
+        # (a horizon more): the same numbers as on one rank
+        long = ("-analysis_t_end", "300")
+        run(exe, scene, os.path.join(tmp, "bars300"), (), *long)
+        run(exe, scene, os.path.join(tmp, "bars300_2"), mpirun, *long)
+        a, b = (momentum(os.path.join(tmp, d), 1, right)[0] for d in ("bars300", "bars300_2"))
+        check(abs(a - b) < 1e-10, "bars to t = 300 on 2 ranks (default contact.ghosts): the right bar's momentum %.12g, 1 rank %.12g" % (b, a))
+        r = subprocess.run(list(mpirun) + [exe, scene, "-output_dir", os.path.join(tmp, "bars300_g0"), "-quiet", "-contact_ghosts", "0", *long], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        check(r.returncode != 0 and "contact.ghosts" in r.stdout and not os.path.exists(os.path.join(tmp, "bars300_g0")), "bars to t = 300 on 2 ranks with contact.ghosts 0: refused (%s)" % ([l for l in r.stdout.splitlines() if "perilin: error" in l] or ["no message"])[0][:200])
 
 
 def pulled_one(exe, scene, out, what, drift, args=()):

@@ -32,7 +32,8 @@ PetscErrorCode PeriDiscSetLocalView(MPI_Comm comm, PeriDisc *disc, PeriParticles
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PeriHaloCreate(comm, owned, radius, &disc->halo));
-  disc->particles = *owned;
+  disc->ghost_radius = radius;
+  disc->particles    = *owned;
   PetscCall(PetscMemzero(owned, sizeof(*owned)));
   PetscCall(PeriMeshGroupsRestrict(&disc->particles));
   disc->N      = disc->halo.N;

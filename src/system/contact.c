@@ -10,6 +10,7 @@ static const PeriKey contact_keys[] = {
     {"radius", PERI_KEY_REAL, "1.35 x the mean spacing", "(0, inf)", "[length]", NULL, "r_c: pairs closer than min(0.9 |X_j - X_i|, r_c) repel (LAMMPS's pair peri)"},
     {"stiffness", PERI_KEY_REAL, "15 c (c = 18K/(pi delta^4) in 3D, 9E/(pi t delta^3) in 2D)", "(0, inf)", "[stress/length^4]", NULL, "k: the force k V_i V_j (d - r)/delta of a pair at distance r < d"},
     {"skin", PERI_KEY_REAL, "0.3 x the mean spacing", "(0, inf)", "[length]", NULL, "the candidate list holds pairs within r_c + skin, rebuilt when a particle has moved more than skin/2"},
+    {"ghosts", PERI_KEY_REAL, "the horizon", "[0, inf)", "[length]", NULL, "several ranks: each rank also holds the other ranks' particles this much beyond the bonds' reach, so that it sees every pair while no two particles have moved relative to each other by more than the horizon plus this, less r_c and the skin (the run stops past it)"},
     {NULL},
 };
 /* impactors.<k>: read by src/system/impactors.c */
@@ -52,8 +53,27 @@ static PetscErrorCode ReadContact(PeriSystem sys, PeriNode node)
   PetscCall(PeriSceneGetReal(s, node, "radius", PETSC_FALSE, &C->radius, NULL));
   PetscCall(PeriSceneGetReal(s, node, "skin", PETSC_FALSE, &C->skin, NULL));
   PetscCall(PeriSceneGetReal(s, node, "stiffness", PETSC_FALSE, &C->k, &given));
-  C->reach = sys->disc.delta - C->radius - C->skin;
+  C->reach = sys->disc.ghost_radius - C->radius - C->skin;
   PeriInputCheck(C->radius < sys->disc.delta, s, node, "radius", "%g reaches beyond the horizon %g: contact acts closer than the bonds reach", (double)C->radius, (double)sys->disc.delta);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriContactGhostMargin - how much farther than the bonds' search radius the ghosts reach: on
+  several ranks with contact on, contact.ghosts (default the horizon), else 0. Read before the
+  local view is built (the rest of contact after it, PeriContactSetUp). Not collective.
+@*/
+PetscErrorCode PeriContactGhostMargin(PeriSystem sys, PetscReal *margin)
+{
+  PeriNode node;
+
+  PetscFunctionBeginUser;
+  *margin = 0;
+  PetscCall(PeriSceneGetNode(sys->scene->root, "contact", &node));
+  if (sys->size == 1 || !node || node->kind != PERI_NODE_MAP || !(sys->stiffness.needs.transient || sys->stiffness.needs.dry_run)) PetscFunctionReturn(PETSC_SUCCESS);
+  *margin = sys->disc.delta;
+  PetscCall(PeriSceneGetReal(sys->scene, node, "ghosts", PETSC_FALSE, margin, NULL));
+  sys->contact.ghost_margin = *margin;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -408,7 +428,7 @@ PetscErrorCode PeriContactCheckReach(PeriSystem sys, Vec u)
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPIU_REAL, MPI_MAX, sys->comm));
   for (PetscInt d = 0; d < sys->disc.particles.dim; d++) spread += hi[d] + lo[d] > 0 ? PetscSqr(hi[d] + lo[d]) : 0;
   spread = PetscSqrtReal(spread);
-  PetscCheck(spread <= sys->contact.reach, sys->comm, PETSC_ERR_SUP, "%s: contact on %d ranks: two particles have moved %g relative to each other, farther than the %g (the horizon less the contact radius) within which each rank sees every pair it owns: run on one rank, or with a larger horizon", sys->scene->file, sys->size, (double)spread, (double)sys->contact.reach);
+  PetscCheck(spread <= sys->contact.reach, sys->comm, PETSC_ERR_SUP, "%s: contact on %d ranks: two particles have moved %g relative to each other, farther than the %g (the ghosts' reach less the contact radius and skin) within which each rank sees every pair it owns: give a larger contact.ghosts (now %g; above %g for this step, more for the rest of the run), or run on one rank", sys->scene->file, sys->size, (double)spread, (double)sys->contact.reach, (double)sys->contact.ghost_margin, (double)(sys->contact.ghost_margin + spread - sys->contact.reach));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -411,7 +411,7 @@ static PetscErrorCode SetLocalView(PeriSystem sys)
 {
   PeriParticles owned;
   PetscMPIInt  *target;
-  PetscReal     hmax = 0;
+  PetscReal     hmax = 0, margin;
 
   PetscFunctionBeginUser;
   PetscCall(PeriPartitionBlocks(sys->comm, &sys->disc.particles, sys->disc.delta, &target));
@@ -423,7 +423,8 @@ static PetscErrorCode SetLocalView(PeriSystem sys)
   for (PetscInt k = 0; k < owned.n; k++) hmax = PetscMax(hmax, owned.spacing[k]);
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &hmax, 1, MPIU_REAL, MPI_MAX, sys->comm));
   if (sys->disc.horizon_k) PetscCall(NeighborsHorizonBound(sys, &owned));
-  PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax)));
+  PetscCall(PeriContactGhostMargin(sys, &margin));
+  PetscCall(PeriDiscSetLocalView(sys->comm, &sys->disc, &owned, PeriSearchRadius(sys->disc.partial_volume, sys->disc.delta, hmax) + margin));
   if (sys->disc.horizon_m > 0) PetscCall(SetHorizons(sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

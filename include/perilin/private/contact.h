@@ -49,6 +49,7 @@ typedef struct {
   PetscReal     *ubuild;             /* the local translations at the last build (3 per particle) */
   PetscInt       builds;             /* candidate lists built */
   PetscReal      reach;              /* several ranks: the ghosts hold every pair while the spread of u stays below this */
+  PetscReal      ghost_margin;       /* several ranks: contact.ghosts, how much farther than the bonds the ghosts reach */
   PetscReal      t;                  /* the time of the next evaluation (the impactors' positions) */
   PetscBool      record;             /* the next evaluation is the step's force: keep the impactors' */
   PetscReal      fstep[12];          /* this rank's share of each impactor's force in the step */
@@ -64,6 +65,7 @@ PETSC_EXTERN PetscErrorCode   PeriContactSetUp(PeriSystem);
 PETSC_EXTERN PetscBool        PeriContactActive(PeriSystem);
 PETSC_EXTERN PetscErrorCode   PeriContactSetTime(PeriSystem, PetscReal, PetscBool);
 PETSC_EXTERN PetscErrorCode   PeriContactCheckReach(PeriSystem, Vec);
+PETSC_EXTERN PetscErrorCode   PeriContactGhostMargin(PeriSystem, PetscReal *);
 PETSC_EXTERN PetscErrorCode   PeriContactTally(PeriSystem);
 PETSC_EXTERN PetscErrorCode   PeriContactSummary(PeriSystem, PeriJSON);
 PETSC_EXTERN PetscErrorCode   PeriContactDestroy(PeriContact *);

@@ -164,13 +164,14 @@ PETSC_EXTERN const PeriSchema PeriParticlesSchema[], PeriRegionsSchema[];
  * local particle's global index). Every per-particle array is sized to the local view; the bonds'
  * rows are the owned particles and their j are local indices. */
 typedef struct {
-  PeriParticles         particles; /* the local view: owned, then ghosts */
-  PetscInt              N;         /* particles of the whole body */
-  PetscInt              nowned;    /* this rank's own particles */
-  PetscInt              rstart;    /* the global index of local particle 0 */
-  PetscMPIInt           size;      /* ranks */
-  PetscInt             *range;     /* size + 1: rank r owns global indices range[r]..range[r+1]-1 */
-  PeriHalo              halo;      /* the ghosts and the SF that refreshes them */
+  PeriParticles         particles;    /* the local view: owned, then ghosts */
+  PetscInt              N;            /* particles of the whole body */
+  PetscInt              nowned;       /* this rank's own particles */
+  PetscInt              rstart;       /* the global index of local particle 0 */
+  PetscMPIInt           size;         /* ranks */
+  PetscInt             *range;        /* size + 1: rank r owns global indices range[r]..range[r+1]-1 */
+  PeriHalo              halo;         /* the ghosts and the SF that refreshes them */
+  PetscReal             ghost_radius; /* the ghosts are the other ranks' particles within this of an owned one */
   PetscInt              nregions;
   PeriRegion           *regions;
   PetscReal             delta;       /* the horizon: the body's one, or the largest of horizon[] */
