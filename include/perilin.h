@@ -65,6 +65,10 @@ PETSC_EXTERN PetscErrorCode PeriProblemGetConstraints(PeriProblem, PetscInt *, c
 PETSC_EXTERN PetscErrorCode PeriProblemGetLayout(PeriProblem, PetscInt *, PetscInt *, const char *const **, PetscInt *, PetscInt *, PetscInt *, const PetscReal *[]);
 PETSC_EXTERN PetscErrorCode PeriProblemGetSummary(PeriProblem, char **);
 PETSC_EXTERN PetscErrorCode PeriProblemGetScene(PeriProblem, char **);
+/* q set up on p's particles and bonds where the changed keys leave them (set() without
+ * rebuilding, docs/python.md); *reused says whether it did; p is then to be destroyed. */
+PETSC_EXTERN PetscErrorCode PeriProblemSetUpFrom(PeriProblem, PeriProblem, PetscInt, const char *const[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PeriProblemGetBonds(PeriProblem, const void **, PetscInt *);
 /* The body's K as a MATSHELL applied bond by bond (the matrix-free operator, no conditions). */
 PETSC_EXTERN PetscErrorCode PeriProblemGetOperator(PeriProblem, Mat *);
 /* A modal run's modes: their count and the shapes kept, then mode k's frequency (Hz), relative

@@ -88,33 +88,54 @@ static PyObject *Version(PyObject *self, PyObject *args)
   return Py_BuildValue("(sss)", perilin, petsc, slepc);
 }
 
-static PetscErrorCode CreateProblem(MPI_Comm comm, const char file[], PetscInt n, const char *const keys[], const char *const values[], PeriProblem *p)
+/* A new problem; with old, set up on old's particles and bonds where the changed keys allow it
+ * (*reused). */
+static PetscErrorCode CreateProblem(MPI_Comm comm, const char file[], PetscInt n, const char *const keys[], const char *const values[], PeriProblem old, PetscInt nchanged, const char *const changed[], PeriProblem *p, PetscBool *reused)
 {
   PetscFunctionBeginUser;
+  *reused = PETSC_FALSE;
   PetscCall(PeriProblemCreate(comm, p));
   PetscCall(PeriProblemLoadOverrides(*p, file, n, keys, values));
-  PetscCall(PeriProblemSetUp(*p));
+  if (old)
+    PetscCall(PeriProblemSetUpFrom(*p, old, nchanged, changed, reused));
+  else
+    PetscCall(PeriProblemSetUp(*p));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* create(file, keys, values, comm): a problem set up from the scene file with the overrides
- * keys[k] = values[k] (strings), on comm (a petsc4py Comm, or None: PETSC_COMM_WORLD). */
+/* A Python list of str as a NULL-ended C array (borrowed strings; free the array); NULL on error. */
+static const char **Strings(PyObject *list)
+{
+  Py_ssize_t   n = PyList_Size(list);
+  const char **a = (const char **)calloc((size_t)n + 1, sizeof(*a));
+
+  if (!a) return (const char **)PyErr_NoMemory();
+  for (Py_ssize_t i = 0; i < n; i++)
+    if (!(a[i] = PyUnicode_AsUTF8(PyList_GetItem(list, i)))) {
+      free(a);
+      return NULL;
+    }
+  return a;
+}
+
+/* create(file, keys, values, comm[, old, changed]): a problem set up from the scene file with the
+ * overrides keys[k] = values[k] (strings), on comm (a petsc4py Comm, or None: PETSC_COMM_WORLD);
+ * with old (a problem of the same file) and the keys changed from its overrides, set up on old's
+ * particles and bonds where they allow it. Returns (problem, reused). */
 static PyObject *Create(PyObject *self, PyObject *args)
 {
   const char    *file;
-  PyObject      *keys, *values, *comm_obj, *ok;
+  PyObject      *keys, *values, *comm_obj, *ok, *old_obj = Py_None, *changed = NULL, *cap;
   MPI_Comm       comm = PETSC_COMM_WORLD;
-  Py_ssize_t     n;
-  const char   **k = NULL, **v = NULL;
-  PeriProblem    p = NULL;
+  const char   **k = NULL, **v = NULL, **c = NULL;
+  PeriProblem    p = NULL, old = NULL;
+  PetscBool      reused = PETSC_FALSE;
   Handle        *h;
-  PyObject      *cap;
   PetscErrorCode ierr;
 
   (void)self;
-  if (!PyArg_ParseTuple(args, "sO!O!O", &file, &PyList_Type, &keys, &PyList_Type, &values, &comm_obj)) return NULL;
-  n = PyList_Size(keys);
-  if (PyList_Size(values) != n) {
+  if (!PyArg_ParseTuple(args, "sO!O!O|OO!", &file, &PyList_Type, &keys, &PyList_Type, &values, &comm_obj, &old_obj, &PyList_Type, &changed)) return NULL;
+  if (PyList_Size(values) != PyList_Size(keys)) {
     PyErr_SetString(PyExc_ValueError, "keys and values differ in length");
     return NULL;
   }
@@ -122,28 +143,19 @@ static PyObject *Create(PyObject *self, PyObject *args)
     comm = PyPetscComm_Get(comm_obj);
     if (PyErr_Occurred()) return NULL;
   }
-  k = (const char **)calloc((size_t)n + 1, sizeof(*k));
-  v = (const char **)calloc((size_t)n + 1, sizeof(*v));
-  if (!k || !v) {
+  if (old_obj != Py_None && !(old = GetProblem(old_obj))) return NULL;
+  if (!(k = Strings(keys)) || !(v = Strings(values)) || (changed && !(c = Strings(changed)))) {
     free(k);
     free(v);
-    return PyErr_NoMemory();
-  }
-  for (Py_ssize_t i = 0; i < n; i++) {
-    k[i] = PyUnicode_AsUTF8(PyList_GetItem(keys, i));
-    v[i] = PyUnicode_AsUTF8(PyList_GetItem(values, i));
-    if (!k[i] || !v[i]) {
-      free(k);
-      free(v);
-      return NULL;
-    }
+    return NULL;
   }
   Begin();
   Py_BEGIN_ALLOW_THREADS;
-  ierr = CreateProblem(comm, file, (PetscInt)n, k, v, &p);
+  ierr = CreateProblem(comm, file, (PetscInt)PyList_Size(keys), k, v, old, changed ? (PetscInt)PyList_Size(changed) : 0, c, &p, &reused);
   Py_END_ALLOW_THREADS;
   free(k);
   free(v);
+  free(c);
   if (!(ok = End(ierr))) {
     DestroyQuietly(&p);
     return NULL;
@@ -157,8 +169,28 @@ static PyObject *Create(PyObject *self, PyObject *args)
   if (!(cap = PyCapsule_New(h, CAPSULE, CapsuleFree))) {
     DestroyQuietly(&h->p);
     free(h);
+    return NULL;
   }
-  return cap;
+  return Py_BuildValue("(NO)", cap, reused ? Py_True : Py_False);
+}
+
+/* bonds(problem): (address of this rank's bond storage, its bond count): the same address after a
+ * set() that kept the bonds. */
+static PyObject *Bonds(PyObject *self, PyObject *args)
+{
+  PyObject      *cap, *ok;
+  PeriProblem    p;
+  const void    *id = NULL;
+  PetscInt       n  = 0;
+  PetscErrorCode ierr;
+
+  (void)self;
+  if (!PyArg_ParseTuple(args, "O", &cap) || !(p = GetProblem(cap))) return NULL;
+  Begin();
+  ierr = PeriProblemGetBonds(p, &id, &n);
+  if (!(ok = End(ierr))) return NULL;
+  Py_DECREF(ok);
+  return Py_BuildValue("(KL)", (unsigned long long)(size_t)id, (long long)n);
 }
 
 static PyObject *Destroy(PyObject *self, PyObject *args)
@@ -457,7 +489,8 @@ static PyObject *Write(PyObject *self, PyObject *args)
 static PyMethodDef methods[] = {
     {"initialize", Initialize, METH_NOARGS, "perilin's registries in the PETSc session petsc4py and slepc4py started"},
     {"versions", Version, METH_NOARGS, "(perilin, PETSc, SLEPc) versions"},
-    {"create", Create, METH_VARARGS, "create(file, keys, values, comm): a problem set up from the scene"},
+    {"create", Create, METH_VARARGS, "create(file, keys, values, comm[, old, changed]): (a problem set up from the scene, whether it reused old's bonds)"},
+    {"bonds", Bonds, METH_VARARGS, "bonds(problem): (address of this rank's bond storage, bond count)"},
     {"destroy", Destroy, METH_VARARGS, "destroy(problem)"},
     {"run", Run, METH_VARARGS, "run(problem): the scene's analysis"},
     {"layout", Layout, METH_VARARGS, "layout(problem): (dim, dofs, components, N, rstart, nowned, x bytes)"},

@@ -402,3 +402,78 @@ PetscErrorCode PeriProblemGetTable(PeriProblem p, const char **name, char **text
   if (has) PetscCall(BcastText(p->comm, p->rank, text));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* Whether a changed key leaves the particles, regions and bonds as they are: the material (but its
+ * thickness, which sets the particles' volumes), the loads, the bc items, the analysis' keys (but
+ * its type, whose needs the set-up's memory estimate reads), the solver's and the output's keys.
+ * Every other key (grid, particles, horizon, corrections, regions, cracks, model, dim, ...) may
+ * change them. */
+static PetscBool KeepsBonds(const char key[])
+{
+  static const char *const keep[] = {"material.", "loads.", "bc.", "analysis.", "solver.", "output.", NULL};
+
+  if (!strcmp(key, "material.thickness") || !strcmp(key, "analysis.type")) return PETSC_FALSE;
+  if (!strcmp(key, "loads") || !strcmp(key, "bc")) return PETSC_TRUE;
+  for (PetscInt k = 0; keep[k]; k++)
+    if (!strncmp(key, keep[k], strlen(keep[k]))) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
+/* q's resolved scene starts as p's (the keys q's set-up does not read again: grid, horizon,
+ * regions, ...), without the changed keys' stale values. */
+static PetscErrorCode TakeResolved(PeriScene q, PeriScene p, PetscInt n, const char *const changed[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriNodeDestroy(&q->resolved));
+  PetscCall(PeriNodeDuplicate(p->resolved, &q->resolved));
+  for (PetscInt k = 0; k < n && q->resolved; k++) PetscCall(PeriNodeRemovePath(q->resolved, changed[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriProblemSetUpFrom - PeriProblemSetUp of q (loaded: p's scene file with the overrides, of which
+  the keys changed[] differ from p's) on p's particles, regions and bonds where the changed keys
+  leave them as they are (material but its thickness, loads, bc, analysis but its type, solver,
+  output) and p's system can lend them (PeriSystemCanReuse): then q takes them, and sets up again
+  only the model's constants and calibration, the conditions, the loads and the analysis; p keeps
+  its scene and analysis but has no particles left, and is to be destroyed. Otherwise a whole
+  PeriProblemSetUp. *reused says which. On an error p is as it was. Collective.
+@*/
+PetscErrorCode PeriProblemSetUpFrom(PeriProblem q, PeriProblem p, PetscInt n, const char *const changed[], PetscBool *reused)
+{
+  PetscBool      keep = (PetscBool)(p && p->sys);
+  const char    *why  = NULL;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < n; k++) keep = (PetscBool)(keep && KeepsBonds(changed[k]));
+  if (keep) PetscCall(PeriSystemCanReuse(p->sys, &keep, &why));
+  *reused = keep;
+  if (!keep) {
+    PetscCall(PeriProblemSetUp(q));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
+  PetscCall(TakeResolved(q->scene, p->scene, n, changed));
+  PetscCall(PeriProblemSetFromScene(q));
+  PetscCall(PeriSystemSetUpFrom(q->sys, p->sys));
+  ierr = PeriAnalysisSetUp(q->analysis, q->sys);
+  if (ierr) PetscCall(PeriSystemGiveBackDisc(q->sys, p->sys));
+  PetscCall(ierr);
+  q->sys->run.log.memory_phase_mb[0] = PeriPeakMemoryMB();
+  PetscCall(PetscLogStagePop());
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriProblemGetBonds - this rank's bond storage (its address, for identity only: a set-up that
+  reused another problem's bonds has the same) and its count. Not collective.
+@*/
+PetscErrorCode PeriProblemGetBonds(PeriProblem p, const void **id, PetscInt *nbonds)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(p->sys, PETSC_COMM_SELF, PETSC_ERR_ORDER, "the bonds of a problem before its set-up");
+  *id     = (const void *)p->sys->disc.bonds.offset;
+  *nbonds = p->sys->disc.bonds.nbonds;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

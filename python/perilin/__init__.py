@@ -136,15 +136,22 @@ class Problem:
         else:
             self.file = os.path.abspath(os.fspath(scene))
         self._overrides = dict(overrides or {})
+        self.rebuilt = True  # whether the last set-up built the particles and bonds (False: set() kept them)
+        self.setups = 1  # set-ups so far, and of them those that built the particles and bonds
+        self.builds = 1
         try:
-            self._handle = self._build(self._overrides)
+            self._handle, _ = self._build(self._overrides)
         except BaseException:
             self._remove_tmp()
             raise
 
-    def _build(self, overrides):
+    def _build(self, overrides, old=None, changed=()):
+        """A new problem's handle and whether it reused old's particles and bonds."""
         keys = list(overrides)
-        return _perilin.create(self.file, keys, [_text(overrides[k]) for k in keys], self.comm)
+        values = [_text(overrides[k]) for k in keys]
+        if old is None:
+            return _perilin.create(self.file, keys, values, self.comm)
+        return _perilin.create(self.file, keys, values, self.comm, old, list(changed))
 
     def _remove_tmp(self):
         if self._tmp:
@@ -202,14 +209,26 @@ class Problem:
         return node
 
     def set(self, key, value):
-        """Sets the dotted key to value. At present the problem is set up again from the scene with
-        every override (particles and bonds included; docs/python.md); on an error the problem
+        """Sets the dotted key to value and sets the problem up again with every override. Keys of
+        the material (but material.thickness), loads, bc, analysis (but analysis.type), solver and
+        output keep the particles and bonds: only the model's constants and calibration, the
+        conditions, the loads and the analysis are set up again (self.rebuilt is False after
+        it); every other key (grid, particles, horizon, corrections, regions, model, dim, ...)
+        builds them anew, as do scenes whose bonds a run may break (failure), with fictitious
+        layers or torsion, or with horizon.neighbors (docs/python.md). On an error the problem
         stays as it was."""
         overrides = dict(self._overrides)
         overrides[key] = value
-        handle = self._build(overrides)
+        handle, reused = self._build(overrides, self._handle, [key])
         _perilin.destroy(self._handle)
         self._handle, self._overrides, self._result = handle, overrides, None
+        self.rebuilt = not reused
+        self.setups += 1
+        self.builds += 0 if reused else 1
+
+    def _bonds(self):
+        """(address of this rank's bond storage, its bond count): for the tests."""
+        return _perilin.bonds(self._handle)
 
     # the run
     def solve(self):

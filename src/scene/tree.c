@@ -54,6 +54,58 @@ PetscErrorCode PeriNodeDestroy(PeriNode *node)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriNodeDuplicate - a deep copy of node (NULL for NULL): a problem set up again from its scene
+  with one key changed keeps the values the first set-up resolved (PeriProblemSetUpFrom). Not
+  collective.
+@*/
+PetscErrorCode PeriNodeDuplicate(PeriNode node, PeriNode *copy)
+{
+  PeriNode c;
+
+  PetscFunctionBeginUser;
+  *copy = NULL;
+  if (!node) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscNew(&c));
+  c->kind = node->kind;
+  c->line = node->line;
+  PetscCall(PetscStrallocpy(node->key, &c->key));
+  PetscCall(PetscStrallocpy(node->path, &c->path));
+  PetscCall(PetscStrallocpy(node->value, &c->value));
+  if (node->n) PetscCall(PetscCalloc1(node->n, &c->child));
+  for (PetscInt k = 0; k < node->n; k++) PetscCall(PeriNodeDuplicate(node->child[k], &c->child[k]));
+  c->n  = node->n;
+  *copy = c;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriNodeRemovePath - removes the node at the dotted path below root (and all below it), if there
+  is one: a changed key's resolved value is stale. Not collective.
+@*/
+PetscErrorCode PeriNodeRemovePath(PeriNode root, const char path[])
+{
+  char     buf[512], *tok, *next, *save;
+  PeriNode node = root;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(buf, path, sizeof(buf)));
+  for (tok = strtok_r(buf, ".", &save); tok && node; tok = next) {
+    PetscInt k = 0;
+    next       = strtok_r(NULL, ".", &save);
+    while (k < node->n && strcmp(node->child[k]->key, tok)) k++;
+    if (k == node->n) break;
+    if (next) {
+      node = node->child[k];
+      continue;
+    }
+    PetscCall(PeriNodeDestroy(&node->child[k]));
+    for (PetscInt m = k + 1; m < node->n; m++) node->child[m - 1] = node->child[m];
+    node->n--;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The option that sets a key: "-material_nu" for path "material.nu". */
 void PeriSceneOptionName(const char path[], char opt[], size_t len)
 {

@@ -507,21 +507,11 @@ static PetscErrorCode Calibrate(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriSystemSetUp - particles, partition, bonds, corrections, calibration, regions, probes and
-  boundary conditions, with every input check. After PeriSystemSetFromScene. Collective.
-@*/
-PetscErrorCode PeriSystemSetUp(PeriSystem sys)
+/* What stands on the particles and bonds: shear moduli, calibration, probes, failure, reference,
+ * conditions, layers, contact, loads and the checks that need them. */
+static PetscErrorCode SetUpOnBonds(PeriSystem sys)
 {
-  PeriScene s = sys->scene;
-
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
-  PetscCall(ReadHorizon(sys));
-  PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
-  PetscCall(ReadCorrections(sys));
-  PetscCall(SetUpBonds(sys));
-  PetscCall(PeriRegionsCreateFromScene(sys->comm, s, &sys->disc.particles, sys->disc.nowned, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
   PetscCall(PeriCheckBonded(sys)); /* the regions name where */
   PetscCall(ReadShearModuli(sys));
   PetscCall(Calibrate(sys));
@@ -539,6 +529,107 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(PetscLogEventBegin(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
   PetscCall(PeriCheckMechanisms(sys)); /* pieces of many particles, after the single ones */
   PetscCall(PetscLogEventEnd(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemSetUp - particles, partition, bonds, corrections, calibration, regions, probes and
+  boundary conditions, with every input check. After PeriSystemSetFromScene. Collective.
+@*/
+PetscErrorCode PeriSystemSetUp(PeriSystem sys)
+{
+  PeriScene s = sys->scene;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
+  PetscCall(ReadHorizon(sys));
+  PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
+  PetscCall(ReadCorrections(sys));
+  PetscCall(SetUpBonds(sys));
+  PetscCall(PeriRegionsCreateFromScene(sys->comm, s, &sys->disc.particles, sys->disc.nowned, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
+  PetscCall(SetUpOnBonds(sys));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemCanReuse - whether sys's particles, regions and bonds (its disc) can serve a system of
+  the same scene whose other keys (material, loads, bc, analysis, solver) changed
+  (PeriSystemSetUpFrom); why not (static text) otherwise: its bonds carry a run's state (a scene
+  with failure breaks and softens them), its particles' set-up read conditions (fictitious layers,
+  torsion), or its horizons came from a neighbour count. Collective.
+@*/
+PetscErrorCode PeriSystemCanReuse(PeriSystem sys, PetscBool *can, const char **why)
+{
+  const PeriDisc *d   = &sys->disc;
+  PetscInt        bad = 0;
+
+  PetscFunctionBeginUser;
+  *why = NULL;
+  if (d->bonds.cause || d->bonds.intact)
+    bad = 1;
+  else if (sys->conditions.layers.nfaces || sys->conditions.torsion.active)
+    bad = 2;
+  else if (d->horizon_k)
+    bad = 3;
+  else if (!d->particles.n)
+    bad = 4;
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, sys->comm));
+  *can = (PetscBool)!bad;
+  if (bad == 1) *why = "its bonds may break or soften (failure)";
+  if (bad == 2) *why = "its fictitious layers and torsion are read with the particles";
+  if (bad == 3) *why = "horizon.neighbors: each horizon is a search's result";
+  if (bad == 4) *why = "it has no particles";
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The disc goes from one system to another (a failed set-up gives it back). */
+static PetscErrorCode MoveDisc(PeriSystem to, PeriSystem from)
+{
+  PetscFunctionBeginUser;
+  to->disc                 = from->disc;
+  to->run.log.nbonds_total = from->run.log.nbonds_total;
+  to->run.log.edge_cut     = from->run.log.edge_cut;
+  PetscCall(PetscMemzero(&from->disc, sizeof(from->disc)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemSetUpFrom - PeriSystemSetUp on old's particles, regions and bonds, which sys takes
+  (PeriSystemCanReuse must have said yes; sys's scene differs from old's in keys the particles
+  and bonds do not read): the model's constants, calibration, conditions and loads are set up
+  again, no particle is created and no bond searched. On an error old gets its disc back, as it
+  was. After PeriSystemSetFromScene. Collective.
+@*/
+PetscErrorCode PeriSystemSetUpFrom(PeriSystem sys, PeriSystem old)
+{
+  PeriDisc      *d = &sys->disc;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(MoveDisc(sys, old));
+  /* a run may have released the bonds' geometry (PeriSystemReleaseBondGeometry) */
+  ierr                = d->bonds.xi || !d->bonds.nbonds ? PETSC_SUCCESS : PeriBondsRestoreGeometry(&d->particles, d->delta, d->horizon, d->partial_volume, &d->bonds);
+  sys->model->horizon = d->horizon;
+  /* delta as the first set-up gave it: without horizon.neighbors the local view keeps it */
+  if (!ierr) ierr = PeriModelSetFromScene(sys->model, sys->scene, d->delta);
+  if (!ierr) ierr = ReadCorrections(sys);
+  if (!ierr) ierr = SetUpOnBonds(sys);
+  if (ierr) PetscCall(PeriSystemGiveBackDisc(sys, old));
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemGiveBackDisc - after PeriSystemSetUpFrom(sys, old), old's disc goes back to old as it
+  was (the failure arrays sys's set-up added are freed: old had none). Not collective.
+@*/
+PetscErrorCode PeriSystemGiveBackDisc(PeriSystem sys, PeriSystem old)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(sys->disc.bonds.cause));
+  PetscCall(PetscFree(sys->disc.bonds.intact));
+  sys->model->horizon = NULL;
+  PetscCall(MoveDisc(old, sys));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

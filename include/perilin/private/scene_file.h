@@ -42,6 +42,8 @@ PETSC_EXTERN PetscErrorCode PeriNodeCreate(PeriNodeKind, const char[], const cha
 PETSC_EXTERN PetscErrorCode PeriNodeAppend(PeriNode, PeriNode);
 PETSC_EXTERN PetscErrorCode PeriNodeSetItems(PeriNode, const char[], const char[]);
 PETSC_EXTERN PetscErrorCode PeriNodeDestroy(PeriNode *);
+PETSC_EXTERN PetscErrorCode PeriNodeDuplicate(PeriNode, PeriNode *);
+PETSC_EXTERN PetscErrorCode PeriNodeRemovePath(PeriNode, const char[]);
 
 /* The resolved scene (docs/summary.md): the value the run used for map.key (a dotted key; list: a
  * flow list "[0, 0]" of numbers), a path made absolute (src/scene/tree.c), and the scene written
