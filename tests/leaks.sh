@@ -75,6 +75,10 @@ analysis: {type: dynamic, t_end: 0.002}
 output: {vtk: true, plots: false}
 EOF
 check dynamic 0 'explicit dynamics' "$tmp/pushed.yaml"
+# -restart from a damaged checkpoint (the dynamic run's own, cut short): refused after the run's set-up
+cp -r "$tmp/dynamic-out" "$tmp/cut"
+truncate -s -30 "$tmp/cut/checkpoint/state.bin"
+check refused_restart_cut 1 'state\.bin is cut short' "$tmp/pushed.yaml" -restart "$tmp/cut"
 sed "s|t_end: 0.002|t_end: 0.002, initial: {file: $tmp/dynamic-out/particles.vtu}|" "$tmp/pushed.yaml" > "$tmp/pushed_initial.yaml"
 check refused_initial_other_body 1 'holds 50 particles, the body 200: the file must come from the same body' "$tmp/pushed_initial.yaml" -grid_spacing 0.05
 

@@ -218,6 +218,30 @@ PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis an, PetscViewer *v, char fi
 }
 
 /*@C
+  PeriAnalysisRestartEnd - closes the checkpoint v the analysis has read, its reading run under
+  PetscReturnErrorHandler and ended with ierr. PETSc's own refusals of a damaged file ("Not a
+  vector next in file", "Vector in file different size (7) than input vector (320)", "Read past
+  end of file") name neither the file nor -restart: they are said as a damaged checkpoint. perilin's
+  own refusals, and errors that are not the file's (memory), go on as they were. Collective.
+@*/
+PetscErrorCode PeriAnalysisRestartEnd(PeriAnalysis an, PetscViewer *v, const char file[], PetscErrorCode ierr)
+{
+  char     *msg = NULL, copy[1024] = "";
+  PetscBool file_error;
+
+  PetscFunctionBeginUser;
+  if (ierr) {
+    PetscCall(PetscErrorMessage(ierr, NULL, &msg));
+    PetscCall(PetscStrncpy(copy, msg ? msg : "", sizeof(copy)));
+  }
+  PetscCall(PetscViewerDestroy(v));
+  if (!ierr) PetscFunctionReturn(PETSC_SUCCESS);
+  file_error = (PetscBool)(ierr == PETSC_ERR_FILE_READ || ierr == PETSC_ERR_FILE_UNEXPECTED || ierr == PETSC_ERR_FILE_OPEN || ierr == PETSC_ERR_ARG_SIZ || ierr == PETSC_ERR_ARG_WRONG || ierr == PETSC_ERR_ARG_OUTOFRANGE);
+  PetscCheck(!file_error, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is damaged (%s): restart from an undamaged checkpoint, or run the scene from the start", file, copy);
+  SETERRQ(an->comm, ierr, "%s", copy);
+}
+
+/*@C
   PeriAnalysisCheckpointFits - refuses a count read from the checkpoint open in v when n items of
   each bytes cannot be in what is left of the file (or n < 0): a damaged count would otherwise size
   an allocation. Collective.

@@ -643,7 +643,7 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
   } else {
     PetscCall(PetscViewerBinaryRead(v, r, 2, NULL, PETSC_REAL));
     PetscCall(PetscViewerBinaryRead(v, n, 5, NULL, PETSC_INT));
-    PetscCheck(n[4] == w && n[0] > 0, an->comm, PETSC_ERR_FILE_UNEXPECTED, "-restart: the checkpoint's steps do not fit this scene's reaction regions");
+    PetscCheck(n[4] == w && n[0] > 0, an->comm, PETSC_ERR_USER_INPUT, "-restart: the checkpoint's steps do not fit this scene's reaction regions: restart with the scene of the run that wrote it");
     /* counts and the load factor from the file, checked before they size anything (found by
        tests/fuzz/fuzz_checkpoint.c: a count of 2^62 steps) */
     PetscCall(PeriAnalysisCheckpointFits(an, v, n[0], (PERI_STEP_REALS + w) * sizeof(PetscReal) + PERI_STEP_INTS * sizeof(PetscInt)));
@@ -720,10 +720,12 @@ static PetscErrorCode Restart(PeriAnalysis an, Loop *L, PeriCheckpoint *eq, Pets
 
   PetscFunctionBeginUser;
   PetscCall(PeriAnalysisRestartBegin(an, &v, file, sizeof(file)));
+  /* PETSc's refusals of a damaged file are said by PeriAnalysisRestartEnd, naming the file */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   ierr = StateBinary(an, v, lambda, dl, PETSC_FALSE);
   if (!ierr) ierr = PeriCheckpointLoad(an->sys, eq, v, file);
-  PetscCall(PetscViewerDestroy(&v)); /* a refused checkpoint too */
-  PetscCall(ierr);
+  PetscCall(PetscPopErrorHandler());
+  PetscCall(PeriAnalysisRestartEnd(an, &v, file, ierr)); /* a refused checkpoint is closed too */
   PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_TRUE, PETSC_TRUE));
   PetscCall(PeriAnalysisAdoptSnapshots(an, &((QSData *)an->data)->nsnaps, ((QSData *)an->data)->snaps, NULL));
   q->peak_load_factor = q->steps[q->nsteps - 1].lambda;
