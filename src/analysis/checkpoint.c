@@ -4,7 +4,10 @@
  * temporary name and renamed at each equilibrium, so that the file is always one whole state.
  * -restart DIR continues a run from DIR/checkpoint/state.bin. The file starts with a header that
  * ties it to the run that wrote it (the scene's fingerprint, the ranks, the particles, bonds and
- * DOFs); the analysis writes its own state after it, then the system's (PeriCheckpointView). */
+ * DOFs); the analysis writes its own state after it, then the system's (PeriCheckpointView), and
+ * the file ends with a mark, so that one cut short is told from a damaged one. A write that fails
+ * (a full disk) keeps the previous file and stops the run; a file refused on -restart is named,
+ * with what is wrong in it (docs/reliability.md, "Faults during runs"). */
 #include "perilin/private/analysis.h"
 
 #include <errno.h>
@@ -269,15 +272,15 @@ PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis an, PetscViewer v, PetscI
 @*/
 PetscErrorCode PeriAnalysisCheckpointFinite(PeriAnalysis an, const PetscReal x[], PetscInt n, Vec u, const char what[])
 {
-  PetscReal sum = 0;
+  PetscReal norm = 0;
+  PetscInt  bad  = 0;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < n; k++) sum += PetscAbsReal(x[k]) * 0; /* 0 * inf and 0 * NaN are NaN */
-  if (u)
-    PetscCall(VecNorm(u, NORM_INFINITY, &sum)); /* collective: every rank gets the same */
-  else
-    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPIU_REAL, MPIU_SUM, an->comm));
-  PetscCheck(!PetscIsInfOrNanReal(sum), an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: its %s are not finite (NaN or inf): restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, what);
+  for (PetscInt k = 0; k < n && !bad; k++) bad = PetscIsInfOrNanReal(x[k]);
+  if (u) PetscCall(VecNorm(u, NORM_INFINITY, &norm)); /* a NaN or inf anywhere makes it so */
+  bad = bad || PetscIsInfOrNanReal(norm);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, an->comm));
+  PetscCheck(!bad, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: its %s are not finite (NaN or inf): restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, what);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
