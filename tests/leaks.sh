@@ -79,6 +79,11 @@ check dynamic 0 'explicit dynamics' "$tmp/pushed.yaml"
 cp -r "$tmp/dynamic-out" "$tmp/cut"
 truncate -s -30 "$tmp/cut/checkpoint/state.bin"
 check refused_restart_cut 1 'state\.bin is cut short' "$tmp/pushed.yaml" -restart "$tmp/cut"
+# a quasi-static checkpoint whose first step's load factor is a NaN (offset 100, as the case
+# filesystem/restart_nan_steps): refused while the steps are read (found by the checkpoint fuzzer)
+check checkpoint_scene 0 'strain energy' "$ex/../tests/fuzz/checkpoint.yaml" -quiet
+printf '\177\370\0\0\0\0\0\0' | dd of="$tmp/checkpoint_scene-out/checkpoint/state.bin" bs=1 seek=100 conv=notrunc 2> /dev/null
+check refused_restart_nan 1 'is damaged: its steps' "$ex/../tests/fuzz/checkpoint.yaml" -restart "$tmp/checkpoint_scene-out"
 sed "s|t_end: 0.002|t_end: 0.002, initial: {file: $tmp/dynamic-out/particles.vtu}|" "$tmp/pushed.yaml" > "$tmp/pushed_initial.yaml"
 check refused_initial_other_body 1 'holds 50 particles, the body 200: the file must come from the same body' "$tmp/pushed_initial.yaml" -grid_spacing 0.05
 
