@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
-# A full disk during a checkpoint write (issue 40, item 3): once the quasi-static edge crack has
-# written its first checkpoint, checkpoint/state.bin.tmp in its staging directory is made a
+# A full disk during a checkpoint write (issue 40, item 3): once the quasi-static edge crack (or the
+# dynamic Kalthoff-Winkler plate) has written its first checkpoint, checkpoint/state.bin.tmp in its staging directory is made a
 # symbolic link to /dev/full (every write fails with ENOSPC), so the next checkpoint cannot be
 # written. The run must stop with exit 1 and a message naming the file and "No space left on
 # device", leave no output directory, and keep the staging directory with the previous checkpoint
 # whole: -restart from it runs to the end. On 1 and 2 ranks (rank 0 writes the file).
-# usage: disk_full.sh PERILIN SCENE MPIEXEC...   (MPIEXEC: the command that runs 2 ranks)
+# usage: disk_full.sh PERILIN REPO MPIEXEC...   (MPIEXEC: the command that runs 2 ranks)
 set -u
-exe=$1 scene=$2
+exe=$1 repo=$2
 shift 2
 mpi=("$@")
 [ -w /dev/full ] || { echo "SKIP: no /dev/full"; exit 77; }
@@ -15,14 +15,17 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 unset PETSC_OPTIONS
 export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-opts=(-grid_spacing 0.025 -analysis_min_step 1.25 -quiet)
 fail=0
 bad() { echo "FAIL: $*"; fail=1; }
 
-full() { # NAME launcher...
-  local name=$1 d=$tmp/$1 pid st partial t0
+full() { # NAME launcher... -- SCENE OPTIONS...
+  local name=$1 d=$tmp/$1 pid st partial t0 launch=() run=()
   shift
-  "$@" "$exe" "$scene" "${opts[@]}" -output_dir "$d" > "$d.log" 2>&1 < /dev/null &
+  while [ "$1" != "--" ]; do launch+=("$1"); shift; done
+  shift
+  run=("$@" -quiet)
+  set -- "${launch[@]}"
+  "$@" "$exe" "${run[@]}" -output_dir "$d" > "$d.log" 2>&1 < /dev/null &
   pid=$!
   t0=$SECONDS
   until compgen -G "$d.partial-*/checkpoint/state.bin" > /dev/null; do
@@ -45,11 +48,13 @@ full() { # NAME launcher...
   [ -e "$d" ] && bad "$name: an output directory $d was left"
   [ -e "$partial/checkpoint/state.bin.tmp" ] && bad "$name: the link state.bin.tmp was left"
   [ -f "$partial/checkpoint/state.bin" ] && [ ! -L "$partial/checkpoint/state.bin" ] || { bad "$name: state.bin is no longer the previous checkpoint"; ls -la "$partial/checkpoint"; return; }
-  "$@" "$exe" "$scene" "${opts[@]}" -restart "$partial" -output_dir "$d.cont" > "$d.cont.log" 2>&1 < /dev/null || { bad "$name: -restart $partial exited $?"; cat "$d.cont.log"; return; }
+  "$@" "$exe" "${run[@]}" -restart "$partial" -output_dir "$d.cont" > "$d.cont.log" 2>&1 < /dev/null || { bad "$name: -restart $partial exited $?"; cat "$d.cont.log"; return; }
   grep -q '"complete": true' "$d.cont/summary.json" || bad "$name: the restarted run is not complete"
   [ $fail -eq 0 ] && echo "ok: $name: $(grep -o 'cannot write.*device' "$d.log"); restarted from the previous checkpoint to the end"
 }
 
-full one_rank env
-[ ${#mpi[@]} -gt 0 ] && full two_ranks "${mpi[@]}"
+qs=("$repo/examples/fracture/edge_crack.yaml" -grid_spacing 0.025 -analysis_min_step 1.25)
+full quasistatic env -- "${qs[@]}"
+[ ${#mpi[@]} -gt 0 ] && full quasistatic_2ranks "${mpi[@]}" -- "${qs[@]}"
+full dynamic env -- "$repo/examples/dynamics/kalthoff_winkler.yaml" -grid_spacing 4e-3
 exit $fail

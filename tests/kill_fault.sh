@@ -2,8 +2,9 @@
 # SIGKILL of one rank of a 2-rank run (issue 40, item 3): a quasi-static run (the edge crack of
 # tests/restart.sh) and a dynamic one (Kalthoff-Winkler without contact, as tests/dynamic_restart.sh
 # runs it on 2 ranks) are killed, rank 1 alone by SIGKILL, as soon as their first checkpoint is in
-# place. Nothing can be saved then: what is on disk must be the output directory as it was (here:
-# none) and the staging directory DIR.partial-XXXXXX, whose checkpoint/state.bin is whole. -restart
+# place. Nothing can be saved then: what is on disk must be the output directory as it was (a
+# previous complete set, the same bytes) and the staging directory DIR.partial-XXXXXX, whose
+# checkpoint/state.bin is whole. -restart
 # from that directory must continue the run to the end of the uninterrupted one: the same broken
 # bonds and steps; quasi-static steps.csv as tests/restart.sh compares it (load factors to 1e-12,
 # the rest to 1e-8); dynamic energies and impactors to 1e-12 and history.csv the same bytes.
@@ -35,6 +36,7 @@ killed() {
   shift
   mkdir -p "$d"
   "${mpi[@]}" "$exe" "$@" -quiet -output_dir "$d/ref" > "$d/ref.log" 2>&1 < /dev/null || { bad "$name: the uninterrupted run exited $?"; cat "$d/ref.log"; return; }
+  cp -a "$d/ref" "$d/out" # a previous complete set, which the killed run must leave as it was
   "${mpi[@]}" "$exe" "$@" -quiet -output_dir "$d/out" > "$d/out.log" 2>&1 < /dev/null &
   mpid=$!
   t0=$SECONDS
@@ -48,7 +50,7 @@ killed() {
   st=$?
   [ -n "$r1" ] || { bad "$name: the run ended (exit $st) before rank 1 could be killed"; return; }
   [ $st -ne 0 ] || bad "$name: mpiexec exited 0 although rank 1 was killed"
-  [ -e "$d/out" ] && bad "$name: the killed run left an output directory $d/out (it had none before)"
+  diff -r "$d/ref" "$d/out" > /dev/null || bad "$name: the killed run changed the previous set in $d/out"
   partial=$(compgen -G "$d/out.partial-*")
   [ "$(echo "$partial" | wc -l)" -eq 1 ] && [ -s "$partial/checkpoint/state.bin" ] || { bad "$name: no single staging directory with a checkpoint: '$partial'"; ls -la "$d"; return; }
   "${mpi[@]}" "$exe" "$@" -quiet -restart "$partial" -output_dir "$d/cont" > "$d/cont.log" 2>&1 < /dev/null || { bad "$name: the restart from $partial exited $?"; cat "$d/cont.log"; return; }

@@ -4,7 +4,10 @@
  * temporary name and renamed at each equilibrium, so that the file is always one whole state.
  * -restart DIR continues a run from DIR/checkpoint/state.bin. The file starts with a header that
  * ties it to the run that wrote it (the scene's fingerprint, the ranks, the particles, bonds and
- * DOFs); the analysis writes its own state after it, then the system's (PeriCheckpointView). */
+ * DOFs); the analysis writes its own state after it, then the system's (PeriCheckpointView), and
+ * the file ends with a mark, so that one cut short is told from a damaged one. A write that fails
+ * (a full disk) keeps the previous file and stops the run; a file refused on -restart is named,
+ * with what is wrong in it (docs/reliability.md, "Faults during runs"). */
 #include "perilin/private/analysis.h"
 
 #include <errno.h>
@@ -218,6 +221,30 @@ PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis an, PetscViewer *v, char fi
 }
 
 /*@C
+  PeriAnalysisRestartEnd - closes the checkpoint v the analysis has read, its reading run under
+  PetscReturnErrorHandler and ended with ierr. PETSc's own refusals of a damaged file ("Not a
+  vector next in file", "Vector in file different size (7) than input vector (320)", "Read past
+  end of file") name neither the file nor -restart: they are said as a damaged checkpoint. perilin's
+  own refusals, and errors that are not the file's (memory), go on as they were. Collective.
+@*/
+PetscErrorCode PeriAnalysisRestartEnd(PeriAnalysis an, PetscViewer *v, const char file[], PetscErrorCode ierr)
+{
+  char     *msg = NULL, copy[1024] = "";
+  PetscBool file_error;
+
+  PetscFunctionBeginUser;
+  if (ierr) {
+    PetscCall(PetscErrorMessage(ierr, NULL, &msg));
+    PetscCall(PetscStrncpy(copy, msg ? msg : "", sizeof(copy)));
+  }
+  PetscCall(PetscViewerDestroy(v));
+  if (!ierr) PetscFunctionReturn(PETSC_SUCCESS);
+  file_error = (PetscBool)(ierr == PETSC_ERR_FILE_READ || ierr == PETSC_ERR_FILE_UNEXPECTED || ierr == PETSC_ERR_FILE_OPEN || ierr == PETSC_ERR_ARG_SIZ || ierr == PETSC_ERR_ARG_WRONG || ierr == PETSC_ERR_ARG_OUTOFRANGE);
+  PetscCheck(!file_error, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s is damaged (%s): restart from an undamaged checkpoint, or run the scene from the start", file, copy);
+  SETERRQ(an->comm, ierr, "%s", copy);
+}
+
+/*@C
   PeriAnalysisCheckpointFits - refuses a count read from the checkpoint open in v when n items of
   each bytes cannot be in what is left of the file (or n < 0): a damaged count would otherwise size
   an allocation. Collective.
@@ -245,15 +272,15 @@ PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis an, PetscViewer v, PetscI
 @*/
 PetscErrorCode PeriAnalysisCheckpointFinite(PeriAnalysis an, const PetscReal x[], PetscInt n, Vec u, const char what[])
 {
-  PetscReal sum = 0;
+  PetscReal norm = 0;
+  PetscInt  bad  = 0;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < n; k++) sum += PetscAbsReal(x[k]) * 0; /* 0 * inf and 0 * NaN are NaN */
-  if (u)
-    PetscCall(VecNorm(u, NORM_INFINITY, &sum)); /* collective: every rank gets the same */
-  else
-    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &sum, 1, MPIU_REAL, MPIU_SUM, an->comm));
-  PetscCheck(!PetscIsInfOrNanReal(sum), an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: its %s are not finite (NaN or inf): restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, what);
+  for (PetscInt k = 0; k < n && !bad; k++) bad = PetscIsInfOrNanReal(x[k]);
+  if (u) PetscCall(VecNorm(u, NORM_INFINITY, &norm)); /* a NaN or inf anywhere makes it so */
+  bad = bad || PetscIsInfOrNanReal(norm);
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, an->comm));
+  PetscCheck(!bad, an->comm, PETSC_ERR_USER_INPUT, "-restart: %s/%s is damaged: its %s are not finite (NaN or inf): restart from an undamaged checkpoint, or run the scene from the start", an->restart, PERI_CHECKPOINT_FILE, what);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

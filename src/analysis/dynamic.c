@@ -1044,14 +1044,17 @@ static PetscErrorCode Restart(PeriAnalysis an, Vec U, Vec V)
 
   PetscFunctionBeginUser;
   PetscCall(PetscFree(d->hist));
+  PetscCall(PeriAnalysisRestartBegin(an, &v, file, sizeof(file))); /* a refused header: nothing to free */
   PetscCall(PeriCheckpointCreate(an->sys, &eq));
-  PetscCall(PeriAnalysisRestartBegin(an, &v, file, sizeof(file)));
   PetscCall(GetState(an, U, &q, &p));
+  /* PETSc's refusals of a damaged file are said by PeriAnalysisRestartEnd, naming the file */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   ierr = StateBinary(an, v, &t, PETSC_FALSE);
   if (!ierr) ierr = PeriCheckpointLoad(an->sys, &eq, v, file);
   if (!ierr) ierr = VecLoad(d->implicit ? V : p, v);
   if (!ierr) ierr = PeriAnalysisCheckpointFinite(an, NULL, 0, d->implicit ? V : p, "velocities");
-  PetscCall(PetscViewerDestroy(&v)); /* a refused checkpoint too */
+  PetscCall(PetscPopErrorHandler());
+  ierr = PeriAnalysisRestartEnd(an, &v, file, ierr); /* a refused checkpoint is closed too */
   if (!ierr) ierr = VecCopy(eq.u, q);
   if (!ierr) ierr = VecCopy(eq.u, d->uprev);
   PetscCall(RestoreState(an, U, &q, &p));

@@ -625,6 +625,33 @@ static PetscErrorCode StepsAllocate(PeriAnalysis an, PetscInt n, PetscInt nsnaps
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The steps so far (steps.csv's rows as sr, si: PERI_STEP_REALS and PERI_STEP_INTS each, and their
+ * reactions) and the snapshots written, into v or (write false) from v, checked finite. */
+static PetscErrorCode StepsBinary(PeriAnalysis an, PetscViewer v, PetscReal sr[], PetscInt si[], PetscBool write)
+{
+  PeriQuasistatic *q    = QS(an);
+  QSData          *data = (QSData *)an->data;
+  const PetscInt   w    = an->sys->conditions.reactions.nregions * PERI_MAX_DOF;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; write && k < q->nsteps; k++) StepPack(&q->steps[k], &sr[k * PERI_STEP_REALS], &si[k * PERI_STEP_INTS]);
+  if (write) {
+    PetscCall(PetscViewerBinaryWrite(v, sr, q->nsteps * PERI_STEP_REALS, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, si, q->nsteps * PERI_STEP_INTS, PETSC_INT));
+    PetscCall(PetscViewerBinaryWrite(v, q->reactions, q->nsteps * w, PETSC_REAL));
+    PetscCall(PetscViewerBinaryWrite(v, data->snaps, data->nsnaps, PETSC_INT));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscViewerBinaryRead(v, sr, q->nsteps * PERI_STEP_REALS, NULL, PETSC_REAL));
+  PetscCall(PetscViewerBinaryRead(v, si, q->nsteps * PERI_STEP_INTS, NULL, PETSC_INT));
+  PetscCall(PetscViewerBinaryRead(v, q->reactions, q->nsteps * w, NULL, PETSC_REAL));
+  PetscCall(PetscViewerBinaryRead(v, data->snaps, data->nsnaps, NULL, PETSC_INT));
+  PetscCall(PeriAnalysisCheckpointFinite(an, sr, q->nsteps * PERI_STEP_REALS, NULL, "steps' load factors, displacements and times"));
+  PetscCall(PeriAnalysisCheckpointFinite(an, q->reactions, q->nsteps * w, NULL, "steps' reactions"));
+  for (PetscInt k = 0; k < q->nsteps; k++) StepUnpack(&sr[k * PERI_STEP_REALS], &si[k * PERI_STEP_INTS], &q->steps[k]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The loop's state at an equilibrium, besides the bonds and u (PeriCheckpointView): the load factor
  * and the next step, the counters, the steps so far (steps.csv's rows and their reactions) and the
  * snapshots written (particles.pvd's frames). write: into v, else from v. Collective. */
@@ -635,6 +662,7 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
   const PetscInt   w    = an->sys->conditions.reactions.nregions * PERI_MAX_DOF;
   PetscReal        r[2] = {*lambda, *dl}, *sr;
   PetscInt         n[5] = {q->nsteps, q->pc_setups, q->solves, data->nsnaps, w}, *si;
+  PetscErrorCode   ierr;
 
   PetscFunctionBeginUser;
   if (write) {
@@ -643,7 +671,7 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
   } else {
     PetscCall(PetscViewerBinaryRead(v, r, 2, NULL, PETSC_REAL));
     PetscCall(PetscViewerBinaryRead(v, n, 5, NULL, PETSC_INT));
-    PetscCheck(n[4] == w && n[0] > 0, an->comm, PETSC_ERR_FILE_UNEXPECTED, "-restart: the checkpoint's steps do not fit this scene's reaction regions");
+    PetscCheck(n[4] == w && n[0] > 0, an->comm, PETSC_ERR_USER_INPUT, "-restart: the checkpoint's steps do not fit this scene's reaction regions: restart with the scene of the run that wrote it");
     /* counts and the load factor from the file, checked before they size anything (found by
        tests/fuzz/fuzz_checkpoint.c: a count of 2^62 steps) */
     PetscCall(PeriAnalysisCheckpointFits(an, v, n[0], (PERI_STEP_REALS + w) * sizeof(PetscReal) + PERI_STEP_INTS * sizeof(PetscInt)));
@@ -654,22 +682,9 @@ static PetscErrorCode StateBinary(PeriAnalysis an, PetscViewer v, PetscReal *lam
     q->nsteps = n[0], q->pc_setups = n[1], q->solves = n[2], data->nsnaps = n[3];
   }
   PetscCall(PetscMalloc2(q->nsteps * PERI_STEP_REALS, &sr, q->nsteps * PERI_STEP_INTS, &si));
-  for (PetscInt k = 0; write && k < q->nsteps; k++) StepPack(&q->steps[k], &sr[k * PERI_STEP_REALS], &si[k * PERI_STEP_INTS]);
-  if (write) {
-    PetscCall(PetscViewerBinaryWrite(v, sr, q->nsteps * PERI_STEP_REALS, PETSC_REAL));
-    PetscCall(PetscViewerBinaryWrite(v, si, q->nsteps * PERI_STEP_INTS, PETSC_INT));
-    PetscCall(PetscViewerBinaryWrite(v, q->reactions, q->nsteps * w, PETSC_REAL));
-    PetscCall(PetscViewerBinaryWrite(v, data->snaps, data->nsnaps, PETSC_INT));
-  } else {
-    PetscCall(PetscViewerBinaryRead(v, sr, q->nsteps * PERI_STEP_REALS, NULL, PETSC_REAL));
-    PetscCall(PetscViewerBinaryRead(v, si, q->nsteps * PERI_STEP_INTS, NULL, PETSC_INT));
-    PetscCall(PetscViewerBinaryRead(v, q->reactions, q->nsteps * w, NULL, PETSC_REAL));
-    PetscCall(PetscViewerBinaryRead(v, data->snaps, data->nsnaps, NULL, PETSC_INT));
-    PetscCall(PeriAnalysisCheckpointFinite(an, sr, q->nsteps * PERI_STEP_REALS, NULL, "steps' load factors, displacements and times"));
-    PetscCall(PeriAnalysisCheckpointFinite(an, q->reactions, q->nsteps * w, NULL, "steps' reactions"));
-  }
-  for (PetscInt k = 0; !write && k < q->nsteps; k++) StepUnpack(&sr[k * PERI_STEP_REALS], &si[k * PERI_STEP_INTS], &q->steps[k]);
-  PetscCall(PetscFree2(sr, si));
+  ierr = StepsBinary(an, v, sr, si, write);
+  PetscCall(PetscFree2(sr, si)); /* a refused checkpoint too (found by tests/fuzz/fuzz_checkpoint.c) */
+  PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -720,10 +735,12 @@ static PetscErrorCode Restart(PeriAnalysis an, Loop *L, PeriCheckpoint *eq, Pets
 
   PetscFunctionBeginUser;
   PetscCall(PeriAnalysisRestartBegin(an, &v, file, sizeof(file)));
+  /* PETSc's refusals of a damaged file are said by PeriAnalysisRestartEnd, naming the file */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   ierr = StateBinary(an, v, lambda, dl, PETSC_FALSE);
   if (!ierr) ierr = PeriCheckpointLoad(an->sys, eq, v, file);
-  PetscCall(PetscViewerDestroy(&v)); /* a refused checkpoint too */
-  PetscCall(ierr);
+  PetscCall(PetscPopErrorHandler());
+  PetscCall(PeriAnalysisRestartEnd(an, &v, file, ierr)); /* a refused checkpoint is closed too */
   PetscCall(PeriCheckpointRestore(an->sys, eq, PETSC_TRUE, PETSC_TRUE));
   PetscCall(PeriAnalysisAdoptSnapshots(an, &((QSData *)an->data)->nsnaps, ((QSData *)an->data)->snaps, NULL));
   q->peak_load_factor = q->steps[q->nsteps - 1].lambda;

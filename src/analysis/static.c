@@ -14,6 +14,7 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
   PetscLogDouble     t0, t1;
   PetscBool          released = PETSC_FALSE;
   Mat                K;
+  PetscErrorCode     ierr;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Allreduce(&an->sys->conditions.nconstrained, &nc, 1, MPIU_INT, MPI_SUM, an->comm));
@@ -42,8 +43,10 @@ static PetscErrorCode PeriAnalysisRun_Static(PeriAnalysis an)
     PetscCall(PeriStaticPieces(an->sys, &nhold, &hold, &held));
     /* the solve reads K only: the bonds' geometry makes room for GAMG, and comes back after it */
     PetscCall(PeriSystemReleaseBondGeometry(an->sys, &released));
-    PetscCall(PeriStaticSolve(an->sys, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason));
-    PetscCall(PetscFree2(hold, held));
+    ierr = PeriStaticSolve(an->sys, &ksp, 1.0, PETSC_TRUE, nhold, hold, held, &reason);
+    PetscCall(PetscFree2(hold, held)); /* and the solver, when the solve refused the scene */
+    if (ierr) PetscCall(KSPDestroy(&ksp));
+    PetscCall(ierr);
   }
   PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
   if (an->sys->run.interrupted) {

@@ -351,12 +351,12 @@ static PetscErrorCode Run_Tune(PeriAnalysis an)
     if (an->sys->run.interrupted) break;
   }
   PetscCall(Rank(T));
-  if (!an->sys->run.interrupted) {
-    PetscCheck(T->winner >= 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: no configuration of the %" PetscInt_FMT " converged (first: %s: %s): try a direct solver (\"-ksp_type preonly -pc_type cholesky -solver_operator assembled\"), raise -ksp_max_it, or check the constraints", an->sys->scene->file, T->n, T->rows[0].config, T->rows[0].reason);
+  if (!an->sys->run.interrupted && T->winner >= 0) {
     PetscCall(RunConfiguration(an, T->rows[T->winner].config, nhold, hold, held, &last));
     PetscCall(PeriSignalReceived(an->comm, &an->sys->run.interrupted));
   }
-  PetscCall(PetscFree2(hold, held));
+  PetscCall(PetscFree2(hold, held)); /* before the refusal below: the Python module lives on after it */
+  PetscCheck(an->sys->run.interrupted || T->winner >= 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: no configuration of the %" PetscInt_FMT " converged (first: %s: %s): try a direct solver (\"-ksp_type preonly -pc_type cholesky -solver_operator assembled\"), raise -ksp_max_it, or check the constraints", an->sys->scene->file, T->n, T->rows[0].config, T->rows[0].reason);
   if (an->sys->run.interrupted) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriStaticCheckConverged(an->sys, last.ksp_reason));
   an->sys->run.log.solve_s = Total(&last);

@@ -335,8 +335,59 @@ static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[]
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The bytes per particle of the particles and their bonds (src/system/memory.c's Estimate without
+ * the model's matrix and solver): a lower bound of what the run will hold. m is the horizon in
+ * spacings; with horizon.delta (not known in spacings before the mesh is refined) the default 3. */
+static PetscErrorCode RefinedBytes(PeriScene scene, PetscInt dim, PetscReal *m, PetscReal *bytes)
+{
+  PeriNode       hz = NULL;
+  PetscReal      r, ball;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  *m = 3;
+  /* a bad horizon is reported later, by the reader of the horizon: quietly keep the default here */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = PeriSceneGetMap(scene, scene->root, "horizon", PETSC_FALSE, &hz);
+  if (!ierr && hz) ierr = PeriSceneGetReal(scene, hz, "m", PETSC_FALSE, m, NULL);
+  PetscCall(PetscPopErrorHandler());
+  if (ierr || !(*m >= 1)) *m = 1;
+  r    = *m + 0.5; /* the continued partial-volume ramp's half spacing */
+  ball = (dim == 2 ? PETSC_PI * r * r : 4.0 / 3.0 * PETSC_PI * r * r * r) - 1;
+  /* coordinates, volumes, the particle arrays and the displacements; the neighbour search reserves
+     1.05 ball / 2 bonds of j, xi, length, alpha and live, and each bond gets its lambda */
+  *bytes = (8 + 2 * dim + 1) * sizeof(PetscReal) + 6 * sizeof(PetscInt) + ball / 2 * (1.05 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1) + sizeof(PetscReal));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* particles.refine splits every element into 2^dim per level: the particles and bonds that gives
+ * are estimated before Gmsh refines, and refused above what the machine has (as a grid's are,
+ * src/system/memory.c): refined into millions of particles, a run ended in a SIGSEGV or a raw
+ * allocation error (issue 40, item 4). Every rank reads the mesh: the estimate is one rank's. */
+static PetscErrorCode RefineFits(PeriScene scene, PeriNode node, const char path[], PetscInt dim, PetscInt refine)
+{
+  MeshElements e;
+  PetscReal    m = 3, per = 0, n, need, have;
+  PetscBool    check = PETSC_TRUE;
+  size_t       count;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_memory_check", &check, NULL));
+  if (!check || refine <= 0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ElementsGet(dim, -1, &e));
+  count = e.count;
+  ElementsFree(&e);
+  PetscCall(RefinedBytes(scene, dim, &m, &per));
+  n    = (PetscReal)count * PetscPowReal(dim == 2 ? 4 : 8, (PetscReal)refine);
+  need = n * per;
+  have = PeriMemoryAvailable();
+  PetscCall(PetscInfo(NULL, "particles.refine %" PetscInt_FMT ": %g particles, at least %g bytes, %g available\n", refine, (double)n, (double)need, (double)have));
+  PeriInputCheck(!(have > 0) || need <= have, scene, node, "refine", "%s's %zu elements split %" PetscInt_FMT " times give %.3g particles, whose particles and bonds alone (a horizon of %.3g spacings) need about %.3g GB, and this machine has %.3g GB available: give a smaller particles.refine, a coarser mesh or a smaller horizon (-peri_memory_check false skips this estimate)", path, count, refine, (double)n, (double)m, (double)(need / 1e9), (double)(have / 1e9));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* particles.refine: every element split uniformly that many times. */
-static PetscErrorCode MeshRefine(PeriScene scene, PeriNode node, const char path[])
+static PetscErrorCode MeshRefine(PeriScene scene, PeriNode node, const char path[], PetscInt dim)
 {
   PetscInt refine = 0;
   int      ierr   = 0;
@@ -344,6 +395,7 @@ static PetscErrorCode MeshRefine(PeriScene scene, PeriNode node, const char path
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetInt(scene, node, "refine", PETSC_FALSE, &refine, NULL));
+  PetscCall(RefineFits(scene, node, path, dim, refine));
   for (PetscInt k = 0; k < refine && !ierr; k++) gmshModelMeshRefine(&ierr);
   if (ierr) PeriGmshLastError(msg, sizeof(msg));
   PeriInputCheck(!ierr, scene, node, "refine", "Gmsh cannot refine %s: %s", path, msg);
@@ -531,7 +583,7 @@ PetscErrorCode PeriMeshRead(PeriScene scene, PeriNode node, PetscInt dim, PetscR
   PetscCall(GmshStart(verbose));
   if (format) PetscCall(MeshImport(scene, node, path, format, dir, sizeof(dir), msh, sizeof(msh)));
   PetscCall(MeshOpen(scene, node, path, dir, msh, geo, lc, dim));
-  PetscCall(MeshRefine(scene, node, path));
+  PetscCall(MeshRefine(scene, node, path, dim));
   PetscCall(NodesGet(&nodes));
   for (PetscInt d = 0; d < 3; d++) {
     box[d]     = d < dim ? PETSC_MAX_REAL : 0;

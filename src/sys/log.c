@@ -37,6 +37,29 @@ PetscReal PeriHeapInUseMB(void)
 #endif
 }
 
+/* Bytes this node can still give: MemAvailable, or the cgroup's limit when lower; 0 if unknown.
+ * Here, at the bottom, so that the readers of every layer can check an estimate before they
+ * allocate (the system's of a grid scene, the mesh reader's of particles.refine). Not collective. */
+PetscReal PeriMemoryAvailable(void)
+{
+  PetscReal have = 0;
+  char      line[256];
+  FILE     *fp = fopen("/proc/meminfo", "r");
+  if (fp) {
+    while (fgets(line, sizeof(line), fp))
+      if (!strncmp(line, "MemAvailable:", 13)) have = 1024.0 * strtod(line + 13, NULL);
+    fclose(fp);
+  }
+  if ((fp = fopen("/sys/fs/cgroup/memory.max", "r"))) {
+    double limit = 0, used = 0;
+    FILE  *fu = fopen("/sys/fs/cgroup/memory.current", "r");
+    if (fscanf(fp, "%lf", &limit) == 1 && fu && fscanf(fu, "%lf", &used) == 1 && limit - used < have) have = limit - used;
+    if (fu) fclose(fu);
+    fclose(fp);
+  }
+  return have;
+}
+
 /*@C
   PeriMallocInitialize - gives freed arrays back to the system. Constructors of the libraries
   PETSc loads turn off glibc's mmap and heap trimming (M_MMAP_MAX 0 from Debian's libsuperlu_dist,

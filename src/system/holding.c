@@ -78,13 +78,15 @@ static const char advice[] = "give a larger horizon.m or horizon.delta, or space
 @*/
 PetscErrorCode PeriCheckBonded(PeriSystem sys)
 {
-  PetscBool *bad;
+  PetscBool     *bad;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(sys->disc.nowned, &bad));
   for (PetscInt i = 0; i < sys->disc.nowned; i++) bad[i] = (PetscBool)(sys->disc.neighbor_count[i] == 0 && !PeriParticleIsFictitious(&sys->disc.particles, i));
-  PetscCall(Refuse(sys, bad, "without bonds would move freely", advice));
-  PetscCall(PetscFree(bad));
+  ierr = Refuse(sys, bad, "without bonds would move freely", advice);
+  PetscCall(PetscFree(bad)); /* a refused scene too: the Python module lives on after it */
+  PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -177,6 +179,7 @@ PetscErrorCode PeriCheckHeld(PeriSystem sys)
   PetscBool     *bad, free[PERI_MAX_DOF];
   PetscInt       nbad = 0, loc;
   char           what[256];
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   if (sys->model->ops.family_stiffness) PetscFunctionReturn(PETSC_SUCCESS);
@@ -195,7 +198,8 @@ PetscErrorCode PeriCheckHeld(PeriSystem sys)
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &nbad, 1, MPIU_INT, MPI_SUM, sys->comm));
   if (nbad) PetscCall(ExemptHeldPieces(sys, bad));
   PetscCall(PetscSNPrintf(what, sizeof(what), "cannot be held by their bonds (model %s: each has a motion without energy%s)", sys->model->type, sys->model->central_force ? (sys->model->dim == 2 ? ", its central bonds all along one line" : ", its central bonds all in one plane") : ""));
-  PetscCall(Refuse(sys, bad, what, advice));
-  PetscCall(PetscFree(bad));
+  ierr = Refuse(sys, bad, what, advice);
+  PetscCall(PetscFree(bad)); /* a refused scene too: the Python module lives on after it */
+  PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -175,27 +175,6 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Bytes this node can still give: MemAvailable, or the cgroup's limit when lower; 0 if unknown. */
-static PetscReal NodeAvailable(void)
-{
-  PetscReal have = 0;
-  char      line[256];
-  FILE     *fp = fopen("/proc/meminfo", "r");
-  if (fp) {
-    while (fgets(line, sizeof(line), fp))
-      if (!strncmp(line, "MemAvailable:", 13)) have = 1024.0 * strtod(line + 13, NULL);
-    fclose(fp);
-  }
-  if ((fp = fopen("/sys/fs/cgroup/memory.max", "r"))) {
-    double limit = 0, used = 0;
-    FILE  *fu = fopen("/sys/fs/cgroup/memory.current", "r");
-    if (fscanf(fp, "%lf", &limit) == 1 && fu && fscanf(fu, "%lf", &used) == 1 && limit - used < have) have = limit - used;
-    if (fu) fclose(fu);
-    fclose(fp);
-  }
-  return have;
-}
-
 /* The need and the memory available on the node whose ratio is the worst, on every rank. */
 static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
 {
@@ -214,7 +193,7 @@ static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
   PetscCallMPI(MPI_Comm_size(node, &nlocal));
   PetscCallMPI(MPI_Comm_free(&node));
   e->need    = nlocal * (e->per_rank + e->shared / size);
-  e->have    = NodeAvailable();
+  e->have    = PeriMemoryAvailable();
   mine.ratio = e->have > 0 ? e->need / e->have : 0;
   mine.rank  = rank;
   PetscCallMPI(MPI_Allreduce(&mine, &worst, 1, MPI_DOUBLE_INT, MPI_MAXLOC, comm));

@@ -94,6 +94,31 @@ static PetscErrorCode ReportMissing(PeriSystem sys, const char path[], PetscInt 
   SETERRQ(sys->comm, PETSC_ERR_USER_INPUT, "%s has no point at particle %" PetscInt_FMT "'s position (%g, %g, %g): the file must come from a run of the same body (grid, spacing, mesh) as this scene", path, first, (double)x[0], (double)x[1], (double)x[2]);
 }
 
+/* PeriSystemReadDOFs' part once the file d is read: its particles and arrays checked against the
+ * body and the model, then copied into u. Collective. */
+static PetscErrorCode ReadInto(PeriSystem sys, const PeriVTUData *d, const char path[], const char array[], PetscReal scale, Vec u)
+{
+  const PetscInt bs = sys->model->dofs;
+  PetscInt      *match, k[PERI_MAX_DOF], comp[PERI_MAX_DOF], N, miss;
+  PetscScalar   *a;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Allreduce(&d->n, &N, 1, MPIU_INT, MPI_MAX, sys->comm));
+  PetscCheck(N == sys->disc.N, sys->comm, PETSC_ERR_USER_INPUT, "%s holds %" PetscInt_FMT " particles, the body %" PetscInt_FMT ": the file must come from the same body", path, N, sys->disc.N);
+  for (PetscInt c = 0; c < bs; c++) PetscCall(ComponentArray(sys, d, path, array, c, &k[c], &comp[c]));
+  PetscCall(PetscMalloc1(sys->disc.nowned, &match));
+  ierr = MatchParticles(sys, d, match, &miss);
+  if (!ierr) ierr = ReportMissing(sys, path, miss);
+  if (!ierr) ierr = VecGetArray(u, &a);
+  for (PetscInt i = 0; !ierr && i < sys->disc.nowned; i++)
+    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = scale * d->data[k[c]][d->ncomp[k[c]] * match[i] + comp[c]];
+  if (!ierr) ierr = VecRestoreArray(u, &a);
+  PetscCall(PetscFree(match));
+  PetscCall(ierr);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriSystemReadDOFs - sets the owned DOFs of u to scale times the field array of the particles
   file path (a .vtu or .pvtu perilin wrote of the same body): the translations from the vector
@@ -103,24 +128,14 @@ static PetscErrorCode ReportMissing(PeriSystem sys, const char path[], PetscInt 
 @*/
 PetscErrorCode PeriSystemReadDOFs(PeriSystem sys, const char path[], const char array[], PetscReal scale, Vec u)
 {
-  const PetscInt bs = sys->model->dofs;
   PeriVTUData    d;
-  PetscInt      *match, k[PERI_MAX_DOF], comp[PERI_MAX_DOF], N, miss;
-  PetscScalar   *a;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PeriReadParticles(path, &d));
-  PetscCallMPI(MPI_Allreduce(&d.n, &N, 1, MPIU_INT, MPI_MAX, sys->comm));
-  PetscCheck(N == sys->disc.N, sys->comm, PETSC_ERR_USER_INPUT, "%s holds %" PetscInt_FMT " particles, the body %" PetscInt_FMT ": the file must come from the same body", path, N, sys->disc.N);
-  for (PetscInt c = 0; c < bs; c++) PetscCall(ComponentArray(sys, &d, path, array, c, &k[c], &comp[c]));
-  PetscCall(PetscMalloc1(sys->disc.nowned, &match));
-  PetscCall(MatchParticles(sys, &d, match, &miss));
-  PetscCall(ReportMissing(sys, path, miss));
-  PetscCall(VecGetArray(u, &a));
-  for (PetscInt i = 0; i < sys->disc.nowned; i++)
-    for (PetscInt c = 0; c < bs; c++) a[i * bs + c] = scale * d.data[k[c]][d.ncomp[k[c]] * match[i] + comp[c]];
-  PetscCall(VecRestoreArray(u, &a));
-  PetscCall(PetscFree(match));
+  /* the file's arrays are freed on a refusal too: the Python module lives on after an input error */
+  ierr = ReadInto(sys, &d, path, array, scale, u);
   PetscCall(PeriVTUDataDestroy(&d));
+  PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

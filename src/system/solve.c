@@ -537,21 +537,24 @@ static PetscErrorCode RecordSolve(PeriSystem sys, KSP ksp, Mat A, Vec b, KSPConv
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* One static solve with the present PC (PeriStaticSolve). */
+/* One static solve with the present PC (PeriStaticSolve). Its operators, right-hand side and free
+ * motions are freed whatever the outcome: a refused scene (loads unbalanced along a free motion)
+ * is an input error of a process that may go on (the Python module; found by -malloc_dump). */
 static PetscErrorCode SolveAttempt(PeriSystem sys, KSP *ksp, PetscReal lambda, PetscBool inplace, PetscInt nhold, const PetscInt hold[], const PetscReal held[], KSPConvergedReason *reason)
 {
-  Mat       A, P;
-  Vec       b, free[PERI_MAX_MODES];
-  PetscReal diag, scale = 1;
-  PetscInt  nfree = 0;
+  Mat            A, P;
+  Vec            b, free[PERI_MAX_MODES];
+  PetscReal      diag, scale = 1;
+  PetscInt       nfree = 0;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(StaticOperator(sys, lambda, inplace, &A, &P, &b));
-  PetscCall(EliminatePrescribed(sys, A, P, b, lambda, nhold, hold, held, &diag, &scale));
-  PetscCall(CheckRightHandSide(sys, b));
-  PetscCall(HandleFreeMotions(sys, A, P, sys->fields.u, b, diag, nhold, hold, &nfree, free));
-  PetscCall(SolveWithFallback(sys, ksp, A, P, b, reason));
-  PetscCall(RecordSolve(sys, *ksp, A, b, *reason));
+  ierr = EliminatePrescribed(sys, A, P, b, lambda, nhold, hold, held, &diag, &scale);
+  if (!ierr) ierr = CheckRightHandSide(sys, b);
+  if (!ierr) ierr = HandleFreeMotions(sys, A, P, sys->fields.u, b, diag, nhold, hold, &nfree, free);
+  if (!ierr) ierr = SolveWithFallback(sys, ksp, A, P, b, reason);
+  if (!ierr) ierr = RecordSolve(sys, *ksp, A, b, *reason);
   /* the residual's scale in the scene's units and the load factor: the equilibrium check of the
      reactions (reactions.c) allows what this residual explains */
   sys->fields.solve.rhs_norm *= scale;
@@ -559,14 +562,15 @@ static PetscErrorCode SolveAttempt(PeriSystem sys, KSP *ksp, PetscReal lambda, P
   /* the solution orthogonal to the free rigid motions */
   for (PetscInt q = 0; q < nfree; q++) {
     PetscScalar dot;
-    PetscCall(VecDot(sys->fields.u, free[q], &dot));
-    PetscCall(VecAXPY(sys->fields.u, -dot, free[q]));
+    if (!ierr) ierr = VecDot(sys->fields.u, free[q], &dot);
+    if (!ierr) ierr = VecAXPY(sys->fields.u, -dot, free[q]);
     PetscCall(VecDestroy(&free[q]));
   }
-  PetscCall(PeriLayersComplete(sys, lambda, sys->fields.u));
+  if (!ierr) ierr = PeriLayersComplete(sys, lambda, sys->fields.u);
   PetscCall(VecDestroy(&b));
   PetscCall(MatDestroy(&A));
   PetscCall(MatDestroy(&P));
+  PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -609,6 +613,7 @@ PetscErrorCode PeriStaticPieces(PeriSystem sys, PetscInt *nhold, PetscInt **hold
 
   PetscFunctionBeginUser;
   PetscCall(PeriPieces(sys, nhold, hold, held, &npieces, &lost));
+  if (lost) PetscCall(PetscFree2(*hold, *held)); /* refused: the caller gets nothing to free */
   PetscCheck(!lost, sys->comm, PETSC_ERR_USER_INPUT, "%s: the body is in %" PetscInt_FMT " pieces and a loaded one is not connected to the constraints: it cannot carry its load", sys->scene->file, npieces);
   if (npieces > 1) PetscCall(PetscPrintf(sys->comm, "perilin: note: the body is in %" PetscInt_FMT " pieces; those not connected to the constraints are unloaded and held in place\n", npieces));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -274,6 +274,20 @@ static PetscReal BondShearModulus(PeriSystem sys, PetscInt nr, PeriRegion *const
   return 1 / inv;
 }
 
+/* material.mu_by_region's regions and moduli (map: one region name to one modulus > 0). */
+static PetscErrorCode RegionModuli(PeriSystem sys, PeriNode map, PeriRegion **reg, PetscReal val[])
+{
+  PeriScene s = sys->scene;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < map->n; k++) {
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, sys->disc.nregions, sys->disc.regions, &reg[k]));
+    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &val[k], NULL));
+    PeriInputCheck(val[k] > 0, s, map, map->child[k]->key, "must be positive, got %g", (double)val[k]);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* material.mu_by_region: the shear modulus of every particle (later entries win), and of every
  * bond (BondShearModulus). */
 static PetscErrorCode ReadShearModuli(PeriSystem sys)
@@ -285,6 +299,7 @@ static PetscErrorCode ReadShearModuli(PeriSystem sys)
   PeriRegion         **reg;
   PetscReal           *val, *cut;
   PetscInt             nr;
+  PetscErrorCode       ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetMap(s, s->root, "material", PETSC_TRUE, &mat));
@@ -293,11 +308,9 @@ static PetscErrorCode ReadShearModuli(PeriSystem sys)
   PeriInputCheck(PeriModelOutOfPlane(sys->model), s, map, NULL, "applies to the cross-section models (antiplane, antiplane_os), not %s", sys->model->type);
   nr = map->n;
   PetscCall(PetscMalloc3(nr, &reg, nr, &val, 6 * (nr + 1) + 2, &cut));
-  for (PetscInt k = 0; k < nr; k++) {
-    PetscCall(PeriRegionFind(s, map->child[k], NULL, sys->disc.nregions, sys->disc.regions, &reg[k]));
-    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &val[k], NULL));
-    PeriInputCheck(val[k] > 0, s, map, map->child[k]->key, "must be positive, got %g", (double)val[k]);
-  }
+  ierr = RegionModuli(sys, map, reg, val);
+  if (ierr) PetscCall(PetscFree3(reg, val, cut)); /* refused: the Python module lives on after it */
+  PetscCall(ierr);
   PetscCall(PetscMalloc1(pt->n, &sys->materials.mu));
   for (PetscInt i = 0; i < pt->n; i++) sys->materials.mu[i] = ShearModulusAt(sys, nr, reg, val, &pt->x[3 * i]);
   PetscCall(PetscMalloc1(b->nbonds, &sys->materials.bond_mu));

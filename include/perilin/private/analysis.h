@@ -133,6 +133,7 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointSetFromOptions(PeriAnalysis);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointWrite(PeriAnalysis, PetscErrorCode (*)(PeriAnalysis, PetscViewer, void *), void *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis, PetscViewer *, char[], size_t);
+PETSC_EXTERN PetscErrorCode PeriAnalysisRestartEnd(PeriAnalysis, PetscViewer *, const char[], PetscErrorCode);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointFits(PeriAnalysis, PetscViewer, PetscInt, size_t);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointFinite(PeriAnalysis, const PetscReal[], PetscInt, Vec, const char[]);
 PETSC_EXTERN PetscErrorCode PeriAnalysisAdoptSnapshots(PeriAnalysis, PetscInt *, PetscInt[], PetscReal[]);

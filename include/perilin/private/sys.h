@@ -21,6 +21,7 @@ PETSC_EXTERN PetscErrorCode PeriInitializePackage(void);
 PETSC_EXTERN const char    *PeriBuildVersion(void);
 PETSC_EXTERN PetscReal      PeriPeakMemoryMB(void);
 PETSC_EXTERN PetscReal      PeriHeapInUseMB(void);
+PETSC_EXTERN PetscReal      PeriMemoryAvailable(void);
 PETSC_EXTERN PetscErrorCode PeriMallocInitialize(void);
 /* PERI_ASAN: built with AddressSanitizer (-DPERILIN_SANITIZE=ON, tests/sanitize/run.sh): GCC's
  * macro, clang's feature */
