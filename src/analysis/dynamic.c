@@ -716,42 +716,53 @@ static PetscErrorCode WorstResidual(Dynamic *d, SNES snes)
 }
 
 /* After each step: the bonds past the criteria break; the energy they held is dissipated. */
+/* After a step to t at the displacements q: the impactors moved, the contact reach checked, the
+ * bonds past their criteria broken (their number in nb) and their energy counted. */
+static PetscErrorCode AfterStep(PeriAnalysis an, Vec q, PetscReal t, PetscInt *nb)
+{
+  Dynamic  *d = DYN(an);
+  PetscReal before, after = 0, released;
+  /* the broken bonds' energy from their own blocks; a model with states (lps) also releases the
+     share of each state the bond carried, which is measured as K's energy before and after */
+  const PetscBool bybond = (PetscBool)(an->sys->model->ops.bond_stiffness && !an->sys->model->ops.bond_state);
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriImpactorsAdvance(an->sys, t));
+  PetscCall(PeriContactCheckReach(an->sys, q));
+  if (!an->sys->bond_state.failure.active) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecCopy(q, an->sys->fields.u));
+  if (bybond)
+    PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, nb, &released));
+  else {
+    /* K changed in more than the broken bonds' blocks: the energy it held before and after */
+    PetscCall(StrainEnergy(an, q, &before));
+    PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, nb, NULL));
+    if (*nb) PetscCall(StrainEnergy(an, q, &after));
+    released = *nb ? before - after : 0;
+  }
+  d->dissipated += released;
+  d->broken += *nb;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode PostStep(TS ts)
 {
-  PeriAnalysis an;
-  Dynamic     *d;
-  Vec          U, q, p;
-  PetscInt     nb = 0;
-  PetscReal    before, after = 0, released, t;
-  PetscInt     step;
-  PetscBool    bybond;
+  PeriAnalysis   an;
+  Dynamic       *d;
+  Vec            U, q, p;
+  PetscInt       nb = 0, step;
+  PetscReal      t;
+  PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(TSGetApplicationContext(ts, &an));
-  /* the broken bonds' energy from their own blocks; a model with states (lps) also releases the
-     share of each state the bond carried, which is measured as K's energy before and after */
-  bybond = (PetscBool)(an->sys->model->ops.bond_stiffness && !an->sys->model->ops.bond_state);
-  d      = DYN(an);
+  d = DYN(an);
   PetscCall(TSGetSolution(ts, &U));
-  PetscCall(GetState(an, U, &q, &p));
   PetscCall(TSGetTime(ts, &t));
-  PetscCall(PeriImpactorsAdvance(an->sys, t));
-  PetscCall(PeriContactCheckReach(an->sys, q));
-  if (an->sys->bond_state.failure.active) {
-    PetscCall(VecCopy(q, an->sys->fields.u));
-    if (bybond)
-      PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, &nb, &released));
-    else {
-      /* K changed in more than the broken bonds' blocks: the energy it held before and after */
-      PetscCall(StrainEnergy(an, q, &before));
-      PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, &nb, NULL));
-      if (nb) PetscCall(StrainEnergy(an, q, &after));
-      released = nb ? before - after : 0;
-    }
-    d->dissipated += released;
-    d->broken += nb;
-  }
+  PetscCall(GetState(an, U, &q, &p));
+  ierr = AfterStep(an, q, t, &nb); /* a refusal (the contact reach) gives the state back first */
   PetscCall(RestoreState(an, U, &q, &p));
+  PetscCall(ierr);
   /* a signal ends the run after this step (TSStep resets the reason, so a monitor could not) */
   PetscCall(TSGetStepNumber(ts, &step));
   if (step == d->stop_after) PeriSignalSimulate(SIGINT);
