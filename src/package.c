@@ -6,6 +6,7 @@
 #include "perilin/private/problem.h"
 #include "perilin/private/system.h"
 #include <slepcsys.h>
+#include <stdlib.h>
 
 static PetscBool PeriPackageInitialized = PETSC_FALSE;
 
@@ -54,9 +55,25 @@ PetscErrorCode PeriInitializePackage(void)
   PeriInitialize - starts SLEPc (and with it PETSc) once for the process, installs the signal
   handlers (SIGINT, SIGTERM end a run early with its last complete state) and fills the registries.
 @*/
+/* A process started without mpiexec (no launcher's variables) is an MPI singleton: it talks to
+ * no other process, so Open MPI's probing of fast networks (UCX: 0.2 s) and its helper daemon
+ * (0.1 s) are pure start-up cost, most of a small run's 0.4 s. Open MPI's own switches, only where
+ * the user set none; other MPIs ignore them. Under mpiexec nothing changes. */
+static void SingletonMPIDefaults(void)
+{
+  static const char *const launched[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "SLURM_PROCID", "MPI_LOCALNRANKS", NULL};
+
+  for (int k = 0; launched[k]; k++)
+    if (getenv(launched[k])) return;
+  (void)setenv("OMPI_MCA_pml", "ob1", 0);
+  (void)setenv("OMPI_MCA_osc", "pt2pt", 0);
+  (void)setenv("OMPI_MCA_ess_singleton_isolated", "1", 0);
+}
+
 PetscErrorCode PeriInitialize(int *argc, char ***argv, const char help[])
 {
   PetscFunctionBeginUser;
+  SingletonMPIDefaults();
   /* under LeakSanitizer, what MPI allocates at start and end is MPI's (Open MPI keeps much of it to
    * the end): not counted, so that a leak reported is perilin's (tests/sanitize/run.sh) */
   PeriLeakCheckPause(PETSC_TRUE);
