@@ -11,11 +11,19 @@
  * (b / 2 m_i) sum_j omega e^2 alpha V_j: central springs k_ij = b omega alpha V_i V_j (1/m_i + 1/m_j)
  * plus one state per particle, theta_i, with modulus A_i = V_i (kappa - b/d^2) (ops.bond_state).
  * m_i stays that of the reference family when bonds break, as in Peridigm: the force of this
- * energy on a live bond is then Peridigm's LPS force state, and the energy stays >= 0. */
+ * energy on a live bond is then Peridigm's LPS force state, and the energy stays >= 0.
+ * model.dilatation: affine replaces theta_i in the (kappa/2) theta_i^2 term (only there) by
+ *   theta_i = sum_j omega alpha V_j (S_i^-1 xi) . (u_j - u_i),  S_i = sum_j omega alpha V_j xi xi^T
+ * the trace of the family's least-squares deformation gradient, exact for every affine field at
+ * every particle, surfaces included (the standard theta is exact only where S_i is isotropic). The
+ * energy is then the springs plus two states, the standard one with modulus -V_i b/d^2 and this
+ * one with V_i kappa: W_i = (kappa/2) theta_i^2 + (b / 2 m_i) sum_j omega (e - phi_i |xi| / d)^2
+ * alpha V_j, phi_i the standard dilatation; >= 0 by the same Cauchy-Schwarz bound. */
 #include <perilin/model.h>
 
 static const char *const influences[]  = {"constant", "inverse", "gaussian", NULL};
 static const char *const corrections[] = {"none", NULL};
+static const char *const dilatations[] = {"standard", "affine", NULL};
 
 typedef enum {
   INFLUENCE_CONSTANT,
@@ -29,10 +37,13 @@ typedef struct {
   PetscInt   n;
   PetscReal *m; /* weighted volume per particle of the local view */
   PetscReal *V; /* the particles' volumes (borrowed from the calibration data) */
+  PetscBool  affine;
+  PetscReal *Sinv; /* model.dilatation: affine: the inverse shape tensor per particle, dim x dim */
 } LPS;
 
 static const PeriKey lps_keys[] = {
     {"influence", PERI_KEY_CHOICE, "constant", NULL, NULL, influences, "influence function omega(|xi|): constant 1, inverse delta/|xi|, gaussian exp(-|xi|^2/delta^2)"},
+    {"dilatation", PERI_KEY_CHOICE, "standard", NULL, NULL, dilatations, "the dilatation of the bulk term: standard (d/m_i) sum omega |xi| e V (Silling et al.), affine the trace of the family's fitted deformation gradient (exact for affine fields at surfaces; assembled operator only)"},
     {NULL},
 };
 static const PeriSchema lps_schema[] = {{"model", lps_keys}, {NULL}};
@@ -45,6 +56,11 @@ static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetChoice(scene, node, "influence", influences, &k, NULL));
   lps->influence = (Influence)k;
+  k              = 0;
+  PetscCall(PeriSceneGetChoice(scene, node, "dilatation", dilatations, &k, NULL));
+  lps->affine           = (PetscBool)(k == 1);
+  m->nstates            = lps->affine ? 2 : 1;
+  m->states_along_bonds = (PetscBool)!lps->affine;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -65,6 +81,53 @@ static PetscReal Omega(PeriModel m, const PeriBondGeometry *b)
   if (lps->influence == INFLUENCE_INVERSE) return d / b->length;
   if (lps->influence == INFLUENCE_GAUSSIAN) return PetscExpReal(-PetscSqr(b->length / d));
   return 1;
+}
+
+/* Inverts the symmetric d x d matrix S in place (d = 2, 3) by its adjugate; false when it is
+ * singular relative to its size (a family whose bonds do not span the dimension). */
+static PetscBool InvertShape(PetscInt d, PetscReal S[])
+{
+  PetscReal a[9], det;
+  if (d == 2) {
+    det = S[0] * S[3] - S[1] * S[2];
+    if (!(PetscAbsReal(det) > 1e-12 * PetscSqr(S[0] + S[3]))) return PETSC_FALSE;
+    a[0] = S[3], a[1] = -S[1], a[2] = -S[2], a[3] = S[0];
+  } else {
+    a[0] = S[4] * S[8] - S[5] * S[7], a[1] = S[2] * S[7] - S[1] * S[8], a[2] = S[1] * S[5] - S[2] * S[4];
+    a[3] = S[5] * S[6] - S[3] * S[8], a[4] = S[0] * S[8] - S[2] * S[6], a[5] = S[2] * S[3] - S[0] * S[5];
+    a[6] = S[3] * S[7] - S[4] * S[6], a[7] = S[1] * S[6] - S[0] * S[7], a[8] = S[0] * S[4] - S[1] * S[3];
+    det = S[0] * a[0] + S[1] * a[3] + S[2] * a[6];
+    if (!(PetscAbsReal(det) > 1e-12 * PetscPowRealInt(S[0] + S[4] + S[8], 3))) return PETSC_FALSE;
+  }
+  for (PetscInt k = 0; k < d * d; k++) S[k] = a[k] / det;
+  return PETSC_TRUE;
+}
+
+/* model.dilatation: affine: S_i = sum_j omega alpha V_j xi xi^T over the actual family (a periodic
+ * self-image bond adds both of its images, +xi and -xi, through its two ends), then inverted. */
+static PetscErrorCode ShapeTensors(PeriModel m, const PeriCalibrationData *data)
+{
+  LPS             *lps = (LPS *)m->data;
+  const PeriBonds *bd  = data->bonds;
+  const PetscInt   d = m->dim, dd = d * d;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(lps->Sinv));
+  PetscCall(PetscCalloc1(data->n * dd, &lps->Sinv));
+  for (PetscInt i = bd->rstart; i < bd->rend; i++)
+    for (PetscInt k = bd->offset[i - bd->rstart]; k < bd->offset[i - bd->rstart + 1]; k++) {
+      PeriBondGeometry g  = {.i = i, .j = bd->j[k], .length = bd->length[k]};
+      const PetscReal *xi = bd->xi + 3 * k, w = Omega(m, &g) * bd->alpha[k];
+      for (PetscInt a = 0; a < d; a++)
+        for (PetscInt c = 0; c < d; c++) {
+          lps->Sinv[i * dd + a * d + c] += w * lps->V[g.j] * xi[a] * xi[c];
+          lps->Sinv[g.j * dd + a * d + c] += w * lps->V[i] * xi[a] * xi[c];
+        }
+    }
+  PetscCall(data->combine(data, MPIU_REAL, dd, MPI_SUM, lps->Sinv));
+  for (PetscInt i = 0; i < data->n; i++)
+    PetscCheck(InvertShape(d, lps->Sinv + i * dd) || i >= data->nowned, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "lps with model.dilatation: affine: the family of particle %" PetscInt_FMT " does not span the dimension (its bonds lie on a line or plane); use model.dilatation: standard or a larger horizon", i);
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* m_i over the rank's bonds, then summed over the ranks that hold each particle. A periodic
@@ -93,6 +156,7 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
     }
   PetscCall(data->combine(data, MPIU_REAL, 1, MPI_SUM, lps->m));
   for (PetscInt i = 0; i < data->nowned; i++) PetscCheck(lps->m[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "lps: particle %" PetscInt_FMT " has no neighbours, its weighted volume is 0 (is the horizon smaller than the spacing?)", i);
+  if (lps->affine) PetscCall(ShapeTensors(m, data));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -103,22 +167,36 @@ static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[]
   PeriCentralBondBlock(m, b, lps->b * Omega(m, b) * b->weight * b->Vi * b->Vj * (1 / lps->m[b->i] + 1 / lps->m[b->j]), Ke);
 }
 
-/* theta_i += (d omega |xi| alpha V_j / m_i) n . (u_j - u_i), and theta_j alike with V_i / m_j */
-static void BondState(PeriModel m, const PeriBondGeometry *b, PetscReal gi[], PetscReal gj[])
+/* State 0, the standard dilatation: theta_i += (d omega |xi| alpha V_j / m_i) n . (u_j - u_i), and
+ * theta_j alike with V_i / m_j. State 1 (affine): omega alpha V_j S_i^-1 xi, and V_i S_j^-1 xi. */
+static void BondState(PeriModel m, const PeriBondGeometry *b, PetscInt s, PetscReal gi[], PetscReal gj[])
 {
   const LPS      *lps = (const LPS *)m->data;
-  const PetscReal c   = m->dim * Omega(m, b) * b->length * b->weight;
+  const PetscInt  d = m->dim, dd = d * d;
+  const PetscReal w = Omega(m, b) * b->weight, c = d * w * b->length;
   for (PetscInt a = 0; a < m->dofs; a++) {
-    const PetscReal n = a < m->dim ? b->xi[a] / b->length : 0;
-    gi[a]             = c * b->Vj / lps->m[b->i] * n;
-    gj[a]             = c * b->Vi / lps->m[b->j] * n;
+    gi[a] = gj[a] = 0;
+    for (PetscInt e = 0; e < d && a < d; e++) {
+      if (s == 0 && e == a) {
+        gi[a] = c * b->Vj / lps->m[b->i] * b->xi[a] / b->length;
+        gj[a] = c * b->Vi / lps->m[b->j] * b->xi[a] / b->length;
+      }
+      if (s == 1) {
+        gi[a] += w * b->Vj * lps->Sinv[b->i * dd + a * d + e] * b->xi[e];
+        gj[a] += w * b->Vi * lps->Sinv[b->j * dd + a * d + e] * b->xi[e];
+      }
+    }
   }
 }
 
-static PetscReal StateModulus(PeriModel m, PetscInt i)
+/* standard: V_i (kappa - b/d^2) on theta; affine: -V_i b/d^2 on the standard theta, V_i kappa on
+ * the affine one */
+static PetscReal StateModulus(PeriModel m, PetscInt i, PetscInt s)
 {
-  const LPS *lps = (const LPS *)m->data;
-  return lps->V[i] * (lps->kappa - lps->b / (m->dim * m->dim));
+  const LPS      *lps = (const LPS *)m->data;
+  const PetscReal dev = lps->b / (m->dim * m->dim);
+  if (!lps->affine) return lps->V[i] * (lps->kappa - dev);
+  return s == 0 ? -lps->V[i] * dev : lps->V[i] * lps->kappa;
 }
 
 /* The critical stretch for the energy release rate G of the LPS with a constant influence
@@ -137,6 +215,7 @@ static PetscErrorCode Destroy(PeriModel m)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscFree(((LPS *)m->data)->m));
+  PetscCall(PetscFree(((LPS *)m->data)->Sinv));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -158,6 +237,8 @@ static PetscErrorCode PeriModelCreate_LPS(PeriModel m)
   m->ops.destroy         = Destroy;
   m->surface_corrections = corrections; /* m_i from the actual family is the model's own */
   m->takes_own_horizon   = PETSC_TRUE;
+  m->nstates             = 1;
+  m->states_along_bonds  = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -57,16 +57,16 @@ typedef struct {
      on its whole family fam[0..n-1] (all with fam[k].i == i): ((n+1) dofs)^2, row-major, the DOFs
      of i first, then those of fam[0], fam[1], ... */
   PetscErrorCode (*family_stiffness)(PeriModel, PetscInt, const PeriBondGeometry[], PetscReal[]);
-  /* Family models with a scalar state per particle (the LPS dilatation; models/lps.c), else NULL.
-     Their energy is the pair springs of bond_stiffness plus sum_i (1/2) A_i theta_i^2, where
-     theta_i = sum over i's live bonds of gi . (u_j - u_i) (each bond (i, j) adds gi to theta_i and
-     gj to theta_j, both times the same u_j - u_i). bond_state writes the bond's gi and gj (dofs
-     each); state_modulus returns A_i of local particle i (it may be negative: the springs keep the
-     whole positive). The system applies, assembles and breaks this term from these two kernels
-     (src/system/operator.c, assembly.c); a broken bond leaves both its spring and its share of
-     the states. */
-  void (*bond_state)(PeriModel, const PeriBondGeometry *, PetscReal[], PetscReal[]);
-  PetscReal (*state_modulus)(PeriModel, PetscInt);
+  /* Family models with scalar states per particle (the LPS dilatation; models/lps.c), else NULL.
+     Their energy is the pair springs of bond_stiffness plus sum_i sum_s (1/2) A_is theta_is^2,
+     s < nstates, where theta_is = sum over i's live bonds of gi_s . (u_j - u_i) (each bond (i, j)
+     adds gi_s to theta_is and gj_s to theta_js, both times the same u_j - u_i). bond_state writes
+     the bond's gi and gj of state s (dofs each); state_modulus returns A_is of local particle i
+     (it may be negative: the springs and the other states keep the whole positive). The system
+     applies, assembles and breaks these terms from the two kernels (src/system/operator.c,
+     assembly.c); a broken bond leaves its spring and its share of every state. */
+  void (*bond_state)(PeriModel, const PeriBondGeometry *, PetscInt, PetscReal[], PetscReal[]);
+  PetscReal (*state_modulus)(PeriModel, PetscInt, PetscInt);
   /* The critical value of the first measure (stretch, shear angle) of this bond for the energy
      release rate G: breaking every bond across a unit crack area releases G. May be NULL. */
   PetscReal (*critical_from_G)(PeriModel, const PeriBondGeometry *, PetscReal);
@@ -94,9 +94,11 @@ struct _p_PeriModel {
   PeriCalibrationKind calibration;              /* set before calibrate */
   char                warning[256];             /* set by calibration; printed once by the problem */
   PeriMaterial        material;
-  PetscReal           delta;             /* the horizon; with per-particle horizons, the largest */
-  const PetscReal    *horizon;           /* horizon.spacing: own: each particle's of the local view (b->i, b->j index it); else NULL */
-  PetscBool           takes_own_horizon; /* the model calibrates per particle, so it takes per-particle horizons */
+  PetscReal           delta;              /* the horizon; with per-particle horizons, the largest */
+  const PetscReal    *horizon;            /* horizon.spacing: own: each particle's of the local view (b->i, b->j index it); else NULL */
+  PetscBool           takes_own_horizon;  /* the model calibrates per particle, so it takes per-particle horizons */
+  PetscInt            nstates;            /* states per particle of ops.bond_state (set by the model, 1 or more) */
+  PetscBool           states_along_bonds; /* every state's weights lie along their bond: the matrix-free operator applies only these */
   void               *data;
   /* what each of the nmeasures bond measures is, in the order of measure_names: the failure
      criteria find theirs by kind (PeriModelMeasureIndex) */

@@ -83,17 +83,17 @@ static void RowAdd(PetscInt bs, PetscInt j, const PetscReal *B, PetscInt ld, Pet
     for (PetscInt c = 0; c < bs; c++) dst[a * bs + c] += B[a * ld + c];
 }
 
-/* The family block of a model with a per-particle state (ops.bond_state): A_i G G^T with
- * G = (-sum_t g_t, g_1, ..., g_n), g_t the weights of bond t toward theta_i. */
-static void StateFamilyBlock(PeriModel m, PetscInt n, const PeriBondGeometry fam[], PetscReal G[], PetscReal Ke[])
+/* The family block of state s of a model with per-particle states (ops.bond_state): A_is G G^T
+ * with G = (-sum_t g_t, g_1, ..., g_n), g_t the weights of bond t toward theta_is. */
+static void StateFamilyBlock(PeriModel m, PetscInt s, PetscInt n, const PeriBondGeometry fam[], PetscReal G[], PetscReal Ke[])
 {
   const PetscInt  bs = m->dofs, N = (n + 1) * bs;
-  const PetscReal A = n ? m->ops.state_modulus(m, fam[0].i) : 0;
+  const PetscReal A = n ? m->ops.state_modulus(m, fam[0].i, s) : 0;
   PetscReal       gj[PERI_MAX_DOF];
 
   for (PetscInt c = 0; c < bs; c++) G[c] = 0;
   for (PetscInt t = 0; t < n; t++) {
-    m->ops.bond_state(m, &fam[t], &G[(t + 1) * bs], gj);
+    m->ops.bond_state(m, &fam[t], s, &G[(t + 1) * bs], gj);
     for (PetscInt c = 0; c < bs; c++) G[c] -= G[(t + 1) * bs + c];
   }
   if (!Ke) return; /* the gradient only */
@@ -101,8 +101,9 @@ static void StateFamilyBlock(PeriModel m, PetscInt n, const PeriBondGeometry fam
     for (PetscInt c = 0; c < N; c++) Ke[a * N + c] = A * G[a] * G[c];
 }
 
-/* Visits the families of the owned particles (state-based models). */
-static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
+/* Visits the families of the owned particles (state-based models): their dense blocks, or the
+ * rank-one blocks of state s. */
+static PetscErrorCode FamiliesForEach(PeriSystem sys, PetscInt s, PeriElementFn fn, void *ctx)
 {
   PeriModel         m  = sys->model;
   const PetscInt    bs = m->dofs, nmax = PeriSystemMaxFamily(sys);
@@ -127,10 +128,10 @@ static PetscErrorCode FamiliesForEach(PeriSystem sys, PeriElementFn fn, void *ct
     if (m->ops.family_stiffness)
       PetscCall(m->ops.family_stiffness(m, n, fam, Ke));
     else {
-      StateFamilyBlock(m, n, fam, Ke, NULL);
+      StateFamilyBlock(m, s, n, fam, Ke, NULL);
       el.K = NULL;
       el.G = Ke;
-      el.A = n ? m->ops.state_modulus(m, i) : 0;
+      el.A = n ? m->ops.state_modulus(m, i, s) : 0;
     }
     idx[0] = i;
     for (PetscInt t = 0; t < n; t++) idx[t + 1] = fam[t].j;
@@ -211,10 +212,11 @@ PetscErrorCode PeriElementsForEach(PeriSystem sys, PeriElementFn fn, void *ctx)
 {
   PetscFunctionBeginUser;
   if (sys->model->ops.family_stiffness)
-    PetscCall(FamiliesForEach(sys, fn, ctx));
+    PetscCall(FamiliesForEach(sys, 0, fn, ctx));
   else
     PetscCall(BondsForEach(sys, fn, ctx));
-  if (sys->model->ops.bond_state) PetscCall(FamiliesForEach(sys, fn, ctx)); /* the springs, then the states */
+  if (sys->model->ops.bond_state) /* the springs, then the states */
+    for (PetscInt s = 0; s < sys->model->nstates; s++) PetscCall(FamiliesForEach(sys, s, fn, ctx));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -503,15 +505,38 @@ static PetscErrorCode AssembleBonds(PeriSystem sys, const BondFilter *f, Mat *K)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The rows of a family model's measures (the interaction terms as linear maps of the DOFs): one
- * per owned particle, its state's gradient G_q (StateFamilyBlock), and one per live bond of an
- * owned row, sqrt(k) n . (u_j - u_i) (the spring). K = B^T diag(A_q, 1) B. */
+/* Inserts the state rows of the owned particles from row r (nstates each: the gradients G_qs of
+ * StateFamilyBlock) and their moduli into d (the rows from row0); advances r. */
+static PetscErrorCode StateRows(PeriSystem sys, Mat B, PetscScalar d[], PetscInt row0, PetscInt *r, PeriBondGeometry fam[], PetscInt cols[], PetscReal vals[])
+{
+  PeriModel        m  = sys->model;
+  const PeriBonds *b  = &sys->disc.bonds;
+  const PetscInt   bs = m->dofs, *G = sys->disc.particles.global;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = b->rstart; i < b->rend; i++) {
+    PetscInt n;
+    PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
+    for (PetscInt t = 0; t <= n; t++)
+      for (PetscInt c = 0; c < bs; c++) cols[t * bs + c] = G[t ? fam[t - 1].j : i] * bs + c;
+    for (PetscInt s = 0; s < m->nstates; s++, (*r)++) {
+      StateFamilyBlock(m, s, n, fam, vals, NULL);
+      PetscCall(MatSetValues(B, 1, r, (n + 1) * bs, cols, vals, ADD_VALUES)); /* periodic images repeat a column */
+      d[*r - row0] = n ? m->ops.state_modulus(m, i, s) : 0;
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The rows of a family model's measures (the interaction terms as linear maps of the DOFs):
+ * nstates per owned particle, its states' gradients G_qs (StateFamilyBlock), and one per live bond
+ * of an owned row, sqrt(k) n . (u_j - u_i) (the spring). K = B^T diag(A_qs, 1) B. */
 static PetscErrorCode StateMeasures(PeriSystem sys, Mat *B, Vec *D)
 {
   PeriModel         m  = sys->model;
   const PeriBonds  *b  = &sys->disc.bonds;
   const PetscInt    bs = m->dofs, nown = b->rend - b->rstart, nmax = PeriSystemMaxFamily(sys), *G = sys->disc.particles.global;
-  PetscInt          nrow = nown, row0, *dnz, *onz, *cols, r = 0;
+  PetscInt          nrow = nown * m->nstates, row0, *dnz, *onz, *cols, r = 0;
   PetscReal        *vals, *work, Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
   PeriBondGeometry *fam, g;
   PetscScalar      *d;
@@ -527,6 +552,10 @@ static PetscErrorCode StateMeasures(PeriSystem sys, Mat *B, Vec *D)
     dnz[r] = bs;
     for (PetscInt t = 0; t < n; t++) dnz[r] += fam[t].j < sys->disc.nowned ? bs : 0;
     onz[r] = (n + 1) * bs - dnz[r];
+    for (PetscInt s = 1; s < m->nstates; s++, r++) {
+      dnz[r + 1] = dnz[r];
+      onz[r + 1] = onz[r];
+    }
     r++;
   }
   for (PetscInt i = b->rstart; i < b->rend; i++)
@@ -542,15 +571,7 @@ static PetscErrorCode StateMeasures(PeriSystem sys, Mat *B, Vec *D)
   PetscCall(MatGetOwnershipRange(*B, &row0, NULL));
   PetscCall(VecGetArray(*D, &d));
   r = row0;
-  for (PetscInt i = b->rstart; i < b->rend; i++, r++) {
-    PetscInt n;
-    PetscCall(PeriSystemFamilyGeometry(sys, i, &n, fam));
-    StateFamilyBlock(m, n, fam, vals, NULL);
-    for (PetscInt t = 0; t <= n; t++)
-      for (PetscInt c = 0; c < bs; c++) cols[t * bs + c] = G[t ? fam[t - 1].j : i] * bs + c;
-    PetscCall(MatSetValues(*B, 1, &r, (n + 1) * bs, cols, vals, ADD_VALUES)); /* periodic images repeat a column */
-    d[r - row0] = n ? m->ops.state_modulus(m, i) : 0;
-  }
+  PetscCall(StateRows(sys, *B, d, row0, &r, fam, cols, vals));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PetscReal kb = 0;

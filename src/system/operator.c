@@ -437,6 +437,7 @@ PetscErrorCode PeriOperatorCreateMat(PeriSystem sys, Mat *A)
 @*/
 const char *PeriOperatorWhyNotModel(PeriModel m)
 {
+  if (m->ops.bond_state && (m->nstates != 1 || !m->states_along_bonds)) return "the model's states are more than one per particle or not along the bonds (lps with model.dilatation: affine)";
   if (m->central_force) return NULL;
   if (!m->ops.bond_stiffness || m->ops.family_stiffness) return "the model has no per-bond blocks";
   if (m->dim == 2 && (m->dofs == 2 || m->dofs == 3)) return NULL;
@@ -528,7 +529,7 @@ static PetscErrorCode StateNumbers(PeriModel m, const PeriOperator op, const Per
   PetscReal gv[2][PERI_MAX_DOF], ww = 0;
 
   PetscFunctionBeginUser;
-  m->ops.bond_state(m, g, gv[0], gv[1]);
+  m->ops.bond_state(m, g, 0, gv[0], gv[1]);
   for (PetscInt d = 0; d < op->bs; d++) ww += w[d] * w[d];
   for (PetscInt e = 0; e < 2; e++) {
     PetscReal gw = 0, dev = 0, size = 0;
@@ -721,7 +722,7 @@ static PetscErrorCode SetUpStates(PeriSystem sys, PeriOperator op)
   PetscFunctionBeginUser;
   PetscCall(VecCreateGhost(sys->comm, op->nloc, PETSC_DECIDE, op->nghost, op->ghost, &op->theta));
   PetscCall(VecGetArrayWrite(op->theta, &w));
-  for (PetscInt i = 0; i < op->nloc; i++) w[i] = sys->model->ops.state_modulus(sys->model, i);
+  for (PetscInt i = 0; i < op->nloc; i++) w[i] = sys->model->ops.state_modulus(sys->model, i, 0);
   PetscCall(VecRestoreArrayWrite(op->theta, &w));
   PetscCall(VecGhostUpdateBegin(op->theta, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGhostUpdateEnd(op->theta, INSERT_VALUES, SCATTER_FORWARD));
@@ -768,7 +769,7 @@ static PetscErrorCode AddStateExpansion(PeriSystem sys, PeriOperator op, PetscRe
       t++;
     }
   PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_SUM, theta));
-  for (PetscInt i = 0; i < disc->nowned; i++) full[i] = PetscMax(full[i] + 2 * sys->model->ops.state_modulus(sys->model, i) * PetscSqr(theta[i]), 0);
+  for (PetscInt i = 0; i < disc->nowned; i++) full[i] = PetscMax(full[i] + 2 * sys->model->ops.state_modulus(sys->model, i, 0) * PetscSqr(theta[i]), 0);
   PetscCall(PetscFree(theta));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -21,7 +21,8 @@
  *      In 2D the lattice promise is also checked at m = 2 and 4 (on a 23 x 23 patch: two search
  *      radii at m = 4 are 9 spacings), energy only.
  *
- * usage: test_model_contract tests/scenes/contract_2d.yaml tests/scenes/contract_3d.yaml */
+ * usage: test_model_contract tests/scenes/contract_2d.yaml tests/scenes/contract_3d.yaml
+ *        [-contract_types lps -model_dilatation affine]: only the types listed, with a key of theirs */
 #include "testing.h"
 #include <slepcds.h>
 
@@ -354,6 +355,8 @@ int main(int argc, char **argv)
   PetscCheck(argc >= 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_model_contract contract_2d.yaml contract_3d.yaml");
   PetscCall(PeriInitializePackage());
   PetscCall(PeriModelListTypes(list, sizeof(list)));
+  /* -contract_types a,b: those types only, e.g. with a model key of theirs among the options */
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-contract_types", list, sizeof(list), NULL));
   PetscCall(PetscStrlen(list, &len));
   PetscCheck(len + 1 < sizeof(list), PETSC_COMM_WORLD, PETSC_ERR_PLIB, "the list of model types is too long for this test's buffer");
   for (size_t k = 0; k < len; k++)
