@@ -19,7 +19,15 @@ static const PeriKey grid_keys[] = {
     {"upper", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "the box's upper corner, dim numbers, above lower on every axis"},
     {"spacing", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "particle spacing dx: every box length a whole number of spacings"},
     {"periodic", PERI_KEY_BOOLS, "all false", NULL, NULL, NULL, "dim booleans: the periodic axes (minimum image)"},
+    {"holes", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "holes cut out of the grid: the cells whose centre lies inside a circle (2D), a cylinder or a sphere (3D) are left out"},
     {NULL},
+};
+static const char *const hole_axes[] = {"x", "y", "z", "none", NULL};
+static const PeriKey     hole_keys[] = {
+        {"center", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "a point on the hole's axis (its centre), dim numbers"},
+        {"radius", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "the hole's radius: cells closer to the axis (to the centre for a sphere) are left out"},
+        {"axis", PERI_KEY_CHOICE, "z", NULL, NULL, hole_axes, "3D: the cylinder's axis, or none for a sphere"},
+        {NULL},
 };
 static const PeriKey particles_keys[] = {
     {"file", PERI_KEY_STRING, NULL, NULL, NULL, NULL, "CSV file of x, y[, z], volume[, material] (relative to the scene file), instead of grid; give file or mesh"},
@@ -32,6 +40,7 @@ static const PeriKey particles_keys[] = {
 };
 const PeriSchema PeriParticlesSchema[] = {
     {"grid", grid_keys},
+    {"grid.holes.<k>", hole_keys},
     {"particles", particles_keys},
     {NULL},
 };
@@ -62,6 +71,58 @@ void PeriParticlesPeriodicBox(PeriParticles *p, const PetscReal box[6])
       p->lower[d] = box[d];
       p->upper[d] = box[3 + d];
     }
+}
+
+#define PERI_MAX_HOLES 64
+
+/* grid.holes: the cells left out of the grid */
+typedef struct {
+  PetscInt  n;
+  PetscReal c[PERI_MAX_HOLES][3], r2[PERI_MAX_HOLES];
+  PetscInt  axis[PERI_MAX_HOLES]; /* 0, 1, 2, or -1 for a sphere (and in 2D, where z is 0) */
+} GridHoles;
+
+/* Reads grid.holes into holes. */
+static PetscErrorCode HolesParse(PeriScene scene, PeriNode grid, PetscInt dim, GridHoles *holes)
+{
+  PeriNode list;
+
+  PetscFunctionBeginUser;
+  holes->n = 0;
+  PetscCall(PeriSceneGetNode(grid, "holes", &list));
+  if (!list) PetscFunctionReturn(PETSC_SUCCESS);
+  PeriInputCheck(list->kind == PERI_NODE_SEQ && list->n <= PERI_MAX_HOLES, scene, grid, "holes", "a list of at most %d holes [{center: [..], radius: r}, ..]", PERI_MAX_HOLES);
+  for (PetscInt k = 0; k < list->n; k++) {
+    PeriNode  item = list->child[k];
+    PeriNode  given;
+    PetscReal r;
+    PetscInt  n, axis = 2;
+    PeriInputCheck(item->kind == PERI_NODE_MAP, scene, item, NULL, "a hole is {center: [..], radius: r(, axis: x|y|z|none)}");
+    PetscCall(PeriSceneCheckSection(scene, item, "grid.holes.<k>"));
+    for (PetscInt d = 0; d < 3; d++) holes->c[k][d] = 0;
+    PetscCall(PeriSceneGetRealArray(scene, item, "center", PETSC_TRUE, dim, dim, holes->c[k], &n));
+    PetscCall(PeriSceneGetReal(scene, item, "radius", PETSC_TRUE, &r, NULL));
+    PetscCall(PeriSceneGetNode(item, "axis", &given));
+    PeriInputCheck(dim == 3 || !given, scene, item, "axis", "is for 3D grids only (a 2D hole is a circle)");
+    PetscCall(PeriSceneGetChoice(scene, item, "axis", hole_axes, &axis, NULL));
+    holes->r2[k]   = r * r;
+    holes->axis[k] = dim == 2 ? 2 : axis == 3 ? -1
+                                              : axis;
+  }
+  holes->n = list->n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The hole that holds x, or -1. */
+static PetscInt HoleAt(const GridHoles *holes, const PetscReal x[])
+{
+  for (PetscInt k = 0; k < holes->n; k++) {
+    PetscReal d2 = 0;
+    for (PetscInt d = 0; d < 3; d++)
+      if (d != holes->axis[k]) d2 += PetscSqr(x[d] - holes->c[k][d]);
+    if (d2 < holes->r2[k]) return k;
+  }
+  return -1;
 }
 
 /* Reads grid.*: the box into p, the cells per axis and the spacing. */
@@ -103,37 +164,82 @@ static PetscErrorCode GridParse(PeriScene scene, PeriNode grid, PetscInt dim, Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The grid's cells kstart..kend-1 (x fastest), one particle at each centre. */
-static PetscErrorCode GridFill(PeriParticles *p, const PetscInt cells[3], PetscReal h, PetscInt kstart, PetscInt kend)
+/* The centre of cell k (x fastest). */
+static inline void CellCentre(const PeriParticles *p, const PetscInt cells[3], PetscReal h, PetscInt k, PetscReal x[3])
+{
+  const PetscInt c[3] = {k % cells[0], (k / cells[0]) % cells[1], k / (cells[0] * cells[1])};
+  for (PetscInt d = 0; d < 3; d++) x[d] = d < p->dim ? p->lower[d] + (c[d] + 0.5) * h : 0;
+}
+
+/* The grid's cells kstart..kend-1 (x fastest) outside the holes, one particle at each centre. */
+static PetscErrorCode GridFill(PeriParticles *p, const PetscInt cells[3], PetscReal h, const GridHoles *holes, PetscInt kstart, PetscInt kend)
 {
   const PetscReal cellvol = p->dim == 3 ? h * h * h : h * h * p->thickness;
+  PetscInt        n = 0, l = 0;
+  PetscReal       x[3];
 
   PetscFunctionBeginUser;
-  PetscCall(PeriParticlesAllocate(p, kend - kstart));
   for (PetscInt k = kstart; k < kend; k++) {
-    const PetscInt c[3] = {k % cells[0], (k / cells[0]) % cells[1], k / (cells[0] * cells[1])}, l = k - kstart;
-    for (PetscInt d = 0; d < p->dim; d++) p->x[3 * l + d] = p->lower[d] + (c[d] + 0.5) * h;
+    CellCentre(p, cells, h, k, x);
+    n += HoleAt(holes, x) < 0;
+  }
+  PetscCall(PeriParticlesAllocate(p, n));
+  for (PetscInt k = kstart; k < kend; k++) {
+    CellCentre(p, cells, h, k, x);
+    if (HoleAt(holes, x) >= 0) continue;
+    for (PetscInt d = 0; d < p->dim; d++) p->x[3 * l + d] = x[d];
     p->volume[l]      = cellvol;
     p->spacing[l]     = h;
     p->source_line[l] = 0;
+    l++;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The grid's count of particles, N cells less those in the holes; an input error for a hole that
+ * takes no cell or every one. */
+static PetscErrorCode GridCount(PeriScene scene, PeriNode grid, const PeriParticles *p, const PetscInt cells[3], PetscReal h, const GridHoles *holes, PetscInt *N)
+{
+  PetscInt  taken[PERI_MAX_HOLES] = {0}, left = 0;
+  PetscReal x[3];
+  PeriNode  list;
+
+  PetscFunctionBeginUser;
+  if (!holes->n) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; k < *N; k++) {
+    PetscInt hole;
+    CellCentre(p, cells, h, k, x);
+    hole = HoleAt(holes, x);
+    if (hole >= 0)
+      taken[hole]++;
+    else
+      left++;
+  }
+  PetscCall(PeriSceneGetNode(grid, "holes", &list));
+  for (PetscInt k = 0; k < holes->n; k++) PeriInputCheck(taken[k] > 0, scene, list->child[k], "radius", "the hole takes no particle: no cell centre lies inside it that an earlier hole did not take (outside the body, smaller than a cell, or inside another hole)");
+  PeriInputCheck(left > 0, scene, grid, "holes", "the holes take every particle of the grid");
+  *N = left;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
-  PeriGridCreate - the grid's particles (grid.*): of its *N cells in x-fastest order, the share
-  floor(rank N / size) .. floor((rank + 1) N / size) - 1; p's box, periodic axes and spacing are
-  the whole grid's. Not collective.
+  PeriGridCreate - the grid's particles (grid.*): of its N cells in x-fastest order, those of the
+  share floor(rank N / size) .. floor((rank + 1) N / size) - 1 that lie outside grid.holes; *N is
+  the whole body's count (every rank counts the holes' cells); p's box, periodic axes and spacing
+  are the whole grid's. Not collective.
 @*/
 PetscErrorCode PeriGridCreate(PeriScene scene, PeriNode grid, PetscInt dim, PetscMPIInt rank, PetscMPIInt size, PeriParticles *p, PetscInt *N)
 {
-  PetscInt  cells[3];
+  PetscInt  cells[3], ncells;
   PetscReal h;
+  GridHoles holes;
 
   PetscFunctionBeginUser;
   PetscCall(GridParse(scene, grid, dim, p, cells, &h));
-  *N = cells[0] * cells[1] * cells[2];
-  PetscCall(GridFill(p, cells, h, (PetscInt)((PetscInt64)*N * rank / size), (PetscInt)((PetscInt64)*N * (rank + 1) / size)));
+  PetscCall(HolesParse(scene, grid, dim, &holes));
+  *N = ncells = cells[0] * cells[1] * cells[2];
+  PetscCall(GridCount(scene, grid, p, cells, h, &holes, N));
+  PetscCall(GridFill(p, cells, h, &holes, (PetscInt)((PetscInt64)ncells * rank / size), (PetscInt)((PetscInt64)ncells * (rank + 1) / size)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -60,15 +60,16 @@ static const char *WhyNot(PeriSystem sys)
 
 /*@C
   PeriMultigridWhyNotBody - why the body cannot have the geometric multigrid's levels (not from a
-  grid, periodic, per-particle horizons), or NULL; the operator is not looked at. Not collective.
+  grid, a grid with holes, periodic, per-particle horizons), or NULL; the operator is not looked at. Not collective.
 @*/
 const char *PeriMultigridWhyNotBody(PeriSystem sys)
 {
-  PeriNode grid = NULL;
+  PeriNode grid = NULL, holes = NULL;
   PetscInt most, take;
 
   (void)PeriSceneGetNode(sys->scene->root, "grid", &grid); /* the scene was read: no error here */
   if (!grid) return "the body does not come from a grid (its coarse levels are the grid at twice the spacing)";
+  if (PeriSceneGetNode(grid, "holes", &holes) == PETSC_SUCCESS && holes) return "the grid has holes (a coarse level's cell at a hole's edge may hold no particle)";
   for (PetscInt d = 0; d < 3; d++)
     if (sys->disc.particles.periodic[d]) return "the body is periodic";
   if (sys->disc.horizon_m > 0 || sys->disc.horizon_k > 0) return "the particles have their own horizons";

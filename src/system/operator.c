@@ -38,12 +38,16 @@ struct _p_PeriOperator {
   PetscReal *w;   /* nw per bond: sqrt(k) e; A (xx, xy, yy); A, c (x, y), a, b */
   PetscInt  *ghost;
   PetscInt  *slot; /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
-  /* The state term of family models (ops.bond_state; the LPS dilatation), else NULL: per bond the
-     weights toward theta_i and theta_j as multiples p of w (2 numbers: they are parallel to the
-     bond), per particle of the operator's local numbering the modulus A_i. A broken bond's w = 0
-     takes it out of both terms at once. */
+  /* The state terms of family models (ops.bond_state; the LPS dilatation), else NULL: per bond the
+     weights toward theta_i and theta_j, as multiples p of w (2 numbers, one state along the
+     bond), or as vectors (pvec: 2 ns bs numbers), per particle and state of the operator's local
+     numbering the modulus A. A broken bond's w = 0 (and its vectors' 0) takes it out of both
+     terms at once. */
   PetscReal     *p, *A;
-  Vec            theta;       /* ghosted, one per particle: the states, then A theta */
+  PetscInt       ns;          /* states per particle (the model's nstates) */
+  PetscBool      pvec;        /* p holds the weights as vectors (bs numbers per end and state; states off the bond), not as multiples of w */
+  Vec            theta;       /* ghosted, ns per particle: the states, then A theta */
+  Vec            sg;          /* ghosted scratch, ns bs per particle: each state's own gradient (StateOwnGradients) */
   PeriShortRange short_range; /* the preconditioning matrix's bonds and their scales */
   Vec            xm, ym;      /* ghosted work vectors: the input with held DOFs zeroed, and K of it */
   Vec            kdiag;       /* the diagonal of K */
@@ -171,6 +175,51 @@ static inline void SpringStateLoop(const PeriOperator op, const PetscInt bs, con
   }
 }
 
+/* Weight d of state s toward theta_i (side 0) or theta_j (side 1) of stored bond b. */
+static inline PetscReal StateWeight(const PeriOperator op, PetscInt b, PetscInt s, PetscInt side, PetscInt d)
+{
+  if (op->pvec) return op->p[((b * op->ns + s) * 2 + side) * op->bs + d];
+  return op->p[2 * b + side] * op->w[op->bs * b + d];
+}
+
+/* The first pass with the weights as vectors: theta_is += gi_s . (u_j - u_i), theta_js alike. */
+static void VecStateLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *th)
+{
+  const PetscInt bs = op->bs, ns = op->ns;
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal *g = op->p + 2 * ns * bs * b;
+      const PetscInt   j = op->jl[b];
+      for (PetscInt s = 0; s < ns; s++, g += 2 * bs)
+        for (PetscInt d = 0; d < bs; d++) {
+          const PetscScalar t = x[bs * j + d] - x[bs * i + d];
+          th[ns * i + s] += g[d] * t;
+          th[ns * j + s] += g[bs + d] * t;
+        }
+    }
+}
+
+/* The second pass with the weights as vectors: the spring's force along w plus
+ * sum_s (q_is gi_s + q_js gj_s), on j, and its opposite on i. */
+static void VecSpringStateLoop(const PeriOperator op, const PetscScalar *x, const PetscScalar *q, PetscScalar *y)
+{
+  const PetscInt bs = op->bs, ns = op->ns;
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscReal *w = op->w + bs * b, *g = op->p + 2 * ns * bs * b;
+      const PetscInt   j = op->jl[b];
+      PetscScalar      t = 0, v[PERI_MAX_DOF];
+      for (PetscInt d = 0; d < bs; d++) t += w[d] * (x[bs * j + d] - x[bs * i + d]);
+      for (PetscInt d = 0; d < bs; d++) v[d] = t * w[d];
+      for (PetscInt s = 0; s < ns; s++, g += 2 * bs)
+        for (PetscInt d = 0; d < bs; d++) v[d] += q[ns * i + s] * g[d] + q[ns * j + s] * g[bs + d];
+      for (PetscInt d = 0; d < bs; d++) {
+        y[bs * i + d] -= v[d];
+        y[bs * j + d] += v[d];
+      }
+    }
+}
+
 /* The two passes of a family model's product, with the states' ghost exchange between them:
  * every bond is stored once, so an owned state sums the contributions of every rank that holds
  * one of its bonds (reverse), and the ghosts then get their owners' sums (forward). */
@@ -183,7 +232,9 @@ static PetscErrorCode StateProduct(const PeriOperator op, const PetscScalar *x, 
   PetscCall(VecGhostGetLocalForm(op->theta, &tl));
   PetscCall(VecSet(tl, 0));
   PetscCall(VecGetArray(tl, &th));
-  if (op->bs == 3)
+  if (op->pvec)
+    VecStateLoop(op, x, th);
+  else if (op->bs == 3)
     StateLoop(op, 3, x, th);
   else
     StateLoop(op, op->bs, x, th);
@@ -195,8 +246,10 @@ static PetscErrorCode StateProduct(const PeriOperator op, const PetscScalar *x, 
   PetscCall(VecGhostUpdateEnd(op->theta, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGhostGetLocalForm(op->theta, &tl));
   PetscCall(VecGetArray(tl, &th));
-  for (PetscInt i = 0; i < op->nloc + op->nghost; i++) th[i] *= op->A[i];
-  if (op->bs == 3)
+  for (PetscInt i = 0; i < (op->nloc + op->nghost) * op->ns; i++) th[i] *= op->A[i];
+  if (op->pvec)
+    VecSpringStateLoop(op, x, th, y);
+  else if (op->bs == 3)
     SpringStateLoop(op, 3, x, th, y);
   else
     SpringStateLoop(op, op->bs, x, th, y);
@@ -224,6 +277,7 @@ static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y
 static PetscReal FormFlops(const PeriOperator op)
 {
   return op->form == FORM_MICROPOLAR ? 32 : op->form == FORM_SHEAR ? 14
+                                        : op->pvec                 ? (6.0 + 8.0 * op->ns) * op->bs
                                         : op->p                    ? 10.0 * op->bs + 8
                                                                    : 6.0 * op->bs;
 }
@@ -437,7 +491,6 @@ PetscErrorCode PeriOperatorCreateMat(PeriSystem sys, Mat *A)
 @*/
 const char *PeriOperatorWhyNotModel(PeriModel m)
 {
-  if (m->ops.bond_state && (m->nstates != 1 || !m->states_along_bonds)) return "the model's states are more than one per particle or not along the bonds (lps with model.dilatation: affine)";
   if (m->central_force) return NULL;
   if (!m->ops.bond_stiffness || m->ops.family_stiffness) return "the model has no per-bond blocks";
   if (m->dim == 2 && (m->dofs == 2 || m->dofs == 3)) return NULL;
@@ -522,13 +575,17 @@ static PetscErrorCode BondNumbers(PeriModel m, const PeriOperator op, const Peri
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The bond's state weights gi, gj (ops.bond_state) as multiples of its numbers w (the central
- * form): an error when they are not parallel to it. */
+/* The bond's state weights gi, gj (ops.bond_state): as vectors (pvec), or as multiples of its
+ * numbers w (the central form), an error when they are not parallel to it. */
 static PetscErrorCode StateNumbers(PeriModel m, const PeriOperator op, const PeriBondGeometry *g, const PetscReal w[], PetscReal p[])
 {
   PetscReal gv[2][PERI_MAX_DOF], ww = 0;
 
   PetscFunctionBeginUser;
+  if (op->pvec) {
+    for (PetscInt s = 0; s < op->ns; s++) m->ops.bond_state(m, g, s, p + 2 * s * op->bs, p + (2 * s + 1) * op->bs);
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   m->ops.bond_state(m, g, 0, gv[0], gv[1]);
   for (PetscInt d = 0; d < op->bs; d++) ww += w[d] * w[d];
   for (PetscInt e = 0; e < 2; e++) {
@@ -565,7 +622,11 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->nw, &op->w));
   PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
   if (sys->bond_state.failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
-  if (m->ops.bond_state) PetscCall(PetscMalloc1(2 * b->nbonds, &op->p));
+  if (m->ops.bond_state) {
+    op->ns   = m->nstates;
+    op->pvec = (PetscBool)(m->nstates != 1 || !m->states_along_bonds);
+    PetscCall(PetscMalloc1((op->pvec ? 2 * op->ns * op->bs : 2) * b->nbonds, &op->p));
+  }
   op->nghost = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     op->ptr[i - b->rstart] = nb;
@@ -576,7 +637,7 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
       PetscCall(BondNumbers(m, op, &g, Ke, op->w + nb * op->nw));
-      if (op->p) PetscCall(StateNumbers(m, op, &g, op->w + nb * op->nw, op->p + 2 * nb));
+      if (op->p) PetscCall(StateNumbers(m, op, &g, op->w + nb * op->nw, op->p + (op->pvec ? 2 * op->ns * op->bs : 2) * nb));
       if (g.j < sys->disc.nowned)
         op->jl[nb] = g.j;
       else { /* for now -1 - its global index: numbered below, as the ghosted vectors number them */
@@ -621,18 +682,18 @@ static PetscErrorCode GhostSum(Vec v)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Each particle's own state gradient S_p = d theta_p / d u_p = sum of -p_i w (bonds stored at p)
- * and +p_j w (bonds toward p), bs per particle in xm's local form, summed over the ranks and copied
- * to the ghosts; with T (theta's local form) also sum |p w_d| over p's bonds, ||G_p||_1 without
- * S_p's own share. Scratch use of xm and theta. Collective. */
+/* Each particle's own state gradients S_ps = d theta_ps / d u_p = sum of -gi_s (bonds stored at
+ * p) and +gj_s (bonds toward p), ns bs per particle in sg's local form, summed over the ranks and
+ * copied to the ghosts; with T (theta's local form) also sum_d |g_sd| over p's bonds per state,
+ * ||G_ps||_1 without S_ps's own share. Scratch use of sg and theta. Collective. */
 static PetscErrorCode StateOwnGradients(PeriOperator op, PetscBool abs_sums)
 {
-  const PetscInt bs = op->bs;
+  const PetscInt bs = op->bs, ns = op->ns;
   Vec            sl, tl;
   PetscScalar   *S, *T;
 
   PetscFunctionBeginUser;
-  PetscCall(VecGhostGetLocalForm(op->xm, &sl));
+  PetscCall(VecGhostGetLocalForm(op->sg, &sl));
   PetscCall(VecGhostGetLocalForm(op->theta, &tl));
   PetscCall(VecSet(sl, 0));
   PetscCall(VecSet(tl, 0));
@@ -640,44 +701,46 @@ static PetscErrorCode StateOwnGradients(PeriOperator op, PetscBool abs_sums)
   PetscCall(VecGetArray(tl, &T));
   for (PetscInt i = 0; i < op->nloc; i++)
     for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
-      const PetscReal *w = op->w + bs * b, pi = op->p[2 * b], pj = op->p[2 * b + 1];
-      const PetscInt   j = op->jl[b];
-      for (PetscInt d = 0; d < bs; d++) {
-        S[bs * i + d] -= pi * w[d];
-        S[bs * j + d] += pj * w[d];
-        T[i] += PetscAbsReal(pi * w[d]);
-        T[j] += PetscAbsReal(pj * w[d]);
-      }
+      const PetscInt j = op->jl[b];
+      for (PetscInt s = 0; s < ns; s++)
+        for (PetscInt d = 0; d < bs; d++) {
+          const PetscReal gi = StateWeight(op, b, s, 0, d), gj = StateWeight(op, b, s, 1, d);
+          S[(ns * i + s) * bs + d] -= gi;
+          S[(ns * j + s) * bs + d] += gj;
+          T[ns * i + s] += PetscAbsReal(gi);
+          T[ns * j + s] += PetscAbsReal(gj);
+        }
     }
   PetscCall(VecRestoreArray(tl, &T));
   PetscCall(VecRestoreArray(sl, &S));
   PetscCall(VecGhostRestoreLocalForm(op->theta, &tl));
-  PetscCall(VecGhostRestoreLocalForm(op->xm, &sl));
-  PetscCall(GhostSum(op->xm));
+  PetscCall(VecGhostRestoreLocalForm(op->sg, &sl));
+  PetscCall(GhostSum(op->sg));
   if (abs_sums) PetscCall(GhostSum(op->theta));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The state term's diagonal, added to ya (the local form of ym): sum_q A_q (d theta_q / d u_p)^2:
- * a bond (i, j) adds p_i w to theta_i's gradient at j and p_j w to theta_j's at i; a particle's
- * own gradient is S_p (StateOwnGradients). Collective. */
+/* The state terms' diagonal, added to ya (the local form of ym): sum_q,s A_qs (d theta_qs / d u_p)^2:
+ * a bond (i, j) adds gi_s to theta_is's gradient at j and gj_s to theta_js's at i; a particle's
+ * own gradients are S_ps (StateOwnGradients). Collective. */
 static PetscErrorCode StateDiagonal(PeriOperator op, PetscScalar *ya)
 {
-  const PetscInt bs = op->bs;
+  const PetscInt bs = op->bs, ns = op->ns;
   PetscScalar   *S;
 
   PetscFunctionBeginUser;
   PetscCall(StateOwnGradients(op, PETSC_FALSE));
-  PetscCall(VecGetArray(op->xm, &S));
-  for (PetscInt i = 0; i < op->nloc; i++) {
-    for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += op->A[i] * PetscSqr(S[bs * i + d]);
-    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++)
-      for (PetscInt d = 0; d < bs; d++) {
-        ya[bs * op->jl[b] + d] += op->A[i] * PetscSqr(op->p[2 * b] * op->w[bs * b + d]);
-        ya[bs * i + d] += op->A[op->jl[b]] * PetscSqr(op->p[2 * b + 1] * op->w[bs * b + d]);
-      }
-  }
-  PetscCall(VecRestoreArray(op->xm, &S));
+  PetscCall(VecGetArray(op->sg, &S));
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt s = 0; s < ns; s++) {
+      for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += op->A[ns * i + s] * PetscSqr(S[(ns * i + s) * bs + d]);
+      for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++)
+        for (PetscInt d = 0; d < bs; d++) {
+          ya[bs * op->jl[b] + d] += op->A[ns * i + s] * PetscSqr(StateWeight(op, b, s, 0, d));
+          ya[bs * i + d] += op->A[ns * op->jl[b] + s] * PetscSqr(StateWeight(op, b, s, 1, d));
+        }
+    }
+  PetscCall(VecRestoreArray(op->sg, &S));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -711,25 +774,28 @@ static PetscErrorCode ComputeDiagonal(PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The state term's ghosted states and its moduli A on the operator's local numbering (the
- * ghosts' from their owners). */
+/* The state terms' ghosted states (ns per particle), their scratch sg and their moduli A on the
+ * operator's local numbering (the ghosts' from their owners). */
 static PetscErrorCode SetUpStates(PeriSystem sys, PeriOperator op)
 {
+  const PetscInt     ns = op->ns;
   Vec                al;
   const PetscScalar *a;
   PetscScalar       *w;
 
   PetscFunctionBeginUser;
-  PetscCall(VecCreateGhost(sys->comm, op->nloc, PETSC_DECIDE, op->nghost, op->ghost, &op->theta));
+  PetscCall(VecCreateGhostBlock(sys->comm, ns, op->nloc * ns, PETSC_DECIDE, op->nghost, op->ghost, &op->theta));
+  PetscCall(VecCreateGhostBlock(sys->comm, ns * op->bs, op->nloc * ns * op->bs, PETSC_DECIDE, op->nghost, op->ghost, &op->sg));
   PetscCall(VecGetArrayWrite(op->theta, &w));
-  for (PetscInt i = 0; i < op->nloc; i++) w[i] = sys->model->ops.state_modulus(sys->model, i, 0);
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt s = 0; s < ns; s++) w[ns * i + s] = sys->model->ops.state_modulus(sys->model, i, s);
   PetscCall(VecRestoreArrayWrite(op->theta, &w));
   PetscCall(VecGhostUpdateBegin(op->theta, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGhostUpdateEnd(op->theta, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(PetscMalloc1(op->nloc + op->nghost, &op->A));
+  PetscCall(PetscMalloc1((op->nloc + op->nghost) * ns, &op->A));
   PetscCall(VecGhostGetLocalForm(op->theta, &al));
   PetscCall(VecGetArrayRead(al, &a));
-  for (PetscInt i = 0; i < op->nloc + op->nghost; i++) op->A[i] = PetscRealPart(a[i]);
+  for (PetscInt i = 0; i < (op->nloc + op->nghost) * ns; i++) op->A[i] = PetscRealPart(a[i]);
   PetscCall(VecRestoreArrayRead(al, &a));
   PetscCall(VecGhostRestoreLocalForm(op->theta, &al));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -747,29 +813,34 @@ static PetscErrorCode SetUpGhosts(PeriSystem sys, PeriOperator op)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Adds to each owned particle's full the state term's energy of the uniform expansion u = X on
- * the springs' scale (where a spring's k |xi|^2 is twice its energy at each end): 2 A_i theta_i^2,
- * so that the scaled short-range springs store the whole K's energy of it. Collective. */
+/* Adds to each owned particle's full the state terms' energy of the uniform expansion u = X on
+ * the springs' scale (where a spring's k |xi|^2 is twice its energy at each end): 2 sum_s A_is
+ * theta_is^2, so that the scaled short-range springs store the whole K's energy of it. Collective. */
 static PetscErrorCode AddStateExpansion(PeriSystem sys, PeriOperator op, PetscReal full[])
 {
   const PeriDisc  *disc = &sys->disc;
   const PeriBonds *b    = &disc->bonds;
+  const PetscInt   ns   = op->ns;
   PetscReal       *theta;
   PetscInt         t = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc1(disc->particles.n, &theta));
+  PetscCall(PetscCalloc1(disc->particles.n * ns, &theta));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscReal s = 0;
       if (!OperatorBond(b, i, k)) continue;
-      for (PetscInt d = 0; d < op->bs; d++) s += op->w[op->nw * t + d] * b->xi[3 * k + d];
-      theta[i] += op->p[2 * t] * s;
-      theta[b->j[k]] += op->p[2 * t + 1] * s;
+      for (PetscInt s = 0; s < ns; s++)
+        for (PetscInt d = 0; d < op->bs; d++) {
+          theta[ns * i + s] += StateWeight(op, t, s, 0, d) * b->xi[3 * k + d];
+          theta[ns * b->j[k] + s] += StateWeight(op, t, s, 1, d) * b->xi[3 * k + d];
+        }
       t++;
     }
-  PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, 1, MPI_SUM, theta));
-  for (PetscInt i = 0; i < disc->nowned; i++) full[i] = PetscMax(full[i] + 2 * sys->model->ops.state_modulus(sys->model, i, 0) * PetscSqr(theta[i]), 0);
+  PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, ns, MPI_SUM, theta));
+  for (PetscInt i = 0; i < disc->nowned; i++) {
+    for (PetscInt s = 0; s < ns; s++) full[i] += 2 * sys->model->ops.state_modulus(sys->model, i, s) * PetscSqr(theta[ns * i + s]);
+    full[i] = PetscMax(full[i], 0);
+  }
   PetscCall(PetscFree(theta));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -973,37 +1044,38 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The state term's share of the absolute row sums of K, from above: sum_q |A_q| |G_q,r| ||G_q||_1
- * with G_q the gradient of theta_q (StateDiagonal). Adds to ya (ym's local form, reduced by the
- * caller). Uses xm and theta as scratch. Collective. */
+/* The state terms' share of the absolute row sums of K, from above: sum_q,s |A_qs| |G_qs,r|
+ * ||G_qs||_1 with G_qs the gradient of theta_qs (StateDiagonal). Adds to ya (ym's local form,
+ * reduced by the caller). Uses sg and theta as scratch. Collective. */
 static PetscErrorCode StateRowSums(PeriOperator op, PetscScalar *ya)
 {
-  const PetscInt bs = op->bs;
+  const PetscInt bs = op->bs, ns = op->ns;
   Vec            sl, tl;
   PetscScalar   *S, *T;
 
   PetscFunctionBeginUser;
   PetscCall(StateOwnGradients(op, PETSC_TRUE));
-  PetscCall(VecGhostGetLocalForm(op->xm, &sl));
+  PetscCall(VecGhostGetLocalForm(op->sg, &sl));
   PetscCall(VecGhostGetLocalForm(op->theta, &tl));
   PetscCall(VecGetArray(sl, &S));
   PetscCall(VecGetArray(tl, &T));
-  for (PetscInt i = 0; i < op->nloc + op->nghost; i++) { /* T becomes |A| ||G||_1 */
-    for (PetscInt d = 0; d < bs; d++) T[i] += PetscAbsScalar(S[bs * i + d]);
-    T[i] *= PetscAbsReal(op->A[i]);
+  for (PetscInt q = 0; q < (op->nloc + op->nghost) * ns; q++) { /* T becomes |A| ||G||_1 */
+    for (PetscInt d = 0; d < bs; d++) T[q] += PetscAbsScalar(S[bs * q + d]);
+    T[q] *= PetscAbsReal(op->A[q]);
   }
-  for (PetscInt i = 0; i < op->nloc; i++) {
-    for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += T[i] * PetscAbsScalar(S[bs * i + d]);
-    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++)
-      for (PetscInt d = 0; d < bs; d++) {
-        ya[bs * op->jl[b] + d] += T[i] * PetscAbsReal(op->p[2 * b] * op->w[bs * b + d]);
-        ya[bs * i + d] += T[op->jl[b]] * PetscAbsReal(op->p[2 * b + 1] * op->w[bs * b + d]);
-      }
-  }
+  for (PetscInt i = 0; i < op->nloc; i++)
+    for (PetscInt s = 0; s < ns; s++) {
+      for (PetscInt d = 0; d < bs; d++) ya[bs * i + d] += T[ns * i + s] * PetscAbsScalar(S[(ns * i + s) * bs + d]);
+      for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++)
+        for (PetscInt d = 0; d < bs; d++) {
+          ya[bs * op->jl[b] + d] += T[ns * i + s] * PetscAbsReal(StateWeight(op, b, s, 0, d));
+          ya[bs * i + d] += T[ns * op->jl[b] + s] * PetscAbsReal(StateWeight(op, b, s, 1, d));
+        }
+    }
   PetscCall(VecRestoreArray(tl, &T));
   PetscCall(VecRestoreArray(sl, &S));
   PetscCall(VecGhostRestoreLocalForm(op->theta, &tl));
-  PetscCall(VecGhostRestoreLocalForm(op->xm, &sl));
+  PetscCall(VecGhostRestoreLocalForm(op->sg, &sl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1058,6 +1130,8 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
   for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= op->form == FORM_CENTRAL ? PetscSqrtReal(factor) : factor;
+  if (op->pvec) /* as the multiples of w do with it */
+    for (PetscInt d = 0; d < 2 * op->ns * op->bs; d++) op->p[2 * op->ns * op->bs * t + d] *= PetscSqrtReal(factor);
   if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc.bonds, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(op->form == FORM_CENTRAL, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the preconditioning matrix of shear and micropolar bonds is diagonally scaled and cannot follow a broken bond");
   for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc.bonds, i, k) * Ke[a];
@@ -1093,6 +1167,7 @@ PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
   PetscCall(PetscFree((*op)->p));
   PetscCall(PetscFree((*op)->A));
   PetscCall(VecDestroy(&(*op)->theta));
+  PetscCall(VecDestroy(&(*op)->sg));
   PetscCall(VecDestroy(&(*op)->xm));
   PetscCall(VecDestroy(&(*op)->ym));
   PetscCall(VecDestroy(&(*op)->kdiag));
