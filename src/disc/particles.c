@@ -19,14 +19,16 @@ static const PeriKey grid_keys[] = {
     {"upper", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "the box's upper corner, dim numbers, above lower on every axis"},
     {"spacing", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "particle spacing dx: every box length a whole number of spacings"},
     {"periodic", PERI_KEY_BOOLS, "all false", NULL, NULL, NULL, "dim booleans: the periodic axes (minimum image)"},
-    {"holes", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "holes cut out of the grid: the cells whose centre lies inside a circle (2D), a cylinder or a sphere (3D) are left out"},
+    {"holes", PERI_KEY_LIST, NULL, NULL, NULL, NULL, "holes cut out of the grid: the cells whose centre lies inside a circle (2D), a cylinder or a sphere (3D), or a box, are left out"},
     {NULL},
 };
 static const char *const hole_axes[] = {"x", "y", "z", "none", NULL};
 static const PeriKey     hole_keys[] = {
-        {"center", PERI_KEY_REALS, "required", NULL, "[length]", NULL, "a point on the hole's axis (its centre), dim numbers"},
-        {"radius", PERI_KEY_REAL, "required", "(0, inf)", "[length]", NULL, "the hole's radius: cells closer to the axis (to the centre for a sphere) are left out"},
-        {"axis", PERI_KEY_CHOICE, "z", NULL, NULL, hole_axes, "3D: the cylinder's axis, or none for a sphere"},
+        {"center", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a round hole: a point on its axis (its centre), dim numbers; with radius"},
+        {"radius", PERI_KEY_REAL, NULL, "(0, inf)", "[length]", NULL, "a round hole's radius: cells closer to the axis (to the centre for a sphere) are left out"},
+        {"axis", PERI_KEY_CHOICE, "z", NULL, NULL, hole_axes, "3D, a round hole: the cylinder's axis, or none for a sphere"},
+        {"lower", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a box hole instead: its lower corner, dim numbers; with upper (cells whose centre lies in the closed box are left out)"},
+        {"upper", PERI_KEY_REALS, NULL, NULL, "[length]", NULL, "a box hole's upper corner, above lower on every axis"},
         {NULL},
 };
 static const PeriKey particles_keys[] = {
@@ -78,9 +80,25 @@ void PeriParticlesPeriodicBox(PeriParticles *p, const PetscReal box[6])
 /* grid.holes: the cells left out of the grid */
 typedef struct {
   PetscInt  n;
-  PetscReal c[PERI_MAX_HOLES][3], r2[PERI_MAX_HOLES];
-  PetscInt  axis[PERI_MAX_HOLES]; /* 0, 1, 2, or -1 for a sphere (and in 2D, where z is 0) */
+  PetscReal c[PERI_MAX_HOLES][3], r2[PERI_MAX_HOLES], hi[PERI_MAX_HOLES][3]; /* a box: c is its lower corner */
+  PetscInt  axis[PERI_MAX_HOLES];                                            /* 0, 1, 2, -1 for a sphere, -2 for a box */
 } GridHoles;
+
+/* A box hole's corners (lower, upper). */
+static PetscErrorCode BoxHoleParse(PeriScene scene, PeriNode item, PetscInt dim, PetscReal lo[], PetscReal hi[])
+{
+  PeriNode round;
+  PetscInt n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSceneGetNode(item, "center", &round));
+  PeriInputCheck(!round, scene, item, "center", "a hole is a box (lower, upper) or round (center, radius), not both");
+  PetscCall(PeriSceneGetRealArray(scene, item, "lower", PETSC_TRUE, dim, dim, lo, &n));
+  PetscCall(PeriSceneGetRealArray(scene, item, "upper", PETSC_TRUE, dim, dim, hi, &n));
+  for (PetscInt d = 0; d < dim; d++) PeriInputCheck(hi[d] >= lo[d], scene, item, "upper", "must be at least lower on every axis (axis %" PetscInt_FMT ": %g < %g)", d, (double)hi[d], (double)lo[d]);
+  for (PetscInt d = dim; d < 3; d++) lo[d] = hi[d] = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 /* Reads grid.holes into holes. */
 static PetscErrorCode HolesParse(PeriScene scene, PeriNode grid, PetscInt dim, GridHoles *holes)
@@ -97,9 +115,15 @@ static PetscErrorCode HolesParse(PeriScene scene, PeriNode grid, PetscInt dim, G
     PeriNode  given;
     PetscReal r;
     PetscInt  n, axis = 2;
-    PeriInputCheck(item->kind == PERI_NODE_MAP, scene, item, NULL, "a hole is {center: [..], radius: r(, axis: x|y|z|none)}");
+    PeriInputCheck(item->kind == PERI_NODE_MAP, scene, item, NULL, "a hole is {center: [..], radius: r(, axis: x|y|z|none)} or {lower: [..], upper: [..]}");
     PetscCall(PeriSceneCheckSection(scene, item, "grid.holes.<k>"));
-    for (PetscInt d = 0; d < 3; d++) holes->c[k][d] = 0;
+    for (PetscInt d = 0; d < 3; d++) holes->c[k][d] = holes->hi[k][d] = 0;
+    PetscCall(PeriSceneGetNode(item, "lower", &given));
+    if (given) {
+      PetscCall(BoxHoleParse(scene, item, dim, holes->c[k], holes->hi[k]));
+      holes->axis[k] = -2;
+      continue;
+    }
     PetscCall(PeriSceneGetRealArray(scene, item, "center", PETSC_TRUE, dim, dim, holes->c[k], &n));
     PetscCall(PeriSceneGetReal(scene, item, "radius", PETSC_TRUE, &r, NULL));
     PetscCall(PeriSceneGetNode(item, "axis", &given));
@@ -118,6 +142,12 @@ static PetscInt HoleAt(const GridHoles *holes, const PetscReal x[])
 {
   for (PetscInt k = 0; k < holes->n; k++) {
     PetscReal d2 = 0;
+    if (holes->axis[k] == -2) {
+      PetscBool in = PETSC_TRUE;
+      for (PetscInt d = 0; d < 3; d++) in = (PetscBool)(in && x[d] >= holes->c[k][d] && x[d] <= holes->hi[k][d]);
+      if (in) return k;
+      continue;
+    }
     for (PetscInt d = 0; d < 3; d++)
       if (d != holes->axis[k]) d2 += PetscSqr(x[d] - holes->c[k][d]);
     if (d2 < holes->r2[k]) return k;
@@ -216,7 +246,7 @@ static PetscErrorCode GridCount(PeriScene scene, PeriNode grid, const PeriPartic
       left++;
   }
   PetscCall(PeriSceneGetNode(grid, "holes", &list));
-  for (PetscInt k = 0; k < holes->n; k++) PeriInputCheck(taken[k] > 0, scene, list->child[k], "radius", "the hole takes no particle: no cell centre lies inside it that an earlier hole did not take (outside the body, smaller than a cell, or inside another hole)");
+  for (PetscInt k = 0; k < holes->n; k++) PeriInputCheck(taken[k] > 0, scene, list->child[k], holes->axis[k] == -2 ? "lower" : "radius", "the hole takes no particle: no cell centre lies inside it that an earlier hole did not take (outside the body, smaller than a cell, or inside another hole)");
   PeriInputCheck(left > 0, scene, grid, "holes", "the holes take every particle of the grid");
   *N = left;
   PetscFunctionReturn(PETSC_SUCCESS);
