@@ -14,7 +14,9 @@ Checks, each with its number:
      to the largest), the positions exactly, and the summary's counts and energy its summary.json's;
   3. K u - f from stiffness() and rhs() (petsc4py) vanishes on the free DOFs (relative 1e-8), u
      holds the prescribed values on the others, and an LU solve of the free block with petsc4py
-     gives solve()'s u to 1e-8;
+     gives solve()'s u to 1e-8; with a prescribed value that is not 0 (the plate's roller moved),
+     stiffness(conditions=True) and rhs(conditions=True) solved by petsc4py give solve()'s u on the
+     free DOFs to 1e-8;
   4. a misspelt key and a bad value raise perilin.Error naming the key (and the file and line), and
      the same process goes on to solve again with the same result;
   5. set('material.E', 2 E) halves u (1e-10), a failing set() leaves the problem as it was;
@@ -22,8 +24,8 @@ Checks, each with its number:
   7. operator() (perilin's matrix-free K as a shell Mat) times a random x equals stiffness() times x
      to 1e-13 (relative, 2-norm) on the plate (pmb's central bonds) and the lamina (mppd's
      micropolar bonds); mass(as_matrix=True) is the diagonal Mat of mass();
-  8. modes() of the lamina (coarsened to 0.02 m): the frequencies equal slepc4py's on the free blocks
-     of stiffness() and mass(as_matrix=True) to 1e-8; each shape's residual ||K x - w^2 M x|| /
+  8. modes() of the lamina (coarsened to 0.02 m): the frequencies equal slepc4py's on
+     stiffness(conditions=True) and mass(as_matrix=True, conditions=True) to 1e-8; each shape's residual ||K x - w^2 M x|| /
      (w^2 ||M x||), computed here with petsc4py, is below 1e-7 and within 10 % of the one modes()
      reports (relative to it + 1e-11: both are near round-off); shapes vanish on the prescribed DOFs and have max |translation| 1;
   9. Result.steps (quasi-static) and Result.history (dynamic) hold the command line's steps.csv and
@@ -118,6 +120,25 @@ lu = (x - uf).norm(PETSc.NormType.INFINITY) / uf.norm(PETSc.NormType.INFINITY)
 u.restoreSubVector(free, uf)
 check(lu < 1e-8, "petsc4py's LU solve of the free block gives solve()'s u to %.2g (< 1e-8)" % lu)
 
+# 3b. the reduced system with a prescribed value that is not 0: stiffness(conditions=True) and
+# rhs(conditions=True) solved by petsc4py give solve()'s u on the free DOFs
+scene = yaml.safe_load(open(plate))
+scene["bc"][0] = {"region": "left", "value": {"ux": -2e-5}}
+with perilin.Problem(scene, comm=comm) as q:
+    rq = q.solve()
+    Kff, bf, free = q.stiffness(conditions=True), q.rhs(conditions=True), q.free_dofs()
+    ksp = PETSc.KSP().create(comm)
+    ksp.setOperators(Kff)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    if size > 1:
+        ksp.getPC().setFactorSolverType("mumps")
+    x = bf.duplicate()
+    ksp.solve(bf, x)
+    uq = PETSc.Vec().createWithArray(rq.u.ravel()[free.getIndices()], comm=comm)
+    rel = (x - uq).norm(PETSc.NormType.INFINITY) / uq.norm(PETSc.NormType.INFINITY)
+    check(Kff.getSize()[0] == free.getSize() and rel < 1e-8, "stiffness(conditions=True), rhs(conditions=True) with ux = -2e-5 prescribed: petsc4py's LU gives solve()'s u on the %d free DOFs to %.2g (< 1e-8)" % (free.getSize(), rel))
+
 # 4. errors are perilin.Error, and the process goes on
 for overrides, words in (({"materal.E": 1e9}, ["materal", "did you mean -material_E"]), ({"material.E": -1}, ["material.E", "plate_traction.yaml", "(0, inf)"])):
     try:
@@ -181,7 +202,7 @@ from slepc4py import SLEPc
 with perilin.Problem(lamina, {"grid.spacing": 0.02, "output.plots": False}) as q:
     md = q.modes()
     K, M, free = q.stiffness(), q.mass(as_matrix=True), q.free_dofs()
-    Kff, Mff = K.createSubMatrix(free, free), M.createSubMatrix(free, free)
+    Kff, Mff = q.stiffness(conditions=True), q.mass(as_matrix=True, conditions=True)  # what SLEPc gets in the modal analysis
     eps = SLEPc.EPS().create(comm=comm)
     eps.setOperators(Kff, Mff)
     eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)

@@ -279,33 +279,73 @@ class Problem:
         _perilin.write(self._handle, os.path.abspath(os.fspath(directory)))
 
     # the operators
-    def stiffness(self):
+    def stiffness(self, conditions=False):
         """A new assembled stiffness K (petsc4py Mat) of the body, every DOF (particle-major: DOF d
-        of particle i is row i*dofs + d), before the conditions are applied."""
-        return _perilin.stiffness(self._handle)
+        of particle i is row i*dofs + d), before the conditions are applied. conditions=True: the
+        system the static solve and the modal eigensolve reduce to, K_ff on the free DOFs
+        (free_dofs(), in their order); its solution with rhs(conditions=True) is solve()'s u there."""
+        K = _perilin.stiffness(self._handle)
+        return self._free_block(K, "stiffness") if conditions else K
 
-    def rhs(self):
-        """A new petsc4py Vec with the scene's loads f (load factor 1), in K's layout."""
-        return _perilin.loads(self._handle)
+    def rhs(self, conditions=False):
+        """A new petsc4py Vec with the scene's loads f (load factor 1), in K's layout.
+        conditions=True: the reduced right-hand side f_f - K_fc u_c on the free DOFs, u_c the
+        prescribed values (constraints())."""
+        f = _perilin.loads(self._handle)
+        if not conditions:
+            return f
+        self._reducible("rhs")
+        K, uc = _perilin.stiffness(self._handle), f.duplicate()
+        rows, values = self.constraints()
+        lo, hi = uc.getOwnershipRange()
+        mine = (rows >= lo) & (rows < hi)
+        uc.setValues(rows[mine].astype(PETSc.IntType), values[mine])
+        uc.assemble()
+        b = f - K * uc
+        free = self.free_dofs()
+        bf = b.getSubVector(free)
+        out = bf.copy()
+        b.restoreSubVector(free, bf)
+        for o in (K, uc, b, f, free):
+            o.destroy()
+        return out
 
-    def mass(self, as_matrix=False):
+    def mass(self, as_matrix=False, conditions=False):
         """A new petsc4py Vec with the lumped mass per DOF (the diagonal of M), in K's layout; with
         as_matrix=True, M itself as a new diagonal petsc4py Mat (AIJ, one entry a row) in that
-        layout, for SLEPc's K x = lambda M x."""
+        layout, for SLEPc's K x = lambda M x; conditions=True (with as_matrix): M_ff on the free
+        DOFs, beside stiffness(conditions=True), as the modal analysis gives them to SLEPc."""
         m = _perilin.mass(self._handle)
         if not as_matrix:
+            if conditions:
+                raise Error("mass(conditions=True) needs as_matrix=True (the free block of M)")
             return m
         M = PETSc.Mat().createAIJ((m.getSizes(), m.getSizes()), nnz=(1, 0), comm=m.getComm())
         M.setDiagonal(m)
         M.assemble()
         m.destroy()
-        return M
+        return self._free_block(M, "mass") if conditions else M
+
+    def _reducible(self, what):
+        """Fictitious layers (boundary_layers, torsion) enter K through a transfer matrix, not as
+        prescribed DOFs: no free block describes that system."""
+        sc = self.scene()
+        if sc.get("boundary_layers") or sc.get("torsion"):
+            raise Error("%s(conditions=True): the scene's fictitious layers (boundary_layers, torsion) are not prescribed DOFs; take the operators before the conditions" % what)
+
+    def _free_block(self, A, what):
+        self._reducible(what)
+        free = self.free_dofs()
+        B = A.createSubMatrix(free, free)
+        A.destroy()
+        free.destroy()
+        return B
 
     def operator(self):
         """The body's K as a new petsc4py shell Mat applied bond by bond (perilin's matrix-free
         operator, no matrix stored), in stiffness()'s layout and before the conditions: mult
-        equals stiffness() times x to round-off. perilin.Error for models whose bonds it cannot
-        apply (family models such as lps's, 3D shear bonds)."""
+        equals stiffness() times x to round-off (lps's states included). perilin.Error for models
+        whose bonds it cannot apply (3D shear bonds, dense family blocks)."""
         return _perilin.operator(self._handle)
 
     def constraints(self):
