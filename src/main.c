@@ -205,13 +205,18 @@ int main(int argc, char **argv)
   ierr = Run(argc, argv, mode, &p, &status);
   PetscCall(PetscPopErrorHandler());
   if (ierr) {
-    PetscBool all;
+    PetscBool all, kept = PETSC_FALSE;
+    char      staging[PETSC_MAX_PATH_LEN] = "";
     PetscCallMPI(MPI_Comm_size(PETSC_COMM_WORLD, &size));
     PetscCallMPI(MPI_Comm_rank(PETSC_COMM_WORLD, &rank));
-    if (rank == 0) PeriOutputSetDiscard(); /* the previous results stay as they were */
+    /* a write that failed after a checkpoint (a full disk at the end): that checkpoint stays for
+       -restart; else the previous results stay as they were */
+    if (rank == 0 && ierr == PETSC_ERR_FILE_WRITE) kept = PeriOutputSetKeepCheckpoint(staging, sizeof(staging));
+    if (rank == 0) PeriOutputSetDiscard();
     all = size == 1 ? PETSC_TRUE : EveryRankFailed();
     /* through PETSc's printer, which first erases a status line on the terminal (src/sys/progress.c) */
     if (rank == 0 || !all) (void)PetscFPrintf(PETSC_COMM_SELF, stderr, "perilin: error: %s\n", PeriErrorFirst()[0] ? PeriErrorFirst() : "unknown error");
+    if (kept) (void)PetscFPrintf(PETSC_COMM_SELF, stderr, "perilin: the run's last checkpoint is kept whole in %s: free space, then continue with -restart %s\n", staging, staging);
     if (!all) MPI_Abort(PETSC_COMM_WORLD, 1);
     /* every rank is here: free what the run held, so that -malloc_dump shows real leaks only */
     PetscCall(PetscPushErrorHandler(PetscIgnoreErrorHandler, NULL));

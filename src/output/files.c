@@ -333,6 +333,25 @@ void PeriOutputSetDiscard(void)
 }
 
 /*@C
+  PeriOutputSetKeepCheckpoint - a run that failed writing its results (a full disk, a quota) after
+  it wrote a checkpoint: its staging directory, which holds that whole checkpoint, is kept for
+  -restart instead of discarded; its path goes to dir (len bytes). False (nothing kept) when the
+  set holds no checkpoint. Not collective: rank 0's.
+@*/
+PetscBool PeriOutputSetKeepCheckpoint(char dir[], size_t len)
+{
+  char        path[PETSC_MAX_PATH_LEN + 32];
+  struct stat st;
+
+  if (!peri_staging[0]) return PETSC_FALSE;
+  snprintf(path, sizeof(path), "%s/checkpoint/state.bin", peri_staging);
+  if (stat(path, &st) != 0 || !S_ISREG(st.st_mode)) return PETSC_FALSE;
+  snprintf(dir, len, "%s", peri_staging);
+  peri_staging[0] = 0;
+  return PETSC_TRUE;
+}
+
+/*@C
   PeriOutputSetKeep - a failed run's staging directory is kept by PeriOutputSetDiscard: it holds
   the last checkpoint of a run whose next one could not be written (a full disk), which -restart
   continues. Not collective: rank 0 discards.

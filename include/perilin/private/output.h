@@ -51,6 +51,7 @@ PETSC_EXTERN PetscErrorCode PeriOutputSetOpen(MPI_Comm, char[], size_t, char[], 
 PETSC_EXTERN PetscErrorCode PeriOutputSetCommit(MPI_Comm, const char[], const char[]);
 PETSC_EXTERN void           PeriOutputSetDiscard(void);
 PETSC_EXTERN void           PeriOutputSetKeep(void);
+PETSC_EXTERN PetscBool      PeriOutputSetKeepCheckpoint(char[], size_t);
 PETSC_EXTERN PetscErrorCode PeriOutputSetAddNames(const char *const[]);
 PETSC_EXTERN PetscErrorCode PeriOutputSetAdopt(MPI_Comm, const char[], const char[], const char[], PetscBool *);
 PETSC_EXTERN int            PeriOutputRemoveTree(const char[]);
