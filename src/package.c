@@ -190,6 +190,7 @@ static const char *const own_options[][2] = {
     {"-peri_checkpoint_every N", "quasistatic: write the checkpoint every N equilibria (default 1); dynamic: every N time steps (default: at the frames, about 25 over the run); 0 writes none"},
     {"-peri_stop_after_step K", "quasistatic: stop after equilibrium K, dynamic: after time step K, as a SIGINT would (to test restarts)"},
     {"-options_unused_ok", "options that nothing reads are warnings, not errors"},
+    {"-peri_scene_sealed <bool>", "an error when any part reads the scene after the set-up (a test that settings are read once)"},
     {"-peri_partition TYPE", "how the particles are shared out on several ranks: geometric (default), metis, ptscotch"},
     {"-peri_memory_check <bool>", "refuse a scene that does not fit in the node's available memory; default true"},
     {"-peri_release_bond_geometry <bool>", "free the bonds' geometry while a static solve runs; default true"},

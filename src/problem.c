@@ -165,6 +165,7 @@ PetscErrorCode PeriProblemSetUp(PeriProblem p)
   PetscCall(PeriSystemSetUp(p->sys));
   PetscCall(PeriAnalysisSetUp(p->analysis, p->sys));
   p->sys->run.log.memory_phase_mb[0] = PeriPeakMemoryMB();
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_scene_sealed", &p->scene->sealed, NULL));
   PetscCall(PetscLogStagePop());
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -91,6 +91,9 @@ struct _p_PeriScene {
    * horizon.delta times 2^coarsen, the grid's cells halved (rounded up) per level about the box's
    * centre; 0 for the scene itself. */
   PetscInt coarsen;
+  /* -peri_scene_sealed: set when the problem is set up; a getter called after it is an error
+   * (nothing reads the scene during a run: issue 39, docs/python.md) */
+  PetscBool sealed;
 };
 
 PETSC_EXTERN PetscErrorCode PeriSceneWhere(PeriScene, PeriNode, const char[], char[], size_t);

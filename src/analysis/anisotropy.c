@@ -155,7 +155,7 @@ static PetscErrorCode OnlyCriterion(PeriAnalysis an, PetscInt c)
 
   PetscFunctionBeginUser;
   PetscCall(PeriFailureSelect(F, select[c], PETSC_FALSE));
-  PetscCall(PeriSceneGetMap(an->sys->scene, an->sys->scene->root, "failure", PETSC_FALSE, &node));
+  PetscCall(PeriSceneGetNode(an->sys->scene->root, "failure", &node)); /* locates the message only */
   PeriInputCheck(PeriFailureIsActive(F, select[c][0]) && (c != 2 || PeriFailureValue(F, "cohesion") > 0), an->sys->scene, node, c == 0 ? "stretch" : c == 1 ? "sliding"
                                                                                                                                                             : "friction_angle",
                  "the anisotropy analysis's criterion %s needs its limit here (%s)", criteria[c], c == 0 ? "failure.critical_stretch" : c == 1 ? "failure.sliding"

@@ -36,6 +36,7 @@ typedef struct {
   PetscReal      velocity[3];                /* analysis.velocity.value, on the particles of region */
   PeriNode       vnode;                      /* analysis.velocity, or NULL */
   PeriNode       unode;                      /* analysis.displacement, or NULL */
+  PeriRegion    *vregion, *uregion;          /* their regions, found at the set-up (NULL: none) */
   PetscReal      displacement[3];            /* analysis.displacement.value, on the particles of region */
   PetscInt       pulse_axis;                 /* the pulse's axis */
   PetscInt       pulse_dir;                  /* the axis it displaces along: pulse_axis (a longitudinal wave) or across it (a shear wave) */
@@ -283,6 +284,8 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+static PetscErrorCode LoadTerms(PeriAnalysis);
+
 /* What needs the system: a density (the mass service checks it), bc and loads only. */
 static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
 {
@@ -295,6 +298,10 @@ static PetscErrorCode SetUp_Dynamic(PeriAnalysis an)
   PeriInputCheck(!d->pulse || PeriModelTranslation(an->sys->model, d->pulse_dir) >= 0, s, s->root, d->pulse_dir == d->pulse_axis ? "analysis.pulse.axis" : "analysis.pulse.direction", "model %s does not translate along this axis", an->sys->model->type);
   PetscCall(PeriMassSetUp(an->sys));
   PeriInputCheck(!d->implicit || !an->sys->contact.nimpactors, s, s->root, "impactors", "impactors move with the explicit integrator (analysis.integrator: explicit)");
+  /* what the run takes from the scene, read now: the regions of the initial values, the loads */
+  if (d->vnode) PetscCall(PeriRegionFind(s, d->vnode, "region", an->sys->disc.nregions, an->sys->disc.regions, &d->vregion));
+  if (d->unode) PetscCall(PeriRegionFind(s, d->unode, "region", an->sys->disc.nregions, an->sys->disc.regions, &d->uregion));
+  PetscCall(LoadTerms(an));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -331,18 +338,16 @@ static void ChooseStep(Dynamic *d)
   if (!d->implicit && d->dt <= 0) d->dt = d->t_end / PetscCeilReal(d->t_end / (0.8 * d->dt_limit));
 }
 
-/* Adds value (one number per dimension) to the translations of the particles of node.region
- * (node: analysis.velocity or analysis.displacement; nothing when NULL). */
-static PetscErrorCode AddRegionValue(PeriAnalysis an, PeriNode node, const PetscReal value[], Vec v)
+/* Adds value (one number per dimension) to the translations of the particles of region r
+ * (analysis.velocity's or analysis.displacement's; nothing when NULL). */
+static PetscErrorCode AddRegionValue(PeriAnalysis an, const PeriRegion *r, const PetscReal value[], Vec v)
 {
   PeriSystem     sys = an->sys;
   const PetscInt bs = sys->model->dofs, nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart, dim = sys->disc.particles.dim;
-  PeriRegion    *r;
   PetscScalar   *a;
 
   PetscFunctionBeginUser;
-  if (!node) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriRegionFind(sys->scene, node, "region", sys->disc.nregions, sys->disc.regions, &r));
+  if (!r) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecGetArray(v, &a));
   for (PetscInt i = 0; i < nloc; i++)
     if (PeriRegionContains(r, &sys->disc.particles.x[3 * i]))
@@ -375,7 +380,7 @@ static PetscErrorCode InitialDisplacement(PeriAnalysis an, Vec u)
     }
     PetscCall(VecRestoreArray(u, &a));
   }
-  PetscCall(AddRegionValue(an, d->unode, d->displacement, u));
+  PetscCall(AddRegionValue(an, d->uregion, d->displacement, u));
   PetscCall(VecSetValues(u, sys->conditions.nconstrained, sys->conditions.constrained, sys->conditions.constrained_value, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(u));
   PetscCall(VecAssemblyEnd(u));
@@ -398,7 +403,7 @@ static PetscErrorCode InitialVelocity(PeriAnalysis an, Vec v)
 {
   PetscFunctionBeginUser;
   PetscCall(VecSet(v, 0));
-  PetscCall(AddRegionValue(an, DYN(an)->vnode, DYN(an)->velocity, v));
+  PetscCall(AddRegionValue(an, DYN(an)->vregion, DYN(an)->velocity, v));
   PetscCall(ZeroHeld(an, v));
   if (an->sys->conditions.constrained_velocity) { /* the moving boundaries: held, at their velocity (owned rows) */
     const PeriConditions *C = &an->sys->conditions;
@@ -1339,7 +1344,7 @@ static PetscErrorCode ChooseOperator(PeriAnalysis an)
   PeriNode       node;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetMap(an->sys->scene, an->sys->scene->root, "solver", PETSC_FALSE, &node));
+  PetscCall(PeriSceneGetNode(an->sys->scene->root, "solver", &node)); /* locates the message only */
   PeriInputCheck(!DYN(an)->implicit || S->operator_kind != PERI_OPERATOR_MATRIX_FREE, an->sys->scene, node, "operator", "matrix_free serves the explicit integrator only: the implicit step builds its Jacobian from K's entries");
   if (S->operator_kind == PERI_OPERATOR_AUTO) S->operator_kind = !DYN(an)->implicit && !PeriMatrixFreeWhyNot(an->sys) ? PERI_OPERATOR_MATRIX_FREE : PERI_OPERATOR_ASSEMBLED;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -1459,7 +1464,6 @@ static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
   if (!an->sys->fields.u) PetscCall(PeriSystemCreateVec(an->sys, &an->sys->fields.u));
   PetscCall(VecDuplicate(an->sys->fields.u, &d->tmp));
   PetscCall(VecDuplicate(an->sys->fields.u, &d->uprev));
-  PetscCall(LoadTerms(an));
   PetscCall(SetUpTS(an, U, V));
   PetscCall(GetState(an, *U, &q, &p));
   PetscCall(VecCopy(q, d->uprev));

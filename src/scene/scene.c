@@ -475,9 +475,19 @@ PetscErrorCode PeriSceneDestroy(PeriScene *scene)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* -peri_scene_sealed: a scene read after the set-up names the key (the caller is in the
+ * traceback of -peri_scene_sealed's error). */
+static PetscErrorCode SealCheck(PeriScene scene, PeriNode map, const char key[])
+{
+  PetscFunctionBeginUser;
+  PetscCheck(!scene->sealed, PETSC_COMM_SELF, PETSC_ERR_PLIB, "-peri_scene_sealed: the scene key '%s%s%s' is read after the set-up (a part reads its settings during the run)", map->path, map->path[0] ? "." : "", key);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PeriSceneGetMap(PeriScene scene, PeriNode map, const char key[], PetscBool required, PeriNode *child)
 {
   PetscFunctionBeginUser;
+  PetscCall(SealCheck(scene, map, key));
   PetscCall(PeriSceneGetNode(map, key, child));
   PeriInputCheck(*child || !required, scene, map, key, "is required");
   PeriInputCheck(!*child || (*child)->kind == PERI_NODE_MAP, scene, *child, NULL, "must be a mapping of keys");
@@ -561,6 +571,7 @@ static PetscErrorCode GetDecl(PeriScene scene, PeriNode map, const char key[], P
   static const char *const names[] = {"number", "whole number", "boolean", "string", "choice", "list of numbers", "list of booleans", "mapping", "list"};
 
   PetscFunctionBeginUser;
+  PetscCall(SealCheck(scene, map, key));
   PetscCall(PeriSceneFindKey(scene, map, key, &d->sec, &d->key));
   PetscCheck(!d->key || d->key->type == type || (type == PERI_KEY_STRING && d->key->type == PERI_KEY_CHOICE), PETSC_COMM_SELF, PETSC_ERR_PLIB, "key '%s%s%s' is declared as a %s but read as a %s", map->path, map->path[0] ? "." : "", key, names[d->key->type], names[type]);
   PetscFunctionReturn(PETSC_SUCCESS);

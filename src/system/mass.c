@@ -5,26 +5,46 @@
 
 /* The density of each owned particle: material.rho, or material.rho_by_region {region: rho}
  * (later regions win where they overlap). */
+/*@C
+  PeriMassSetFromScene - material.rho_by_region into the mass's settings (its regions and
+  densities, each checked positive), read once at the set-up, and the node that locates a missing
+  density; the mass itself is built on first request. Not collective.
+@*/
+PetscErrorCode PeriMassSetFromScene(PeriSystem sys)
+{
+  PeriScene s = sys->scene;
+  PeriMass *m = &sys->mass;
+  PeriNode  map;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree2(m->by_region, m->by_value));
+  m->nby = 0;
+  PetscCall(PeriSceneGetNode(s->root, "material", &m->where));
+  PetscCall(PeriSceneGetMap(s, m->where, "rho_by_region", PETSC_FALSE, &map));
+  if (!map) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc2(map->n, &m->by_region, map->n, &m->by_value));
+  for (PetscInt k = 0; k < map->n; k++) {
+    PetscCall(PeriRegionFind(s, map->child[k], NULL, sys->disc.nregions, sys->disc.regions, &m->by_region[k]));
+    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &m->by_value[k], NULL));
+    PeriInputCheck(m->by_value[k] > 0, s, map, map->child[k]->key, "must be positive");
+    m->nby = k + 1;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The density of each owned particle: material.rho, or the last rho_by_region that holds it. */
 static PetscErrorCode Densities(PeriSystem sys, PetscReal rho[])
 {
-  PeriScene      s    = sys->scene;
-  const PetscInt nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
-  PeriNode       mat, map;
+  const PeriMass *m    = &sys->mass;
+  const PetscInt  nloc = sys->disc.bonds.rend - sys->disc.bonds.rstart;
 
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < nloc; i++) rho[i] = sys->model->material.rho;
-  PetscCall(PeriSceneGetNode(s->root, "material", &mat));
-  PeriInputCheck(sys->model->material.rho > 0, s, mat, "rho", "an analysis with inertia needs the density (material.rho > 0)");
-  PetscCall(PeriSceneGetMap(s, mat, "rho_by_region", PETSC_FALSE, &map));
-  for (PetscInt k = 0; map && k < map->n; k++) {
-    PeriRegion *r;
-    PetscReal   v;
-    PetscCall(PeriRegionFind(s, map->child[k], NULL, sys->disc.nregions, sys->disc.regions, &r));
-    PetscCall(PeriSceneGetReal(s, map, map->child[k]->key, PETSC_TRUE, &v, NULL));
-    PeriInputCheck(v > 0, s, map, map->child[k]->key, "must be positive");
+  /* the node only locates the message: nothing is read from the scene here */
+  PeriInputCheck(sys->model->material.rho > 0, sys->scene, m->where, "rho", "an analysis with inertia needs the density (material.rho > 0)");
+  for (PetscInt k = 0; k < m->nby; k++)
     for (PetscInt i = 0; i < nloc; i++)
-      if (PeriRegionContains(r, &sys->disc.particles.x[3 * (sys->disc.bonds.rstart + i)])) rho[i] = v;
-  }
+      if (PeriRegionContains(m->by_region[k], &sys->disc.particles.x[3 * (sys->disc.bonds.rstart + i)])) rho[i] = m->by_value[k];
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -112,6 +132,8 @@ PetscErrorCode PeriMassDestroy(PeriMass *m)
   PetscCall(PetscFree(m->rho));
   PetscCall(VecDestroy(&m->diag));
   PetscCall(MatDestroy(&m->M));
+  PetscCall(PetscFree2(m->by_region, m->by_value));
+  m->nby = 0;
   m->set = PETSC_FALSE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -40,7 +40,7 @@ static PetscErrorCode UseMatrixFree(PeriSystem sys, PetscBool *mf)
     if (sys->model->calibration == PERI_CALIBRATION_PATCH) *mf = PETSC_FALSE;
   }
   if (sys->stiffness.operator_kind != PERI_OPERATOR_MATRIX_FREE || !why) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriSceneGetMap(sys->scene, sys->scene->root, "solver", PETSC_FALSE, &node));
+  PetscCall(PeriSceneGetNode(sys->scene->root, "solver", &node)); /* locates the message only */
   PeriInputCheck(PETSC_FALSE, sys->scene, node, "operator", "matrix_free cannot apply here: %s; use assembled or auto", why);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -529,6 +529,7 @@ static PetscErrorCode SetUpOnBonds(PeriSystem sys)
   PetscCall(ReadShearModuli(sys));
   PetscCall(Calibrate(sys));
   PetscCall(PeriReadProbes(sys));
+  PetscCall(PeriMassSetFromScene(sys));
   PetscCall(PeriFailureSetUp(sys));
   PetscCall(PeriReferenceSetUp(sys));
   PetscCall(PeriBoundarySetUp(sys));
@@ -674,6 +675,7 @@ PetscErrorCode PeriSystemDestroy(PeriSystem *system)
   PetscCall(PetscFree(sys->materials.mu));
   PetscCall(PetscFree(sys->materials.bond_mu));
   PetscCall(PeriProgressDestroy(&sys->run.progress));
+  PetscCall(PetscFree(sys->scene_view)); /* the struct only: its trees are the problem scene's */
   PetscCall(PetscFree(sys));
   *system = NULL;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -698,17 +700,22 @@ static PetscErrorCode SetUpCoarse(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The system's level factory (PeriLevelFactory): level l of fine's scene, set up. Collective. */
+/* The system's level factory (PeriLevelFactory): level l of fine's scene, set up. The level reads
+ * its own view of the scene (the same keys, coarsen = l, not sealed; the system owns it), so the
+ * public scene is neither edited nor read after its set-up. Collective. */
 static PetscErrorCode CreateLevel(PeriSystem fine, PetscInt l, PeriSystem *c)
 {
-  PetscErrorCode ierr;
+  PeriScene view;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSystemCreate(fine->comm, fine->scene, c));
+  PetscCall(PetscNew(&view));
+  *view         = *fine->scene; /* shares the key tree, the owners and the resolved tree */
+  view->coarsen = l;
+  view->sealed  = PETSC_FALSE;
+  PetscCall(PeriSystemCreate(fine->comm, view, c));
+  (*c)->scene_view      = view;
   (*c)->stiffness.needs = fine->stiffness.needs;
-  fine->scene->coarsen  = l;
-  ierr                  = SetUpCoarse(*c);
-  fine->scene->coarsen  = 0;
-  PetscCall(ierr);
+  PetscCall(SetUpCoarse(*c));
+  fine->scene->resolved = view->resolved; /* a default first resolved by the level: the tree is the fine scene's to free */
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <petscmat.h>
+#include "perilin/private/disc.h"
 
 typedef struct _p_PeriSystem *PeriSystem;
 
@@ -16,8 +17,14 @@ typedef struct {
   Vec        diag;  /* the lumped mass per DOF, in the layout of K */
   Mat        M;     /* the same as a diagonal matrix, built on request (PeriMassGetMatrix) */
   PetscReal  total; /* the body's mass (translations; rotations carry inertia, not mass) */
+  /* settings, read at the set-up (PeriMassSetFromScene): material.rho_by_region */
+  PetscInt     nby;
+  PeriRegion **by_region;
+  PetscReal   *by_value;
+  PeriNode     where; /* the material section: locates a missing density */
 } PeriMass;
 
+PETSC_EXTERN PetscErrorCode PeriMassSetFromScene(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriMassSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriMassGetDiagonal(PeriSystem, Vec *);
 PETSC_EXTERN PetscErrorCode PeriMassGetMatrix(PeriSystem, Mat *);

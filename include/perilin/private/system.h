@@ -70,6 +70,7 @@ struct _p_PeriSystem {
   MPI_Comm       comm;
   PetscMPIInt    rank, size;
   PeriScene      scene;      /* borrowed from the problem: for reading sections and locating errors */
+  PeriScene      scene_view; /* a multigrid level's own view of the problem's scene (coarsen set), freed with the level */
   PeriDisc       disc;       /* the particles, regions, bonds and volumes (disc.h) */
   PeriModel      model;      /* the bond model and its calibration (model.h) */
   PeriMaterials  materials;  /* material data per particle and bond */
