@@ -52,6 +52,19 @@ rank, size = comm.getRank(), comm.getSize()
 failures = 0
 
 
+def lu_solve(A, b):
+    """x with A x = b by petsc4py's LU (MUMPS on several ranks)."""
+    ksp = PETSc.KSP().create(A.getComm())
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    if A.getComm().getSize() > 1:
+        ksp.getPC().setFactorSolverType("mumps")
+    x = b.duplicate()
+    ksp.solve(b, x)
+    return x
+
+
 def check(ok, what):
     global failures
     if rank == 0:
@@ -107,14 +120,7 @@ check(len(rows) > 0 and np.array_equal(r.u.ravel()[rows], values), "u holds the 
 Kff = K.createSubMatrix(free, free)
 b = f.getSubVector(free).copy()  # the prescribed values are 0 on this plate: no K_fc u_c term
 check(not np.any(values), "the plate's prescribed values are 0")
-ksp = PETSc.KSP().create(comm)
-ksp.setOperators(Kff)
-ksp.setType("preonly")
-ksp.getPC().setType("lu")
-if size > 1:
-    ksp.getPC().setFactorSolverType("mumps")
-x = b.duplicate()
-ksp.solve(b, x)
+x = lu_solve(Kff, b)
 uf = u.getSubVector(free)
 lu = (x - uf).norm(PETSc.NormType.INFINITY) / uf.norm(PETSc.NormType.INFINITY)
 u.restoreSubVector(free, uf)
@@ -127,14 +133,7 @@ scene["bc"][0] = {"region": "left", "value": {"ux": -2e-5}}
 with perilin.Problem(scene, comm=comm) as q:
     rq = q.solve()
     Kff, bf, free = q.stiffness(conditions=True), q.rhs(conditions=True), q.free_dofs()
-    ksp = PETSc.KSP().create(comm)
-    ksp.setOperators(Kff)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    if size > 1:
-        ksp.getPC().setFactorSolverType("mumps")
-    x = bf.duplicate()
-    ksp.solve(bf, x)
+    x = lu_solve(Kff, bf)
     uq = PETSc.Vec().createWithArray(rq.u.ravel()[free.getIndices()], comm=comm)
     rel = (x - uq).norm(PETSc.NormType.INFINITY) / uq.norm(PETSc.NormType.INFINITY)
     check(Kff.getSize()[0] == free.getSize() and rel < 1e-8, "stiffness(conditions=True), rhs(conditions=True) with ux = -2e-5 prescribed: petsc4py's LU gives solve()'s u on the %d free DOFs to %.2g (< 1e-8)" % (free.getSize(), rel))
