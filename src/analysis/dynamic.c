@@ -1535,14 +1535,11 @@ static int HistoryRows(PeriAnalysis an, FILE *fp)
 /* history.csv: one row per step. Rank 0 writes (temporary name, then rename). */
 static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
 {
-  char  path[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
-  FILE *fp;
+  char path[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
-  if (an->rank) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(path, sizeof(path), "%s/history.csv", dir));
-  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  PetscCall(PeriFileCloseCommit(fp, tmp, path, HistoryRows(an, fp)));
+  PetscCall(PeriAnalysisWriteTable(an, PETSC_TRUE, HistoryRows, path, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1550,8 +1547,7 @@ static PetscErrorCode WriteHistory(PeriAnalysis an, const char dir[])
 static PetscErrorCode Table_Dynamic(PeriAnalysis an, FILE *fp)
 {
   PetscFunctionBeginUser;
-  if (an->rank || !DYN(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(!HistoryRows(an, fp), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing the history's table failed");
+  PetscCall(PeriAnalysisWriteTable(an, DYN(an)->started, HistoryRows, NULL, fp));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -1012,18 +1012,11 @@ static int StepsRows(PeriAnalysis an, FILE *fp)
   return bad;
 }
 
-/*@C
-  PeriWriteStepsCSV - one row per load step. Rank 0 writes (temporary name, then rename). Collective.
-@*/
+/* steps.csv: one row per load step. Rank 0 writes (temporary name, then rename). */
 static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
 {
-  char  tmp[PETSC_MAX_PATH_LEN];
-  FILE *fp;
-
   PetscFunctionBeginUser;
-  if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  PetscCall(PeriFileCloseCommit(fp, tmp, path, StepsRows(an, fp)));
+  PetscCall(PeriAnalysisWriteTable(an, QS(an)->started, StepsRows, path, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1031,8 +1024,7 @@ static PetscErrorCode PeriWriteStepsCSV(PeriAnalysis an, const char path[])
 static PetscErrorCode QSTable(PeriAnalysis an, FILE *fp)
 {
   PetscFunctionBeginUser;
-  if (an->rank || !QS(an)->started) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(!StepsRows(an, fp), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing the steps' table failed");
+  PetscCall(PeriAnalysisWriteTable(an, QS(an)->started, StepsRows, NULL, fp));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

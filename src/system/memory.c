@@ -205,42 +205,21 @@ static PetscErrorCode NodeBalance(MPI_Comm comm, MemoryEstimate *e)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/*@C
-  PeriParticlesCheckMemory - estimates, from the scene's grid, horizon and the model, the memory the
-  run will need (bonds, matrix, solver, particle arrays) and refuses with an input error
-  naming grid.spacing when it exceeds what the nodes have available (MemAvailable shared by the
-  node's ranks). Called before any particle is allocated; errors in the grid or horizon are left
-  to the readers that report them. Skipped with -peri_memory_check false, and for particles.file.
-  Collective.
-@*/
-PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m, const PeriSystemNeeds *needs)
+/* The estimate of n particles at a search radius of r spacings, pairs left by the faces share, a
+ * grid (multigrid possible; NULL periodic: not a grid) or not, refused with an input error at
+ * where.key when the fullest node lacks it. */
+static PetscErrorCode CheckEstimate(MPI_Comm comm, PeriScene s, PeriModel m, const PeriSystemNeeds *needs, PetscReal n, PetscReal r, PetscReal share, const PetscBool periodic[], PeriNode where, const char key[], const char what[])
 {
   MemoryEstimate  e = {0};
   PeriSystemNeeds at;
-  PetscReal       h = 0, r = 0, cells[3];
-  PetscBool       run = PETSC_TRUE, failure, periodic[3], mf;
-  PeriNode        grid;
-  PetscErrorCode  ierr;
+  PeriNode        node;
+  PetscBool       failure, mf;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_memory_check", &run, NULL));
-  if (!run) PetscFunctionReturn(PETSC_SUCCESS);
-  /* a bad grid or horizon is reported later, in the order of the other checks: quietly skip here */
-  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-  ierr = GridSize(s, m->dim, &e.n, &h, cells, periodic);
-  if (!ierr && e.n > 0) ierr = SearchRadius(s, h, &r);
-  if (!ierr && r > 0) {
-    /* a horizon beyond the body's diagonal is an input error of its own (ReadHorizon) */
-    PetscReal diag2 = 0;
-    for (PetscInt d = 0; d < m->dim; d++) diag2 += cells[d] * cells[d];
-    if (r - 0.5 > PetscSqrtReal(diag2)) r = 0;
-  }
-  PetscCall(PetscPopErrorHandler());
-  if (ierr || !(e.n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PeriSceneGetNode(s->root, "failure", &grid));
-  failure = grid ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(PeriSceneGetNode(s->root, "failure", &node));
+  failure = node ? PETSC_TRUE : PETSC_FALSE;
   at      = *needs;
-  if (at.iterative_dofs > 0 && e.n * m->dofs >= at.iterative_dofs) {
+  if (at.iterative_dofs > 0 && n * m->dofs >= at.iterative_dofs) {
     /* the analysis' iterative default (a modal LOBPCG): no factor, and K matrix-free where the
        operator applies (solver.operator assembled or a forced factorization then need more) */
     at.factor_fill = 0;
@@ -248,11 +227,73 @@ PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m,
   } else
     PetscCall(MatrixFree(s, m, &at, &mf));
   if (failure && !m->central_force) mf = PETSC_FALSE; /* PeriMatrixFreeWhyNot */
-  PetscCall(Estimate(m, e.n, r, SurfaceShare(m->dim, r, cells, periodic), failure, &at, mf, Multigrid(m, &at, mf, failure, e.n, periodic), &e));
+  PetscCall(Estimate(m, n, r, share, failure, &at, mf, (PetscBool)(periodic && Multigrid(m, &at, mf, failure, n, periodic)), &e));
   PetscCall(NodeBalance(comm, &e));
-  PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
-  PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, grid, "spacing", "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: use a coarser grid.spacing, a smaller horizon, or more nodes", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9));
+  PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, where, key, "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: %s", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9), what);
   PetscCall(PetscInfo(NULL, "memory estimate: %g bytes on the fullest node, %g available (%g particles, %g bonds)\n", (double)e.need, (double)e.have, (double)e.n, (double)e.nbonds));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriParticlesCheckMemory - estimates, from the scene's grid, horizon and the model, the memory the
+  run will need (bonds, matrix, solver, particle arrays) and refuses with an input error
+  naming grid.spacing when it exceeds what the nodes have available (MemAvailable shared by the
+  node's ranks). Called before any particle is allocated; errors in the grid or horizon are left
+  to the readers that report them. Skipped with -peri_memory_check false, and for particles read
+  from a file or mesh (PeriParticlesCheckMemoryRead checks those). Collective.
+@*/
+PetscErrorCode PeriParticlesCheckMemory(MPI_Comm comm, PeriScene s, PeriModel m, const PeriSystemNeeds *needs)
+{
+  PetscReal      n = 0, h = 0, r = 0, cells[3];
+  PetscBool      run = PETSC_TRUE, periodic[3];
+  PeriNode       grid;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_memory_check", &run, NULL));
+  if (!run) PetscFunctionReturn(PETSC_SUCCESS);
+  /* a bad grid or horizon is reported later, in the order of the other checks: quietly skip here */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = GridSize(s, m->dim, &n, &h, cells, periodic);
+  if (!ierr && n > 0) ierr = SearchRadius(s, h, &r);
+  if (!ierr && r > 0) {
+    /* a horizon beyond the body's diagonal is an input error of its own (ReadHorizon) */
+    PetscReal diag2 = 0;
+    for (PetscInt d = 0; d < m->dim; d++) diag2 += cells[d] * cells[d];
+    if (r - 0.5 > PetscSqrtReal(diag2)) r = 0;
+  }
+  PetscCall(PetscPopErrorHandler());
+  if (ierr || !(n > 0) || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetMap(s, s->root, "grid", PETSC_FALSE, &grid));
+  PetscCall(CheckEstimate(comm, s, m, needs, n, r, SurfaceShare(m->dim, r, cells, periodic), periodic, grid, "spacing", "use a coarser grid.spacing, a smaller horizon, or more nodes"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriParticlesCheckMemoryRead - the same estimate for the N particles read from particles.file or
+  particles.mesh (their mean spacing h), made once they are counted and before the bonds are
+  searched (the largest allocation): an input error naming the file's key when the nodes lack
+  it. Faces are not discounted (an upper bound of the bonds). Skipped with -peri_memory_check
+  false and for grids (PeriParticlesCheckMemory). Collective.
+@*/
+PetscErrorCode PeriParticlesCheckMemoryRead(MPI_Comm comm, PeriScene s, PeriModel m, const PeriSystemNeeds *needs, PetscInt N, PetscReal h)
+{
+  PetscReal      r   = 0;
+  PetscBool      run = PETSC_TRUE;
+  PeriNode       particles, file;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_memory_check", &run, NULL));
+  PetscCall(PeriSceneGetNode(s->root, "particles", &particles));
+  if (!run || !particles || !(h > 0) || N <= 0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriSceneGetNode(particles, "file", &file));
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = SearchRadius(s, h, &r);
+  PetscCall(PetscPopErrorHandler());
+  if (ierr || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
+  /* faces not discounted; no particle has more than N - 1 neighbours (a horizon as large as the body) */
+  PetscCall(CheckEstimate(comm, s, m, needs, (PetscReal)N, r, PetscMin(1, (N - 1) / BallCount(m->dim, r)), NULL, particles, file ? "file" : "mesh", "use fewer particles (a coarser mesh or file), a smaller horizon, or more nodes"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -556,6 +556,7 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
 
   PetscFunctionBeginUser;
   PetscCall(PeriParticlesCreateBlock(sys->comm, s, sys->model->dim, sys->materials.thickness, &sys->disc.particles, &sys->disc.N));
+  PetscCall(PeriParticlesCheckMemoryRead(sys->comm, s, sys->model, &sys->stiffness.needs, sys->disc.N, sys->disc.particles.mean_spacing));
   PetscCall(ReadHorizon(sys));
   PetscCall(PeriModelSetFromScene(sys->model, s, sys->disc.delta));
   PetscCall(ReadCorrections(sys));

@@ -130,6 +130,7 @@ PETSC_EXTERN PetscErrorCode PeriAnalysisSetFromScene(PeriAnalysis, PeriScene);
 PETSC_EXTERN PetscErrorCode PeriAnalysisSetUp(PeriAnalysis, PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRun(PeriAnalysis);
 PETSC_EXTERN PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *);
+PETSC_EXTERN PetscErrorCode PeriAnalysisWriteTable(PeriAnalysis, PetscBool, int (*)(PeriAnalysis, FILE *), const char[], FILE *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointSetFromOptions(PeriAnalysis);
 PETSC_EXTERN PetscErrorCode PeriAnalysisCheckpointWrite(PeriAnalysis, PetscErrorCode (*)(PeriAnalysis, PetscViewer, void *), void *);
 PETSC_EXTERN PetscErrorCode PeriAnalysisRestartBegin(PeriAnalysis, PetscViewer *, char[], size_t);

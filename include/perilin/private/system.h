@@ -142,6 +142,7 @@ PETSC_EXTERN void           PeriReferenceDisplacement(PeriSystem, const PetscRea
 /* failure, cracks, damage, pieces (src/system/failure.c) */
 /* fictitious boundary layers and torsion (src/system/layers.c) */
 PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel, const PeriSystemNeeds *);
+PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemoryRead(MPI_Comm, PeriScene, PeriModel, const PeriSystemNeeds *, PetscInt, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem, PetscBool);
 
