@@ -2,7 +2,6 @@
  * src/analysis/analysis_list.h live in a static table, so the registry needs no heap and no finalizer;
  * PeriProblemRun finds the scene's. */
 #include "perilin/private/analysis.h"
-#include "perilin/private/output.h"
 
 #define PERI_ANALYSIS(id) extern const PeriAnalysisType PeriAnalysis_##id;
 #include "analysis_list.h"
@@ -114,26 +113,5 @@ PetscErrorCode PeriAnalysisDestroy(PeriAnalysis *analysis)
   PetscCall(PetscFree(an->data));
   PetscCall(PetscFree(an));
   *analysis = NULL;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriAnalysisWriteTable - an analysis' table (steps.csv, history.csv) as rows(an, fp) writes it
-  (non-zero when a write failed): into the file path (temporary name, then rename) when fp is
-  NULL, else into fp (the embedding's text). Rank 0 writes; nothing before the run began
-  (started false). Not collective.
-@*/
-PetscErrorCode PeriAnalysisWriteTable(PeriAnalysis an, PetscBool started, int (*rows)(PeriAnalysis, FILE *), const char path[], FILE *fp)
-{
-  char tmp[PETSC_MAX_PATH_LEN];
-
-  PetscFunctionBeginUser;
-  if (an->rank || !started) PetscFunctionReturn(PETSC_SUCCESS);
-  if (fp) {
-    PetscCheck(!rows(an, fp), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing the %s table failed", an->type->name);
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(PeriFileOpenTemporary(path, tmp, sizeof(tmp), &fp));
-  PetscCall(PeriFileCloseCommit(fp, tmp, path, rows(an, fp)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
