@@ -15,13 +15,28 @@ import os
 import tempfile
 
 import numpy as np
-import petsc4py
-from petsc4py import PETSc
-import slepc4py
-from slepc4py import SLEPc  # noqa: F401 (starts SLEPc, which perilin's modal analysis uses)
 
-from . import _perilin
-from ._perilin import Error
+
+def _singleton_mpi_defaults():
+    """A script started without mpiexec is an MPI singleton: Open MPI's probing of fast networks
+    (UCX) and its helper daemon are pure start-up cost (0.25 s of importing petsc4py here), so its
+    own switches are set where the user set none, as the perilin command does (src/package.c).
+    Under mpiexec, or once MPI is started, nothing changes; other MPIs ignore them."""
+    launched = ("OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE", "SLURM_PROCID", "MPI_LOCALNRANKS")
+    if any(v in os.environ for v in launched):
+        return
+    for k, v in (("OMPI_MCA_pml", "ob1"), ("OMPI_MCA_osc", "pt2pt"), ("OMPI_MCA_ess_singleton_isolated", "1")):
+        os.environ.setdefault(k, v)
+
+
+_singleton_mpi_defaults()
+import petsc4py  # noqa: E402 (after the MPI defaults)
+from petsc4py import PETSc  # noqa: E402
+import slepc4py  # noqa: E402
+from slepc4py import SLEPc  # noqa: F401, E402 (starts SLEPc, which perilin's modal analysis uses)
+
+from . import _perilin  # noqa: E402
+from ._perilin import Error  # noqa: E402
 
 _perilin.initialize()
 __version__, petsc_version, slepc_version = _perilin.versions()
