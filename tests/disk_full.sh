@@ -11,12 +11,8 @@ exe=$1 repo=$2
 shift 2
 mpi=("$@")
 [ -w /dev/full ] || { echo "SKIP: no /dev/full"; exit 77; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-unset PETSC_OPTIONS
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-fail=0
-bad() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=/dev/null
+source "$(dirname "$0")/run_scratch.sh"
 
 full() { # NAME launcher... -- SCENE OPTIONS...
   local name=$1 d=$tmp/$1 pid st partial t0 launch=() run=()

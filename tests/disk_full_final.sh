@@ -9,16 +9,13 @@
 # usage: disk_full_final.sh PERILIN REPO
 set -u
 exe=$1 repo=$2
-tmp=$(mktemp -d)
+# shellcheck source=/dev/null
+source "$(dirname "$0")/run_scratch.sh"
 mnt=$tmp/small
+on_exit='umount "$mnt" 2> /dev/null'
 mkdir -p "$mnt"
-trap 'umount "$mnt" 2> /dev/null; rm -rf "$tmp"' EXIT
 mount -t tmpfs -o size=64k tmpfs "$mnt" 2> /dev/null || { echo "SKIP: cannot mount a tmpfs here (needs root)"; exit 77; }
 umount "$mnt"
-unset PETSC_OPTIONS
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-fail=0
-bad() { echo "FAIL: $*"; fail=1; }
 
 # full NAME SIZE_KB SCENE OPTIONS...: the run into $mnt/out on a tmpfs of SIZE_KB
 full() {

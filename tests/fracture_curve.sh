@@ -15,12 +15,8 @@
 # usage: fracture_curve.sh PERILIN REPO_DIR
 set -u
 exe=$1 repo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-unset PETSC_OPTIONS
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-fail=0
-bad() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=/dev/null
+source "$(dirname "$0")/run_scratch.sh"
 run() { # name scene options...
   local name=$1 scene=$2
   shift 2

@@ -14,12 +14,8 @@ exe=$1 repo=$2
 shift 2
 mpi=("$@")
 command -v python3 > /dev/null || { echo "SKIP: no python3"; exit 77; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-unset PETSC_OPTIONS
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
-fail=0
-bad() { echo "FAIL: $*"; fail=1; }
+# shellcheck source=/dev/null
+source "$(dirname "$0")/run_scratch.sh"
 
 # the pid of rank 1 among the processes under mpiexec's pid $1 (Open MPI: OMPI_COMM_WORLD_RANK)
 rank1() {

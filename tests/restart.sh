@@ -14,13 +14,9 @@ exe=$1 scene=$2
 shift 2
 mpi=("$@")
 command -v python3 > /dev/null || { echo "SKIP: no python3"; exit 77; }
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-unset PETSC_OPTIONS
-export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1
+# shellcheck source=/dev/null
+source "$(dirname "$0")/run_scratch.sh"
 opts=(-grid_spacing 0.025 -analysis_min_step 1.25 -quiet) # bonds break at steps 7 and 8: before and after the stop; a coarser bracket, a shorter test
-fail=0
-bad() { echo "FAIL: $*"; fail=1; }
 
 # run NAME EXPECTED_STATUS [launcher...] -- options...
 run() {
