@@ -12,7 +12,6 @@
 
 #include <errno.h>
 #include <sys/stat.h>
-#include <sys/statvfs.h>
 #include <unistd.h>
 
 #define PERI_CHECKPOINT_MAGIC   0x50455249 /* "PERI" */
@@ -98,13 +97,6 @@ static PetscErrorCode WriteFile(PeriAnalysis an, const char tmp[], PetscErrorCod
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether the file system of dir has no block left for this user. */
-static PetscBool FullDisk(const char dir[])
-{
-  struct statvfs fs;
-  return (PetscBool)(statvfs(dir, &fs) == 0 && fs.f_bavail == 0);
-}
-
 /* A checkpoint that could not be written (rank 0 writes: a full disk, a quota, an I/O error): its
  * temporary file removed, the previous checkpoint and the staging directory it lies in kept for
  * -restart (a failed run's set is otherwise discarded), and the cause said. */
@@ -114,7 +106,7 @@ static PetscErrorCode WriteFailed(const char dir[], const char tmp[], int err)
   PetscBool found;
 
   PetscFunctionBeginUser;
-  if (!err) err = FullDisk(dir) ? ENOSPC : 0; /* PETSc's error path may have reset errno; before the file's blocks are freed */
+  if (!err) err = PeriFileSystemFull(dir) ? ENOSPC : 0; /* PETSc's error path may have reset errno; before the file's blocks are freed */
   (void)remove(tmp);
   PetscCall(PetscSNPrintf(prev, sizeof(prev), "%s/%s", dir, PERI_CHECKPOINT_FILE));
   PetscCall(PetscTestFile(prev, 'r', &found));

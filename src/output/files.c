@@ -16,6 +16,7 @@
 #include <stdio.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <sys/types.h>
 
 /* Make sure one path (a prefix of the requested directory) is a directory, creating it if missing. */
@@ -80,23 +81,45 @@ PetscErrorCode PeriFileCommit(const char tmp[], const char final[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriFileSystemFull - whether the file system holding path has no block left for this user: the
+  cause of a failed write whose errno was lost (PETSc's error paths and stdio's later calls may
+  reset it). Ask before the failed file's blocks are freed. Not collective.
+@*/
+PetscBool PeriFileSystemFull(const char path[])
+{
+  struct statvfs fs;
+  return (PetscBool)(statvfs(path, &fs) == 0 && fs.f_bavail == 0);
+}
+
 /* A writer's temporary file "<path>.tmp", opened for writing. Not collective. */
 PetscErrorCode PeriFileOpenTemporary(const char path[], char tmp[], size_t len, FILE **fp)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(tmp, len, "%s.tmp", path));
   *fp = fopen(tmp, "w");
-  PetscCheck(*fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s", tmp);
+  PetscCheck(*fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write %s: %s", tmp, strerror(errno));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Closes fp and commits tmp to path, or removes tmp when a write failed (bad). Not collective. */
+/* Closes fp and commits tmp to path, or removes tmp when a write failed (bad, or the flush of the
+ * buffered rest, where a full disk usually shows first), naming the file and the cause: a full
+ * disk at the end of a run said only "writing FILE failed" (issue 40). Not collective. */
 PetscErrorCode PeriFileCloseCommit(FILE *fp, const char tmp[], const char path[], int bad)
 {
+  char dir[PETSC_MAX_PATH_LEN];
+  int  err = bad ? errno : 0; /* the failed fprintf's, unless a later call changed it */
+
   PetscFunctionBeginUser;
-  bad |= fclose(fp) != 0;
-  if (bad) remove(tmp);
-  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "writing %s failed", tmp);
+  if (fflush(fp) != 0) bad = 1, err = errno;
+  bad |= ferror(fp) != 0;
+  if (fclose(fp) != 0 && !err) bad = 1, err = errno;
+  if (bad) {
+    PetscCall(PetscStrncpy(dir, tmp, sizeof(dir)));
+    if (!err && PeriFileSystemFull(dirname(dir))) err = ENOSPC;
+    (void)remove(tmp);
+  }
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Error writing %s: %s%s", tmp, err ? strerror(err) : "a write failed", err == ENOSPC || err == EDQUOT ? " (the disk or the quota is full)" : "");
   PetscCall(PeriFileCommit(tmp, path));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -376,11 +399,13 @@ static PetscErrorCode LinkOrCopy(const char src[], const char dst[])
   out = fopen(dst, "wb");
   if (!out) fclose(in);
   PetscCheck(out, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write %s: %s", dst, strerror(errno));
-  while ((n = fread(buf, 1, sizeof(buf), in)) > 0) bad |= fwrite(buf, 1, n, out) != n;
-  bad |= ferror(in) != 0;
+  while ((n = fread(buf, 1, sizeof(buf), in)) > 0 && !bad)
+    if (fwrite(buf, 1, n, out) != n) bad = errno ? errno : EIO;
+  if (ferror(in) && !bad) bad = errno ? errno : EIO;
   fclose(in);
-  bad |= fclose(out) != 0;
-  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "copying %s to %s failed", src, dst);
+  if (fclose(out) != 0 && !bad) bad = errno ? errno : EIO;
+  if (bad) (void)remove(dst);
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "copying %s to %s failed: %s", src, dst, strerror(bad));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

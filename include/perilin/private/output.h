@@ -45,6 +45,7 @@ PETSC_EXTERN PetscInt       PeriVTUDataFind(const PeriVTUData *, const char[]);
 PETSC_EXTERN PetscErrorCode PeriVTUDataDestroy(PeriVTUData *);
 PETSC_EXTERN PetscErrorCode PeriOutputDirCreate(const char[]);
 PETSC_EXTERN PetscErrorCode PeriFileCommit(const char[], const char[]);
+PETSC_EXTERN PetscBool      PeriFileSystemFull(const char[]);
 PETSC_EXTERN PetscErrorCode PeriFileOpenTemporary(const char[], char[], size_t, FILE **);
 PETSC_EXTERN PetscErrorCode PeriFileCloseCommit(FILE *, const char[], const char[], int);
 PETSC_EXTERN PetscErrorCode PeriOutputSetOpen(MPI_Comm, char[], size_t, char[], size_t);
