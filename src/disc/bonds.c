@@ -1,6 +1,6 @@
-/* Bond storage (PeriBonds): growing it, adding a bond with its partial-volume factor, freeing and
- * restoring its geometry; the partial-volume rule itself. The searches (neighbors.c, levels.c)
- * call these. */
+/* Bond storage (PeriBonds): what it and the particles take (the memory estimates' counts),
+ * growing it, adding a bond with its partial-volume factor, freeing and restoring its geometry;
+ * the partial-volume rule itself. The searches (neighbors.c, levels.c) call these. */
 #include "perilin/private/disc.h"
 
 const char *const PeriPartialVolumes[] = {"none", "linear", "linear_continued", NULL};
@@ -33,6 +33,40 @@ PetscReal PeriPartialVolumeFactor(PeriPartialVolume pv, PetscReal r, PetscReal d
 PetscReal PeriSearchRadius(PeriPartialVolume pv, PetscReal delta, PetscReal hmax)
 {
   return pv == PERI_PARTIAL_VOLUME_LINEAR_CONTINUED ? delta + hmax / 2 : delta * (1 + PERI_HORIZON_SLACK);
+}
+
+/*@C
+  PeriBondsBallCount - the lattice points within r spacings of a particle, itself excluded: its
+  bonds at a search radius of r spacings, as the memory estimates count them (a grid's, a read
+  file's and mesh's in src/system/memory.c; particles.refine's in mesh.c). Not collective.
+@*/
+PetscReal PeriBondsBallCount(PetscInt dim, PetscReal r)
+{
+  return (dim == 2 ? PETSC_PI * r * r : 4.0 / 3.0 * PETSC_PI * r * r * r) - 1;
+}
+
+/*@C
+  PeriBondsBytesPerParticle - the bytes one particle's bonds take, ball of them within its search
+  radius (PeriBondsBallCount), kept here beside the storage they count so that the estimates
+  follow its layout: the neighbour search reserves 1.05 ball / 2 bonds (a half list) of j, xi,
+  length, alpha and live (PeriBondsReserve), of which the share found (the faces leave fewer)
+  each get their lambda. Not collective.
+@*/
+PetscReal PeriBondsBytesPerParticle(PetscReal ball, PetscReal share)
+{
+  return ball / 2 * (1.05 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1) + share * sizeof(PetscReal));
+}
+
+/*@C
+  PeriParticlesBytesPerParticle - the bytes of the arrays every particle holds with dofs
+  displacement components, for the memory estimates (src/system/memory.c, mesh.c's of
+  particles.refine; here beside the bonds' count, below both readers): coordinates, volume,
+  spacing, line, family volume, neighbour count, the cell list, the local view's displacements
+  and energy densities. Not collective.
+@*/
+PetscReal PeriParticlesBytesPerParticle(PetscInt dofs)
+{
+  return (8 + 2 * dofs + 1) * sizeof(PetscReal) + 6 * sizeof(PetscInt);
 }
 
 /* Growable bond storage. */

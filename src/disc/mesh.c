@@ -335,9 +335,10 @@ static PetscErrorCode MeshOpen(PeriScene scene, PeriNode node, const char path[]
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The bytes per particle of the particles and their bonds (src/system/memory.c's Estimate without
- * the model's matrix and solver): a lower bound of what the run will hold. m is the horizon in
- * spacings; with horizon.delta (not known in spacings before the mesh is refined) the default 3. */
+/* The bytes per particle of the particles and their bonds (the counts src/system/memory.c's
+ * Estimate uses, without the model's matrix and solver): a lower bound of what the run will hold.
+ * m is the horizon in spacings; with horizon.delta (not known in spacings before the mesh is
+ * refined) the default 3. */
 static PetscErrorCode RefinedBytes(PeriScene scene, PetscInt dim, PetscReal *m, PetscReal *bytes)
 {
   PeriNode       hz = NULL;
@@ -353,10 +354,10 @@ static PetscErrorCode RefinedBytes(PeriScene scene, PetscInt dim, PetscReal *m, 
   PetscCall(PetscPopErrorHandler());
   if (ierr || !(*m >= 1)) *m = 1;
   r    = *m + 0.5; /* the continued partial-volume ramp's half spacing */
-  ball = (dim == 2 ? PETSC_PI * r * r : 4.0 / 3.0 * PETSC_PI * r * r * r) - 1;
-  /* coordinates, volumes, the particle arrays and the displacements; the neighbour search reserves
-     1.05 ball / 2 bonds of j, xi, length, alpha and live, and each bond gets its lambda */
-  *bytes = (8 + 2 * dim + 1) * sizeof(PetscReal) + 6 * sizeof(PetscInt) + ball / 2 * (1.05 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1) + sizeof(PetscReal));
+  ball = PeriBondsBallCount(dim, r);
+  /* the particles' arrays and their bonds, every one found (faces not discounted: an upper bound
+     of the bonds, but no matrix or solver is counted) */
+  *bytes = PeriParticlesBytesPerParticle(dim) + PeriBondsBytesPerParticle(ball, 1);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

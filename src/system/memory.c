@@ -106,12 +106,6 @@ static PetscBool Multigrid(PeriModel m, const PeriSystemNeeds *needs, PetscBool 
   return (PetscBool)!strcmp(pc, PCMG);
 }
 
-/* Lattice points within r spacings of a particle, itself excluded. */
-static PetscReal BallCount(PetscInt dim, PetscReal r)
-{
-  return (dim == 2 ? PETSC_PI * r * r : 4.0 / 3.0 * PETSC_PI * r * r * r) - 1;
-}
-
 /* The share of the lattice's pairs within r spacings that faces leave: a pair spans on average
  * E|dx| = 4r/(3 pi) (2D) or 3r/8 (3D) along an axis, and a box of c cells keeps 1 - E|dx|/c of
  * them along a non-periodic axis. */
@@ -129,7 +123,7 @@ static PetscReal SurfaceShare(PetscInt dim, PetscReal r, const PetscReal cells[]
  * each family in full and couple particles up to 2 delta apart. */
 static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const PeriSystemNeeds *needs, PetscBool mf, PetscBool mg, MemoryEstimate *e)
 {
-  const PetscReal dofs = m->dofs, ball = BallCount(m->dim, r);
+  const PetscReal dofs = m->dofs, ball = PeriBondsBallCount(m->dim, r);
   PetscReal       reserved, per_bond, blocks, nnz, matrix;
   char            type[64];
   PetscBool       aij;
@@ -142,14 +136,14 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   PetscCall(PetscStrcmp(type, MATAIJ, &aij));
   e->n      = n;
   e->nbonds = n * ball / 2 * share;
-  /* the search reserves 1.05 ball / 2 per particle of j, xi, length, alpha, live; every bond found
-     gets lambda, and with failure the cause and the softening share */
-  reserved = 1.05 * n * ball / 2 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1);
-  per_bond = sizeof(PetscReal) + (failure ? 1 + sizeof(PetscReal) : 0);
+  /* the search's reserve and every bond's lambda (the bond storage's count), and with failure each
+     bond's cause and softening share */
+  reserved = n * PeriBondsBytesPerParticle(ball, share);
+  per_bond = failure ? 1 + sizeof(PetscReal) : 0;
   /* a matrix-free K: its matrix is the short-range one (1.75 spacings, PeriOperatorPreconditioner)
      beside the operator's partner and sqrt(k) e per bond */
-  blocks = 1 + share * (mf ? BallCount(m->dim, 1.75) : PeriModelHasFamilies(m) ? BallCount(m->dim, 2 * r)
-                                                                               : ball);
+  blocks = 1 + share * (mf ? PeriBondsBallCount(m->dim, 1.75) : PeriModelHasFamilies(m) ? PeriBondsBallCount(m->dim, 2 * r)
+                                                                                        : ball);
   nnz    = n * blocks * dofs * dofs;
   matrix = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
   /* the geometric multigrid stores no matrix but the coarsest's: its levels hold a third of the
@@ -167,10 +161,9 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
      modal shift-and-invert: nested-dissection fill grew as 0.45 log2(n) matrices on the 2D lamina,
      3,600 to 230,400 particles) */
   e->shared += matrix * (needs->matrix_copies + needs->factor_fill * PetscLog2Real(n));
-  /* coordinates, volume, spacing, line, family volume, neighbour count, the cell list, the local
-     view's displacements and energy densities: each rank holds its own particles' (and a thin
-     layer of ghosts), so they share out like the rest (docs/distributed.md) */
-  e->shared += n * (8 * sizeof(PetscReal) + 6 * sizeof(PetscInt) + (2 * dofs + 1) * sizeof(PetscReal));
+  /* the particles' arrays: each rank holds its own particles' (and a thin layer of ghosts), so
+     they share out like the rest (docs/distributed.md) */
+  e->shared += n * PeriParticlesBytesPerParticle(m->dofs);
   e->per_rank = PERI_MEMORY_RUNTIME;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -293,7 +286,7 @@ PetscErrorCode PeriParticlesCheckMemoryRead(MPI_Comm comm, PeriScene s, PeriMode
   PetscCall(PetscPopErrorHandler());
   if (ierr || !(r > 0)) PetscFunctionReturn(PETSC_SUCCESS);
   /* faces not discounted; no particle has more than N - 1 neighbours (a horizon as large as the body) */
-  PetscCall(CheckEstimate(comm, s, m, needs, (PetscReal)N, r, PetscMin(1, (N - 1) / BallCount(m->dim, r)), NULL, particles, file ? "file" : "mesh", "use fewer particles (a coarser mesh or file), a smaller horizon, or more nodes"));
+  PetscCall(CheckEstimate(comm, s, m, needs, (PetscReal)N, r, PetscMin(1, (N - 1) / PeriBondsBallCount(m->dim, r)), NULL, particles, file ? "file" : "mesh", "use fewer particles (a coarser mesh or file), a smaller horizon, or more nodes"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -11,6 +11,7 @@ PETSC_EXTERN PetscErrorCode PeriParticlesCreateFromScene(PeriScene, PetscInt, Pe
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateBlock(MPI_Comm, PeriScene, PetscInt, PetscReal, PeriParticles *, PetscInt *);
 PETSC_EXTERN PetscErrorCode PeriParticlesCreateOwned(MPI_Comm, PeriScene, PetscInt, PetscReal, PetscReal, PeriParticles *, PetscInt *, PetscInt **);
 PETSC_EXTERN PetscErrorCode PeriParticlesAllocate(PeriParticles *, PetscInt);
+PETSC_EXTERN PetscReal      PeriParticlesBytesPerParticle(PetscInt);
 PETSC_EXTERN PetscErrorCode PeriParticlesPermute(PeriParticles *, const PetscInt[]);
 PETSC_EXTERN PetscErrorCode PeriParticlesSlice(const PeriParticles *, PetscInt, PetscInt, PeriParticles *);
 PETSC_EXTERN PetscErrorCode PeriParticlesDestroy(PeriParticles *);
@@ -104,6 +105,8 @@ PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevelsRows(const PeriParticles *, 
 PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsAdd(const PeriParticles *, PetscInt, PetscInt, const PetscReal[], PetscReal, PeriPartialVolume, PeriBonds *, PetscInt *);
 PETSC_EXTERN PetscErrorCode PeriBondsReserve(PeriBonds *, PetscInt, PetscInt *);
+PETSC_EXTERN PetscReal      PeriBondsBallCount(PetscInt, PetscReal);
+PETSC_EXTERN PetscReal      PeriBondsBytesPerParticle(PetscReal, PetscReal);
 PETSC_EXTERN PetscErrorCode PeriBondsDestroy(PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *, PeriBonds *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PeriBonds *);
