@@ -7,27 +7,17 @@
 # whole: -restart from it runs to the end. On 1 and 2 ranks (rank 0 writes the file).
 # usage: disk_full.sh PERILIN REPO MPIEXEC...   (MPIEXEC: the command that runs 2 ranks)
 set -u
-exe=$1 repo=$2
-shift 2
-mpi=("$@")
-[ -w /dev/full ] || { echo "SKIP: no /dev/full"; exit 77; }
-# shellcheck source=/dev/null
+# shellcheck source=tests/run_scratch.sh
 source "$(dirname "$0")/run_scratch.sh"
+[ -w /dev/full ] || { echo "SKIP: no /dev/full"; exit 77; }
 
 full() { # NAME launcher... -- SCENE OPTIONS...
-  local name=$1 d=$tmp/$1 pid st partial t0 launch=() run=()
+  local name=$1 d=$tmp/$1 pid st partial launch=() run=()
   shift
-  while [ "$1" != "--" ]; do launch+=("$1"); shift; done
-  shift
-  run=("$@" -quiet)
-  set -- "${launch[@]}"
-  "$@" "$exe" "${run[@]}" -output_dir "$d" > "$d.log" 2>&1 < /dev/null &
+  split_run "$@" -quiet
+  "${launch[@]}" "$exe" "${run[@]}" -output_dir "$d" > "$d.log" 2>&1 < /dev/null &
   pid=$!
-  t0=$SECONDS
-  until compgen -G "$d.partial-*/checkpoint/state.bin" > /dev/null; do
-    kill -0 $pid 2> /dev/null && [ $((SECONDS - t0)) -lt 20 ] || break
-    sleep 0.01
-  done
+  await $pid "$d.partial-*/checkpoint/state.bin"
   partial=$(compgen -G "$d.partial-*")
   # not while a checkpoint is being written (then state.bin.tmp exists): the link would be
   # renamed into place as if it were the written file
@@ -44,7 +34,7 @@ full() { # NAME launcher... -- SCENE OPTIONS...
   [ -e "$d" ] && bad "$name: an output directory $d was left"
   [ -e "$partial/checkpoint/state.bin.tmp" ] && bad "$name: the link state.bin.tmp was left"
   [ -f "$partial/checkpoint/state.bin" ] && [ ! -L "$partial/checkpoint/state.bin" ] || { bad "$name: state.bin is no longer the previous checkpoint"; ls -la "$partial/checkpoint"; return; }
-  "$@" "$exe" "${run[@]}" -restart "$partial" -output_dir "$d.cont" > "$d.cont.log" 2>&1 < /dev/null || { bad "$name: -restart $partial exited $?"; cat "$d.cont.log"; return; }
+  "${launch[@]}" "$exe" "${run[@]}" -restart "$partial" -output_dir "$d.cont" > "$d.cont.log" 2>&1 < /dev/null || { bad "$name: -restart $partial exited $?"; cat "$d.cont.log"; return; }
   grep -q '"complete": true' "$d.cont/summary.json" || bad "$name: the restarted run is not complete"
   [ $fail -eq 0 ] && echo "ok: $name: $(grep -o 'cannot write.*device' "$d.log"); restarted from the previous checkpoint to the end"
 }

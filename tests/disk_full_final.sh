@@ -8,8 +8,7 @@
 #    once there is space, -restart from it ends the run complete.
 # usage: disk_full_final.sh PERILIN REPO
 set -u
-exe=$1 repo=$2
-# shellcheck source=/dev/null
+# shellcheck source=tests/run_scratch.sh
 source "$(dirname "$0")/run_scratch.sh"
 mnt=$tmp/small
 on_exit='umount "$mnt" 2> /dev/null'

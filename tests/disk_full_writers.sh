@@ -11,27 +11,20 @@
 #    with its whole checkpoint and said with -restart; -restart from it ends the run complete.
 # usage: disk_full_writers.sh PERILIN REPO MPIEXEC...   (MPIEXEC: the command that runs 2 ranks)
 set -u
-exe=$1 repo=$2
-shift 2
-mpi=("$@")
-[ -w /dev/full ] || { echo "SKIP: no /dev/full"; exit 77; }
-# shellcheck source=/dev/null
+# shellcheck source=tests/run_scratch.sh
 source "$(dirname "$0")/run_scratch.sh"
+[ -w /dev/full ] || { echo "SKIP: no /dev/full"; exit 77; }
 
 # full NAME FILE launcher... -- SCENE OPTIONS...: the run into $tmp/NAME with FILE's temporary
 # name on /dev/full; sets $partial (the staging directory) and checks the exit and the message
 full() {
-  local name=$1 file=$2 d=$tmp/$1 pid st t0 launch=()
+  local name=$1 file=$2 d=$tmp/$1 pid st launch=() run=()
   shift 2
-  while [ "$1" != "--" ]; do launch+=("$1"); shift; done
-  shift
-  "${launch[@]}" "$exe" "$@" -quiet -output_dir "$d" > "$d.log" 2>&1 < /dev/null &
+  split_run "$@" -quiet
+  "${launch[@]}" "$exe" "${run[@]}" -output_dir "$d" > "$d.log" 2>&1 < /dev/null &
   pid=$!
-  t0=$SECONDS
-  until partial=$(compgen -G "$d.partial-*"); do
-    kill -0 $pid 2> /dev/null && [ $((SECONDS - t0)) -lt 20 ] || break
-    sleep 0.005
-  done
+  await $pid "$d.partial-*"
+  partial=$(compgen -G "$d.partial-*")
   [ -n "$partial" ] && ln -s /dev/full "$partial/$file.tmp"
   wait $pid
   st=$?

@@ -14,8 +14,7 @@
 #      scene with a curve, and refuses a static run's output with a message, not a traceback.
 # usage: fracture_curve.sh PERILIN REPO_DIR
 set -u
-exe=$1 repo=$2
-# shellcheck source=/dev/null
+# shellcheck source=tests/run_scratch.sh
 source "$(dirname "$0")/run_scratch.sh"
 run() { # name scene options...
   local name=$1 scene=$2

@@ -10,12 +10,9 @@
 # the rest to 1e-8); dynamic energies and impactors to 1e-12 and history.csv the same bytes.
 # usage: kill_fault.sh PERILIN REPO MPIEXEC...   (MPIEXEC: the command that runs 2 ranks)
 set -u
-exe=$1 repo=$2
-shift 2
-mpi=("$@")
-command -v python3 > /dev/null || { echo "SKIP: no python3"; exit 77; }
-# shellcheck source=/dev/null
+# shellcheck source=tests/run_scratch.sh
 source "$(dirname "$0")/run_scratch.sh"
+need python3
 
 # the pid of rank 1 among the processes under mpiexec's pid $1 (Open MPI: OMPI_COMM_WORLD_RANK)
 rank1() {
@@ -28,18 +25,14 @@ rank1() {
 # killed NAME OPTIONS...: the uninterrupted run (ref), the run whose rank 1 is killed (out), its
 # restart from the staging directory it left (cont)
 killed() {
-  local name=$1 d=$tmp/$1 t0 mpid r1 st partial
+  local name=$1 d=$tmp/$1 mpid r1 st partial
   shift
   mkdir -p "$d"
   "${mpi[@]}" "$exe" "$@" -quiet -output_dir "$d/ref" > "$d/ref.log" 2>&1 < /dev/null || { bad "$name: the uninterrupted run exited $?"; cat "$d/ref.log"; return; }
   cp -a "$d/ref" "$d/out" # a previous complete set, which the killed run must leave as it was
   "${mpi[@]}" "$exe" "$@" -quiet -output_dir "$d/out" > "$d/out.log" 2>&1 < /dev/null &
   mpid=$!
-  t0=$SECONDS
-  until compgen -G "$d/out.partial-*/checkpoint/state.bin" > /dev/null; do
-    kill -0 $mpid 2> /dev/null && [ $((SECONDS - t0)) -lt 20 ] || break
-    sleep 0.02
-  done
+  await $mpid "$d/out.partial-*/checkpoint/state.bin"
   r1=$(rank1 $mpid)
   [ -n "$r1" ] && kill -KILL "$r1"
   wait $mpid

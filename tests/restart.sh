@@ -10,22 +10,19 @@
 # an analysis without checkpoints.
 # usage: restart.sh PERILIN SCENE MPIEXEC...   (MPIEXEC: the command that runs 2 ranks)
 set -u
-exe=$1 scene=$2
-shift 2
-mpi=("$@")
-command -v python3 > /dev/null || { echo "SKIP: no python3"; exit 77; }
-# shellcheck source=/dev/null
+# shellcheck source=tests/run_scratch.sh
 source "$(dirname "$0")/run_scratch.sh"
+need python3
+scene=$repo
 opts=(-grid_spacing 0.025 -analysis_min_step 1.25 -quiet) # bonds break at steps 7 and 8: before and after the stop; a coarser bracket, a shorter test
 
 # run NAME EXPECTED_STATUS [launcher...] -- options...
 run() {
   local name=$1 want=$2 rc
   shift 2
-  local launch=()
-  while [ "$1" != "--" ]; do launch+=("$1"); shift; done
-  shift
-  "${launch[@]}" "$exe" "$scene" "${opts[@]}" "$@" -output_dir "$tmp/$name" > "$tmp/$name.log" 2>&1 < /dev/null
+  local launch=() run=()
+  split_run "$@"
+  "${launch[@]}" "$exe" "$scene" "${opts[@]}" "${run[@]}" -output_dir "$tmp/$name" > "$tmp/$name.log" 2>&1 < /dev/null
   rc=$?
   [ "$rc" -eq "$want" ] || { bad "$name: exit $rc, expected $want"; cat "$tmp/$name.log"; }
 }
