@@ -302,6 +302,7 @@ PetscErrorCode PeriProblemCheckOptions(PeriProblem p)
 {
   PetscFunctionBeginUser;
   PetscCall(PeriOptionsCheckScene(p->comm, p->scene));
+  PetscCall(PeriOptionsCheckTypes(p->comm)); /* before PETSc's leaking refusal of an unknown type */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

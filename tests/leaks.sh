@@ -62,6 +62,12 @@ refused sizes/empty_region                # a region without particles
 refused ranges/mu_by_region_zero          # a shear modulus by region <= 0
 refused solver/tune_none_converged        # no tune configuration converges
 refused solver/modal_st_jacobi            # an inexact inner solve: stopped inside SLEPc's EPSSolve
+# unknown solver types: PETSc 3.18's own refusal (inside KSPSetFromOptions, PCSetFromOptions,
+# STSetFromOptions) leaked its 16-byte copy of the name; perilin refuses them first (option_types.c)
+refused solver/ksp_nonsense
+refused solver/pc_nonexistent
+refused solver/modal_st_type_nonsense
+refused solver/tune_pc_type_unknown
 # analysis.initial from another body (src/system/readback.c): the file read, then refused
 cat > "$tmp/pushed.yaml" << 'EOF'
 dim: 2

@@ -121,6 +121,9 @@ PETSC_EXTERN PetscErrorCode PeriSceneGetPath(PeriScene, PeriNode, const char[], 
 PETSC_EXTERN PetscErrorCode PeriSceneParseReal(PeriScene, PeriNode, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriSceneParseBool(PeriScene, PeriNode, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriSceneParseRealArray(PeriScene, PeriNode, PetscInt, PetscInt, PetscReal[], PetscInt *);
+/* The solver types an option string of the scene names (a tune configuration), against the
+ * registered lists: why not, or "" (src/scene/option_types.c). */
+PETSC_EXTERN PetscErrorCode PeriOptionsCheckTypesString(const char[], char[], size_t);
 
 /* A user-input error that names the file, the line and the key. */
 #define PeriInputCheck(cond, scene, node, key, fmt, ...)                                      \

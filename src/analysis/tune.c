@@ -78,9 +78,12 @@ static PetscErrorCode ValidateConfiguration(PeriAnalysis an, PeriScene s, PeriNo
   PetscOptions   opts;
   PetscErrorCode ierr;
   KSP            ksp = NULL;
-  char          *msg = NULL, copy[PERI_TUNE_REASON_LEN] = "";
+  char          *msg = NULL, copy[PERI_TUNE_REASON_LEN] = "", types[4096];
 
   PetscFunctionBeginUser;
+  /* an unknown type is refused before PETSc's own refusal, which leaks its copy of the name */
+  PetscCall(PeriOptionsCheckTypesString(config, types, sizeof(types)));
+  PeriInputCheck(!types[0], s, node, NULL, "configuration '%s' cannot be set up: %s", config, types);
   PetscCall(ConfigOptionsCreate(config, &opts));
   PetscCall(PetscOptionsPush(opts));
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
