@@ -21,102 +21,78 @@
 #include <slepc/private/epsimpl.h>
 #include <petscblaslapack.h>
 
-/* A block of vectors with their products by K and M, kept side by side. */
+/* The basis Z = [X W P] in one set of 3 bs columns, with its products by K and M beside it: X (the
+ * Ritz vectors) in columns [0, bs), W (the new directions) in [bs, 2 bs), P (the previous steps) in
+ * [2 bs, 3 bs); column j of each block belongs to pair j. Every update is a product Z Q made in
+ * place (BVMultInPlace), where Q holds zeros for the columns that take no part: before, X, W and P
+ * were separate and copied into a fourth basis for the Rayleigh-Ritz step, 18 bs vectors where 9 bs
+ * do (the modal analysis' peak memory, docs/performance.md "Modal peak memory"). */
 typedef struct {
-  BV v, av, bv;
-} Block;
-
-typedef struct {
-  Block      x, w, p, z; /* Ritz vectors, new directions (first the residuals), previous steps; z: [x w p] */
-  PetscReal *lam;        /* the block's Ritz values */
-  Mat        H;          /* bs x bs work matrix (the M-products of W with X) */
+  BV         v, av, bv; /* Z, K Z, M Z */
+  PetscReal *lam;       /* the block's Ritz values */
+  Mat        Q;         /* 3 bs x 3 bs: the coefficients of an in-place update */
+  Mat        GA, GB;    /* 3 bs x 3 bs: Z^T K Z and Z^T M Z */
+  PetscInt  *idx;       /* the columns of Z in the Rayleigh-Ritz basis */
 } LOBPCG;
 
-static PetscErrorCode BlockCreate(BV tmpl, PetscInt m, Block *b)
+/* The active columns [l, k) of Z and both products. */
+static PetscErrorCode Active(LOBPCG *c, PetscInt l, PetscInt k)
 {
-  BV *all[3] = {&b->v, &b->av, &b->bv};
-
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < 3; i++) {
-    PetscCall(BVDuplicateResize(tmpl, m, all[i]));
-    PetscCall(BVSetMatrix(*all[i], NULL, PETSC_FALSE)); /* plain dot products: M is applied explicitly */
-  }
+  PetscCall(BVSetActiveColumns(c->v, l, k));
+  PetscCall(BVSetActiveColumns(c->av, l, k));
+  PetscCall(BVSetActiveColumns(c->bv, l, k));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode BlockDestroy(Block *b)
-{
-  PetscFunctionBeginUser;
-  PetscCall(BVDestroy(&b->v));
-  PetscCall(BVDestroy(&b->av));
-  PetscCall(BVDestroy(&b->bv));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The active columns [l, k) of all three. */
-static PetscErrorCode BlockActive(Block *b, PetscInt l, PetscInt k)
-{
-  PetscFunctionBeginUser;
-  PetscCall(BVSetActiveColumns(b->v, l, k));
-  PetscCall(BVSetActiveColumns(b->av, l, k));
-  PetscCall(BVSetActiveColumns(b->bv, l, k));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* dst's active columns = src's (as many). */
-static PetscErrorCode BlockCopy(Block *src, Block *dst)
-{
-  PetscFunctionBeginUser;
-  PetscCall(BVCopy(src->v, dst->v));
-  PetscCall(BVCopy(src->av, dst->av));
-  PetscCall(BVCopy(src->bv, dst->bv));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* dst = beta dst + alpha src Q on the active columns (BVMult), for v and bv, and for av if withK. */
-static PetscErrorCode BlockMult(Block *dst, PetscScalar alpha, PetscScalar beta, Block *src, Mat Q, PetscBool withK)
-{
-  PetscFunctionBeginUser;
-  PetscCall(BVMult(dst->v, alpha, beta, src->v, Q));
-  if (withK) PetscCall(BVMult(dst->av, alpha, beta, src->av, Q));
-  PetscCall(BVMult(dst->bv, alpha, beta, src->bv, Q));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The products of the active columns: M v, and K v if withK (the only products of K here). */
-static PetscErrorCode BlockProducts(EPS eps, Block *b, PetscBool withK)
+/* The products of the columns [l, k): M z, and K z if withK (the only products of K here). */
+static PetscErrorCode Products(EPS eps, LOBPCG *c, PetscInt l, PetscInt k, PetscBool withK)
 {
   Mat A, B;
 
   PetscFunctionBeginUser;
+  PetscCall(Active(c, l, k));
   PetscCall(STGetMatrix(eps->st, 0, &A));
   PetscCall(STGetMatrix(eps->st, 1, &B));
-  if (withK) PetscCall(BVMatMult(b->v, A, b->av));
-  PetscCall(BVMatMult(b->v, B, b->bv));
+  if (withK) PetscCall(BVMatMult(c->v, A, c->av));
+  PetscCall(BVMatMult(c->v, B, c->bv));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Scales the active columns to unit M-norm (v, av and bv alike). */
-static PetscErrorCode BlockNormalize(Block *b)
+/* Z(:, s:e) = Z Q(:, s:e) in place, for v, and for av and bv if withProducts. */
+static PetscErrorCode Update(LOBPCG *c, PetscInt s, PetscInt e, PetscBool withProducts)
 {
-  PetscInt l, k;
+  PetscInt m;
 
   PetscFunctionBeginUser;
-  PetscCall(BVGetActiveColumns(b->v, &l, &k));
+  PetscCall(BVGetSizes(c->v, NULL, NULL, &m));
+  PetscCall(Active(c, 0, m));
+  PetscCall(BVMultInPlace(c->v, c->Q, s, e));
+  if (withProducts) {
+    PetscCall(BVMultInPlace(c->av, c->Q, s, e));
+    PetscCall(BVMultInPlace(c->bv, c->Q, s, e));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Scales the columns [l, k) to unit M-norm (v, av and bv alike). */
+static PetscErrorCode Normalize(LOBPCG *c, PetscInt l, PetscInt k)
+{
+  PetscFunctionBeginUser;
   for (PetscInt j = l; j < k; j++) {
     Vec         v, bv;
     PetscScalar d;
     PetscReal   s;
-    PetscCall(BVGetColumn(b->v, j, &v));
-    PetscCall(BVGetColumn(b->bv, j, &bv));
+    PetscCall(BVGetColumn(c->v, j, &v));
+    PetscCall(BVGetColumn(c->bv, j, &bv));
     PetscCall(VecDot(bv, v, &d));
-    PetscCall(BVRestoreColumn(b->bv, j, &bv));
-    PetscCall(BVRestoreColumn(b->v, j, &v));
-    PetscCheck(PetscRealPart(d) > 0, PetscObjectComm((PetscObject)b->v), PETSC_ERR_CONV_FAILED, "perilin_lobpcg: a direction of zero M-norm (the preconditioner returned zero)");
+    PetscCall(BVRestoreColumn(c->bv, j, &bv));
+    PetscCall(BVRestoreColumn(c->v, j, &v));
+    PetscCheck(PetscRealPart(d) > 0, PetscObjectComm((PetscObject)c->v), PETSC_ERR_CONV_FAILED, "perilin_lobpcg: a direction of zero M-norm (the preconditioner returned zero)");
     s = 1 / PetscSqrtReal(PetscRealPart(d));
-    PetscCall(BVScaleColumn(b->v, j, s));
-    PetscCall(BVScaleColumn(b->av, j, s));
-    PetscCall(BVScaleColumn(b->bv, j, s));
+    PetscCall(BVScaleColumn(c->v, j, s));
+    PetscCall(BVScaleColumn(c->av, j, s));
+    PetscCall(BVScaleColumn(c->bv, j, s));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -150,37 +126,79 @@ static PetscErrorCode Symmetrize(DS ds, DSMatType m, PetscInt n, PetscBool *chol
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Rayleigh-Ritz on [X, W(nc:bs), P(nc:bs) if withP]: the new Ritz pairs in X and lam, and the new
- * P(nc:bs) = [W P] times the Ritz coefficients (the step just taken). ok = PETSC_FALSE, and
- * nothing changed, where the basis' M Gram matrix is not positive definite. */
-static PetscErrorCode RayleighRitz(EPS eps, LOBPCG *ctx, PetscInt nc, PetscBool withW, PetscBool withP, PetscBool *ok)
+/* The Gram matrices Z^T K Z and Z^T M Z of the first k columns, from the kept products. */
+static PetscErrorCode Gram(LOBPCG *c, PetscInt k)
 {
-  const PetscInt bs = eps->ncv, na = withW ? bs - nc : 0, nv = bs + na + (withP ? na : 0);
-  PetscScalar   *eig;
-  Mat            G, Q;
+  PetscFunctionBeginUser;
+  PetscCall(Active(c, 0, k));
+  PetscCall(BVMatProject(c->av, NULL, c->v, c->GA));
+  PetscCall(BVMatProject(c->bv, NULL, c->v, c->GB));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The DS matrix m = the rows and columns idx[0:nv) of the Gram matrix G. */
+static PetscErrorCode Gather(DS ds, DSMatType m, Mat G, const PetscInt *idx, PetscInt nv)
+{
+  Mat                D;
+  PetscScalar       *d;
+  const PetscScalar *g;
+  PetscInt           ld, lg;
 
   PetscFunctionBeginUser;
-  PetscCall(BlockActive(&ctx->x, 0, bs));
-  PetscCall(BlockActive(&ctx->z, 0, bs));
-  PetscCall(BlockCopy(&ctx->x, &ctx->z));
-  if (na) {
-    PetscCall(BlockActive(&ctx->w, nc, bs));
-    PetscCall(BlockActive(&ctx->z, bs, bs + na));
-    PetscCall(BlockCopy(&ctx->w, &ctx->z));
-  }
-  if (withP) {
-    PetscCall(BlockActive(&ctx->p, nc, bs));
-    PetscCall(BlockActive(&ctx->z, bs + na, nv));
-    PetscCall(BlockCopy(&ctx->p, &ctx->z));
-  }
-  PetscCall(BlockActive(&ctx->z, 0, nv));
+  PetscCall(DSGetMat(ds, m, &D));
+  PetscCall(MatDenseGetArray(D, &d));
+  PetscCall(MatDenseGetLDA(D, &ld));
+  PetscCall(MatDenseGetArrayRead(G, &g));
+  PetscCall(MatDenseGetLDA(G, &lg));
+  for (PetscInt j = 0; j < nv; j++)
+    for (PetscInt i = 0; i < nv; i++) d[i + j * ld] = g[idx[i] + idx[j] * lg];
+  PetscCall(MatDenseRestoreArrayRead(G, &g));
+  PetscCall(MatDenseRestoreArray(D, &d));
+  PetscCall(DSRestoreMat(ds, m, &D));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Q for the Rayleigh-Ritz update from the Ritz coefficients R (nv x nv): column j < bs makes the
+ * new x_j from the whole basis; column 2 bs + j (j >= nc, if na) the new p_j from the W and P rows
+ * only (the step just taken). */
+static PetscErrorCode RitzUpdateMatrix(LOBPCG *c, PetscInt bs, PetscInt nc, PetscInt na, PetscInt nv, Mat R)
+{
+  PetscScalar       *q;
+  const PetscScalar *r;
+  PetscInt           lq, lr;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatZeroEntries(c->Q));
+  PetscCall(MatDenseGetArray(c->Q, &q));
+  PetscCall(MatDenseGetLDA(c->Q, &lq));
+  PetscCall(MatDenseGetArrayRead(R, &r));
+  PetscCall(MatDenseGetLDA(R, &lr));
+  for (PetscInt j = 0; j < bs; j++)
+    for (PetscInt i = 0; i < nv; i++) q[c->idx[i] + j * lq] = r[i + j * lr];
+  for (PetscInt j = nc; j < bs && na; j++)
+    for (PetscInt i = bs; i < nv; i++) q[c->idx[i] + (2 * bs + j) * lq] = r[i + j * lr];
+  PetscCall(MatDenseRestoreArrayRead(R, &r));
+  PetscCall(MatDenseRestoreArray(c->Q, &q));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Rayleigh-Ritz on [X, W(nc:bs), P(nc:bs) if withP] from the Gram matrices (Gram): the new Ritz
+ * pairs in X and lam, and the new P(nc:bs) = [W P] times the Ritz coefficients. ok = PETSC_FALSE,
+ * and nothing changed, where the basis' M Gram matrix is not positive definite. */
+static PetscErrorCode RayleighRitz(EPS eps, LOBPCG *c, PetscInt nc, PetscBool withW, PetscBool withP, PetscBool *ok)
+{
+  const PetscInt bs = eps->ncv, na = withW ? bs - nc : 0;
+  PetscInt       nv = 0;
+  PetscScalar   *eig;
+  Mat            R;
+
+  PetscFunctionBeginUser;
+  for (PetscInt j = 0; j < bs; j++) c->idx[nv++] = j;
+  for (PetscInt j = nc; j < bs && na; j++) c->idx[nv++] = bs + j;
+  for (PetscInt j = nc; j < bs && na && withP; j++) c->idx[nv++] = 2 * bs + j;
   PetscCall(DSSetDimensions(eps->ds, nv, 0, 0));
-  PetscCall(DSGetMat(eps->ds, DS_MAT_A, &G));
-  PetscCall(BVMatProject(ctx->z.av, NULL, ctx->z.v, G)); /* Z^T K Z from the kept K Z */
-  PetscCall(DSRestoreMat(eps->ds, DS_MAT_A, &G));
-  PetscCall(DSGetMat(eps->ds, DS_MAT_B, &G));
-  PetscCall(BVMatProject(ctx->z.bv, NULL, ctx->z.v, G));
-  PetscCall(DSRestoreMat(eps->ds, DS_MAT_B, &G));
+  PetscCall(Gather(eps->ds, DS_MAT_A, c->GA, c->idx, nv));
+  PetscCall(Gather(eps->ds, DS_MAT_B, c->GB, c->idx, nv));
   PetscCall(Symmetrize(eps->ds, DS_MAT_A, nv, NULL));
   PetscCall(Symmetrize(eps->ds, DS_MAT_B, nv, ok));
   if (!*ok) PetscFunctionReturn(PETSC_SUCCESS);
@@ -190,44 +208,39 @@ static PetscErrorCode RayleighRitz(EPS eps, LOBPCG *ctx, PetscInt nc, PetscBool 
   PetscCall(DSSort(eps->ds, eig, NULL, NULL, NULL, NULL));
   PetscCall(DSSynchronize(eps->ds, eig, NULL));
   PetscCall(DSVectors(eps->ds, DS_MAT_X, NULL, NULL));
-  for (PetscInt j = 0; j < bs; j++) ctx->lam[j] = eps->eigr[j] = PetscRealPart(eig[j]);
+  for (PetscInt j = 0; j < bs; j++) c->lam[j] = eps->eigr[j] = PetscRealPart(eig[j]);
   PetscCall(PetscFree(eig));
-  PetscCall(DSGetMat(eps->ds, DS_MAT_X, &Q));
-  if (na) { /* P(nc:bs) = Z(bs:nv) Q(bs:nv, nc:bs) */
-    PetscCall(BlockActive(&ctx->z, bs, nv));
-    PetscCall(BlockActive(&ctx->p, nc, bs));
-    PetscCall(BlockMult(&ctx->p, 1, 0, &ctx->z, Q, PETSC_TRUE));
-  }
-  PetscCall(BlockActive(&ctx->z, 0, nv)); /* X = Z Q(:, 0:bs), K X afresh */
-  PetscCall(BlockActive(&ctx->x, 0, bs));
-  PetscCall(BlockMult(&ctx->x, 1, 0, &ctx->z, Q, PETSC_FALSE));
-  PetscCall(DSRestoreMat(eps->ds, DS_MAT_X, &Q));
-  PetscCall(BlockProducts(eps, &ctx->x, PETSC_TRUE));
+  PetscCall(DSGetMat(eps->ds, DS_MAT_X, &R));
+  PetscCall(RitzUpdateMatrix(c, bs, nc, na, nv, R));
+  PetscCall(DSRestoreMat(eps->ds, DS_MAT_X, &R));
+  PetscCall(Update(c, 0, bs, PETSC_FALSE)); /* X first: P's update reads no X row */
+  if (na) PetscCall(Update(c, 2 * bs + nc, 3 * bs, PETSC_TRUE));
+  PetscCall(Products(eps, c, 0, bs, PETSC_TRUE)); /* K X and M X afresh */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The residuals K x_j - lam_j M x_j of the whole block into W, their errors (SLEPc's convergence
  * test), and the number of leading pairs that pass it. */
-static PetscErrorCode Residuals(EPS eps, LOBPCG *ctx, PetscInt *nc)
+static PetscErrorCode Residuals(EPS eps, LOBPCG *c, PetscInt *nc)
 {
   const PetscInt bs    = eps->ncv;
   PetscBool      count = PETSC_TRUE;
 
   PetscFunctionBeginUser;
-  PetscCall(BVSetActiveColumns(ctx->x.av, 0, bs));
-  PetscCall(BVSetActiveColumns(ctx->w.v, 0, bs));
-  PetscCall(BVCopy(ctx->x.av, ctx->w.v));
+  PetscCall(BVSetActiveColumns(c->av, 0, bs));
+  PetscCall(BVSetActiveColumns(c->v, bs, 2 * bs));
+  PetscCall(BVCopy(c->av, c->v));
   *nc = 0;
   for (PetscInt j = 0; j < bs; j++) {
     Vec       r, bx;
     PetscReal norm;
-    PetscCall(BVGetColumn(ctx->w.v, j, &r));
-    PetscCall(BVGetColumn(ctx->x.bv, j, &bx));
-    PetscCall(VecAXPY(r, -ctx->lam[j], bx));
+    PetscCall(BVGetColumn(c->v, bs + j, &r));
+    PetscCall(BVGetColumn(c->bv, j, &bx));
+    PetscCall(VecAXPY(r, -c->lam[j], bx));
     PetscCall(VecNorm(r, NORM_2, &norm));
-    PetscCall(BVRestoreColumn(ctx->x.bv, j, &bx));
-    PetscCall(BVRestoreColumn(ctx->w.v, j, &r));
-    PetscCall((*eps->converged)(eps, ctx->lam[j], 0, norm, &eps->errest[j], eps->convergedctx));
+    PetscCall(BVRestoreColumn(c->bv, j, &bx));
+    PetscCall(BVRestoreColumn(c->v, bs + j, &r));
+    PetscCall((*eps->converged)(eps, c->lam[j], 0, norm, &eps->errest[j], eps->convergedctx));
     if (count && eps->errest[j] < eps->tol)
       (*nc)++;
     else
@@ -236,36 +249,47 @@ static PetscErrorCode Residuals(EPS eps, LOBPCG *ctx, PetscInt *nc)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The new directions W(nc:bs): the preconditioned residuals, M-orthogonal to X, M-normalized, and
- * their products by K (the iteration's only products of K). */
-static PetscErrorCode Directions(EPS eps, LOBPCG *ctx, PetscInt nc)
+/* The new directions W(nc:bs): the preconditioned residuals, M-orthogonal to X (W -= X X^T M W,
+ * in place), M-normalized, and their products by K (the iteration's only products of K). */
+static PetscErrorCode Directions(EPS eps, LOBPCG *c, PetscInt nc)
 {
   const PetscInt bs = eps->ncv;
+  PetscScalar   *q;
+  PetscInt       lq;
   Vec            t;
 
   PetscFunctionBeginUser;
-  PetscCall(BVCreateVec(ctx->w.v, &t));
+  PetscCall(BVCreateVec(c->v, &t));
   for (PetscInt j = nc; j < bs; j++) {
     Vec r;
-    PetscCall(BVGetColumn(ctx->w.v, j, &r));
+    PetscCall(BVGetColumn(c->v, bs + j, &r));
     PetscCall(STApply(eps->st, r, t));
     PetscCall(VecCopy(t, r));
-    PetscCall(BVRestoreColumn(ctx->w.v, j, &r));
+    PetscCall(BVRestoreColumn(c->v, bs + j, &r));
   }
   PetscCall(VecDestroy(&t));
-  PetscCall(BlockActive(&ctx->w, nc, bs));
-  PetscCall(BlockProducts(eps, &ctx->w, PETSC_FALSE));
-  PetscCall(BlockActive(&ctx->x, 0, bs));
-  PetscCall(BVDot(ctx->w.bv, ctx->x.v, ctx->H)); /* H(0:bs, nc:bs) = X^T M W */
-  PetscCall(BlockMult(&ctx->w, -1, 1, &ctx->x, ctx->H, PETSC_FALSE));
-  PetscCall(BlockNormalize(&ctx->w));
-  PetscCall(BlockProducts(eps, &ctx->w, PETSC_TRUE));
+  PetscCall(Products(eps, c, bs + nc, 2 * bs, PETSC_FALSE));
+  PetscCall(MatZeroEntries(c->Q));
+  PetscCall(BVSetActiveColumns(c->v, 0, bs));
+  PetscCall(BVDot(c->bv, c->v, c->Q)); /* Q(0:bs, bs+nc:2bs) = X^T M W */
+  PetscCall(MatDenseGetArray(c->Q, &q));
+  PetscCall(MatDenseGetLDA(c->Q, &lq));
+  for (PetscInt j = bs + nc; j < 2 * bs; j++) {
+    for (PetscInt i = 0; i < bs; i++) q[i + j * lq] = -q[i + j * lq];
+    q[j + j * lq] = 1;
+  }
+  PetscCall(MatDenseRestoreArray(c->Q, &q));
+  PetscCall(Update(c, bs + nc, 2 * bs, PETSC_FALSE));
+  PetscCall(Active(c, 0, 2 * bs));
+  PetscCall(BVMultInPlace(c->bv, c->Q, bs + nc, 2 * bs));
+  PetscCall(Normalize(c, bs + nc, 2 * bs));
+  PetscCall(Products(eps, c, bs + nc, 2 * bs, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 static PetscErrorCode EPSSolve_PeriLOBPCG(EPS eps)
 {
-  LOBPCG        *ctx = (LOBPCG *)eps->data;
+  LOBPCG        *c   = (LOBPCG *)eps->data;
   const PetscInt bs  = eps->ncv;
   PetscInt       its = 0, nc = 0;
   PetscBool      ok, withP   = PETSC_FALSE;
@@ -274,32 +298,66 @@ static PetscErrorCode EPSSolve_PeriLOBPCG(EPS eps)
   for (PetscInt k = eps->nini; k < bs; k++) PetscCall(BVSetRandomColumn(eps->V, k));
   PetscCall(BVSetActiveColumns(eps->V, 0, bs));
   PetscCall(BVOrthogonalize(eps->V, NULL)); /* M-orthonormal: eps->V has M as its inner product */
-  PetscCall(BlockActive(&ctx->x, 0, bs));
-  PetscCall(BVCopy(eps->V, ctx->x.v));
-  PetscCall(BlockProducts(eps, &ctx->x, PETSC_TRUE));
-  PetscCall(RayleighRitz(eps, ctx, bs, PETSC_FALSE, PETSC_FALSE, &ok));
+  PetscCall(BVSetActiveColumns(c->v, 0, bs));
+  PetscCall(BVCopy(eps->V, c->v));
+  PetscCall(Products(eps, c, 0, bs, PETSC_TRUE));
+  PetscCall(Gram(c, bs));
+  PetscCall(RayleighRitz(eps, c, bs, PETSC_FALSE, PETSC_FALSE, &ok));
   PetscCheck(ok, PetscObjectComm((PetscObject)eps), PETSC_ERR_CONV_FAILED, "perilin_lobpcg: the initial block is not M-orthonormal");
   while (eps->reason == EPS_CONVERGED_ITERATING) {
-    PetscCall(Residuals(eps, ctx, &nc));
+    PetscCall(Residuals(eps, c, &nc));
     eps->nconv = nc;
     PetscCall(EPSMonitor(eps, its, nc, eps->eigr, eps->eigi, eps->errest, bs));
     PetscCall((*eps->stopping)(eps, its, eps->max_it, nc, eps->nev, &eps->reason, eps->stoppingctx));
     if (eps->reason != EPS_CONVERGED_ITERATING) break;
-    PetscCall(Directions(eps, ctx, nc));
-    if (withP) {
-      PetscCall(BlockActive(&ctx->p, nc, bs));
-      PetscCall(BlockNormalize(&ctx->p));
-    }
-    PetscCall(RayleighRitz(eps, ctx, nc, PETSC_TRUE, withP, &ok));
-    if (!ok && withP) PetscCall(RayleighRitz(eps, ctx, nc, PETSC_TRUE, PETSC_FALSE, &ok));
+    PetscCall(Directions(eps, c, nc));
+    if (withP) PetscCall(Normalize(c, 2 * bs + nc, 3 * bs));
+    PetscCall(Gram(c, withP ? 3 * bs : 2 * bs));
+    PetscCall(RayleighRitz(eps, c, nc, PETSC_TRUE, withP, &ok));
+    if (!ok && withP) PetscCall(RayleighRitz(eps, c, nc, PETSC_TRUE, PETSC_FALSE, &ok));
     PetscCheck(ok, PetscObjectComm((PetscObject)eps), PETSC_ERR_CONV_FAILED, "perilin_lobpcg: the basis [X W] lost its rank at iteration %" PetscInt_FMT " (a preconditioner that is not positive definite?)", its);
     withP = PETSC_TRUE;
     its++;
   }
   eps->its = its;
   PetscCall(BVSetActiveColumns(eps->V, 0, bs));
-  PetscCall(BVSetActiveColumns(ctx->x.v, 0, bs));
-  PetscCall(BVCopy(ctx->x.v, eps->V));
+  PetscCall(BVSetActiveColumns(c->v, 0, bs));
+  PetscCall(BVCopy(c->v, eps->V));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The basis (m = 3 bs columns, zero: the columns an update leaves out meet zeros in Q), the
+ * coefficient and Gram matrices, and the index and Ritz value arrays. */
+static PetscErrorCode Allocate(BV tmpl, PetscInt m, LOBPCG *c)
+{
+  BV *all[3] = {&c->v, &c->av, &c->bv};
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < 3; i++) {
+    PetscCall(BVDuplicateResize(tmpl, m, all[i]));
+    PetscCall(BVSetMatrix(*all[i], NULL, PETSC_FALSE)); /* plain dot products: M is applied explicitly */
+    PetscCall(BVSetActiveColumns(*all[i], 0, m));
+    PetscCall(BVScale(*all[i], 0)); /* zeroes (SLEPc writes zeros for 0, not 0 times the old) */
+  }
+  PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, m, m, NULL, &c->Q));
+  PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, m, m, NULL, &c->GA));
+  PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, m, m, NULL, &c->GB));
+  PetscCall(PetscMalloc1(m, &c->idx));
+  PetscCall(PetscCalloc1(m / 3, &c->lam));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode Release(LOBPCG *c)
+{
+  PetscFunctionBeginUser;
+  PetscCall(BVDestroy(&c->v));
+  PetscCall(BVDestroy(&c->av));
+  PetscCall(BVDestroy(&c->bv));
+  PetscCall(MatDestroy(&c->Q));
+  PetscCall(MatDestroy(&c->GA));
+  PetscCall(MatDestroy(&c->GB));
+  PetscCall(PetscFree(c->idx));
+  PetscCall(PetscFree(c->lam));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -347,18 +405,8 @@ static PetscErrorCode EPSSetUp_PeriLOBPCG(EPS eps)
   PetscCall(EPS_SetInnerProduct(eps));
   PetscCall(DSSetType(eps->ds, DSGHEP));
   PetscCall(DSAllocate(eps->ds, eps->mpd));
-  PetscCall(BlockDestroy(&ctx->x));
-  PetscCall(BlockDestroy(&ctx->w));
-  PetscCall(BlockDestroy(&ctx->p));
-  PetscCall(BlockDestroy(&ctx->z));
-  PetscCall(BlockCreate(eps->V, eps->ncv, &ctx->x));
-  PetscCall(BlockCreate(eps->V, eps->ncv, &ctx->w));
-  PetscCall(BlockCreate(eps->V, eps->ncv, &ctx->p));
-  PetscCall(BlockCreate(eps->V, eps->mpd, &ctx->z));
-  PetscCall(PetscFree(ctx->lam));
-  PetscCall(PetscCalloc1(eps->ncv, &ctx->lam));
-  PetscCall(MatDestroy(&ctx->H));
-  PetscCall(MatCreateSeqDense(PETSC_COMM_SELF, eps->ncv, eps->ncv, NULL, &ctx->H));
+  PetscCall(Release(ctx));
+  PetscCall(Allocate(eps->V, eps->mpd, ctx));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -367,12 +415,7 @@ static PetscErrorCode EPSDestroy_PeriLOBPCG(EPS eps)
   LOBPCG *ctx = (LOBPCG *)eps->data;
 
   PetscFunctionBeginUser;
-  PetscCall(BlockDestroy(&ctx->x));
-  PetscCall(BlockDestroy(&ctx->w));
-  PetscCall(BlockDestroy(&ctx->p));
-  PetscCall(BlockDestroy(&ctx->z));
-  PetscCall(PetscFree(ctx->lam));
-  PetscCall(MatDestroy(&ctx->H));
+  PetscCall(Release(ctx));
   PetscCall(PetscFree(eps->data));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
