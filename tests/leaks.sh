@@ -68,6 +68,9 @@ refused solver/ksp_nonsense
 refused solver/pc_nonexistent
 refused solver/modal_st_type_nonsense
 refused solver/tune_pc_type_unknown
+# a tune configuration's -solver_operator outside its choices: PETSc's PetscOptionsGetEList leaked
+# 48 bytes on its refusal; tune.c matches the value itself
+refused solver/tune_operator_unknown
 # analysis.initial from another body (src/system/readback.c): the file read, then refused
 cat > "$tmp/pushed.yaml" << 'EOF'
 dim: 2

@@ -57,16 +57,37 @@ static PetscErrorCode ConfigOptionsCreate(const char config[], PetscOptions *opt
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* What a configuration sets up with the options pushed: a KSP and its PC from the options, and
- * -solver_operator. Errors are returned, not raised (ValidateConfiguration). */
+/* A configuration's -solver_operator (kind unchanged when it has none), or in why (len bytes) the
+ * value that is none of PeriOperatorKinds. Read as a string and matched here: PETSc 3.18's
+ * PetscOptionsGetEList leaks its copy of the list on a value outside it (docs/reliability.md). */
+static PetscErrorCode ConfigOperatorKind(PetscOptions opts, PetscInt *kind, char why[], size_t len)
+{
+  char      value[64];
+  PetscBool set;
+
+  PetscFunctionBeginUser;
+  why[0] = 0;
+  PetscCall(PetscOptionsGetString(opts, NULL, "-solver_operator", value, sizeof(value), &set));
+  if (!set) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt k = 0; PeriOperatorKinds[k]; k++) {
+    PetscBool same;
+    PetscCall(PetscStrcmp(value, PeriOperatorKinds[k], &same));
+    if (same) {
+      *kind = k;
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+  }
+  PetscCall(PetscSNPrintf(why, len, "-solver_operator %s is none of auto, assembled, matrix_free", value));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* What a configuration sets up with the options pushed: a KSP and its PC from the options. Errors
+ * are returned, not raised (ValidateConfiguration). */
 static PetscErrorCode TrySetUp(MPI_Comm comm, KSP *ksp)
 {
-  PetscInt kind = 0;
-
   PetscFunctionBeginUser;
   PetscCall(KSPCreate(comm, ksp));
   PetscCall(KSPSetFromOptions(*ksp));
-  PetscCall(PetscOptionsGetEList(NULL, NULL, "-solver_operator", PeriOperatorKinds, 3, &kind, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -77,7 +98,8 @@ static PetscErrorCode ValidateConfiguration(PeriAnalysis an, PeriScene s, PeriNo
 {
   PetscOptions   opts;
   PetscErrorCode ierr;
-  KSP            ksp = NULL;
+  KSP            ksp  = NULL;
+  PetscInt       kind = 0;
   char          *msg = NULL, copy[PERI_TUNE_REASON_LEN] = "", types[4096];
 
   PetscFunctionBeginUser;
@@ -85,6 +107,9 @@ static PetscErrorCode ValidateConfiguration(PeriAnalysis an, PeriScene s, PeriNo
   PetscCall(PeriOptionsCheckTypesString(config, types, sizeof(types)));
   PeriInputCheck(!types[0], s, node, NULL, "configuration '%s' cannot be set up: %s", config, types);
   PetscCall(ConfigOptionsCreate(config, &opts));
+  PetscCall(ConfigOperatorKind(opts, &kind, types, sizeof(types)));
+  if (types[0]) PetscCall(PetscOptionsDestroy(&opts));
+  PeriInputCheck(!types[0], s, node, NULL, "configuration '%s' cannot be set up: %s", config, types);
   PetscCall(PetscOptionsPush(opts));
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   ierr = TrySetUp(an->comm, &ksp);
@@ -263,7 +288,7 @@ static PetscErrorCode RunConfiguration(PeriAnalysis an, const char config[], Pet
 
   PetscFunctionBeginUser;
   PetscCall(ConfigOptionsCreate(config, &opts));
-  PetscCall(PetscOptionsGetEList(opts, NULL, "-solver_operator", PeriOperatorKinds, 3, &kind, NULL));
+  PetscCall(ConfigOperatorKind(opts, &kind, row->reason, sizeof(row->reason))); /* checked at the set-up */
   why          = kind == PERI_OPERATOR_MATRIX_FREE ? PeriMatrixFreeWhyNot(sys) : NULL;
   row->refused = (PetscBool) !!why;
   if (why) {
