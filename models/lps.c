@@ -60,7 +60,7 @@ static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
   PetscCall(PeriSceneGetChoice(scene, node, "dilatation", dilatations, &k, NULL));
   lps->affine           = (PetscBool)(k == 1);
   m->nstates            = lps->affine ? 2 : 1;
-  m->states_along_bonds = (PetscBool)!lps->affine;
+  m->states_along_bonds = 1; /* the standard dilatation (state 0 of either); the affine one is off the bond */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -238,7 +238,7 @@ static PetscErrorCode PeriModelCreate_LPS(PeriModel m)
   m->surface_corrections = corrections; /* m_i from the actual family is the model's own */
   m->takes_own_horizon   = PETSC_TRUE;
   m->nstates             = 1;
-  m->states_along_bonds  = PETSC_TRUE;
+  m->states_along_bonds  = 1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -98,7 +98,7 @@ struct _p_PeriModel {
   const PetscReal    *horizon;            /* horizon.spacing: own: each particle's of the local view (b->i, b->j index it); else NULL */
   PetscBool           takes_own_horizon;  /* the model calibrates per particle, so it takes per-particle horizons */
   PetscInt            nstates;            /* states per particle of ops.bond_state (set by the model, 1 or more) */
-  PetscBool           states_along_bonds; /* every state's weights lie along their bond: the matrix-free operator applies only these */
+  PetscInt            states_along_bonds; /* the leading states whose weights lie along their bond (the matrix-free operator keeps 2 numbers per bond for each, 2 dofs for the others) */
   void               *data;
   /* what each of the nmeasures bond measures is, in the order of measure_names: the failure
      criteria find theirs by kind (PeriModelMeasureIndex) */

@@ -39,13 +39,14 @@ struct _p_PeriOperator {
   PetscInt  *ghost;
   PetscInt  *slot; /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
   /* The state terms of family models (ops.bond_state; the LPS dilatation), else NULL: per bond the
-     weights toward theta_i and theta_j, as multiples p of w (2 numbers, one state along the
-     bond), or as vectors (pvec: 2 ns bs numbers), per particle and state of the operator's local
-     numbering the modulus A. A broken bond's w = 0 (and its vectors' 0) takes it out of both
-     terms at once. */
+     weights toward theta_i and theta_j, np numbers: for each of the na leading states (those
+     along the bond) 2 multiples of w, for each other state 2 vectors of bs numbers (the affine
+     dilatation: 8 numbers in 3D where all as vectors took 12); per particle and state of the
+     operator's local numbering the modulus A. A broken bond's w = 0 (and its vectors' 0) takes it
+     out of both terms at once. */
   PetscReal     *p, *A;
   PetscInt       ns;          /* states per particle (the model's nstates) */
-  PetscBool      pvec;        /* p holds the weights as vectors (bs numbers per end and state; states off the bond), not as multiples of w */
+  PetscInt       na, np;      /* the leading states along the bond (the model's states_along_bonds), numbers of p per bond */
   Vec            theta;       /* ghosted, ns per particle: the states, then A theta */
   Vec            sg;          /* ghosted scratch, ns bs per particle: each state's own gradient (StateOwnGradients) */
   PeriShortRange short_range; /* the preconditioning matrix's bonds and their scales */
@@ -178,40 +179,58 @@ static inline void SpringStateLoop(const PeriOperator op, const PetscInt bs, con
 /* Weight d of state s toward theta_i (side 0) or theta_j (side 1) of stored bond b. */
 static inline PetscReal StateWeight(const PeriOperator op, PetscInt b, PetscInt s, PetscInt side, PetscInt d)
 {
-  if (op->pvec) return op->p[((b * op->ns + s) * 2 + side) * op->bs + d];
-  return op->p[2 * b + side] * op->w[op->bs * b + d];
+  const PetscReal *p = op->p + op->np * b;
+  if (s < op->na) return p[2 * s + side] * op->w[op->bs * b + d];
+  return p[2 * op->na + (2 * (s - op->na) + side) * op->bs + d];
 }
 
-/* The first pass with the weights as vectors: theta_is += gi_s . (u_j - u_i), theta_js alike. */
+/* Whether the product takes the general loops (several states, or states off the bond). */
+static inline PetscBool StatesMixed(const PeriOperator op)
+{
+  return (PetscBool)(op->ns != 1 || op->na != 1);
+}
+
+/* The first pass, general: theta_is += p_is s (s = w . (u_j - u_i)) for the states along the bond,
+ * gi_s . (u_j - u_i) for the others; theta_js alike. */
 static void VecStateLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *th)
 {
-  const PetscInt bs = op->bs, ns = op->ns;
+  const PetscInt bs = op->bs, ns = op->ns, na = op->na;
   for (PetscInt i = 0; i < op->nloc; i++)
     for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
-      const PetscReal *g = op->p + 2 * ns * bs * b;
+      const PetscReal *w = op->w + bs * b, *p = op->p + op->np * b, *g = p + 2 * na;
       const PetscInt   j = op->jl[b];
-      for (PetscInt s = 0; s < ns; s++, g += 2 * bs)
+      PetscScalar      t[PERI_MAX_DOF], tw = 0;
+      for (PetscInt d = 0; d < bs; d++) {
+        t[d] = x[bs * j + d] - x[bs * i + d];
+        tw += w[d] * t[d];
+      }
+      for (PetscInt s = 0; s < na; s++) {
+        th[ns * i + s] += p[2 * s] * tw;
+        th[ns * j + s] += p[2 * s + 1] * tw;
+      }
+      for (PetscInt s = na; s < ns; s++, g += 2 * bs)
         for (PetscInt d = 0; d < bs; d++) {
-          const PetscScalar t = x[bs * j + d] - x[bs * i + d];
-          th[ns * i + s] += g[d] * t;
-          th[ns * j + s] += g[bs + d] * t;
+          th[ns * i + s] += g[d] * t[d];
+          th[ns * j + s] += g[bs + d] * t[d];
         }
     }
 }
 
-/* The second pass with the weights as vectors: the spring's force along w plus
- * sum_s (q_is gi_s + q_js gj_s), on j, and its opposite on i. */
+/* The second pass, general: the force along w, s + sum over the states along the bond of
+ * p_is q_is + p_js q_js, plus sum over the others of q_is gi_s + q_js gj_s, on j, and its
+ * opposite on i. */
 static void VecSpringStateLoop(const PeriOperator op, const PetscScalar *x, const PetscScalar *q, PetscScalar *y)
 {
-  const PetscInt bs = op->bs, ns = op->ns;
+  const PetscInt bs = op->bs, ns = op->ns, na = op->na;
   for (PetscInt i = 0; i < op->nloc; i++)
     for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
-      const PetscReal *w = op->w + bs * b, *g = op->p + 2 * ns * bs * b;
+      const PetscReal *w = op->w + bs * b, *p = op->p + op->np * b, *g = p + 2 * na;
       const PetscInt   j = op->jl[b];
       PetscScalar      t = 0, v[PERI_MAX_DOF];
       for (PetscInt d = 0; d < bs; d++) t += w[d] * (x[bs * j + d] - x[bs * i + d]);
+      for (PetscInt s = 0; s < na; s++) t += p[2 * s] * q[ns * i + s] + p[2 * s + 1] * q[ns * j + s];
       for (PetscInt d = 0; d < bs; d++) v[d] = t * w[d];
-      for (PetscInt s = 0; s < ns; s++, g += 2 * bs)
+      for (PetscInt s = na; s < ns; s++, g += 2 * bs)
         for (PetscInt d = 0; d < bs; d++) v[d] += q[ns * i + s] * g[d] + q[ns * j + s] * g[bs + d];
       for (PetscInt d = 0; d < bs; d++) {
         y[bs * i + d] -= v[d];
@@ -232,7 +251,7 @@ static PetscErrorCode StateProduct(const PeriOperator op, const PetscScalar *x, 
   PetscCall(VecGhostGetLocalForm(op->theta, &tl));
   PetscCall(VecSet(tl, 0));
   PetscCall(VecGetArray(tl, &th));
-  if (op->pvec)
+  if (StatesMixed(op))
     VecStateLoop(op, x, th);
   else if (op->bs == 3)
     StateLoop(op, 3, x, th);
@@ -247,7 +266,7 @@ static PetscErrorCode StateProduct(const PeriOperator op, const PetscScalar *x, 
   PetscCall(VecGhostGetLocalForm(op->theta, &tl));
   PetscCall(VecGetArray(tl, &th));
   for (PetscInt i = 0; i < (op->nloc + op->nghost) * op->ns; i++) th[i] *= op->A[i];
-  if (op->pvec)
+  if (StatesMixed(op))
     VecSpringStateLoop(op, x, th, y);
   else if (op->bs == 3)
     SpringStateLoop(op, 3, x, th, y);
@@ -277,7 +296,7 @@ static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y
 static PetscReal FormFlops(const PeriOperator op)
 {
   return op->form == FORM_MICROPOLAR ? 32 : op->form == FORM_SHEAR ? 14
-                                        : op->pvec                 ? (6.0 + 8.0 * op->ns) * op->bs
+                                        : op->p && StatesMixed(op) ? (6.0 + 8.0 * (op->ns - op->na)) * op->bs + 4.0 * op->na
                                         : op->p                    ? 10.0 * op->bs + 8
                                                                    : 6.0 * op->bs;
 }
@@ -575,18 +594,14 @@ static PetscErrorCode BondNumbers(PeriModel m, const PeriOperator op, const Peri
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The bond's state weights gi, gj (ops.bond_state): as vectors (pvec), or as multiples of its
- * numbers w (the central form), an error when they are not parallel to it. */
-static PetscErrorCode StateNumbers(PeriModel m, const PeriOperator op, const PeriBondGeometry *g, const PetscReal w[], PetscReal p[])
+/* p[0..1] = the multiples of w that state s's weights gi, gj (ops.bond_state) are (the central
+ * form), an error when they are not parallel to it. */
+static PetscErrorCode AlongBond(PeriModel m, const PeriOperator op, const PeriBondGeometry *g, PetscInt s, const PetscReal w[], PetscReal p[])
 {
   PetscReal gv[2][PERI_MAX_DOF], ww = 0;
 
   PetscFunctionBeginUser;
-  if (op->pvec) {
-    for (PetscInt s = 0; s < op->ns; s++) m->ops.bond_state(m, g, s, p + 2 * s * op->bs, p + (2 * s + 1) * op->bs);
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  m->ops.bond_state(m, g, 0, gv[0], gv[1]);
+  m->ops.bond_state(m, g, s, gv[0], gv[1]);
   for (PetscInt d = 0; d < op->bs; d++) ww += w[d] * w[d];
   for (PetscInt e = 0; e < 2; e++) {
     PetscReal gw = 0, dev = 0, size = 0;
@@ -596,8 +611,18 @@ static PetscErrorCode StateNumbers(PeriModel m, const PeriOperator op, const Per
       size = PetscMax(size, PetscAbsReal(gv[e][d]));
       dev  = PetscMax(dev, PetscAbsReal(gv[e][d] - p[e] * w[d]));
     }
-    PetscCheck(dev <= 1e-10 * size, PETSC_COMM_SELF, PETSC_ERR_PLIB, "model %s: the state weights of bond %" PetscInt_FMT "-%" PetscInt_FMT " are not along its spring (deviation %g of %g): the matrix-free operator cannot apply them", m->type, g->i, g->j, (double)dev, (double)size);
+    PetscCheck(dev <= 1e-10 * size, PETSC_COMM_SELF, PETSC_ERR_PLIB, "model %s: the weights of state %" PetscInt_FMT " of bond %" PetscInt_FMT "-%" PetscInt_FMT " are not along its spring (deviation %g of %g): the matrix-free operator cannot apply them", m->type, s, g->i, g->j, (double)dev, (double)size);
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The bond's np state numbers: the multiples of w for the leading na states, then the others'
+ * weights gi, gj as vectors. */
+static PetscErrorCode StateNumbers(PeriModel m, const PeriOperator op, const PeriBondGeometry *g, const PetscReal w[], PetscReal p[])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < op->na; s++) PetscCall(AlongBond(m, op, g, s, w, p + 2 * s));
+  for (PetscInt s = op->na, o = 2 * op->na; s < op->ns; s++, o += 2 * op->bs) m->ops.bond_state(m, g, s, p + o, p + o + op->bs);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -623,9 +648,10 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
   if (sys->bond_state.failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
   if (m->ops.bond_state) {
-    op->ns   = m->nstates;
-    op->pvec = (PetscBool)(m->nstates != 1 || !m->states_along_bonds);
-    PetscCall(PetscMalloc1((op->pvec ? 2 * op->ns * op->bs : 2) * b->nbonds, &op->p));
+    op->ns = m->nstates;
+    op->na = PetscMin(m->states_along_bonds, m->nstates);
+    op->np = 2 * op->na + 2 * (op->ns - op->na) * op->bs;
+    PetscCall(PetscMalloc1(op->np * b->nbonds, &op->p));
   }
   op->nghost = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++) {
@@ -637,7 +663,7 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
       PetscCall(BondNumbers(m, op, &g, Ke, op->w + nb * op->nw));
-      if (op->p) PetscCall(StateNumbers(m, op, &g, op->w + nb * op->nw, op->p + (op->pvec ? 2 * op->ns * op->bs : 2) * nb));
+      if (op->p) PetscCall(StateNumbers(m, op, &g, op->w + nb * op->nw, op->p + op->np * nb));
       if (g.j < sys->disc.nowned)
         op->jl[nb] = g.j;
       else { /* for now -1 - its global index: numbered below, as the ghosted vectors number them */
@@ -1130,8 +1156,7 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
   for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= op->form == FORM_CENTRAL ? PetscSqrtReal(factor) : factor;
-  if (op->pvec) /* as the multiples of w do with it */
-    for (PetscInt d = 0; d < 2 * op->ns * op->bs; d++) op->p[2 * op->ns * op->bs * t + d] *= PetscSqrtReal(factor);
+  for (PetscInt d = 2 * op->na; op->p && d < op->np; d++) op->p[op->np * t + d] *= PetscSqrtReal(factor); /* the vectors, as the multiples of w do with it */
   if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc.bonds, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(op->form == FORM_CENTRAL, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the preconditioning matrix of shear and micropolar bonds is diagonally scaled and cannot follow a broken bond");
   for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc.bonds, i, k) * Ke[a];
