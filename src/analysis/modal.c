@@ -18,9 +18,16 @@ static const char *const eigensolvers[] = {"auto", "shift_invert", "lobpcg", NUL
  * fill outgrows the machine (docs/performance.md, "Modes at scale (issue 29, item 1)"); with the
  * geometric multigrid (a matrix-free K of a grid body) from MODAL_LOBPCG_MIN_DOFS_MG on (perilin's
  * LOBPCG on the gerstle lamina, 10 modes: a tie at 4,800 DOFs, 0.67 s against 0.76 s at 10,800,
- * 1.8 s against 2.8 s at 43,200) */
-#define MODAL_LOBPCG_MIN_DOFS    300000
-#define MODAL_LOBPCG_MIN_DOFS_MG 8000
+ * 1.8 s against 2.8 s at 43,200); on a free body of a state-based model (whose two-horizon K
+ * factorizes slowly) with a matrix-free K (GAMG on its shifted short-range stiffness,
+ * ShiftFreeBody) from MODAL_LOBPCG_MIN_DOFS_FREE on (the free lps bar, 8 modes: 0.71 of the
+ * factorization's wall at 7,500 DOFs, 0.50 at 30,720; 1.6 times it at 3,840; a free pmb bar,
+ * examples/pmb/bar_modes.yaml, 9,600 DOFs: 1.6 times it, so bond-based free bodies keep the
+ * factorization up to MODAL_LOBPCG_MIN_DOFS) */
+#define MODAL_LOBPCG_MIN_DOFS      300000
+#define MODAL_LOBPCG_MIN_DOFS_MG   8000
+#define MODAL_LOBPCG_MIN_DOFS_FREE 8000
+#define MODAL_FREE_SHIFT           1e-5
 
 /* the analysis' results (its data) */
 static inline PeriModal *Modal(PeriAnalysis an)
@@ -296,7 +303,8 @@ static PetscBool UseMultigrid(PeriAnalysis an)
 {
   PetscBool set = PETSC_FALSE;
 
-  if (Modal(an)->eigensolver != EIGENSOLVER_LOBPCG || !an->sys->stiffness.op || !PeriMultigridApplies(an->sys)) return PETSC_FALSE;
+  /* a free body's coarse levels would be singular: GAMG on the shifted short-range stiffness */
+  if (Modal(an)->eigensolver != EIGENSOLVER_LOBPCG || Modal(an)->free_body || !an->sys->stiffness.op || !PeriMultigridApplies(an->sys)) return PETSC_FALSE;
   PetscOptionsHasName(NULL, NULL, "-st_pc_type", &set);
   return (PetscBool)!set;
 }
@@ -395,7 +403,7 @@ static void SortPairs(PetscInt n, Pair a[])
  * ascending; with one, by distance |f - target| (ties: the lower frequency first). Of a free body
  * the lowest nfree with |omega^2| < 1e-6 scale are its rigid-body modes: counted, not returned.
  * radius: the largest |omega^2 - sigma| among all converged pairs. */
-static PetscErrorCode OrderPairs(EPS eps, PetscReal target_hz, PetscReal sigma, PetscInt nfree, PetscReal scale, PetscInt *nrigid, PetscInt *n, Pair **pairs, PetscReal *radius)
+static PetscErrorCode OrderPairs(EPS eps, PetscReal target_hz, PetscReal sigma, PetscReal shift, PetscInt nfree, PetscReal scale, PetscInt *nrigid, PetscInt *n, Pair **pairs, PetscReal *radius)
 {
   PetscInt nconv, m = 0;
   Pair    *a;
@@ -408,7 +416,7 @@ static PetscErrorCode OrderPairs(EPS eps, PetscReal target_hz, PetscReal sigma, 
     PetscScalar kr;
     PetscCall(EPSGetEigenvalue(eps, k, &kr, NULL));
     a[k].k   = k;
-    a[k].lam = a[k].key = PetscRealPart(kr);
+    a[k].lam = a[k].key = PetscRealPart(kr) - shift; /* a free body's LOBPCG: (K + shift M, M) */
     *radius             = PetscMax(*radius, PetscAbsReal(a[k].lam - sigma));
   }
   SortPairs(nconv, a);
@@ -451,7 +459,7 @@ static PetscErrorCode SolveModes(PeriAnalysis an, EPS eps, const InnerCheck *inn
   for (;;) {
     PetscCall(EPSSolve(eps));
     PetscCheck(!inner->failed[0], an->comm, PETSC_ERR_NOT_CONVERGED, "%s", inner->failed);
-    PetscCall(OrderPairs(eps, target_hz, sigma, nfree, scale, &md->nrigid, n, pairs, &radius));
+    PetscCall(OrderPairs(eps, target_hz, sigma, md->shift, nfree, scale, &md->nrigid, n, pairs, &radius));
     if (target_hz == 0 || nreq >= md->nfree_dofs || Covered(*pairs, *n, nev, target_hz, sigma, radius)) break;
     PetscCall(PetscFree(*pairs));
     nreq = PetscMin(2 * nreq, md->nfree_dofs);
@@ -465,15 +473,15 @@ static PetscErrorCode SolveModes(PeriAnalysis an, EPS eps, const InnerCheck *inn
 /* ||K x - lam M x|| / (max(|lam|, lam_floor) ||M x||): relative to the eigenvalue, unlike a residual
  * scaled by ||K||, which hides errors in the low modes. Below lam_floor = sqrt(eps) ||K||_1/||M||_1 an
  * omega^2 is at the round-off of K x itself: only its error relative to lam_floor can be asked for. */
-static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal lam_floor, Vec r, Vec y, PetscReal *res)
+static PetscErrorCode ModeResidual(Mat K, Mat M, Vec x, PetscReal lam, PetscReal shift, PetscReal lam_floor, Vec r, Vec y, PetscReal *res)
 {
   PetscReal rn, yn;
 
   PetscFunctionBeginUser;
-  PetscCall(MatMult(K, x, r));
+  PetscCall(MatMult(K, x, r)); /* K + shift M where the eigensolver was given that (ShiftFreeBody) */
   PetscCall(MatMult(M, x, y));
   PetscCall(VecNorm(y, NORM_2, &yn));
-  PetscCall(VecAXPY(r, -lam, y));
+  PetscCall(VecAXPY(r, -(lam + shift), y));
   PetscCall(VecNorm(r, NORM_2, &rn));
   *res = rn / (PetscMax(PetscAbsReal(lam), lam_floor) * yn);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -583,7 +591,7 @@ static PetscErrorCode CollectModes(PeriAnalysis an, EPS eps, Mat Kff, Mat Mff, I
     PetscReal l    = pairs[s].lam;
     PetscCheck(l > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: a negative eigenvalue omega^2 = %g: the stiffness is indefinite (Poisson ratio above the bond-based value?)", an->sys->scene->file, (double)l);
     PetscCall(EPSGetEigenvector(eps, pairs[s].k, x, NULL));
-    PetscCall(ModeResidual(Kff, Mff, x, l, lam_floor, r, y, &mode->residual));
+    PetscCall(ModeResidual(Kff, Mff, x, l, md->shift, lam_floor, r, y, &mode->residual));
     mode->omega2 = l;
     mode->f_hz   = Frequency(l);
     PetscCall(VecSet(full, 0));
@@ -632,6 +640,7 @@ static PetscErrorCode RecordSolver(PeriAnalysis an, EPS eps, PetscInt nev, const
 /* What one modal solve holds: freed whether it succeeds or a check stops it inside SLEPc. */
 typedef struct {
   Mat        M, Kff, Mff, Pff; /* M: borrowed from the mass service; Pff: NULL but with a matrix-free K */
+  Mat        Ks;               /* what the eigensolver is given: Kff, or a free body's K_ff + shift M_ff (ShiftFreeBody) */
   IS         isfree;
   Vec        mdiag; /* borrowed from the mass service */
   EPS        eps;
@@ -645,10 +654,41 @@ static PetscErrorCode ModalWorkDestroy(ModalWork *w)
   PetscCall(PetscFree(w->pairs));
   PetscCall(VecDestroy(&w->inner.r));
   PetscCall(EPSDestroy(&w->eps));
+  PetscCall(MatDestroy(&w->Ks));
   PetscCall(MatDestroy(&w->Kff));
   PetscCall(MatDestroy(&w->Mff));
   PetscCall(MatDestroy(&w->Pff));
   PetscCall(ISDestroy(&w->isfree));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* LOBPCG on a free body: K_ff is singular, and so would be GAMG's matrix. The eigensolver is
+ * given (K_ff + shift M_ff, M_ff), whose eigenvalues are omega^2 + shift, all positive, with the
+ * same vectors; GAMG the short-range stiffness plus shift M_ff (an assembled K_ff is shifted in
+ * place). The rigid-body modes come out at omega^2 = 0 and are counted as such (OrderPairs).
+ * shift: MODAL_FREE_SHIFT of the scale of the largest omega^2, below the lowest elastic
+ * omega^2 of the bodies measured (docs/modal.md, "Free bodies with LOBPCG"). */
+static PetscErrorCode ShiftFreeBody(PeriAnalysis an, PetscReal scale, ModalWork *w)
+{
+  PeriModal *md = Modal(an);
+  Mat        sM;
+
+  PetscFunctionBeginUser;
+  md->shift = 0;
+  PetscCall(PetscObjectReference((PetscObject)w->Kff));
+  w->Ks = w->Kff;
+  if (md->eigensolver != EIGENSOLVER_LOBPCG || !md->free_body) PetscFunctionReturn(PETSC_SUCCESS);
+  md->shift = MODAL_FREE_SHIFT * scale;
+  if (w->Pff) {
+    PetscCall(MatAXPY(w->Pff, md->shift, w->Mff, SUBSET_NONZERO_PATTERN));
+    PetscCall(MatDestroy(&w->Ks));
+    PetscCall(MatDuplicate(w->Mff, MAT_COPY_VALUES, &sM));
+    PetscCall(MatScale(sM, md->shift));
+    PetscCall(MatCreateComposite(an->comm, 2, (Mat[]){w->Kff, sM}, &w->Ks));
+    PetscCall(MatDestroy(&sM));
+  } else
+    PetscCall(MatAXPY(w->Kff, md->shift, w->Mff, SUBSET_NONZERO_PATTERN));
+  PetscCall(MatSetOption(w->Ks, MAT_SYMMETRIC, PETSC_TRUE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -684,8 +724,9 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   sigma = PetscSqr(2 * PETSC_PI * target_hz);
   /* a free body makes K singular: shift just below its zero eigenvalues */
   if (nfree && target_hz == 0) sigma = -1e-8 * scale;
+  PetscCall(ShiftFreeBody(an, scale, w));
 
-  PetscCall(CreateEPS(an, w->Kff, w->Mff, w->Pff, w->isfree, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
+  PetscCall(CreateEPS(an, w->Ks, w->Mff, w->Pff, w->isfree, sigma, PetscMin(PetscMin(nev, md->nfree_dofs) + nfree, md->nfree_dofs), &w->inner, &w->eps));
   /* the factorization (MUMPS) and its solves run with the BLAS threads (src/sys/threads.c) */
   PetscCall(PeriBLASThreads(PETSC_TRUE));
   PetscCall(PeriProgressUpdate(an->sys->run.progress, PERI_PROGRESS_PHASE, "factorization"));
@@ -699,7 +740,7 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   md->solve_s              = t2 - t1;
   an->sys->run.log.solve_s = t2 - t0;
   PetscCheck(npairs + md->nrigid > 0, an->comm, PETSC_ERR_NOT_CONVERGED, "%s: the eigensolver converged no mode (try -eps_ncv, -eps_max_it, or a target with analysis.target_hz)", an->sys->scene->file);
-  PetscCall(CollectModes(an, w->eps, w->Kff, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
+  PetscCall(CollectModes(an, w->eps, w->Ks, w->Mff, w->isfree, w->mdiag, nev, npairs, w->pairs, PETSC_SQRT_MACHINE_EPSILON * scale));
   PetscCall(EPSGetTolerances(w->eps, &eps_tol, NULL));
   PetscCall(CheckModes(an, eps_tol));
   /* a free bar's lowest longitudinal mode is half a wave over its length */
@@ -721,10 +762,12 @@ static PetscErrorCode ModalSolve(PeriAnalysis an, PetscInt nev, PetscReal target
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* analysis.eigensolver as run. auto takes LOBPCG from MODAL_LOBPCG_MIN_DOFS DOFs on, for a held
- * body without a target: LOBPCG finds the lowest modes only, and a free body's zero modes would
- * leave GAMG a singular matrix. LOBPCG applies K matrix-free where the operator can (solver.operator
- * auto); the factorization needs K's entries. Before K is built. Collective. */
+/* analysis.eigensolver as run. auto takes LOBPCG, without a target (LOBPCG finds the lowest modes
+ * only), from MODAL_LOBPCG_MIN_DOFS_MG DOFs on where the geometric multigrid applies (a held grid
+ * body, matrix-free), from MODAL_LOBPCG_MIN_DOFS_FREE on a free body of a state-based model with a
+ * matrix-free K (GAMG on its shifted short-range stiffness), else from MODAL_LOBPCG_MIN_DOFS. LOBPCG applies K
+ * matrix-free where the operator can (solver.operator auto); the factorization needs K's entries.
+ * Before K is built. Collective. */
 static PetscErrorCode ChooseEigensolver(PeriAnalysis an)
 {
   PeriModal     *md = Modal(an);
@@ -735,15 +778,18 @@ static PetscErrorCode ChooseEigensolver(PeriAnalysis an)
 
   PetscFunctionBeginUser;
   PetscCall(PeriRigidMotionFree(an->sys, &nfree, NULL, 0, NULL));
-  lowest = (PetscBool)(!nfree && md->target_hz == 0);
+  md->free_body = (PetscBool)(nfree > 0);
+  lowest        = (PetscBool)(md->target_hz == 0);
   if (md->eigensolver == EIGENSOLVER_AUTO) {
     const PetscReal dofs = (PetscReal)an->sys->disc.N * an->sys->model->dofs;
-    const PetscBool mg   = (PetscBool)(S->operator_kind != PERI_OPERATOR_ASSEMBLED && !PeriOperatorWhyNotModel(an->sys->model) && !PeriMultigridWhyNotBody(an->sys));
-    md->eigensolver      = lowest && dofs >= (mg ? MODAL_LOBPCG_MIN_DOFS_MG : MODAL_LOBPCG_MIN_DOFS) ? EIGENSOLVER_LOBPCG : EIGENSOLVER_SHIFT_INVERT;
+    const PetscBool mf   = (PetscBool)(S->operator_kind != PERI_OPERATOR_ASSEMBLED && !PeriOperatorWhyNotModel(an->sys->model));
+    const PetscBool mg   = (PetscBool)(mf && !md->free_body && !PeriMultigridWhyNotBody(an->sys));
+    const PetscReal from = mg ? MODAL_LOBPCG_MIN_DOFS_MG : mf && md->free_body && PeriModelHasFamilies(an->sys->model) ? MODAL_LOBPCG_MIN_DOFS_FREE
+                                                                                                                       : MODAL_LOBPCG_MIN_DOFS;
+    md->eigensolver      = lowest && dofs >= from ? EIGENSOLVER_LOBPCG : EIGENSOLVER_SHIFT_INVERT;
   }
   PetscCall(PeriSceneGetNode(an->sys->scene->root, "analysis", &node));
-  PeriInputCheck(md->eigensolver != EIGENSOLVER_LOBPCG || lowest, an->sys->scene, node, "eigensolver", "lobpcg computes the lowest modes of a held body, and this one %s: use shift_invert (or auto)",
-                 nfree ? "can move as a rigid body" : "asks for the modes nearest analysis.target_hz");
+  PeriInputCheck(md->eigensolver != EIGENSOLVER_LOBPCG || lowest, an->sys->scene, node, "eigensolver", "lobpcg computes the lowest modes, and this run asks for the modes nearest analysis.target_hz: use shift_invert (or auto)");
   if (md->eigensolver == EIGENSOLVER_SHIFT_INVERT) PetscFunctionReturn(PETSC_SUCCESS);
   S->needs.matrix_free = PETSC_TRUE;
   if (S->operator_kind == PERI_OPERATOR_AUTO && !PeriMatrixFreeWhyNot(an->sys)) S->operator_kind = PERI_OPERATOR_MATRIX_FREE;
@@ -983,7 +1029,7 @@ static PetscErrorCode ModalDestroy(PeriAnalysis an)
 static const PeriKey modal_keys[] = {
     {"nev", PERI_KEY_INT, "6", "[1, inf)", NULL, NULL, "number of modes"},
     {"target_hz", PERI_KEY_REAL, "0", "[0, inf)", "[1/time]", NULL, "compute the modes nearest this frequency (0: the lowest)"},
-    {"eigensolver", PERI_KEY_CHOICE, "auto", NULL, NULL, eigensolvers, "shift_invert: Krylov-Schur, shift-and-invert with a direct factorization of K; lobpcg: LOBPCG preconditioned by multigrid (geometric on grid bodies, else algebraic), K matrix-free where it can be (the lowest modes of a held body only); auto: lobpcg from 8,000 DOFs on grid bodies and 300,000 elsewhere where it applies, else shift_invert (docs/modal.md)"},
+    {"eigensolver", PERI_KEY_CHOICE, "auto", NULL, NULL, eigensolvers, "shift_invert: Krylov-Schur, shift-and-invert with a direct factorization of K; lobpcg: LOBPCG preconditioned by multigrid (geometric on held grid bodies, else algebraic), K matrix-free where it can be (the lowest modes only; a free body's rigid-body modes counted); auto: lobpcg without a target from 8,000 DOFs on held grid bodies and on free bodies of a state-based model with a matrix-free K, from 300,000 elsewhere, else shift_invert (docs/modal.md)"},
     {NULL},
 };
 static const PeriSchema modal_schema[] = {{"analysis", modal_keys}, {NULL}};
@@ -1021,7 +1067,7 @@ const PeriAnalysisType PeriAnalysis_Modal = {
     .schema        = modal_schema,
     .option_prefix = "st_",
     .files         = modal_files,
-    .needs         = {.factor_fill = 0.45, .iterative_dofs = MODAL_LOBPCG_MIN_DOFS},
+    .needs         = {.factor_fill = 0.45, .iterative_dofs = MODAL_LOBPCG_MIN_DOFS, .iterative_dofs_grid = MODAL_LOBPCG_MIN_DOFS_MG},
     .ops           = {.setfromscene = SetFromScene_Modal, .setup = SetUp_Modal, .run = PeriAnalysisRun_Modal, .fields = ModalAddFields, .files = ModalFiles, .summary = ModalSummary, .report = ModalReport, .solvers_from_options = SolversFromOptions_Modal, .destroy = ModalDestroy},
 };
 

@@ -212,6 +212,7 @@ static PetscErrorCode CheckEstimate(MPI_Comm comm, PeriScene s, PeriModel m, con
   PetscCall(PeriSceneGetNode(s->root, "failure", &node));
   failure = node ? PETSC_TRUE : PETSC_FALSE;
   at      = *needs;
+  if (periodic && at.iterative_dofs_grid > 0) at.iterative_dofs = at.iterative_dofs_grid; /* a grid */
   if (at.iterative_dofs > 0 && n * m->dofs >= at.iterative_dofs) {
     /* the analysis' iterative default (a modal LOBPCG): no factor, and K matrix-free where the
        operator applies (solver.operator assembled or a forced factorization then need more) */

@@ -33,6 +33,8 @@ typedef struct {
   PetscInt   nshapes;
   PetscReal  factor_s, solve_s;
   PetscInt   eigensolver; /* analysis.eigensolver: as read (0 auto), then as run */
+  PetscBool  free_body;   /* constraints leave rigid-body motions free: K_ff is singular */
+  PetscReal  shift;       /* LOBPCG on a free body solves (K + shift M) x = (omega^2 + shift) M x (0 otherwise) */
 } PeriModal;
 
 /* One load step of the quasi-static analysis. */

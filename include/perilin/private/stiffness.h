@@ -51,13 +51,14 @@ static inline PetscReal PeriShortRangeFactor(const PeriShortRange *sr, const Per
 /* What an analysis asks of the stiffness, declared in its type (PeriAnalysisType.needs): the memory
  * estimate and K's defaults read it, so that no file of the system names an analysis. */
 typedef struct {
-  PetscBool matrix_free;    /* uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free (solver.operator) */
-  PetscBool static_solver;  /* solves with the static KSP, K of its default type (PeriStaticDefaultMatType); else K is AIJ */
-  PetscReal matrix_copies;  /* copies of K it holds beside K (the quasi-static loop solves on one: 1) */
-  PetscReal factor_fill;    /* a direct factorization of K, its fill in matrices per log2(particles) (nested dissection measured 0.45), or 0 */
-  PetscReal iterative_dofs; /* from this many DOFs on it solves iteratively by default (no factorization, K matrix-free where the operator applies), or 0 */
-  PetscBool transient;      /* runs in time: loads may carry an amplitude (loads.<k>.amplitude) */
-  PetscBool dry_run;        /* checks any analysis' scene (setup): what only time uses is read and checked, not refused */
+  PetscBool matrix_free;         /* uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free (solver.operator) */
+  PetscBool static_solver;       /* solves with the static KSP, K of its default type (PeriStaticDefaultMatType); else K is AIJ */
+  PetscReal matrix_copies;       /* copies of K it holds beside K (the quasi-static loop solves on one: 1) */
+  PetscReal factor_fill;         /* a direct factorization of K, its fill in matrices per log2(particles) (nested dissection measured 0.45), or 0 */
+  PetscReal iterative_dofs;      /* from this many DOFs on it solves iteratively by default (no factorization, K matrix-free where the operator applies), or 0 */
+  PetscReal iterative_dofs_grid; /* the same for a grid body, where it takes the iterative solver sooner (0: as iterative_dofs) */
+  PetscBool transient;           /* runs in time: loads may carry an amplitude (loads.<k>.amplitude) */
+  PetscBool dry_run;             /* checks any analysis' scene (setup): what only time uses is read and checked, not refused */
 } PeriSystemNeeds;
 
 /* How the geometric multigrid (src/system/multigrid.c) gets the coarse levels of a system: the
