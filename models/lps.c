@@ -43,7 +43,7 @@ typedef struct {
 
 static const PeriKey lps_keys[] = {
     {"influence", PERI_KEY_CHOICE, "constant", NULL, NULL, influences, "influence function omega(|xi|): constant 1, inverse delta/|xi|, gaussian exp(-|xi|^2/delta^2)"},
-    {"dilatation", PERI_KEY_CHOICE, "standard", NULL, NULL, dilatations, "the dilatation of the bulk term: standard (d/m_i) sum omega |xi| e V (Silling et al.), affine the trace of the family's fitted deformation gradient (exact for affine fields at surfaces; assembled operator only)"},
+    {"dilatation", PERI_KEY_CHOICE, "standard", NULL, NULL, dilatations, "the dilatation of the bulk term: standard (d/m_i) sum omega |xi| e V (Silling et al.), affine the trace of the family's fitted deformation gradient (exact for affine fields at surfaces; matrix-free or assembled, docs/models/lps.md)"},
     {NULL},
 };
 static const PeriSchema lps_schema[] = {{"model", lps_keys}, {NULL}};
