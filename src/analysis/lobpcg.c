@@ -25,8 +25,9 @@
  * Ritz vectors) in columns [0, bs), W (the new directions) in [bs, 2 bs), P (the previous steps) in
  * [2 bs, 3 bs); column j of each block belongs to pair j. Every update is a product Z Q made in
  * place (BVMultInPlace), where Q holds zeros for the columns that take no part: before, X, W and P
- * were separate and copied into a fourth basis for the Rayleigh-Ritz step, 18 bs vectors where 9 bs
- * do (the modal analysis' peak memory, docs/performance.md "Modal peak memory"). */
+ * were separate and copied into a fourth basis for the Rayleigh-Ritz step, and SLEPc's basis held
+ * X once more, 19 bs vectors where 9 bs do (the modal analysis' peak memory, docs/performance.md
+ * "Modal peak memory"). Z is the EPS's own basis eps->V. */
 typedef struct {
   BV         v, av, bv; /* Z, K Z, M Z */
   PetscReal *lam;       /* the block's Ritz values */
@@ -291,19 +292,23 @@ static PetscErrorCode EPSSolve_PeriLOBPCG(EPS eps)
 {
   LOBPCG        *c   = (LOBPCG *)eps->data;
   const PetscInt bs  = eps->ncv;
-  PetscInt       its = 0, nc = 0;
-  PetscBool      ok, withP   = PETSC_FALSE;
+  PetscInt       its = 0, nc = 0, m;
+  PetscBool      ok, withP   = PETSC_FALSE, indef;
+  Mat            B;
 
   PetscFunctionBeginUser;
+  /* Z = eps->V: plain dot products while it iterates (an M inner product would also cache M Z, as
+     many vectors again); the first Rayleigh-Ritz step makes the random block M-orthonormal */
+  PetscCall(BVGetMatrix(eps->V, &B, &indef));
+  if (B) PetscCall(PetscObjectReference((PetscObject)B));
+  PetscCall(BVSetMatrix(eps->V, NULL, PETSC_FALSE));
+  PetscCall(BVGetSizes(eps->V, NULL, NULL, &m));
+  if (m < 3 * bs) PetscCall(BVResize(eps->V, 3 * bs, PETSC_TRUE)); /* solved before: the end of the last solve left X only */
   for (PetscInt k = eps->nini; k < bs; k++) PetscCall(BVSetRandomColumn(eps->V, k));
-  PetscCall(BVSetActiveColumns(eps->V, 0, bs));
-  PetscCall(BVOrthogonalize(eps->V, NULL)); /* M-orthonormal: eps->V has M as its inner product */
-  PetscCall(BVSetActiveColumns(c->v, 0, bs));
-  PetscCall(BVCopy(eps->V, c->v));
   PetscCall(Products(eps, c, 0, bs, PETSC_TRUE));
   PetscCall(Gram(c, bs));
   PetscCall(RayleighRitz(eps, c, bs, PETSC_FALSE, PETSC_FALSE, &ok));
-  PetscCheck(ok, PetscObjectComm((PetscObject)eps), PETSC_ERR_CONV_FAILED, "perilin_lobpcg: the initial block is not M-orthonormal");
+  PetscCheck(ok, PetscObjectComm((PetscObject)eps), PETSC_ERR_CONV_FAILED, "perilin_lobpcg: the initial block is linearly dependent");
   while (eps->reason == EPS_CONVERGED_ITERATING) {
     PetscCall(Residuals(eps, c, &nc));
     eps->nconv = nc;
@@ -320,22 +325,29 @@ static PetscErrorCode EPSSolve_PeriLOBPCG(EPS eps)
     its++;
   }
   eps->its = its;
+  /* X, the Ritz vectors, are its first bs columns: W and P go, so that SLEPc's use of the M inner
+     product afterwards caches bs vectors, not 3 bs */
+  PetscCall(BVResize(eps->V, bs, PETSC_TRUE));
+  PetscCall(BVSetMatrix(eps->V, B, indef));
+  PetscCall(MatDestroy(&B));
   PetscCall(BVSetActiveColumns(eps->V, 0, bs));
-  PetscCall(BVSetActiveColumns(c->v, 0, bs));
-  PetscCall(BVCopy(c->v, eps->V));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The basis (m = 3 bs columns, zero: the columns an update leaves out meet zeros in Q), the
  * coefficient and Gram matrices, and the index and Ritz value arrays. */
-static PetscErrorCode Allocate(BV tmpl, PetscInt m, LOBPCG *c)
+static PetscErrorCode Allocate(BV V, PetscInt m, LOBPCG *c)
 {
   BV *all[3] = {&c->v, &c->av, &c->bv};
 
   PetscFunctionBeginUser;
+  /* Z is the eigensolver's own basis (m columns, EPSAllocateSolution): X in its first columns,
+     where SLEPc takes the eigenvectors from, without a copy of its own */
+  PetscCall(PetscObjectReference((PetscObject)V));
+  c->v = V;
   for (PetscInt i = 0; i < 3; i++) {
-    PetscCall(BVDuplicateResize(tmpl, m, all[i]));
-    PetscCall(BVSetMatrix(*all[i], NULL, PETSC_FALSE)); /* plain dot products: M is applied explicitly */
+    if (i) PetscCall(BVDuplicateResize(V, m, all[i]));
+    if (i) PetscCall(BVSetMatrix(*all[i], NULL, PETSC_FALSE)); /* plain dot products: M is applied explicitly */
     PetscCall(BVSetActiveColumns(*all[i], 0, m));
     PetscCall(BVScale(*all[i], 0)); /* zeroes (SLEPc writes zeros for 0, not 0 times the old) */
   }
@@ -401,7 +413,7 @@ static PetscErrorCode EPSSetUp_PeriLOBPCG(EPS eps)
   PetscCheck(eps->n >= 5 * eps->ncv, PetscObjectComm((PetscObject)eps), PETSC_ERR_SUP, "perilin_lobpcg: %" PetscInt_FMT " unknowns are too few for a block of %" PetscInt_FMT, eps->n, eps->ncv);
   eps->mpd = 3 * eps->ncv;
   if (eps->max_it == PETSC_DEFAULT || eps->max_it == PETSC_DETERMINE) eps->max_it = PetscMax(100, 2 * eps->n / eps->ncv);
-  PetscCall(EPSAllocateSolution(eps, 0));
+  PetscCall(EPSAllocateSolution(eps, 2 * eps->ncv)); /* [X W P] */
   PetscCall(EPS_SetInnerProduct(eps));
   PetscCall(DSSetType(eps->ds, DSGHEP));
   PetscCall(DSAllocate(eps->ds, eps->mpd));
