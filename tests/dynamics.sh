@@ -6,7 +6,9 @@
 #  2. The same speeds from the modal analysis (longitudinal_speed = 2 L f of the free bar): within
 #     1 % of the pulse's, for both models.
 #  3. Energy: the explicit run's balance within 1e-3, the implicit (average acceleration) within
-#     1e-10; the implicit pulse at dt 0.4 where the explicit one at dt 0.1 is, within 1 %.
+#     1e-10; the implicit pulse at dt 0.4 where the explicit one at dt 0.1 is, within 1 %. The
+#     explicit (kick-drift-kick) run applies K once a step with the balance checked every step
+#     (-log_view's MatMult count: steps + 1).
 #  4. An explicit dt above the stability limit is an input error naming the limit, before any step.
 #  6. Free vibration (tests/scenes/bar_vibration.yaml, the bar started in its lowest longitudinal
 #     mode): the end oscillates at the modal analysis' f of the same bar (1e-4), and the period
@@ -58,7 +60,7 @@ run() { # name, args...: runs perilin into $tmp/name, quietly
 run npmb "$exe" "$pulse"
 run pmb "$exe" "$pulse" -model_type pmb
 run implicit "$exe" "$pulse" -analysis_integrator implicit -analysis_dt 0.4 -analysis_t_end 40
-run explicit40 "$exe" "$pulse" -analysis_t_end 40
+run explicit40 "$exe" "$pulse" -analysis_t_end 40 -log_view ":$tmp/explicit40.log_view"
 for m in npmb pmb; do
   run modal_$m "$exe" "$repo/examples/pmb/bar_modes.yaml" -model_type $m -grid_upper 500,4,4
 done
@@ -164,6 +166,10 @@ for m, s in (("npmb", s_n), ("pmb", s_p)):
     check(abs(s / v - 1) < 0.01, f"{m}: pulse speed {s:.4f} within 1 % of the modal analysis' 2 L f = {v:.4f} ({100*(s/v-1):+.2f} %)")
 check(dyn("npmb")["energy_drift"] < 1e-3, f"explicit energy drift {dyn('npmb')['energy_drift']:.2g} < 1e-3")
 check(dyn("implicit")["energy_drift"] < 1e-10, f"implicit (average acceleration) energy drift {dyn('implicit')['energy_drift']:.2g} < 1e-10")
+import re
+products = int(re.search(r"^MatMult\s+(\d+)", open(f"{tmp}/explicit40.log_view").read(), re.M).group(1))
+steps = dyn("explicit40")["steps"]
+check(products == steps + 1, f"kick-drift-kick: {products} products with K for {steps} steps with the energy checked at each (one a step, one at t = 0)")
 pi, pe = history("implicit")[-1]["pulse_position"], history("explicit40")[-1]["pulse_position"]
 check(abs(pi - pe) < 0.01 * pe, f"pulse at t = 40: implicit (dt 0.4) {pi:.3f}, explicit (dt 0.1) {pe:.3f}")
 wf = dyn("npmb")["wave_front_speed"]

@@ -1,6 +1,8 @@
 /* Transient dynamics, M a + K u = f(t), on PETSc's TS with the system's stiffness, mass and bond
  * state (issue 26, first part; docs/dynamics.md). Explicit: velocity Verlet (TSBASICSYMPLECTIC,
- * type 2) on the lumped mass, one product with K per step, the step checked against the stability
+ * kick-drift-kick, RegisterKDK; PETSc's drift-kick-drift type 2 with impactors and bc velocities)
+ * on the lumped mass, one product with K per step, the energy balance included (CachedForce), the
+ * step checked against the stability
  * limit 2/omega_max, omega_max^2 bounded from above by Gershgorin's theorem on M^-1 K. Implicit:
  * generalized-alpha for second-order systems (TSALPHA2; spectral radius 1 by default, which is
  * Newmark's average acceleration, beta = 1/4, gamma = 1/2), each step a linear solve with the
@@ -22,6 +24,7 @@ static const char *const dyn_directions[]  = {"both", "positive", "negative", NU
 #define DYN_HISTORY_COLUMNS  11 /* t, kinetic, strain, dissipated, work, balance, broken, pulse position, probe, wave front, damage front */
 #define DYN_IMPACTOR_COLUMNS 9  /* per impactor: its centre, velocity and the particles' force on it */
 #define DYN_ROW(d)           (DYN_HISTORY_COLUMNS + DYN_IMPACTOR_COLUMNS * (d)->nimpactors)
+#define DYN_KDK              "kdk" /* perilin's kick-drift-kick velocity Verlet (RegisterKDK) */
 
 typedef struct {
   /* analysis.* */
@@ -50,6 +53,7 @@ typedef struct {
   const PeriAmplitude **term_amp;
   Vec                  *term_f;
   PetscReal            *term_prev; /* a_k at the last step, for the work */
+  PetscReal            *term_fv;   /* kick-drift-kick: f_k . p at the last step, for the work */
   /* the run */
   PetscBool          started;
   PetscReal          omega2_max, dt_limit; /* Gershgorin's bound of M^-1 K, and 2/omega_max */
@@ -74,6 +78,9 @@ typedef struct {
   Mat                J;                                                          /* implicit: K + shift M with the held rows and columns eliminated */
   const PeriContact *contact;                                                    /* the system's, for the impactors' history */
   IS                 isq, isp;                                                   /* explicit: positions and velocities in the state [q; p] */
+  PetscBool          kdk;                                                        /* explicit, kick-drift-kick: the force at q_(n+1) serves the next step and the balance (CachedForce) */
+  PetscBool          fvalid;                                                     /* fq, fkq and ff hold a force evaluation that the bonds since have not changed */
+  Vec                fq, fkq, ff;                                                /* where it was evaluated, K q there, and the whole internal force */
   TS                 ts;
 } Dynamic;
 
@@ -82,12 +89,37 @@ static inline Dynamic *DYN(PeriAnalysis an)
   return (Dynamic *)an->data;
 }
 
+/* Velocity Verlet as kick-drift-kick (LAMMPS's fix nve): in TSBASICSYMPLECTIC's terms (p += c h
+ * a(q), then q += d h p) c = {1/2, 1/2}, d = {1, 0}, so each step evaluates the force at q_n and
+ * q_(n+1), the latter again at the next step's start, and CachedForce makes that one product.
+ * PETSc's own type 2 (velverlet) is drift-kick-drift, its force at q_(n+1/2), which the balance at
+ * q_(n+1) cannot reuse. Registered once per PETSc session (PetscFinalize frees the list). */
+static PetscBool kdk_registered;
+
+static PetscErrorCode ForgetKDK(void)
+{
+  kdk_registered = PETSC_FALSE;
+  return PETSC_SUCCESS;
+}
+
+static PetscErrorCode RegisterKDK(void)
+{
+  PetscReal c[2] = {0.5, 0.5}, d[2] = {1, 0};
+
+  PetscFunctionBeginUser;
+  if (kdk_registered) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(TSBasicSymplecticRegister(DYN_KDK, 2, 2, c, d));
+  PetscCall(PetscRegisterFinalize(ForgetKDK));
+  kdk_registered = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static const PeriKey dyn_keys[] = {
     {"integrator", PERI_KEY_CHOICE, "explicit", NULL, NULL, dyn_integrators, "explicit: velocity Verlet on the lumped mass (TSBASICSYMPLECTIC), dt held below 2/omega_max; implicit: generalized-alpha (TSALPHA2), a linear solve per step"},
     {"t_end", PERI_KEY_REAL, "required", "(0, inf)", "[time]", NULL, "the end time"},
     {"dt", PERI_KEY_REAL, "0.8 of the explicit limit (explicit); required (implicit)", "(0, inf)", "[time]", NULL, "the time step (-ts_dt overrides it); an explicit dt above the stability limit is an input error"},
     {"energy_tolerance", PERI_KEY_REAL, "0.01", "(0, inf)", NULL, NULL, "the largest drift of the energy balance (kinetic + strain + dissipated - work of the loads) over the run, relative to the largest energy: above it the run fails"},
-    {"energy_every", PERI_KEY_INT, "1", "[1, inf)", NULL, NULL, "the energies, the balance check and a history.csv row every k steps and at the last (the loads' work is summed every step): a k above 1 saves a product with K per step on a run without failure"},
+    {"energy_every", PERI_KEY_INT, "1", "[1, inf)", NULL, NULL, "the energies, the balance check and a history.csv row every k steps and at the last (the loads' work is summed every step): the explicit step's own force evaluation gives the strain energy, so k above 1 saves a product with K per step only with impactors or bc velocities (drift-kick-drift) and on the implicit integrator"},
     {"rho_infinity", PERI_KEY_REAL, "1", "[0, 1]", NULL, NULL, "implicit: the spectral radius at infinite frequency (1: no numerical damping, Newmark's average acceleration)"},
     {"pulse", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "an initial displacement u = amplitude exp(-((x - center)/width)^2) along axis (Ganzenmueller sec. 3.1.2)"},
     {"amplitude", PERI_KEY_MAP, NULL, NULL, NULL, NULL, "the loads' amplitude in time (default: a step, constant from t = 0)"},
@@ -502,6 +534,40 @@ static PetscErrorCode BoundaryAcceleration(PeriAnalysis an, Vec dp, PetscReal t)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* f = the interactions' force at q (K q and the terms'). Kick-drift-kick evaluates it at q_(n+1)
+ * at the end of step n, the energy balance wants K q_(n+1) after the step, and the next step
+ * starts with the same force: one product serves the three. A bond that breaks in between clears
+ * it (AfterStep), and it is used only for the very q it was evaluated at. f may be NULL. */
+static PetscErrorCode CachedForce(PeriAnalysis an, Vec q, Vec f)
+{
+  Dynamic  *d    = DYN(an);
+  PetscBool same = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  if (!d->kdk) {
+    if (f) PetscCall(PeriSystemInternalForce(an->sys, q, f));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  if (!d->fq) {
+    PetscBool terms = PETSC_FALSE; /* without nonlinear terms the whole force is K q */
+    for (PetscInt k = 0; k < an->sys->stiffness.nterms; k++) terms = (PetscBool)(terms || an->sys->stiffness.terms[k]->add_force);
+    PetscCall(VecDuplicate(q, &d->fq));
+    PetscCall(VecDuplicate(q, &d->fkq));
+    if (terms)
+      PetscCall(VecDuplicate(q, &d->ff));
+    else
+      PetscCall(PetscObjectReference((PetscObject)(d->ff = d->fkq)));
+  }
+  if (d->fvalid) PetscCall(VecEqual(q, d->fq, &same));
+  if (!same) {
+    PetscCall(PeriSystemInternalForceParts(an->sys, q, d->fkq, d->ff));
+    PetscCall(VecCopy(q, d->fq));
+    d->fvalid = PETSC_TRUE;
+  }
+  if (f) PetscCall(VecCopy(d->ff, f));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Explicit, momentum split: dp/dt = M^-1 (a(t) f - K q), 0 on the held DOFs. */
 static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
 {
@@ -510,7 +576,7 @@ static PetscErrorCode RHSMomentum(TS ts, PetscReal t, Vec q, Vec dp, void *ctx)
   PetscFunctionBeginUser;
   (void)ts;
   PetscCall(PeriContactSetTime(an->sys, t, PETSC_TRUE)); /* the step's one force: the impactors' kick */
-  PetscCall(PeriSystemInternalForce(an->sys, q, dp));
+  PetscCall(CachedForce(an, q, dp));
   PetscCall(LoadAt(an, t, 1, -1, dp));
   PetscCall(BoundaryWork(an, dp, t));
   PetscCall(VecPointwiseMult(dp, dp, DYN(an)->minv));
@@ -700,11 +766,16 @@ static PetscErrorCode RestoreState(PeriAnalysis an, Vec U, Vec *q, Vec *p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* 1/2 q^T K q with the present bonds, and the energy of contact. */
+/* 1/2 q^T K q with the present bonds, and the energy of contact (kick-drift-kick: from the
+ * step's force evaluation, CachedForce). */
 static PetscErrorCode StrainEnergy(PeriAnalysis an, Vec q, PetscReal *E)
 {
   PetscFunctionBeginUser;
-  PetscCall(PeriSystemStrainEnergy(an->sys, q, DYN(an)->tmp, E));
+  if (DYN(an)->kdk) {
+    PetscCall(CachedForce(an, q, NULL));
+    PetscCall(PeriSystemStrainEnergyFromProduct(an->sys, q, DYN(an)->fkq, E));
+  } else
+    PetscCall(PeriSystemStrainEnergy(an->sys, q, DYN(an)->tmp, E));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -736,12 +807,14 @@ static PetscErrorCode AfterStep(PeriAnalysis an, Vec q, PetscReal t, PetscInt *n
   PetscCall(PeriContactCheckReach(an->sys, q));
   if (!an->sys->bond_state.failure.active) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecCopy(q, an->sys->fields.u));
-  if (bybond)
+  if (bybond) {
     PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, nb, &released));
-  else {
+    if (*nb) d->fvalid = PETSC_FALSE; /* K changed: the kept force is not K's */
+  } else {
     /* K changed in more than the broken bonds' blocks: the energy it held before and after */
     PetscCall(StrainEnergy(an, q, &before));
     PetscCall(PeriBondsBreak(an->sys, an->sys->fields.u, PETSC_TRUE, 1, nb, NULL));
+    if (*nb) d->fvalid = PETSC_FALSE;
     if (*nb) PetscCall(StrainEnergy(an, q, &after));
     released = *nb ? before - after : 0;
   }
@@ -842,19 +915,41 @@ static PetscErrorCode Energies(PeriAnalysis an, Vec q, Vec p)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The loads' work since the last step (trapezoidal in time): every step, a dot product. */
+/* Kick-drift-kick: f_k . p for each load term, kept for the next step's work. */
+static PetscErrorCode LoadPower(PeriAnalysis an, Vec p, PetscScalar fv[])
+{
+  Dynamic *d = DYN(an);
+
+  PetscFunctionBeginUser;
+  if (d->kdk) PetscCall(VecMDot(p, d->nterms, d->term_f, fv));
+  for (PetscInt k = 0; k < d->nterms && d->kdk; k++) d->term_fv[k] = PetscRealPart(fv[k]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The loads' work since the last step: every step, dot products. Drift-kick-drift: trapezoidal in
+ * time over the step's displacement, exact for a free body under loads linear in t. Kick-drift-
+ * kick: each half kick's force times the mean velocity over it, (1/4)(a_n + a_(n+1)) f.(q_(n+1) -
+ * q_n) + (h/4)(a_n f.p_n + a_(n+1) f.p_(n+1)), the kinetic energy the loads give a free body
+ * under any amplitude, exactly. */
 static PetscErrorCode Work(PeriAnalysis an, Vec q, Vec p, PetscReal t)
 {
-  Dynamic    *d = DYN(an);
-  PetscScalar w[PERI_DYN_MAX_TERMS];
+  Dynamic        *d = DYN(an);
+  PetscScalar     w[PERI_DYN_MAX_TERMS], fv[PERI_DYN_MAX_TERMS];
+  PetscReal       fv_prev[PERI_DYN_MAX_TERMS];
+  const PetscReal h = t - d->t_prev;
 
   PetscFunctionBeginUser;
   PetscCall(ImplicitBoundaryWork(an, q, p, t));
   PetscCall(VecWAXPY(d->tmp, -1, d->uprev, q));
   PetscCall(VecMDot(d->tmp, d->nterms, d->term_f, w));
+  PetscCall(PetscArraycpy(fv_prev, d->term_fv, d->nterms));
+  PetscCall(LoadPower(an, p, fv));
   for (PetscInt k = 0; k < d->nterms; k++) {
     const PetscReal a = PeriAmplitudeValue(d->term_amp[k], t);
-    d->work += 0.5 * (a + d->term_prev[k]) * PetscRealPart(w[k]);
+    if (d->kdk)
+      d->work += 0.25 * (a + d->term_prev[k]) * PetscRealPart(w[k]) + 0.25 * h * (d->term_prev[k] * fv_prev[k] + a * d->term_fv[k]);
+    else
+      d->work += 0.5 * (a + d->term_prev[k]) * PetscRealPart(w[k]);
     d->term_prev[k] = a;
   }
   PetscCall(VecCopy(q, d->uprev));
@@ -1101,7 +1196,9 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   if (d->resumed) { /* -restart: this step's row, frame and checkpoint are the stopped run's */
     d->resumed = PETSC_FALSE;
     PetscCall(GetState(an, U, &q, &p));
+    PetscScalar fv[PERI_DYN_MAX_TERMS];
     PetscCall(ImplicitBoundaryWork(an, q, p, t)); /* its reactions, for the next step's work */
+    PetscCall(LoadPower(an, p, fv));
     PetscCall(RestoreState(an, U, &q, &p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -1158,7 +1255,9 @@ static PetscErrorCode CreateExplicit(PeriAnalysis an, Vec *U)
   PetscCall(VecRestoreSubVector(*U, d->isp, &q));
   PetscCall(ierr);
   PetscCall(TSSetType(d->ts, TSBASICSYMPLECTIC));
-  PetscCall(TSBasicSymplecticSetType(d->ts, TSBASICSYMPLECTICVELVERLET));
+  PetscCall(RegisterKDK());
+  /* impactors and moving boundaries are integrated with PETSc's drift-kick-drift (CheckImpactorScheme) */
+  PetscCall(TSBasicSymplecticSetType(d->ts, an->sys->contact.nimpactors || an->sys->conditions.moving ? TSBASICSYMPLECTICVELVERLET : DYN_KDK));
   PetscCall(TSSetRHSFunction(d->ts, NULL, RHSWhole, an));
   PetscCall(TSRHSSplitSetIS(d->ts, "position", d->isq));
   PetscCall(TSRHSSplitSetIS(d->ts, "momentum", d->isp));
@@ -1259,6 +1358,21 @@ static PetscErrorCode CheckImpactorScheme(PeriAnalysis an)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the TS is perilin's kick-drift-kick (its force kept for the next step and the balance). */
+static PetscErrorCode IsKDK(Dynamic *d)
+{
+  TSType                type;
+  TSBasicSymplecticType bt;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetType(d->ts, &type));
+  PetscCall(PetscStrcmp(type, TSBASICSYMPLECTIC, &d->kdk));
+  if (!d->kdk) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(TSBasicSymplecticGetType(d->ts, &bt));
+  PetscCall(PetscStrcmp(bt, DYN_KDK, &d->kdk));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The TS of the run, set from the options after perilin's defaults. */
 static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
 {
@@ -1285,6 +1399,7 @@ static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(TSSetErrorIfStepFails(d->ts, PETSC_FALSE)); /* a failed step is perilin's message (CheckSteps) */
   PetscCall(TSSetFromOptions(d->ts));
   PetscCall(CheckImpactorScheme(an));
+  PetscCall(IsKDK(d));
   PetscCall(TSGetTimeStep(d->ts, &d->dt));
   if (d->implicit) PetscCall(ChooseImplicitPC(an));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
@@ -1360,7 +1475,8 @@ static PetscErrorCode LoadTerms(PeriAnalysis an)
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < d->nloads; k++) n += d->own_amp[k];
   PetscCheck(n <= PERI_DYN_MAX_TERMS, an->comm, PETSC_ERR_SUP, "%s: %" PetscInt_FMT " loads with an amplitude of their own; at most %d", an->sys->scene->file, n - 1, PERI_DYN_MAX_TERMS - 1);
-  PetscCall(PetscMalloc3(n, &d->term_amp, n, &d->term_f, n, &d->term_prev));
+  PetscCall(PetscMalloc4(n, &d->term_amp, n, &d->term_f, n, &d->term_prev, n, &d->term_fv));
+  PetscCall(PetscArrayzero(d->term_fv, n));
   PetscCall(VecDuplicate(an->sys->fields.f, &d->term_f[0]));
   PetscCall(VecCopy(an->sys->fields.f, d->term_f[0]));
   d->term_amp[0] = &d->amp;
@@ -1447,6 +1563,7 @@ static PetscErrorCode Integrate(PeriAnalysis an, Vec *U, Vec *V)
 
   PetscFunctionBeginUser;
   d->started    = PETSC_TRUE;
+  d->fvalid     = PETSC_FALSE; /* no force kept from an earlier run */
   d->contact    = &an->sys->contact;
   d->nimpactors = an->sys->contact.nimpactors;
   /* the explicit step only multiplies by K: BAIJ's blocks make the product about 1.6x faster than
@@ -1668,11 +1785,14 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscCall(VecDestroy(&d->uprev));
   PetscCall(PetscFree(d->reaction));
   PetscCall(VecDestroy(&d->tmp));
+  PetscCall(VecDestroy(&d->fq));
+  PetscCall(VecDestroy(&d->fkq));
+  PetscCall(VecDestroy(&d->ff));
   PetscCall(PetscFree(d->hist));
   PetscCall(PetscFree(d->snap_time));
   PetscCall(PetscFree(d->snap_idx));
   for (PetscInt k = 0; k < d->nterms; k++) PetscCall(VecDestroy(&d->term_f[k]));
-  PetscCall(PetscFree3(d->term_amp, d->term_f, d->term_prev));
+  PetscCall(PetscFree4(d->term_amp, d->term_f, d->term_prev, d->term_fv));
   for (PetscInt k = 0; k < d->nloads; k++) PetscCall(PeriAmplitudeDestroy(&d->load_amp[k]));
   PetscCall(PetscFree2(d->load_amp, d->own_amp));
   PetscCall(PeriAmplitudeDestroy(&d->amp));

@@ -213,19 +213,31 @@ PetscErrorCode PeriSystemAddTerm(PeriSystem sys, const PeriTermOps *term)
 }
 
 /*@C
-  PeriSystemInternalForce - f = K u + the terms' forces: the force the interactions exert at the
-  displacements u (the bonds of the linear models: their Jacobian times u; the terms, such as
-  contact, that are not linear add their own). Collective.
+  PeriSystemInternalForceParts - ku = K u, and f = K u + the terms' forces: the force the
+  interactions exert at the displacements u (the bonds of the linear models: their Jacobian times
+  u; the terms, such as contact, that are not linear add their own). f may be ku; ku is what
+  PeriSystemStrainEnergyFromProduct takes. Collective.
 @*/
-PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
+PetscErrorCode PeriSystemInternalForceParts(PeriSystem sys, Vec u, Vec ku, Vec f)
 {
   Mat K = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemGetJacobian(sys, &K));
-  PetscCall(MatMult(K, u, f));
+  PetscCall(MatMult(K, u, ku));
+  if (f != ku) PetscCall(VecCopy(ku, f));
   for (PetscInt k = 0; k < sys->stiffness.nterms; k++)
     if (sys->stiffness.terms[k]->add_force) PetscCall(sys->stiffness.terms[k]->add_force(sys, u, f));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemInternalForce - f = K u + the terms' forces (PeriSystemInternalForceParts). Collective.
+@*/
+PetscErrorCode PeriSystemInternalForce(PeriSystem sys, Vec u, Vec f)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemInternalForceParts(sys, u, f, f));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -239,25 +251,37 @@ static PetscErrorCode TermsRowSums(PeriSystem sys, Vec rows)
 }
 
 /*@C
-  PeriSystemStrainEnergy - the energy the interactions hold at u: (1/2) u^T K u of the bonds and
-  the terms' own (contact); work is a vector of u's layout. Collective.
+  PeriSystemStrainEnergyFromProduct - the energy the interactions hold at u, given ku = K u:
+  (1/2) u^T K u of the bonds and the terms' own (contact). Collective.
 @*/
-PetscErrorCode PeriSystemStrainEnergy(PeriSystem sys, Vec u, Vec work, PetscReal *E)
+PetscErrorCode PeriSystemStrainEnergyFromProduct(PeriSystem sys, Vec u, Vec ku, PetscReal *E)
 {
-  Mat         K = NULL;
   PetscScalar e;
   PetscReal   ec;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSystemGetJacobian(sys, &K));
-  PetscCall(MatMult(K, u, work));
-  PetscCall(VecDot(u, work, &e));
+  PetscCall(VecDot(u, ku, &e));
   *E = 0.5 * PetscRealPart(e);
   for (PetscInt k = 0; k < sys->stiffness.nterms; k++) {
     if (!sys->stiffness.terms[k]->energy) continue;
     PetscCall(sys->stiffness.terms[k]->energy(sys, u, &ec));
     *E += ec;
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriSystemStrainEnergy - the energy the interactions hold at u (PeriSystemStrainEnergyFromProduct
+  after a product with K into work, a vector of u's layout). Collective.
+@*/
+PetscErrorCode PeriSystemStrainEnergy(PeriSystem sys, Vec u, Vec work, PetscReal *E)
+{
+  Mat K = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemGetJacobian(sys, &K));
+  PetscCall(MatMult(K, u, work));
+  PetscCall(PeriSystemStrainEnergyFromProduct(sys, u, work, E));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -15,16 +15,18 @@
 # (default 3), each rank under /usr/bin/time -f "%e %M", and prints medians:
 #   - per step: LAMMPS's "Loop time" / STEPS (the steps alone, no set-up); perilin's
 #     timing.solve_s / STEPS (the analysis' time loop: the steps plus the per-step energy
-#     monitor, which applies K once more; plus the stability bound) and -log_view's TSStep event
+#     monitor, which since issue 37 takes K q from the step's own force evaluation (kick-drift-
+#     kick); plus the stability bound) and -log_view's TSStep event
 #     / STEPS (the velocity Verlet steps alone). Set-up (neighbours, assembly) is printed apart.
-#   - ns per step per particle (25,600 particles), the ratios LAMMPS/perilin;
+#   - ns per step per particle (25,600 particles, or 102,400 with SCALE=2), the ratios LAMMPS/perilin;
 #   - wall time of the whole process, and peak RSS summed over ranks (perilin/LAMMPS ratio);
 #   - the x-displacement of the site (-70a, 20a, 2a) after the run in both, and their relative
 #     difference (LAMMPS's bonds are geometrically nonlinear: ~1e-7 at this strain, ~1e-6).
 # LAMMPS is Debian's `lammps` package (apt-get install lammps; not installed by .ci/install: a
-# benchmark, not a test). -analysis_energy_every k drops the monitor's second product on k - 1
-# steps of k. Environment: RUNS (3), RANKS ("1 2"), DT (1e-7 s;
-# perilin's limit here is 3.5e-7), KEEP=1 keeps the work directory.
+# benchmark, not a test). -analysis_energy_every k checks the balance every k steps only (it
+# cost a second product per step before the kick-drift-kick step). Environment: RUNS (3), RANKS ("1 2"), DT (1e-7 s;
+# perilin's limit here is 3.5e-7), KEEP=1 keeps the work directory, SCALE=2 the plate scaled up
+# in x and y (320 x 80 x 4 = 102,400 sites, issue 37 item 5; 1 by default).
 set -euo pipefail
 
 if [ $# -lt 1 ]; then
@@ -37,6 +39,11 @@ STEPS=${3:-400}
 RUNS=${RUNS:-3}
 RANKS=${RANKS:-1 2}
 DT=${DT:-1e-7}
+SCALE=${SCALE:-1}
+N=$((25600 * SCALE * SCALE))
+xlo=-$((160 * SCALE - 2)).5 # the plate's faces in units of a: x from xlo to 1.5, y from -0.5 to yhi
+yhi=$((40 * SCALE - 1)).5
+grid="-grid_lower ${xlo}e-3,-0.5e-3,-0.5e-3 -grid_upper 1.5e-3,${yhi}e-3,3.5e-3"
 here=$(cd "$(dirname "$0")" && pwd)
 deck=$here/lammps/dynamic_3d.in
 scene=$here/lammps/dynamic_3d.yaml
@@ -45,7 +52,7 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMP_NUM_THREADS
 
 work=$(mktemp -d /tmp/dynamic_lammps.XXXXXX)
 [ "${KEEP:-0}" = 1 ] || trap 'rm -rf "$work"' EXIT
-echo "25,600 sites, $STEPS steps of $DT s, $RUNS runs each, ranks: $RANKS; work dir $work"
+echo "$N sites, $STEPS steps of $DT s, $RUNS runs each, ranks: $RANKS; work dir $work"
 echo "machine load before: $(cut -d' ' -f1-3 /proc/loadavg)"
 
 # timed NAME P CMD...: every rank under /usr/bin/time (wall, peak RSS) -> NAME.rank*.time
@@ -62,22 +69,22 @@ timed() {
 
 for np in $RANKS; do
   for r in $(seq 1 "$RUNS"); do
-    (cd "$work" && timed "lmp_${np}_$r" "$np" "$LMP" -in "$deck" -log none -var steps "$STEPS" -var dt "$DT")
-    timed "peri_${np}_$r" "$np" "$PERILIN" "$scene" -output_dir "$work/peri_${np}_$r" \
+    (cd "$work" && timed "lmp_${np}_$r" "$np" "$LMP" -in "$deck" -log none -var steps "$STEPS" -var dt "$DT" -var xlo "$xlo" -var yhi "$yhi")
+    timed "peri_${np}_$r" "$np" "$PERILIN" "$scene" $grid -output_dir "$work/peri_${np}_$r" \
       -analysis_dt "$DT" -analysis_t_end "$tend" -log_view ":$work/peri_${np}_$r.log"
-    timed "lean_${np}_$r" "$np" "$PERILIN" "$scene" -output_dir "$work/lean_${np}_$r" -analysis_energy_every "$STEPS" \
+    timed "lean_${np}_$r" "$np" "$PERILIN" "$scene" $grid -output_dir "$work/lean_${np}_$r" -analysis_energy_every "$STEPS" \
       -analysis_dt "$DT" -analysis_t_end "$tend" -log_view ":$work/lean_${np}_$r.log"
-    timed "asm_${np}_$r" "$np" "$PERILIN" "$scene" -output_dir "$work/asm_${np}_$r" -analysis_energy_every "$STEPS" -solver_operator assembled \
+    timed "asm_${np}_$r" "$np" "$PERILIN" "$scene" $grid -output_dir "$work/asm_${np}_$r" -analysis_energy_every "$STEPS" -solver_operator assembled \
       -analysis_dt "$DT" -analysis_t_end "$tend" -log_view ":$work/asm_${np}_$r.log"
     echo "ranks $np run $r done: $(cut -d' ' -f1-3 /proc/loadavg)"
   done
 done
 echo "machine load after: $(cut -d' ' -f1-3 /proc/loadavg)"
 
-python3 - "$work" "$RUNS" "$STEPS" "$RANKS" <<'PY'
+python3 - "$work" "$RUNS" "$STEPS" "$RANKS" "$N" <<'PY'
 import glob, json, re, statistics, sys
 work, runs, steps, ranks = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), sys.argv[4].split()
-N = 25600
+N = int(sys.argv[5])
 med = statistics.median
 def proc(name):  # wall of the slowest rank, RSS summed over ranks (MB)
     t = [tuple(map(float, open(f).read().split()[-2:])) for f in glob.glob(f"{work}/{name}.rank*.time")]

@@ -101,7 +101,9 @@ typedef struct {
 PETSC_EXTERN PetscErrorCode PeriSystemAssemble(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemGetJacobian(PeriSystem, Mat *);
 PETSC_EXTERN PetscErrorCode PeriSystemInternalForce(PeriSystem, Vec, Vec);
+PETSC_EXTERN PetscErrorCode PeriSystemInternalForceParts(PeriSystem, Vec, Vec, Vec);
 PETSC_EXTERN PetscErrorCode PeriSystemStrainEnergy(PeriSystem, Vec, Vec, PetscReal *);
+PETSC_EXTERN PetscErrorCode PeriSystemStrainEnergyFromProduct(PeriSystem, Vec, Vec, PetscReal *);
 PETSC_EXTERN PetscErrorCode PeriSystemStiffnessRowSums(PeriSystem, Vec);
 PETSC_EXTERN PetscErrorCode PeriSystemAddTerm(PeriSystem, const PeriTermOps *);
 PETSC_EXTERN const char    *PeriMatrixFreeWhyNot(PeriSystem);
