@@ -419,6 +419,21 @@ static PetscBool KeepsBonds(const char key[])
   return PETSC_FALSE;
 }
 
+/* Whether a changed key, besides keeping the bonds, leaves the check for mechanisms' verdict as it
+ * was: the verdict depends on the bonds, the held DOFs (bc) and which bond stiffnesses vanish, and
+ * E and rho only scale stiffness and mass (a positive E everywhere, as the input checks hold);
+ * loads, the analysis' keys, the solver's and the output's touch neither. Every other material key
+ * (nu, K, G, the micropolar constants) may zero a stiffness and bc items may free DOFs. */
+static PetscBool KeepsMechanisms(const char key[])
+{
+  static const char *const keep[] = {"loads.", "analysis.", "solver.", "output.", NULL};
+
+  if (!strcmp(key, "material.E") || !strcmp(key, "material.rho") || !strcmp(key, "loads")) return PETSC_TRUE;
+  for (PetscInt k = 0; keep[k]; k++)
+    if (!strncmp(key, keep[k], strlen(keep[k]))) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
 /* q's resolved scene starts as p's (the keys q's set-up does not read again: grid, horizon,
  * regions, ...), without the changed keys' stale values. */
 static PetscErrorCode TakeResolved(PeriScene q, PeriScene p, PetscInt n, const char *const changed[])
@@ -435,18 +450,20 @@ static PetscErrorCode TakeResolved(PeriScene q, PeriScene p, PetscInt n, const c
   the keys changed[] differ from p's) on p's particles, regions and bonds where the changed keys
   leave them as they are (material but its thickness, loads, bc, analysis but its type, solver,
   output) and p's system can lend them (PeriSystemCanReuse): then q takes them, and sets up again
-  only the model's constants and calibration, the conditions, the loads and the analysis; p keeps
+  only the model's constants and calibration, the conditions, the loads and the analysis (and the
+  check for mechanisms only when a changed key may alter its verdict: KeepsMechanisms); p keeps
   its scene and analysis but has no particles left, and is to be destroyed. Otherwise a whole
   PeriProblemSetUp. *reused says which. On an error p is as it was. Collective.
 @*/
 PetscErrorCode PeriProblemSetUpFrom(PeriProblem q, PeriProblem p, PetscInt n, const char *const changed[], PetscBool *reused)
 {
-  PetscBool      keep = (PetscBool)(p && p->sys);
-  const char    *why  = NULL;
+  PetscBool      keep = (PetscBool)(p && p->sys), known = PETSC_TRUE;
+  const char    *why = NULL;
   PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < n; k++) keep = (PetscBool)(keep && KeepsBonds(changed[k]));
+  for (PetscInt k = 0; k < n; k++) known = (PetscBool)(known && KeepsMechanisms(changed[k]));
   if (keep) PetscCall(PeriSystemCanReuse(p->sys, &keep, &why));
   *reused = keep;
   if (!keep) {
@@ -456,7 +473,7 @@ PetscErrorCode PeriProblemSetUpFrom(PeriProblem q, PeriProblem p, PetscInt n, co
   PetscCall(PetscLogStagePush(PERI_STAGE_Setup));
   PetscCall(TakeResolved(q->scene, p->scene, n, changed));
   PetscCall(PeriProblemSetFromScene(q));
-  PetscCall(PeriSystemSetUpFrom(q->sys, p->sys));
+  PetscCall(PeriSystemSetUpFrom(q->sys, p->sys, known));
   ierr = PeriAnalysisSetUp(q->analysis, q->sys);
   if (ierr) PetscCall(PeriSystemGiveBackDisc(q->sys, p->sys));
   PetscCall(ierr);

@@ -521,8 +521,9 @@ static PetscErrorCode Calibrate(PeriSystem sys)
 }
 
 /* What stands on the particles and bonds: shear moduli, calibration, probes, failure, reference,
- * conditions, layers, contact, loads and the checks that need them. */
-static PetscErrorCode SetUpOnBonds(PeriSystem sys)
+ * conditions, layers, contact, loads and the checks that need them (the one for mechanisms, the
+ * costliest, unless the body passed it already with these bonds and held DOFs: mechanisms_known). */
+static PetscErrorCode SetUpOnBonds(PeriSystem sys, PetscBool mechanisms_known)
 {
   PetscFunctionBeginUser;
   PetscCall(PeriCheckBonded(sys)); /* the regions name where */
@@ -540,6 +541,7 @@ static PetscErrorCode SetUpOnBonds(PeriSystem sys)
   PetscCall(PeriLoadsAssemble(sys, sys->fields.f));
   /* after the bcs, which may hold what the bonds do not, and the loads, which tell held pieces */
   PetscCall(PeriCheckHeld(sys));
+  if (mechanisms_known) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
   PetscCall(PeriCheckMechanisms(sys)); /* pieces of many particles, after the single ones */
   PetscCall(PetscLogEventEnd(PERI_EVENT_Mechanisms, 0, 0, 0, 0));
@@ -562,7 +564,7 @@ PetscErrorCode PeriSystemSetUp(PeriSystem sys)
   PetscCall(ReadCorrections(sys));
   PetscCall(SetUpBonds(sys));
   PetscCall(PeriRegionsCreateFromScene(sys->comm, s, &sys->disc.particles, sys->disc.nowned, sys->disc.delta, &sys->disc.nregions, &sys->disc.regions));
-  PetscCall(SetUpOnBonds(sys));
+  PetscCall(SetUpOnBonds(sys, PETSC_FALSE));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -612,10 +614,11 @@ static PetscErrorCode MoveDisc(PeriSystem to, PeriSystem from)
   PeriSystemSetUpFrom - PeriSystemSetUp on old's particles, regions and bonds, which sys takes
   (PeriSystemCanReuse must have said yes; sys's scene differs from old's in keys the particles
   and bonds do not read): the model's constants, calibration, conditions and loads are set up
-  again, no particle is created and no bond searched. On an error old gets its disc back, as it
-  was. After PeriSystemSetFromScene. Collective.
+  again, no particle is created and no bond searched; with mechanisms_known (the caller knows the
+  change cannot turn old's body into a mechanism) neither is the check for mechanisms run. On an
+  error old gets its disc back, as it was. After PeriSystemSetFromScene. Collective.
 @*/
-PetscErrorCode PeriSystemSetUpFrom(PeriSystem sys, PeriSystem old)
+PetscErrorCode PeriSystemSetUpFrom(PeriSystem sys, PeriSystem old, PetscBool mechanisms_known)
 {
   PeriDisc      *d = &sys->disc;
   PetscErrorCode ierr;
@@ -628,7 +631,7 @@ PetscErrorCode PeriSystemSetUpFrom(PeriSystem sys, PeriSystem old)
   /* delta as the first set-up gave it: without horizon.neighbors the local view keeps it */
   if (!ierr) ierr = PeriModelSetFromScene(sys->model, sys->scene, d->delta);
   if (!ierr) ierr = ReadCorrections(sys);
-  if (!ierr) ierr = SetUpOnBonds(sys);
+  if (!ierr) ierr = SetUpOnBonds(sys, mechanisms_known);
   if (ierr) PetscCall(PeriSystemGiveBackDisc(sys, old));
   PetscCall(ierr);
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -89,7 +89,7 @@ PETSC_EXTERN PetscErrorCode PeriSystemSetFromScene(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemSetNeeds(PeriSystem, const PeriSystemNeeds *);
 PETSC_EXTERN PetscErrorCode PeriSystemSetUp(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemCanReuse(PeriSystem, PetscBool *, const char **);
-PETSC_EXTERN PetscErrorCode PeriSystemSetUpFrom(PeriSystem, PeriSystem);
+PETSC_EXTERN PetscErrorCode PeriSystemSetUpFrom(PeriSystem, PeriSystem, PetscBool);
 PETSC_EXTERN PetscErrorCode PeriSystemGiveBackDisc(PeriSystem, PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriMultigridSetUp(PeriSystem, KSP, Mat);
 PETSC_EXTERN PetscBool      PeriMultigridApplies(PeriSystem);
