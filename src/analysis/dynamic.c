@@ -76,6 +76,8 @@ typedef struct {
   PetscBool          resumed;                                                    /* -restart: the first monitor call is the checkpoint's step, recorded already */
   Vec                minv, uprev, tmp;                                           /* 1/m per DOF (0 on held DOFs), the last step's u, work */
   Mat                J;                                                          /* implicit: K + shift M with the held rows and columns eliminated */
+  Mat                Kh, Pa;                                                     /* implicit, matrix-free K: K's view with the held rows and columns eliminated (J's part); the assembled preconditioning matrix (short range + shift M) for a PC that needs entries, or NULL */
+  Vec                jshift;                                                     /* implicit, matrix-free K: shift M on the free DOFs, 0 on the held ones */
   const PeriContact *contact;                                                    /* the system's, for the impactors' history */
   IS                 isq, isp;                                                   /* explicit: positions and velocities in the state [q; p] */
   PetscBool          kdk;                                                        /* explicit, kick-drift-kick: the force at q_(n+1) serves the next step and the balance (CachedForce) */
@@ -714,6 +716,101 @@ static PetscErrorCode I2Function(TS ts, PetscReal t, Vec U, Vec V, Vec A, Vec F,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Implicit, matrix-free K: y = K_h x + (shift M) x, K_h the operator with the held DOFs' rows and
+ * columns replaced by the identity, shift M zero on them. */
+static PetscErrorCode JacobianMult(Mat J, Vec x, Vec y)
+{
+  PeriAnalysis an;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(J, &an));
+  PetscCall(MatMult(DYN(an)->Kh, x, y));
+  PetscCall(VecPointwiseMult(DYN(an)->tmp, DYN(an)->jshift, x));
+  PetscCall(VecAXPY(y, 1, DYN(an)->tmp));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode JacobianDiagonal(Mat J, Vec diag)
+{
+  PeriAnalysis an;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(J, &an));
+  PetscCall(MatGetDiagonal(DYN(an)->Kh, diag));
+  PetscCall(VecAXPY(diag, 1, DYN(an)->jshift));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit, matrix-free K: J as a shell over the operator's bond data (no copy of K). */
+static PetscErrorCode CreateJacobianShell(PeriAnalysis an)
+{
+  Dynamic              *d = DYN(an);
+  const PeriConditions *C = &an->sys->conditions;
+  PetscInt              n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriOperatorCreateMat(an->sys, &d->Kh));
+  PetscCall(MatZeroRowsColumns(d->Kh, C->nconstrained, C->constrained, 1.0, NULL, NULL));
+  PetscCall(VecDuplicate(an->sys->fields.u, &d->jshift));
+  PetscCall(VecSet(d->jshift, 0));
+  PetscCall(VecGetLocalSize(d->jshift, &n));
+  PetscCall(MatCreateShell(an->comm, n, n, PETSC_DETERMINE, PETSC_DETERMINE, an, &d->J));
+  PetscCall(MatSetBlockSize(d->J, an->sys->model->dofs));
+  PetscCall(MatShellSetOperation(d->J, MATOP_MULT, (void (*)(void))JacobianMult));
+  PetscCall(MatShellSetOperation(d->J, MATOP_MULT_TRANSPOSE, (void (*)(void))JacobianMult));
+  PetscCall(MatShellSetOperation(d->J, MATOP_GET_DIAGONAL, (void (*)(void))JacobianDiagonal));
+  PetscCall(MatSetOption(d->J, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(d->J, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode I2Jacobian(TS, PetscReal, Vec, Vec, Vec, PetscReal, PetscReal, Mat, Mat, void *);
+
+/* Implicit, matrix-free K: a PC that reads entries (GAMG, by default beyond 20 explicit limits, or
+ * any -pc_type but jacobi and none) gets the assembled short range plus shift M, as the static
+ * solve's GAMG gets the short range alone. After the PC's type is known. Collective. */
+static PetscErrorCode AssembledPreconditioningMatrix(PeriAnalysis an)
+{
+  Dynamic  *d = DYN(an);
+  SNES      snes;
+  KSP       ksp;
+  PC        pc;
+  PetscBool shell;
+
+  PetscFunctionBeginUser;
+  if (!d->Kh) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(TSGetSNES(d->ts, &snes));
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &shell, PCJACOBI, PCNONE, ""));
+  if (shell) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PeriOperatorPreconditioner(an->sys));
+  PetscCall(MatDuplicate(an->sys->stiffness.Kpc, MAT_COPY_VALUES, &d->Pa));
+  PetscCall(PeriSetNearNullSpace(an->sys, d->Pa, NULL));
+  PetscCall(TSSetI2Jacobian(d->ts, d->J, d->Pa, I2Jacobian, an));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Implicit, matrix-free K: the step's shift into J's diagonal part and the assembled P (if any). */
+static PetscErrorCode ShiftMatrixFree(PeriAnalysis an, Vec m, PetscReal shiftA)
+{
+  Dynamic              *d = DYN(an);
+  const PeriConditions *C = &an->sys->conditions;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecCopy(m, d->jshift));
+  PetscCall(VecScale(d->jshift, shiftA));
+  PetscCall(ZeroHeld(an, d->jshift));
+  /* K or the shift changed: the assembly marks J so, and SNES's lag decides whether the PC follows */
+  PetscCall(MatAssemblyBegin(d->J, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(d->J, MAT_FINAL_ASSEMBLY));
+  if (!d->Pa) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(MatCopy(an->sys->stiffness.Kpc, d->Pa, SAME_NONZERO_PATTERN));
+  PetscCall(MatDiagonalSet(d->Pa, d->jshift, ADD_VALUES));
+  PetscCall(MatZeroRowsColumns(d->Pa, C->nconstrained, C->constrained, 1.0, NULL, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Implicit: J = K + shiftA M, the held rows and columns replaced by the identity. */
 static PetscErrorCode I2Jacobian(TS ts, PetscReal t, Vec U, Vec V, Vec A, PetscReal shiftV, PetscReal shiftA, Mat J, Mat P, void *ctx)
 {
@@ -725,6 +822,14 @@ static PetscErrorCode I2Jacobian(TS ts, PetscReal t, Vec U, Vec V, Vec A, PetscR
   PetscFunctionBeginUser;
   (void)ts, (void)t, (void)U, (void)V, (void)A, (void)shiftV;
   PetscCall(PeriMassGetDiagonal(sys, &m));
+  if (DYN(an)->Kh) {
+    PetscCall(ShiftMatrixFree(an, m, shiftA));
+    if (J != DYN(an)->J) { /* J applied by differences (contact): it takes the new state from its assembly */
+      PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
+    }
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(PeriSystemGetJacobian(sys, &K));
   PetscCall(MatCopy(K, P, SAME_NONZERO_PATTERN));
   PetscCall(VecCopy(m, DYN(an)->tmp));
@@ -1282,8 +1387,12 @@ static PetscErrorCode CreateImplicit(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(InitialDisplacement(an, *U));
   PetscCall(InitialVelocity(an, *V));
   PetscCall(PeriSystemGetJacobian(an->sys, &K));
-  PetscCall(MatDuplicate(K, MAT_COPY_VALUES, &d->J));
-  PetscCall(PeriSetNearNullSpace(an->sys, d->J, NULL));
+  if (an->sys->stiffness.op)
+    PetscCall(CreateJacobianShell(an)); /* no copy of K */
+  else {
+    PetscCall(MatDuplicate(K, MAT_COPY_VALUES, &d->J));
+    PetscCall(PeriSetNearNullSpace(an->sys, d->J, NULL));
+  }
   PetscCall(TSSetType(d->ts, TSALPHA2));
   PetscCall(TSAlpha2SetRadius(d->ts, d->rho_inf));
   PetscCall(TSSetI2Function(d->ts, NULL, I2Function, an));
@@ -1402,6 +1511,7 @@ static PetscErrorCode SetUpTS(PeriAnalysis an, Vec *U, Vec *V)
   PetscCall(IsKDK(d));
   PetscCall(TSGetTimeStep(d->ts, &d->dt));
   if (d->implicit) PetscCall(ChooseImplicitPC(an));
+  if (d->implicit) PetscCall(AssembledPreconditioningMatrix(an));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_steps", &given));
   if (!given) PetscCall(TSSetMaxSteps(d->ts, (PetscInt)PetscCeilReal(d->t_end / d->dt - 1e-9)));
   PetscCall(TSGetMaxSteps(d->ts, &d->every));
@@ -1448,20 +1558,18 @@ static PetscErrorCode RecordSolver(PeriAnalysis an)
   output describes the last completed step. Options: every -ts_* option, and for the implicit
   integrator the -snes_*, -ksp_* and -pc_* options. Collective.
 @*/
-/* solver.operator: the implicit step copies K's entries into its Jacobian, so it needs them; the
- * explicit one only applies K, and auto gives it the matrix-free operator where the model allows
- * (central-force models): 28 bytes per bond instead of an assembled K's ~150 in 3D, the same
- * results, and no slower per step (the EOI at 51,200 particles: 101 MB against 540, peak 506 MB
- * against 910, the time loop 0.86-0.92 of the assembled one's; docs/dynamics.md). */
+/* solver.operator: auto gives both integrators the matrix-free operator where the model allows:
+ * 28 bytes per bond instead of an assembled K's ~150 in 3D, the same results, and no slower per
+ * step (explicit: the EOI at 51,200 particles, 101 MB against 540, peak 506 MB against 910, the
+ * time loop 0.86-0.92 of the assembled one's; docs/dynamics.md). The implicit step's J is then a
+ * shell over the same bond data plus shift M (CreateJacobianShell), with the short range plus
+ * shift M assembled for a PC that needs entries (AssembledPreconditioningMatrix). */
 static PetscErrorCode ChooseOperator(PeriAnalysis an)
 {
   PeriStiffness *S = &an->sys->stiffness;
-  PeriNode       node;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriSceneGetNode(an->sys->scene->root, "solver", &node)); /* locates the message only */
-  PeriInputCheck(!DYN(an)->implicit || S->operator_kind != PERI_OPERATOR_MATRIX_FREE, an->sys->scene, node, "operator", "matrix_free serves the explicit integrator only: the implicit step builds its Jacobian from K's entries");
-  if (S->operator_kind == PERI_OPERATOR_AUTO) S->operator_kind = !DYN(an)->implicit && !PeriMatrixFreeWhyNot(an->sys) ? PERI_OPERATOR_MATRIX_FREE : PERI_OPERATOR_ASSEMBLED;
+  if (S->operator_kind == PERI_OPERATOR_AUTO) S->operator_kind = !PeriMatrixFreeWhyNot(an->sys) ? PERI_OPERATOR_MATRIX_FREE : PERI_OPERATOR_ASSEMBLED;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1779,6 +1887,9 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscFunctionBeginUser;
   PetscCall(TSDestroy(&d->ts));
   PetscCall(MatDestroy(&d->J));
+  PetscCall(MatDestroy(&d->Kh));
+  PetscCall(MatDestroy(&d->Pa));
+  PetscCall(VecDestroy(&d->jshift));
   PetscCall(ISDestroy(&d->isq));
   PetscCall(ISDestroy(&d->isp));
   PetscCall(VecDestroy(&d->minv));

@@ -28,7 +28,7 @@ static const PeriKey corrections_keys[] = {
 };
 const char *const    PeriOperatorKinds[] = {"auto", "assembled", "matrix_free", NULL};
 static const PeriKey solver_keys[]       = {
-          {"operator", PERI_KEY_CHOICE, "auto", NULL, NULL, PeriOperatorKinds, "how K is applied: assembled, or matrix_free (central-force, pds, mppd and gerstle bonds in a static analysis: K u bond by bond, AMG on a short-range stiffness); auto: matrix_free where it applies and the preconditioner is GAMG (the default)"},
+          {"operator", PERI_KEY_CHOICE, "auto", NULL, NULL, PeriOperatorKinds, "how K is applied: assembled, or matrix_free (central-force, pds, mppd and gerstle bonds and lps's states: K u bond by bond, AMG on a short-range stiffness; in the dynamic analysis the explicit step and the implicit step's Jacobian too); auto: matrix_free where it applies and the preconditioner is GAMG (the default)"},
           {"pc_radius", PERI_KEY_REAL, "1.75", "[1, inf)", NULL, NULL, "matrix_free: the bonds no longer than pc_radius times the 2 dim-th shortest bond of either end (on a grid: its nearest neighbours) make the preconditioning matrix"},
           {"residual_tol", PERI_KEY_REAL, "0", "[0, 1)", NULL, NULL, "largest true relative residual ||b - A x|| / ||b|| accepted from any linear solve, and ||K x - lambda M x|| / (|lambda| ||M x||) from any mode; 0: min(max(100 rtol, 1e-6), 1e-3)"},
           {NULL},
