@@ -27,7 +27,7 @@
 # 13. (below) a failed implicit step is an error naming the reasons, with no output.
 #  9. The edge-on impact (examples/dynamics/eoi.yaml, Diehl & Schweitzer) at its coarsest dx
 #     (2.5 mm): the wave front runs within 10 % of the bond-based P-wave speed
-#     sqrt((K + 4G/3)/rho) = 10121 m/s for npmb and pmb (they give +5.1 % and -9.4 % here and
+#     sqrt((K + 4G/3)/rho) = 10121 m/s for npmb and pmb (they give +5.4 % and -9.8 % here and
 #     converge to it as dx shrinks: docs/dynamics.md's table), the damage front behind it, the balance
 #     closes with 200,000 bonds broken (drift < 1 %), and 2 ranks break the same bonds.
 # 10. The cantilever lamina (mppd, with rotations) started at rest from its lowest mode shape, read
