@@ -77,7 +77,7 @@ typedef struct {
   Vec                minv, uprev, tmp;                                           /* 1/m per DOF (0 on held DOFs), the last step's u, work */
   Mat                J;                                                          /* implicit: K + shift M with the held rows and columns eliminated */
   Mat                Kh, Pa;                                                     /* implicit, matrix-free K: K's view with the held rows and columns eliminated (J's part); the assembled preconditioning matrix (short range + shift M) for a PC that needs entries, or NULL */
-  Vec                jshift;                                                     /* implicit, matrix-free K: shift M on the free DOFs, 0 on the held ones */
+  Vec                jshift, jwork;                                              /* implicit, matrix-free K: shift M on the free DOFs, 0 on the held ones; J's own work vector */
   const PeriContact *contact;                                                    /* the system's, for the impactors' history */
   IS                 isq, isp;                                                   /* explicit: positions and velocities in the state [q; p] */
   PetscBool          kdk;                                                        /* explicit, kick-drift-kick: the force at q_(n+1) serves the next step and the balance (CachedForce) */
@@ -725,8 +725,8 @@ static PetscErrorCode JacobianMult(Mat J, Vec x, Vec y)
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(J, &an));
   PetscCall(MatMult(DYN(an)->Kh, x, y));
-  PetscCall(VecPointwiseMult(DYN(an)->tmp, DYN(an)->jshift, x));
-  PetscCall(VecAXPY(y, 1, DYN(an)->tmp));
+  PetscCall(VecPointwiseMult(DYN(an)->jwork, DYN(an)->jshift, x));
+  PetscCall(VecAXPY(y, 1, DYN(an)->jwork));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -753,6 +753,7 @@ static PetscErrorCode CreateJacobianShell(PeriAnalysis an)
   PetscCall(MatZeroRowsColumns(d->Kh, C->nconstrained, C->constrained, 1.0, NULL, NULL));
   PetscCall(VecDuplicate(an->sys->fields.u, &d->jshift));
   PetscCall(VecSet(d->jshift, 0));
+  PetscCall(VecDuplicate(d->jshift, &d->jwork));
   PetscCall(VecGetLocalSize(d->jshift, &n));
   PetscCall(MatCreateShell(an->comm, n, n, PETSC_DETERMINE, PETSC_DETERMINE, an, &d->J));
   PetscCall(MatSetBlockSize(d->J, an->sys->model->dofs));
@@ -1021,13 +1022,15 @@ static PetscErrorCode Energies(PeriAnalysis an, Vec q, Vec p)
 }
 
 /* Kick-drift-kick: f_k . p for each load term, kept for the next step's work. */
-static PetscErrorCode LoadPower(PeriAnalysis an, Vec p, PetscScalar fv[])
+static PetscErrorCode LoadPower(PeriAnalysis an, Vec p)
 {
-  Dynamic *d = DYN(an);
+  Dynamic    *d = DYN(an);
+  PetscScalar fv[PERI_DYN_MAX_TERMS];
 
   PetscFunctionBeginUser;
-  if (d->kdk) PetscCall(VecMDot(p, d->nterms, d->term_f, fv));
-  for (PetscInt k = 0; k < d->nterms && d->kdk; k++) d->term_fv[k] = PetscRealPart(fv[k]);
+  if (!d->kdk) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecMDot(p, d->nterms, d->term_f, fv));
+  for (PetscInt k = 0; k < d->nterms; k++) d->term_fv[k] = PetscRealPart(fv[k]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -1039,7 +1042,7 @@ static PetscErrorCode LoadPower(PeriAnalysis an, Vec p, PetscScalar fv[])
 static PetscErrorCode Work(PeriAnalysis an, Vec q, Vec p, PetscReal t)
 {
   Dynamic        *d = DYN(an);
-  PetscScalar     w[PERI_DYN_MAX_TERMS], fv[PERI_DYN_MAX_TERMS];
+  PetscScalar     w[PERI_DYN_MAX_TERMS];
   PetscReal       fv_prev[PERI_DYN_MAX_TERMS];
   const PetscReal h = t - d->t_prev;
 
@@ -1048,7 +1051,7 @@ static PetscErrorCode Work(PeriAnalysis an, Vec q, Vec p, PetscReal t)
   PetscCall(VecWAXPY(d->tmp, -1, d->uprev, q));
   PetscCall(VecMDot(d->tmp, d->nterms, d->term_f, w));
   PetscCall(PetscArraycpy(fv_prev, d->term_fv, d->nterms));
-  PetscCall(LoadPower(an, p, fv));
+  PetscCall(LoadPower(an, p));
   for (PetscInt k = 0; k < d->nterms; k++) {
     const PetscReal a = PeriAmplitudeValue(d->term_amp[k], t);
     if (d->kdk)
@@ -1301,9 +1304,8 @@ static PetscErrorCode Monitor(TS ts, PetscInt step, PetscReal t, Vec U, void *ct
   if (d->resumed) { /* -restart: this step's row, frame and checkpoint are the stopped run's */
     d->resumed = PETSC_FALSE;
     PetscCall(GetState(an, U, &q, &p));
-    PetscScalar fv[PERI_DYN_MAX_TERMS];
     PetscCall(ImplicitBoundaryWork(an, q, p, t)); /* its reactions, for the next step's work */
-    PetscCall(LoadPower(an, p, fv));
+    PetscCall(LoadPower(an, p));
     PetscCall(RestoreState(an, U, &q, &p));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -1890,6 +1892,7 @@ static PetscErrorCode Destroy_Dynamic(PeriAnalysis an)
   PetscCall(MatDestroy(&d->Kh));
   PetscCall(MatDestroy(&d->Pa));
   PetscCall(VecDestroy(&d->jshift));
+  PetscCall(VecDestroy(&d->jwork));
   PetscCall(ISDestroy(&d->isq));
   PetscCall(ISDestroy(&d->isp));
   PetscCall(VecDestroy(&d->minv));
