@@ -3,6 +3,10 @@
  *   central force (pmb, npmb, cpmb): k [e e^T, -e e^T; -e e^T, e e^T], stored as w = sqrt(k) e
  *     (k the spring constant, e the unit vector), 28 bytes per bond in 3D where the assembled K
  *     holds two dim x dim blocks per bond in each of two rows (about 150 bytes);
+ *   spring (the central form where every bond vector is X_j - X_i, as without periodic images,
+ *     and no state terms): c = k / |xi|^2 only, the block c xi xi^T formed from the coordinates
+ *     gathered beside u_j: 12 bytes per bond (the explicit step is memory-bound, and LAMMPS keeps
+ *     24 a bond: issue 37's target of its peak memory);
  *   shear (pds, 2D): [A, -A; -A, A], A = k_n e e^T + k_t t t^T, stored as A's 3 entries;
  *   micropolar (mppd, gerstle; ux, uy, theta): translations move both ends alike and the sliding
  *     sees the sum of the rotations, so the 6 x 6 block is
@@ -24,6 +28,7 @@
 /* The forms of a bond's block (top of the file), and the numbers each stores per bond. */
 typedef enum {
   FORM_CENTRAL,
+  FORM_SPRING,
   FORM_SHEAR,
   FORM_MICROPOLAR
 } BondForm;
@@ -32,10 +37,11 @@ struct _p_PeriOperator {
   PetscInt   refct; /* the system's reference and one per shell: a reused preconditioner may keep a shell after the system rebuilt its operator */
   PetscInt   nloc, bs, nghost;
   BondForm   form;
-  PetscInt   nw;  /* numbers per bond: bs (central), 3 (shear), 7 (micropolar) */
+  PetscInt   nw;  /* numbers per bond: bs (central), 1 (spring), 3 (shear), 7 (micropolar) */
   PetscInt  *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
   PetscInt  *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
-  PetscReal *w;   /* nw per bond: sqrt(k) e; A (xx, xy, yy); A, c (x, y), a, b */
+  PetscReal *w;   /* nw per bond: sqrt(k) e; k / |xi|^2; A (xx, xy, yy); A, c (x, y), a, b */
+  PetscReal *X;   /* the spring form: per particle of the local numbering its bs coordinates (xi = X_j - X_i), then bs of the product's input */
   PetscInt  *ghost;
   PetscInt  *slot; /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
   /* The state terms of family models (ops.bond_state; the LPS dilatation), else NULL: per bond the
@@ -65,6 +71,12 @@ typedef struct {
   PetscReal   *hd;   /* their diagonal values */
 } Shell;
 
+/* Whether the bonds are central springs (stored as sqrt(k) e or as k / |xi|^2). */
+static inline PetscBool Central(const PeriOperator op)
+{
+  return (PetscBool)(op->form == FORM_CENTRAL || op->form == FORM_SPRING);
+}
+
 /* The central form: y_i += sum_b w_b (w_b . (u_i - u_j)), and the opposite at j, on the local
  * forms (owned, then ghosts). Called with a literal bs, so that the compiler unrolls the inner loops. */
 static inline void BondLoop(const PeriOperator op, const PetscInt bs, const PetscScalar *x, PetscScalar *y)
@@ -84,6 +96,44 @@ static inline void BondLoop(const PeriOperator op, const PetscInt bs, const Pets
     }
     for (PetscInt d = 0; d < bs; d++) y[bs * i + d] += acc[d];
   }
+}
+
+/* The spring form: y_i += c xi (xi . (u_i - u_j)), xi = X_j - X_i, and the opposite at j. xu holds
+ * each particle's X and u side by side (2 bs numbers), so that a bond gathers one block, not two. */
+static inline void SpringLoop(const PeriOperator op, const PetscInt bs, const PetscScalar *xu, PetscScalar *y)
+{
+  for (PetscInt i = 0; i < op->nloc; i++) {
+    const PetscScalar *Xi = xu + 2 * bs * i, *ui = Xi + bs;
+    PetscScalar        acc[PERI_MAX_DOF] = {0};
+    for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
+      const PetscInt     j  = op->jl[b];
+      const PetscScalar *Xj = xu + 2 * bs * j, *uj = Xj + bs;
+      PetscScalar       *yj = y + bs * j, t = 0, e[PERI_MAX_DOF];
+      for (PetscInt d = 0; d < bs; d++) {
+        e[d] = Xj[d] - Xi[d];
+        t += e[d] * (ui[d] - uj[d]);
+      }
+      t *= op->w[b];
+      for (PetscInt d = 0; d < bs; d++) {
+        acc[d] += t * e[d];
+        yj[d] -= t * e[d];
+      }
+    }
+    for (PetscInt d = 0; d < bs; d++) y[bs * i + d] += acc[d];
+  }
+}
+
+/* The spring form's product: x beside X in op->X, then the loop. */
+static void SpringProduct(const PeriOperator op, const PetscScalar *x, PetscScalar *y)
+{
+  const PetscInt bs = op->bs;
+
+  for (PetscInt q = 0; q < op->nloc + op->nghost; q++)
+    for (PetscInt d = 0; d < bs; d++) op->X[2 * bs * q + bs + d] = x[bs * q + d];
+  if (bs == 3)
+    SpringLoop(op, 3, op->X, y);
+  else
+    SpringLoop(op, bs, op->X, y);
 }
 
 /* The shear form in 2D: f = A (u_i - u_j) at i, -f at j. */
@@ -286,6 +336,8 @@ static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y
     MicropolarLoop(op, x, y);
   else if (op->form == FORM_SHEAR)
     ShearLoop(op, x, y);
+  else if (op->form == FORM_SPRING)
+    SpringProduct(op, x, y);
   else if (op->bs == 3)
     BondLoop(op, 3, x, y);
   else if (op->bs == 2)
@@ -298,6 +350,7 @@ static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y
 static PetscReal FormFlops(const PeriOperator op)
 {
   return op->form == FORM_MICROPOLAR ? 32 : op->form == FORM_SHEAR ? 14
+                                        : op->form == FORM_SPRING  ? 7.0 * op->bs + 1
                                         : op->p && StatesMixed(op) ? (6.0 + 8.0 * (op->ns - op->na)) * op->bs + 4.0 * op->na
                                         : op->p                    ? 10.0 * op->bs + 8
                                                                    : 6.0 * op->bs;
@@ -534,7 +587,7 @@ static void FormNumbers(const PeriOperator op, const PeriBondGeometry *g, const 
   const PetscInt n = 2 * op->bs;
   PetscReal      k = 0;
 
-  if (op->form == FORM_CENTRAL) {
+  if (Central(op)) {
     for (PetscInt a = 0; a < op->bs; a++) k += Ke[a * n + a];
     for (PetscInt d = 0; d < op->bs; d++) w[d] = PetscSqrtReal(PetscMax(k, 0)) * g->xi[d] / g->length;
     return;
@@ -556,7 +609,7 @@ static void FormBlock(const PeriOperator op, const PetscReal w[], PetscReal Ke[]
   PetscReal      A[PERI_MAX_DOF * PERI_MAX_DOF];
 
   for (PetscInt r = 0; r < nu; r++)
-    for (PetscInt c = 0; c < nu; c++) A[r * nu + c] = op->form == FORM_CENTRAL ? w[r] * w[c] : w[r + c];
+    for (PetscInt c = 0; c < nu; c++) A[r * nu + c] = Central(op) ? w[r] * w[c] : w[r + c];
   for (PetscInt a = 0; a < n * n; a++) Ke[a] = 0;
   for (PetscInt e = 0; e < 2; e++)
     for (PetscInt f = 0; f < 2; f++)
@@ -590,8 +643,8 @@ static PetscErrorCode BondNumbers(PeriModel m, const PeriOperator op, const Peri
   if (PetscIsInfOrNanReal(size)) PetscFunctionReturn(PETSC_SUCCESS);
   /* a central spring with k < 0 is rebuilt with k = 0, and fails here too */
   PetscCheck(dev <= 1e-10 * size, PETSC_COMM_SELF, PETSC_ERR_PLIB, "model %s: the block of bond %" PetscInt_FMT "-%" PetscInt_FMT " is not of the %s form (deviation %g of %g): the matrix-free operator cannot apply it", m->type, g->i, g->j,
-             op->form == FORM_CENTRAL ? "central-spring (k >= 0)" : op->form == FORM_SHEAR ? "shear"
-                                                                                           : "micropolar",
+             Central(op) ? "central-spring (k >= 0)" : op->form == FORM_SHEAR ? "shear"
+                                                                              : "micropolar",
              (double)dev, (double)size);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -635,19 +688,84 @@ static inline PetscBool OperatorBond(const PeriBonds *b, PetscInt i, PetscInt k)
   return (PetscBool)(b->live[k] && b->j[k] != i);
 }
 
+/* Whether the central form can be the spring form: no state terms, and every operator bond's
+ * vector is X_j - X_i to the bit (a periodic image's is not; a list without vectors has them so). */
+static PetscBool SpringsFromCoordinates(PeriSystem sys, const PeriOperator op)
+{
+  const PeriBonds *b = &sys->disc.bonds;
+  const PetscReal *x = sys->disc.particles.x;
+
+  if (op->form != FORM_CENTRAL || sys->model->ops.bond_state) return PETSC_FALSE;
+  if (!b->xi) return PETSC_TRUE;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      for (PetscInt d = 0; d < 3 && OperatorBond(b, i, k); d++)
+        if (b->xi[3 * k + d] != x[3 * b->j[k] + d] - x[3 * i + d]) return PETSC_FALSE;
+  return PETSC_TRUE;
+}
+
+/* The ghosts the operator's bonds reach, sorted by global index (op->ghost), and each local
+ * particle's number in the operator's local numbering (loc: owned ones as they are, ghosts after
+ * them; -1 for ghosts without an operator bond). Per particle, not per bond: this runs while the
+ * bond list and the operator's arrays are both alive, at the set-up's memory peak. */
+static PetscErrorCode NumberGhosts(PeriSystem sys, PeriOperator op, PetscInt loc[])
+{
+  const PeriDisc  *disc = &sys->disc;
+  const PeriBonds *b    = &disc->bonds;
+  const PetscInt   n = disc->particles.n, no = disc->nowned;
+  PetscInt        *order;
+
+  PetscFunctionBeginUser;
+  for (PetscInt q = 0; q < n; q++) loc[q] = q < no ? q : -1;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      if (OperatorBond(b, i, k) && b->j[k] >= no) loc[b->j[k]] = 0;
+  op->nghost = 0;
+  for (PetscInt q = no; q < n; q++) op->nghost += loc[q] == 0;
+  PetscCall(PetscMalloc1(op->nghost + 1, &op->ghost));
+  PetscCall(PetscMalloc1(op->nghost + 1, &order));
+  op->nghost = 0;
+  for (PetscInt q = no; q < n; q++)
+    if (loc[q] == 0) {
+      op->ghost[op->nghost] = disc->particles.global[q];
+      order[op->nghost++]   = q;
+    }
+  PetscCall(PetscSortIntWithArray(op->nghost, op->ghost, order));
+  for (PetscInt g = 0; g < op->nghost; g++) loc[order[g]] = op->nloc + g;
+  PetscCall(PetscFree(order));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The spring form's coordinates on the operator's local numbering. */
+static PetscErrorCode SpringCoordinates(PeriSystem sys, PeriOperator op, const PetscInt loc[])
+{
+  const PeriParticles *p = &sys->disc.particles;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(2 * (op->nloc + op->nghost) * op->bs, &op->X));
+  for (PetscInt q = 0; q < p->n; q++)
+    for (PetscInt d = 0; d < op->bs && loc[q] >= 0; d++) op->X[2 * op->bs * loc[q] + d] = p->x[3 * q + d];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The live bonds of the owned particles as (jl, w), ghosts numbered after the owned ones. */
 static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
 {
   const PeriBonds *b = &sys->disc.bonds;
   PeriModel        m = sys->model;
-  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF];
+  PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], w[PERI_MAX_DOF * PERI_MAX_DOF];
   PeriBondGeometry g;
-  PetscInt         nb = 0;
+  PetscInt         nb = 0, *loc;
 
   PetscFunctionBeginUser;
+  if (SpringsFromCoordinates(sys, op)) {
+    op->form = FORM_SPRING;
+    op->nw   = 1;
+  }
+  PetscCall(PetscMalloc1(sys->disc.particles.n, &loc));
+  PetscCall(NumberGhosts(sys, op, loc));
   PetscCall(PetscMalloc1(op->nloc + 1, &op->ptr));
   PetscCall(PetscMalloc2(b->nbonds, &op->jl, b->nbonds * op->nw, &op->w));
-  PetscCall(PetscMalloc1(b->nbonds, &op->ghost));
   if (sys->bond_state.failure.active) PetscCall(PetscMalloc1(b->nbonds, &op->slot));
   if (m->ops.bond_state) {
     op->ns = m->nstates;
@@ -655,7 +773,6 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
     op->np = 2 * op->na + 2 * (op->ns - op->na) * op->bs;
     PetscCall(PetscMalloc1(op->np * b->nbonds, &op->p));
   }
-  op->nghost = 0;
   for (PetscInt i = b->rstart; i < b->rend; i++) {
     op->ptr[i - b->rstart] = nb;
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
@@ -664,33 +781,46 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
       if (op->slot) op->slot[k] = nb;
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
-      PetscCall(BondNumbers(m, op, &g, Ke, op->w + nb * op->nw));
+      PetscCall(BondNumbers(m, op, &g, Ke, w));
+      if (op->form == FORM_SPRING) { /* k / |xi|^2 = |w|^2 / |xi|^2 */
+        PetscReal ww = 0, xx = 0;
+        for (PetscInt d = 0; d < op->bs; d++) {
+          ww += w[d] * w[d];
+          xx += g.xi[d] * g.xi[d];
+        }
+        op->w[nb] = ww / xx;
+      } else
+        PetscCall(PetscArraycpy(op->w + nb * op->nw, w, op->nw));
       if (op->p) PetscCall(StateNumbers(m, op, &g, op->w + nb * op->nw, op->p + op->np * nb));
-      if (g.j < sys->disc.nowned)
-        op->jl[nb] = g.j;
-      else { /* for now -1 - its global index: numbered below, as the ghosted vectors number them */
-        op->jl[nb]              = -1 - sys->disc.particles.global[g.j];
-        op->ghost[op->nghost++] = sys->disc.particles.global[g.j];
-      }
-      nb++;
+      op->jl[nb++] = loc[g.j];
     }
   }
   op->ptr[op->nloc] = nb;
-  PetscCall(PetscSortRemoveDupsInt(&op->nghost, op->ghost));
-  PetscCall(PetscRealloc(sizeof(PetscInt) * (op->nghost + 1), &op->ghost));
-  for (PetscInt t = 0; t < nb; t++)
-    if (op->jl[t] < 0) {
-      PetscInt loc;
-      PetscCall(PetscFindInt(-1 - op->jl[t], op->nghost, op->ghost, &loc));
-      op->jl[t] = op->nloc + loc;
-    }
+  if (op->form == FORM_SPRING) PetscCall(SpringCoordinates(sys, op, loc));
+  PetscCall(PetscFree(loc));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The diagonal of a bond's block at either end from its numbers w[]. */
-static void FormDiagonal(const PeriOperator op, const PetscReal w[], PetscReal diag[])
+/* The spring form's bond vector xi = X_j - X_i of bond b of owned particle i; its squared length. */
+static PetscReal SpringVector(const PeriOperator op, PetscInt i, PetscInt b, PetscReal e[])
 {
-  if (op->form == FORM_CENTRAL)
+  PetscReal ee = 0;
+  for (PetscInt d = 0; d < op->bs; d++) {
+    e[d] = op->X[2 * op->bs * op->jl[b] + d] - op->X[2 * op->bs * i + d];
+    ee += e[d] * e[d];
+  }
+  return ee;
+}
+
+/* The diagonal of the block of bond b of owned particle i at either end. */
+static void FormDiagonal(const PeriOperator op, PetscInt i, PetscInt b, PetscReal diag[])
+{
+  const PetscReal *w = op->w + op->nw * b;
+
+  if (op->form == FORM_SPRING) {
+    SpringVector(op, i, b, diag);
+    for (PetscInt d = 0; d < op->bs; d++) diag[d] = w[0] * PetscSqr(diag[d]);
+  } else if (op->form == FORM_CENTRAL)
     for (PetscInt d = 0; d < op->bs; d++) diag[d] = PetscSqr(w[d]);
   else {
     diag[0] = w[0];
@@ -786,7 +916,7 @@ static PetscErrorCode ComputeDiagonal(PeriOperator op)
   for (PetscInt i = 0; i < op->nloc; i++)
     for (PetscInt b = op->ptr[i]; b < op->ptr[i + 1]; b++) {
       PetscReal diag[PERI_MAX_DOF];
-      FormDiagonal(op, op->w + op->nw * b, diag);
+      FormDiagonal(op, i, b, diag);
       for (PetscInt d = 0; d < op->bs; d++) {
         ya[op->bs * i + d] += diag[d];
         ya[op->bs * op->jl[b] + d] += diag[d];
@@ -890,7 +1020,7 @@ static PetscErrorCode ExpansionEnergies(PeriSystem sys, PeriOperator op, PetscRe
       PetscReal e = 0, diag[PERI_MAX_DOF];
       if (!OperatorBond(b, i, k)) continue;
       /* the trace of the translational block times |xi|^2: k |xi|^2 for a central spring */
-      FormDiagonal(op, op->w + op->nw * t++, diag);
+      FormDiagonal(op, i - b->rstart, t++, diag);
       for (PetscInt d = 0; d < (op->form == FORM_MICROPOLAR ? 2 : op->bs); d++) e += diag[d] * PetscSqr(b->length[k]);
       full[i] += e;
       full[b->j[k]] += e;
@@ -1061,7 +1191,7 @@ PetscErrorCode PeriOperatorPreconditioner(PeriSystem sys)
   if (sys->stiffness.Kpc) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
   PetscCall(PeriAssembleShortRange(sys, &sys->stiffness.op->short_range, PERI_BROKEN_SHARE, &sys->stiffness.Kpc));
-  if (sys->stiffness.op->form != FORM_CENTRAL) PetscCall(MatchDiagonal(sys->stiffness.op, sys->stiffness.Kpc));
+  if (!Central(sys->stiffness.op)) PetscCall(MatchDiagonal(sys->stiffness.op, sys->stiffness.Kpc));
   PetscCall(PetscLogEventEnd(PERI_EVENT_Assembly, 0, 0, 0, 0));
   if (!sys->run.log.pc_matrix_counted) { /* summary.json's matrix_mb counts it with the operator */
     PetscReal mb;
@@ -1136,7 +1266,7 @@ PetscErrorCode PeriOperatorRowSums(PeriSystem sys, Vec sums)
 PetscErrorCode PeriOperatorMemoryMB(PeriSystem sys, PeriOperator op, PetscReal *mb)
 {
   PetscFunctionBeginUser;
-  *mb = (op->ptr[op->nloc] * (sizeof(PetscInt) + op->nw * sizeof(PetscReal)) + (op->nloc + 1 + op->nghost) * sizeof(PetscInt) + (2 * op->nghost + 2 * op->nloc) * op->bs * sizeof(PetscScalar)) / 1048576.0;
+  *mb = (op->ptr[op->nloc] * (sizeof(PetscInt) + op->nw * sizeof(PetscReal)) + (op->nloc + 1 + op->nghost) * sizeof(PetscInt) + ((2 * op->nghost + 2 * op->nloc) * op->bs + (op->X ? 2 * (op->nloc + op->nghost) * op->bs : 0)) * sizeof(PetscScalar)) / 1048576.0;
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, mb, 1, MPIU_REAL, MPI_SUM, sys->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -1157,10 +1287,10 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
 
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
-  for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= op->form == FORM_CENTRAL ? PetscSqrtReal(factor) : factor;
-  for (PetscInt d = 2 * op->na; op->p && d < op->np; d++) op->p[op->np * t + d] *= PetscSqrtReal(factor); /* the vectors, as the multiples of w do with it */
+  for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= op->form == FORM_CENTRAL ? PetscSqrtReal(factor) : factor; /* the spring form's c scales as K */
+  for (PetscInt d = 2 * op->na; op->p && d < op->np; d++) op->p[op->np * t + d] *= PetscSqrtReal(factor);                   /* the vectors, as the multiples of w do with it */
   if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc.bonds, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(op->form == FORM_CENTRAL, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the preconditioning matrix of shear and micropolar bonds is diagonally scaled and cannot follow a broken bond");
+  PetscCheck(Central(op), PETSC_COMM_SELF, PETSC_ERR_PLIB, "the preconditioning matrix of shear and micropolar bonds is diagonally scaled and cannot follow a broken bond");
   for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc.bonds, i, k) * Ke[a];
   PetscCall(MatSetValuesBlocked(sys->stiffness.Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -1188,6 +1318,7 @@ PetscErrorCode PeriOperatorDestroy(PeriOperator *op)
   }
   PetscCall(PetscFree((*op)->ptr));
   PetscCall(PetscFree2((*op)->jl, (*op)->w));
+  PetscCall(PetscFree((*op)->X));
   PetscCall(PetscFree2((*op)->short_range.reach, (*op)->short_range.scale));
   PetscCall(PetscFree((*op)->ghost));
   PetscCall(PetscFree((*op)->slot));
