@@ -63,14 +63,15 @@ typedef struct {
   PetscInt       rstart, rend; /* the rows: indices of the particles searched (a local view: its owned particles 0 .. nowned - 1) */
   PetscInt      *offset;       /* rend - rstart + 1 */
   PetscInt      *j;            /* the other particle, a local index of the particles searched (the pair's row is its smaller global index; j == i only for periodic self-images) */
-  PetscReal     *xi;           /* 3 per bond: X_j - X_i, minimum image on periodic axes */
+  PetscReal     *xi;           /* 3 per bond: X_j - X_i, minimum image on periodic axes; NULL when not stored (no_geometry, PeriBondsReleaseGeometry) */
   PetscReal     *length;
-  PetscReal     *alpha;  /* partial-volume factor */
-  PetscReal     *lambda; /* surface correction factor */
-  unsigned char *live;   /* 1 intact, 0 broken */
-  unsigned char *cause;  /* scenes with failure: why a dead bond broke (PeriFailureCause) */
-  PetscReal     *intact; /* softening bonds (Diana & Casolo eqs. 45-46): the remaining share of stiffness in (0, 1]; NULL otherwise */
-  PetscInt       nbonds; /* local */
+  PetscReal     *alpha;       /* partial-volume factor */
+  PetscReal     *lambda;      /* surface correction factor; NULL: all 1 (searches without geometry, surface: none) */
+  unsigned char *live;        /* 1 intact, 0 broken */
+  unsigned char *cause;       /* scenes with failure: why a dead bond broke (PeriFailureCause) */
+  PetscReal     *intact;      /* softening bonds (Diana & Casolo eqs. 45-46): the remaining share of stiffness in (0, 1]; NULL otherwise */
+  PetscInt       nbonds;      /* local */
+  PetscBool      no_geometry; /* set before the search: xi, length and alpha are not stored (NULL), and readers recompute them from the coordinates (PeriDiscBondGeometry) */
 } PeriBonds;
 
 typedef struct {

@@ -1561,7 +1561,7 @@ static PetscErrorCode RecordSolver(PeriAnalysis an)
   integrator the -snes_*, -ksp_* and -pc_* options. Collective.
 @*/
 /* solver.operator: auto gives both integrators the matrix-free operator where the model allows:
- * 28 bytes per bond instead of an assembled K's ~150 in 3D, the same results, and no slower per
+ * 12 bytes per bond (28 before the spring form) instead of an assembled K's ~150 in 3D, the same results, and no slower per
  * step (explicit: the EOI at 51,200 particles, 101 MB against 540, peak 506 MB against 910, the
  * time loop 0.86-0.92 of the assembled one's; docs/dynamics.md). The implicit step's J is then a
  * shell over the same bond data plus shift M (CreateJacobianShell), with the short range plus

@@ -79,15 +79,16 @@ PetscErrorCode PeriBondsReserve(PeriBonds *b, PetscInt need, PetscInt *cap)
     PetscInt      *j;
     PetscReal     *xi, *len, *alpha;
     unsigned char *live;
+    const PetscInt ng = b->no_geometry ? 0 : nc;
     PetscCall(PetscMalloc1(nc, &j));
-    PetscCall(PetscMalloc1(3 * nc, &xi));
-    PetscCall(PetscMalloc1(nc, &len));
-    PetscCall(PetscMalloc1(nc, &alpha));
+    PetscCall(PetscMalloc1(3 * ng, &xi));
+    PetscCall(PetscMalloc1(ng, &len));
+    PetscCall(PetscMalloc1(ng, &alpha));
     PetscCall(PetscMalloc1(nc, &live));
     PetscCall(PetscArraycpy(j, b->j, b->nbonds));
-    PetscCall(PetscArraycpy(xi, b->xi, 3 * b->nbonds));
-    PetscCall(PetscArraycpy(len, b->length, b->nbonds));
-    PetscCall(PetscArraycpy(alpha, b->alpha, b->nbonds));
+    if (ng) PetscCall(PetscArraycpy(xi, b->xi, 3 * b->nbonds));
+    if (ng) PetscCall(PetscArraycpy(len, b->length, b->nbonds));
+    if (ng) PetscCall(PetscArraycpy(alpha, b->alpha, b->nbonds));
     PetscCall(PetscArraycpy(live, b->live, b->nbonds));
     PetscCall(PetscFree(b->j));
     PetscCall(PetscFree(b->xi));
@@ -117,11 +118,15 @@ PetscErrorCode PeriBondsAdd(const PeriParticles *p, PetscInt i, PetscInt j, cons
   alpha = PeriPartialVolumeFactor(pv, len, delta, h);
   if (alpha <= 0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PeriBondsReserve(b, b->nbonds + 1, cap));
-  b->j[b->nbonds] = j;
+  b->j[b->nbonds]    = j;
+  b->live[b->nbonds] = 1;
+  if (b->no_geometry) {
+    b->nbonds++;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   for (PetscInt d = 0; d < 3; d++) b->xi[3 * b->nbonds + d] = x[d];
   b->length[b->nbonds] = len;
   b->alpha[b->nbonds]  = alpha;
-  b->live[b->nbonds]   = 1;
   b->nbonds++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -157,7 +162,7 @@ PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *p, PeriBonds *b, Pe
   PetscCall(PetscFree(b->xi));
   PetscCall(PetscFree(b->length));
   PetscCall(PetscFree(b->alpha));
-  {
+  if (b->lambda) {
     PetscInt k = 0;
     while (k < b->nbonds && b->lambda[k] == 1) k++;
     if (k == b->nbonds) PetscCall(PetscFree(b->lambda));
@@ -166,10 +171,24 @@ PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *p, PeriBonds *b, Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The geometry of the bond from particle i to j of p without an image shift, with the search's
+ * arithmetic (ParticleBonds: x_j + wrap L - x_i with wrap = 0; + 0.0 keeps the sign of a zero
+ * alike), so that every value is the same to the bit. */
+static void BondGeometryFromCoordinates(const PeriParticles *p, PetscReal delta, const PetscReal horizon[], PeriPartialVolume pv, PetscInt i, PetscInt j, PetscReal xi[], PetscReal *len, PetscReal *alpha)
+{
+  PetscReal len2 = 0;
+  for (PetscInt d = 0; d < 3; d++) {
+    xi[d] = p->x[3 * j + d] + 0.0 - p->x[3 * i + d];
+    len2 += xi[d] * xi[d];
+  }
+  *len   = PetscSqrtReal(len2);
+  *alpha = PeriPartialVolumeFactor(pv, *len, horizon ? PetscMax(horizon[i], horizon[j]) : delta, 0.5 * (p->spacing[i] + p->spacing[j]));
+}
+
 /*@C
-  PeriBondsRestoreGeometry - recomputes what PeriBondsReleaseGeometry freed, with the arithmetic
-  of the search (ParticleBonds with no image shift), so every value is the same to the bit; the
-  arrays are sized to the bonds exactly. Not collective.
+  PeriBondsRestoreGeometry - recomputes what PeriBondsReleaseGeometry freed (or a search without
+  geometry left out), with the arithmetic of the search (ParticleBonds with no image shift), so
+  every value is the same to the bit; the arrays are sized to the bonds exactly. Not collective.
 @*/
 PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta, const PetscReal horizon[], PeriPartialVolume pv, PeriBonds *b)
 {
@@ -182,17 +201,35 @@ PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta,
   PetscCall(PetscMalloc1(b->nbonds, &b->length));
   PetscCall(PetscMalloc1(b->nbonds, &b->alpha));
   for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      const PetscInt j    = b->j[k];
-      PetscReal      len2 = 0;
-      for (PetscInt d = 0; d < 3; d++) {
-        /* the search's x_j + wrap L - x_i with wrap = 0 (+ 0.0 keeps the sign of a zero alike) */
-        PetscReal x      = p->x[3 * j + d] + 0.0 - p->x[3 * i + d];
-        b->xi[3 * k + d] = x;
-        len2 += x * x;
-      }
-      b->length[k] = PetscSqrtReal(len2);
-      b->alpha[k]  = PeriPartialVolumeFactor(pv, b->length[k], horizon ? PetscMax(horizon[i], horizon[j]) : delta, 0.5 * (p->spacing[i] + p->spacing[j]));
-    }
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) BondGeometryFromCoordinates(p, delta, horizon, pv, i, b->j[k], &b->xi[3 * k], &b->length[k], &b->alpha[k]);
+  b->no_geometry = PETSC_FALSE;
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
+  PeriDiscBondGeometry - the vector X_j - X_i, length and partial-volume factor of stored bond k of
+  owned particle i in d's pair list: read where the list keeps them, else recomputed from the
+  coordinates as PeriBondsRestoreGeometry does (to the bit). Not collective.
+@*/
+void PeriDiscBondGeometry(const PeriDisc *d, PetscInt i, PetscInt k, PetscReal xi[], PetscReal *len, PetscReal *alpha)
+{
+  const PeriBonds *b = &d->bonds;
+
+  if (!b->xi) {
+    BondGeometryFromCoordinates(&d->particles, d->delta, d->horizon, d->partial_volume, i, b->j[k], xi, len, alpha);
+    return;
+  }
+  for (PetscInt e = 0; e < 3; e++) xi[e] = b->xi[3 * k + e];
+  *len   = b->length[k];
+  *alpha = b->alpha[k];
+}
+
+/* The length of stored bond k of owned particle i in d's pair list (PeriDiscBondGeometry). */
+PetscReal PeriDiscBondLength(const PeriDisc *d, PetscInt i, PetscInt k)
+{
+  PetscReal xi[3], len, alpha;
+
+  if (d->bonds.length) return d->bonds.length[k];
+  PeriDiscBondGeometry(d, i, k, xi, &len, &alpha);
+  return len;
 }

@@ -19,11 +19,13 @@ PetscErrorCode PeriNeighborhoodVolumes(const PeriDisc *d, PetscReal family[], Pe
   PetscCall(PetscArrayzero(count, p->n));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscInt j = b->j[k];
+      PetscInt  j = b->j[k];
+      PetscReal xi[3], len, alpha;
       if (!b->live[k]) continue;
+      PeriDiscBondGeometry(d, i, k, xi, &len, &alpha);
       /* a stored self-image stands for the pair of images +shift and -shift */
-      family[i] += b->alpha[k] * p->volume[j];
-      family[j] += b->alpha[k] * p->volume[i];
+      family[i] += alpha * p->volume[j];
+      family[j] += alpha * p->volume[i];
       count[i]++;
       count[j]++;
     }
@@ -52,6 +54,8 @@ PetscErrorCode PeriSurfaceCorrectionApply(PeriSurfaceCorrection sc, const PeriPa
   PetscReal V0 = HorizonVolume(p, delta);
 
   PetscFunctionBeginUser;
+  if (!b->lambda && sc != PERI_SURFACE_VOLUME) PetscFunctionReturn(PETSC_SUCCESS); /* NULL: all 1 */
+  if (!b->lambda) PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PetscInt j = b->j[k];

@@ -136,17 +136,22 @@ static PetscErrorCode ParticlesBox(const PeriParticles *, PetscReal, PetscReal[]
   particles, then ghosts): the bonds' rows and j are indices into p (p->global maps them to global
   indices). With horizon (each particle's own, horizon.spacing: own) a pair is bonded within the
   larger of its two horizons and the cells are those of PeriNeighborSearchLevels; delta is then the
-  largest. Not collective. Errors on coincident particles.
+  largest. Without geometry the bonds' vectors, lengths and partial-volume factors are not stored
+  (b->no_geometry; one horizon and no periodic axis: they are the coordinates' differences), nor
+  the surface factors (NULL: all 1). Not collective. Errors on coincident particles.
 @*/
-PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, const PetscReal horizon[], PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PeriBonds *b)
+PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, const PetscReal horizon[], PeriPartialVolume pv, PetscInt rstart, PetscInt rend, PetscBool half, PetscBool geometry, PeriBonds *b)
 {
   CellList       cl;
   PetscReal      hmax = 0, r;
   PetscInt       cap  = 0;
   PetscErrorCode ierr = PETSC_SUCCESS;
+  PetscBool      lean = (PetscBool)!geometry;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(b, sizeof(*b)));
+  b->no_geometry = lean;
+  PetscCheck(!lean || (!horizon && !p->periodic[0] && !p->periodic[1] && !p->periodic[2]), PETSC_COMM_SELF, PETSC_ERR_PLIB, "bonds without stored geometry need one horizon and no periodic axis");
   if (horizon) {
     PetscCall(PeriNeighborSearchLevels(p, horizon, pv, rstart, rend, half, b));
     PetscFunctionReturn(PETSC_SUCCESS);
@@ -176,6 +181,7 @@ PetscErrorCode PeriNeighborSearch(const PeriParticles *p, PetscReal delta, const
   }
   PetscCall(CellListDestroy(&cl));
   PetscCall(ierr);
+  if (lean) PetscFunctionReturn(PETSC_SUCCESS); /* every surface factor 1 until a correction sets them */
   PetscCall(PetscMalloc1(b->nbonds, &b->lambda));
   for (PetscInt k = 0; k < b->nbonds; k++) b->lambda[k] = 1;
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -86,7 +86,7 @@ static PetscErrorCode MetisPartition(const PeriParticles *p, PetscReal radius, P
   int       status;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriNeighborSearch(p, radius, NULL, PERI_PARTIAL_VOLUME_NONE, 0, p->n, PETSC_FALSE, &g));
+  PetscCall(PeriNeighborSearch(p, radius, NULL, PERI_PARTIAL_VOLUME_NONE, 0, p->n, PETSC_FALSE, PETSC_TRUE, &g));
   PetscCall(PetscMalloc1(p->n + 1, &off));
   PetscCall(PetscArraycpy(off, g.offset, p->n + 1));
   PetscCall(GraphCompact(p->n, off, g.j));
@@ -118,7 +118,7 @@ static PetscErrorCode BlockGraph(MPI_Comm comm, const PeriParticles *b, PetscRea
   PetscFunctionBeginUser;
   PetscCall(PeriParticlesSlice(b, 0, n, &local));
   PetscCall(PeriHaloCreate(comm, &local, PeriSearchRadius(PERI_PARTIAL_VOLUME_NONE, radius, hmax), &halo));
-  PetscCall(PeriNeighborSearch(&local, radius, NULL, PERI_PARTIAL_VOLUME_NONE, 0, n, PETSC_FALSE, &g));
+  PetscCall(PeriNeighborSearch(&local, radius, NULL, PERI_PARTIAL_VOLUME_NONE, 0, n, PETSC_FALSE, PETSC_TRUE, &g));
   for (PetscInt k = 0; k < g.nbonds; k++) g.j[k] = local.global[g.j[k]]; /* MatCreateMPIAdj's columns are global */
   PetscCall(PeriHaloDestroy(&halo));
   PetscCall(PeriParticlesDestroy(&local));

@@ -9,11 +9,12 @@
 typedef struct {
   const PeriShortRange *sr;
   PetscReal             broken_share;
+  const PeriDisc       *disc; /* whose bonds these are (sr reads their lengths) */
 } BondFilter;
 
 static inline PetscBool Kept(const PeriBonds *b, PetscInt i, PetscInt k, const BondFilter *f)
 {
-  return (PetscBool)((b->live[k] || f->broken_share > 0) && PeriShortRangeHolds(f->sr, b, i, k));
+  return (PetscBool)((b->live[k] || f->broken_share > 0) && PeriShortRangeHolds(f->sr, f->disc, i, k));
 }
 
 /* Distinct partners of owned particle i among its stored bonds (periodic images repeat them). */
@@ -414,7 +415,7 @@ PetscErrorCode PeriBondStiffness(PeriSystem sys, PetscInt i, PetscInt k, PetscRe
 /* The block of bond k under the filter: scaled, broken bonds by their share. */
 static PetscErrorCode BondBlock(PeriSystem sys, const BondFilter *f, PetscInt i, PetscInt k, PeriBondGeometry *g, PetscReal Ke[])
 {
-  const PetscReal scale = PeriShortRangeFactor(f->sr, &sys->disc.bonds, i, k);
+  const PetscReal scale = PeriShortRangeFactor(f->sr, &sys->disc, i, k);
 
   PetscFunctionBeginUser;
   PetscCall(PeriBondStiffness(sys, i, k, sys->disc.bonds.live[k] ? scale : scale * f->broken_share, g, Ke));
@@ -634,7 +635,7 @@ static PetscErrorCode AssembleStates(PeriSystem sys, Mat *K)
 @*/
 PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 {
-  const BondFilter all = {NULL, 0};
+  const BondFilter all = {NULL, 0, &sys->disc};
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PERI_EVENT_Assembly, 0, 0, 0, 0));
@@ -657,7 +658,7 @@ PetscErrorCode PeriAssembleStiffness(PeriSystem sys, Mat *K)
 @*/
 PetscErrorCode PeriAssembleShortRange(PeriSystem sys, const PeriShortRange *sr, PetscReal broken_share, Mat *P)
 {
-  const BondFilter shorter = {sr, broken_share};
+  const BondFilter shorter = {sr, broken_share, &sys->disc};
 
   PetscFunctionBeginUser;
   PetscCheck(!sys->model->ops.family_stiffness, sys->comm, PETSC_ERR_SUP, "a short-range stiffness needs a bond-based model");

@@ -14,25 +14,30 @@ PetscErrorCode PeriSystemCreateVec(PeriSystem sys, Vec *v)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The kernel's view of bond k of owned particle i in the list b (bond_mu: per bond, or NULL). */
-static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const PetscReal bond_mu[], PetscInt i, PetscInt k, PeriBondGeometry *g)
+/* The kernel's view of bond k of owned particle i in the list b with the given vector, length and
+ * partial-volume factor (bond_mu: per bond, or NULL). */
+static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const PetscReal bond_mu[], PetscInt i, PetscInt k, const PetscReal xi[], PetscReal len, PetscReal alpha, PeriBondGeometry *g)
 {
   g->i = i;
   g->j = b->j[k];
-  for (PetscInt d = 0; d < 3; d++) g->xi[d] = b->xi[3 * k + d];
-  g->length = b->length[k];
+  for (PetscInt d = 0; d < 3; d++) g->xi[d] = xi[d];
+  g->length = len;
   g->Vi     = pt->volume[i];
   g->Vj     = pt->volume[g->j];
-  g->weight = b->alpha[k] * b->lambda[k] * (b->intact ? b->intact[k] : 1);
+  g->weight = alpha * (b->lambda ? b->lambda[k] : 1) * (b->intact ? b->intact[k] : 1);
   g->mu     = bond_mu ? bond_mu[k] : 0;
   g->bond   = 0;
 }
 
-/* The kernel's view of local bond k of owned particle i. */
+/* The kernel's view of local bond k of owned particle i (its geometry stored or recomputed:
+ * PeriDiscBondGeometry). */
 PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, PeriBondGeometry *g)
 {
+  PetscReal xi[3], len, alpha;
+
   PetscFunctionBeginUser;
-  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->materials.bond_mu, i, k, g);
+  PeriDiscBondGeometry(&sys->disc, i, k, xi, &len, &alpha);
+  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->materials.bond_mu, i, k, xi, len, alpha, g);
   g->bond = k + 1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -46,7 +51,7 @@ PetscErrorCode PeriSystemFamilyGeometry(PeriSystem sys, PetscInt i, PetscInt *n,
   PetscFunctionBeginUser;
   *n = 0;
   for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-    if (b->live[k]) FillGeometry(pt, b, NULL, i, k, &fam[(*n)++]);
+    if (b->live[k]) FillGeometry(pt, b, NULL, i, k, &b->xi[3 * k], b->length[k], b->alpha[k], &fam[(*n)++]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -4,8 +4,9 @@
  *     (k the spring constant, e the unit vector), 28 bytes per bond in 3D where the assembled K
  *     holds two dim x dim blocks per bond in each of two rows (about 150 bytes);
  *   spring (the central form where every bond vector is X_j - X_i, as without periodic images,
- *     and no state terms): c = k / |xi|^2 only, the block c xi xi^T formed from the coordinates
- *     gathered beside u_j: 12 bytes per bond (the explicit step is memory-bound, and LAMMPS keeps
+ *     and no state terms): s = sqrt(k) / |xi| only, w = s xi formed from the coordinates gathered
+ *     beside u_j (s, not k / |xi|^2: the products keep the central form's magnitudes, which a
+ *     prescribed value of 1e308 taught, tests/bad_input/ranges): 12 bytes per bond (the explicit step is memory-bound, and LAMMPS keeps
  *     24 a bond: issue 37's target of its peak memory);
  *   shear (pds, 2D): [A, -A; -A, A], A = k_n e e^T + k_t t t^T, stored as A's 3 entries;
  *   micropolar (mppd, gerstle; ux, uy, theta): translations move both ends alike and the sliding
@@ -40,7 +41,7 @@ struct _p_PeriOperator {
   PetscInt   nw;  /* numbers per bond: bs (central), 1 (spring), 3 (shear), 7 (micropolar) */
   PetscInt  *ptr; /* nloc + 1: the bonds of owned particle i are ptr[i] .. ptr[i+1]-1 */
   PetscInt  *jl;  /* the other end in the local numbering: owned particles, then the ghosts */
-  PetscReal *w;   /* nw per bond: sqrt(k) e; k / |xi|^2; A (xx, xy, yy); A, c (x, y), a, b */
+  PetscReal *w;   /* nw per bond: sqrt(k) e; sqrt(k) / |xi|; A (xx, xy, yy); A, c (x, y), a, b */
   PetscReal *X;   /* the spring form: per particle of the local numbering its bs coordinates (xi = X_j - X_i), then bs of the product's input */
   PetscInt  *ghost;
   PetscInt  *slot; /* scenes with failure: the bond list's bond k is bond slot[k] here (-1: none) */
@@ -71,7 +72,7 @@ typedef struct {
   PetscReal   *hd;   /* their diagonal values */
 } Shell;
 
-/* Whether the bonds are central springs (stored as sqrt(k) e or as k / |xi|^2). */
+/* Whether the bonds are central springs (stored as sqrt(k) e or as sqrt(k) / |xi|). */
 static inline PetscBool Central(const PeriOperator op)
 {
   return (PetscBool)(op->form == FORM_CENTRAL || op->form == FORM_SPRING);
@@ -98,7 +99,7 @@ static inline void BondLoop(const PeriOperator op, const PetscInt bs, const Pets
   }
 }
 
-/* The spring form: y_i += c xi (xi . (u_i - u_j)), xi = X_j - X_i, and the opposite at j. xu holds
+/* The spring form: y_i += w (w . (u_i - u_j)), w = s (X_j - X_i), and the opposite at j. xu holds
  * each particle's X and u side by side (2 bs numbers), so that a bond gathers one block, not two. */
 static inline void SpringLoop(const PeriOperator op, const PetscInt bs, const PetscScalar *xu, PetscScalar *y)
 {
@@ -110,10 +111,9 @@ static inline void SpringLoop(const PeriOperator op, const PetscInt bs, const Pe
       const PetscScalar *Xj = xu + 2 * bs * j, *uj = Xj + bs;
       PetscScalar       *yj = y + bs * j, t = 0, e[PERI_MAX_DOF];
       for (PetscInt d = 0; d < bs; d++) {
-        e[d] = Xj[d] - Xi[d];
+        e[d] = op->w[b] * (Xj[d] - Xi[d]);
         t += e[d] * (ui[d] - uj[d]);
       }
-      t *= op->w[b];
       for (PetscInt d = 0; d < bs; d++) {
         acc[d] += t * e[d];
         yj[d] -= t * e[d];
@@ -350,7 +350,7 @@ static void FormLoop(const PeriOperator op, const PetscScalar *x, PetscScalar *y
 static PetscReal FormFlops(const PeriOperator op)
 {
   return op->form == FORM_MICROPOLAR ? 32 : op->form == FORM_SHEAR ? 14
-                                        : op->form == FORM_SPRING  ? 7.0 * op->bs + 1
+                                        : op->form == FORM_SPRING  ? 7.0 * op->bs
                                         : op->p && StatesMixed(op) ? (6.0 + 8.0 * (op->ns - op->na)) * op->bs + 4.0 * op->na
                                         : op->p                    ? 10.0 * op->bs + 8
                                                                    : 6.0 * op->bs;
@@ -782,13 +782,13 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
       PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
       m->ops.bond_stiffness(m, &g, Ke);
       PetscCall(BondNumbers(m, op, &g, Ke, w));
-      if (op->form == FORM_SPRING) { /* k / |xi|^2 = |w|^2 / |xi|^2 */
+      if (op->form == FORM_SPRING) { /* sqrt(k) / |xi| = |w| / |xi| */
         PetscReal ww = 0, xx = 0;
         for (PetscInt d = 0; d < op->bs; d++) {
           ww += w[d] * w[d];
           xx += g.xi[d] * g.xi[d];
         }
-        op->w[nb] = ww / xx;
+        op->w[nb] = PetscSqrtReal(ww / xx);
       } else
         PetscCall(PetscArraycpy(op->w + nb * op->nw, w, op->nw));
       if (op->p) PetscCall(StateNumbers(m, op, &g, op->w + nb * op->nw, op->p + op->np * nb));
@@ -819,7 +819,7 @@ static void FormDiagonal(const PeriOperator op, PetscInt i, PetscInt b, PetscRea
 
   if (op->form == FORM_SPRING) {
     SpringVector(op, i, b, diag);
-    for (PetscInt d = 0; d < op->bs; d++) diag[d] = w[0] * PetscSqr(diag[d]);
+    for (PetscInt d = 0; d < op->bs; d++) diag[d] = PetscSqr(w[0] * diag[d]);
   } else if (op->form == FORM_CENTRAL)
     for (PetscInt d = 0; d < op->bs; d++) diag[d] = PetscSqr(w[d]);
   else {
@@ -1021,10 +1021,10 @@ static PetscErrorCode ExpansionEnergies(PeriSystem sys, PeriOperator op, PetscRe
       if (!OperatorBond(b, i, k)) continue;
       /* the trace of the translational block times |xi|^2: k |xi|^2 for a central spring */
       FormDiagonal(op, i - b->rstart, t++, diag);
-      for (PetscInt d = 0; d < (op->form == FORM_MICROPOLAR ? 2 : op->bs); d++) e += diag[d] * PetscSqr(b->length[k]);
+      for (PetscInt d = 0; d < (op->form == FORM_MICROPOLAR ? 2 : op->bs); d++) e += diag[d] * PetscSqr(PeriDiscBondLength(disc, i, k));
       full[i] += e;
       full[b->j[k]] += e;
-      if (!PeriShortRangeHolds(&op->short_range, b, i, k)) continue;
+      if (!PeriShortRangeHolds(&op->short_range, disc, i, k)) continue;
       part[i] += e;
       part[b->j[k]] += e;
     }
@@ -1077,8 +1077,9 @@ static PetscErrorCode ShortestBonds(const PeriDisc *disc, PetscInt m, PetscReal 
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       if (!OperatorBond(b, i, k)) continue;
-      ShortestInsert(&s[m * i], m, b->length[k]);
-      ShortestInsert(&s[m * b->j[k]], m, b->length[k]);
+      const PetscReal len = PeriDiscBondLength(disc, i, k);
+      ShortestInsert(&s[m * i], m, len);
+      ShortestInsert(&s[m * b->j[k]], m, len);
     }
   PetscCallMPI(MPI_Op_create(ShortestMerge, 1, &merge));
   PetscCall(PeriDiscGhostsToOwners(disc, MPIU_REAL, m, merge, s));
@@ -1287,11 +1288,11 @@ PetscErrorCode PeriOperatorScaleBond(PeriSystem sys, PetscInt i, PetscInt k, Pet
 
   PetscFunctionBeginUser;
   PetscCheck(t >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "bond %" PetscInt_FMT " of particle %" PetscInt_FMT " has no place in the matrix-free operator", k, i);
-  for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= op->form == FORM_CENTRAL ? PetscSqrtReal(factor) : factor; /* the spring form's c scales as K */
-  for (PetscInt d = 2 * op->na; op->p && d < op->np; d++) op->p[op->np * t + d] *= PetscSqrtReal(factor);                   /* the vectors, as the multiples of w do with it */
-  if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc.bonds, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt d = 0; d < op->nw; d++) op->w[op->nw * t + d] *= Central(op) ? PetscSqrtReal(factor) : factor;
+  for (PetscInt d = 2 * op->na; op->p && d < op->np; d++) op->p[op->np * t + d] *= PetscSqrtReal(factor); /* the vectors, as the multiples of w do with it */
+  if (!sys->stiffness.Kpc || factor > 0 || !PeriShortRangeHolds(&op->short_range, &sys->disc, i, k)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(Central(op), PETSC_COMM_SELF, PETSC_ERR_PLIB, "the preconditioning matrix of shear and micropolar bonds is diagonally scaled and cannot follow a broken bond");
-  for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc.bonds, i, k) * Ke[a];
+  for (PetscInt a = 0; a < n * n; a++) dP[a] = -(1 - PERI_BROKEN_SHARE) * PeriShortRangeFactor(&op->short_range, &sys->disc, i, k) * Ke[a];
   PetscCall(MatSetValuesBlocked(sys->stiffness.Kpc, 2, idx, 2, idx, dP, ADD_VALUES));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

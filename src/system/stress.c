@@ -61,10 +61,11 @@ static PetscErrorCode GradientMoments(PeriSystem sys, const PetscScalar u[], Pet
   PetscFunctionBeginUser;
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      const PetscInt   j     = b->j[k];
-      const PetscReal *xi    = &b->xi[3 * k];
-      PetscReal        du[3] = {0, 0, 0}, w = b->alpha[k] / (b->length[k] * b->length[k]);
+      const PetscInt j     = b->j[k];
+      PetscReal      du[3] = {0, 0, 0}, xi[3], len, w;
       if (!b->live[k] || j == i) continue;
+      PeriDiscBondGeometry(&sys->disc, i, k, xi, &len, &w);
+      w /= len * len;
       for (PetscInt a = 0; a < dim; a++) du[a] = PetscRealPart(u[j * bs + a] - u[i * bs + a]);
       /* seen from j, xi and du both change sign: the same products */
       AddOuter(&acc[18 * i], w * pt->volume[j], xi, xi, dim);

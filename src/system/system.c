@@ -442,16 +442,40 @@ static PetscErrorCode SetLocalView(PeriSystem sys)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the pair list is searched without its vectors, lengths and partial-volume factors (40
+ * of the 53 bytes a bond; PeriBonds.no_geometry): they are the coordinates' differences for one
+ * horizon without periodic axes, and every reader in such a run (the central-force models'
+ * kernels through PeriSystemBondGeometry; the family volumes, the operator, the short range,
+ * damage and stress through PeriDiscBondGeometry) recomputes them, to the bit. Kept where readers
+ * still take the stored arrays (the lattice and patch calibrations, families, cracks, fictitious
+ * layers) and in runs with failure, whose every step reads each bond's geometry;
+ * -peri_release_bond_geometry false keeps them always. */
+static PetscErrorCode BondsWithoutGeometry(PeriSystem sys, PetscBool *lean)
+{
+  const PeriDisc *d       = &sys->disc;
+  PetscBool       release = PETSC_TRUE;
+  PeriNode        failure, cracks;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_release_bond_geometry", &release, NULL));
+  PetscCall(PeriSceneGetNode(sys->scene->root, "failure", &failure));
+  PetscCall(PeriSceneGetNode(sys->scene->root, "cracks", &cracks));
+  *lean = (PetscBool)(release && sys->model->central_force && !PeriModelHasFamilies(sys->model) && sys->model->calibration == PERI_CALIBRATION_CONTINUUM && !d->horizon && !d->particles.periodic[0] && !d->particles.periodic[1] && !d->particles.periodic[2] && !sys->conditions.layers.nfaces && !failure && !cracks);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The bonds of the owned particles (and their families for state-based models), searched in the
  * local view. */
 static PetscErrorCode SearchBonds(PeriSystem sys)
 {
   PeriDisc *d = &sys->disc;
+  PetscBool lean = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_TRUE, &d->bonds));
+  PetscCall(BondsWithoutGeometry(sys, &lean));
+  PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_TRUE, (PetscBool)!lean, &d->bonds));
   /* a state-based particle's energy needs its whole family, including the bonds stored elsewhere */
-  if (PeriModelHasFamilies(sys->model)) PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_FALSE, &d->family));
+  if (PeriModelHasFamilies(sys->model)) PetscCall(PeriNeighborSearch(&d->particles, d->delta, d->horizon, d->partial_volume, 0, d->nowned, PETSC_FALSE, PETSC_TRUE, &d->family));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -99,7 +99,7 @@ PETSC_EXTERN PetscErrorCode PeriRegionFind(PeriScene, PeriNode, const char[], Pe
 PETSC_EXTERN PetscBool      PeriRegionContains(const PeriRegion *, const PetscReal[]);
 PETSC_EXTERN PetscReal      PeriRegionTolerance(const PeriParticles *);
 
-PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
+PETSC_EXTERN PetscErrorCode PeriNeighborSearch(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriHorizonsByNeighbors(const PeriParticles *, PetscInt, PetscInt, PetscReal[], PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevelsRows(const PeriParticles *, const PetscReal[], PeriPartialVolume, PetscInt, const PetscInt[], PetscInt, PetscBool, PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *, const PetscReal[], PeriPartialVolume, PetscInt, PetscInt, PetscBool, PeriBonds *);
@@ -192,6 +192,8 @@ typedef struct {
 
 PETSC_EXTERN PetscErrorCode PeriDiscDestroy(PeriDisc *);
 PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(const PeriDisc *, PetscReal[], PetscInt[]);
+PETSC_EXTERN void           PeriDiscBondGeometry(const PeriDisc *, PetscInt, PetscInt, PetscReal[], PetscReal *, PetscReal *);
+PETSC_EXTERN PetscReal      PeriDiscBondLength(const PeriDisc *, PetscInt, PetscInt);
 PETSC_EXTERN PetscErrorCode PeriDiscSetLocalView(MPI_Comm, PeriDisc *, PeriParticles *, PetscReal);
 PETSC_EXTERN PetscMPIInt    PeriDiscOwner(const PeriDisc *, PetscInt);
 PETSC_EXTERN PetscInt       PeriDiscLocal(const PeriDisc *, PetscInt);

@@ -35,17 +35,17 @@ typedef struct {
 } PeriShortRange;
 
 /* Whether bond k of particle i is in the short-range stiffness sr (NULL: every bond). */
-static inline PetscBool PeriShortRangeHolds(const PeriShortRange *sr, const PeriBonds *b, PetscInt i, PetscInt k)
+static inline PetscBool PeriShortRangeHolds(const PeriShortRange *sr, const PeriDisc *d, PetscInt i, PetscInt k)
 {
-  return (PetscBool)(!sr || b->length[k] <= PetscMax(sr->reach[i], sr->reach[b->j[k]]));
+  return (PetscBool)(!sr || PeriDiscBondLength(d, i, k) <= PetscMax(sr->reach[i], sr->reach[d->bonds.j[k]]));
 }
 
 /* The factor of bond k of particle i in the short-range stiffness sr, 0 when it is not in it
  * (sr NULL: every bond, factor 1). */
-static inline PetscReal PeriShortRangeFactor(const PeriShortRange *sr, const PeriBonds *b, PetscInt i, PetscInt k)
+static inline PetscReal PeriShortRangeFactor(const PeriShortRange *sr, const PeriDisc *d, PetscInt i, PetscInt k)
 {
   if (!sr) return 1;
-  return PeriShortRangeHolds(sr, b, i, k) ? 0.5 * (sr->scale[i] + sr->scale[b->j[k]]) : 0;
+  return PeriShortRangeHolds(sr, d, i, k) ? 0.5 * (sr->scale[i] + sr->scale[d->bonds.j[k]]) : 0;
 }
 
 /* What an analysis asks of the stiffness, declared in its type (PeriAnalysisType.needs): the memory
