@@ -23,7 +23,8 @@
 #  5. Failure (tests/scenes/dynamic_crack.yaml): bonds break, the dissipated energy closes the
 #     balance (drift < 1 %), and 1, 2 and 3 ranks break the same bonds with the same energies
 #     (1e-10 relative); the implicit integrator on 1, 2 and 3 ranks alike, and its matrix-free J
-#     (the default) as the assembled one (solver.operator: assembled).
+#     (the default) as the assembled one (solver.operator: assembled), and its spring form (one
+#     number a bond, the default) as its vector form (-peri_operator_springs false).
 # 13. (below) a failed implicit step is an error naming the reasons, with no output.
 #  9. The edge-on impact (examples/dynamics/eoi.yaml, Diehl & Schweitzer) at its coarsest dx
 #     (2.5 mm): the wave front runs within 10 % of the bond-based P-wave speed
@@ -78,6 +79,7 @@ for n in 2 3; do run crack$n mpiexec --oversubscribe -n $n "$exe" "$crack"; done
 run icrack1 "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012
 for n in 2 3; do run icrack$n mpiexec --oversubscribe -n $n "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012; done
 run icrack_asm "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012 -solver_operator assembled
+run icrack_vec "$exe" "$crack" -analysis_integrator implicit -analysis_dt 2e-4 -analysis_t_end 0.012 -peri_operator_springs false
 eoi=$repo/examples/dynamics/eoi.yaml
 run eoi1 "$exe" "$eoi"
 run eoi2 mpiexec --oversubscribe -n 2 "$exe" "$eoi"
@@ -211,6 +213,9 @@ for n in (2, 3):
 ia = dyn("icrack_asm")
 same = i1["broken_bonds"] == ia["broken_bonds"] > 0 and abs(i1["kinetic_energy"] / ia["kinetic_energy"] - 1) < 1e-8 and abs(i1["energy_drift"] - ia["energy_drift"]) < 1e-8
 check(same, f"implicit with failure, matrix-free J (the default) = assembled J: {ia['broken_bonds']} bonds, kinetic {i1['kinetic_energy']:.10g} vs {ia['kinetic_energy']:.10g}")
+iv = dyn("icrack_vec")
+same = i1["broken_bonds"] == iv["broken_bonds"] > 0 and abs(i1["kinetic_energy"] / iv["kinetic_energy"] - 1) < 1e-8 and abs(i1["energy_drift"] - iv["energy_drift"]) < 1e-8
+check(same, f"implicit with failure, the operator's spring form (sqrt(k)/|xi| a bond, the default) = its vector form (-peri_operator_springs false): {iv['broken_bonds']} bonds, kinetic {i1['kinetic_energy']:.10g} vs {iv['kinetic_energy']:.10g}")
 K, nu, rho = 2.1e11, 0.25, 3690.0
 cp = math.sqrt((K + 4 * 3 * K * (1 - 2 * nu) / (2 * (1 + nu)) / 3) / rho)
 for name in ("eoi1", "eoi_pmb"):

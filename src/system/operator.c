@@ -690,18 +690,24 @@ static inline PetscBool OperatorBond(const PeriBonds *b, PetscInt i, PetscInt k)
 
 /* Whether the central form can be the spring form: no state terms, and every operator bond's
  * vector is X_j - X_i to the bit (a periodic image's is not; a list without vectors has them so). */
-static PetscBool SpringsFromCoordinates(PeriSystem sys, const PeriOperator op)
+static PetscErrorCode SpringsFromCoordinates(PeriSystem sys, const PeriOperator op, PetscBool *springs)
 {
   const PeriBonds *b = &sys->disc.bonds;
   const PetscReal *x = sys->disc.particles.x;
 
-  if (op->form != FORM_CENTRAL || sys->model->ops.bond_state) return PETSC_FALSE;
-  if (!b->xi) return PETSC_TRUE;
+  PetscFunctionBeginUser;
+  *springs = PETSC_TRUE;
+  /* the product gathers X_j beside u_j: 1.20x the vector form's time on the thin 102,400-site
+     plate of tests/perf/dynamic_lammps.sh (its neighbours in z are 25,600 rows apart, beyond the
+     caches), 1.1x on a cube, for 16 bytes less a bond (docs/performance.md) */
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_operator_springs", springs, NULL));
+  if (op->form != FORM_CENTRAL || sys->model->ops.bond_state) *springs = PETSC_FALSE;
+  if (!*springs || !b->xi) PetscFunctionReturn(PETSC_SUCCESS);
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
       for (PetscInt d = 0; d < 3 && OperatorBond(b, i, k); d++)
-        if (b->xi[3 * k + d] != x[3 * b->j[k] + d] - x[3 * i + d]) return PETSC_FALSE;
-  return PETSC_TRUE;
+        if (b->xi[3 * k + d] != x[3 * b->j[k] + d] - x[3 * i + d]) *springs = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The ghosts the operator's bonds reach, sorted by global index (op->ghost), and each local
@@ -756,9 +762,11 @@ static PetscErrorCode CollectBonds(PeriSystem sys, PeriOperator op)
   PetscReal        Ke[4 * PERI_MAX_DOF * PERI_MAX_DOF], w[PERI_MAX_DOF * PERI_MAX_DOF];
   PeriBondGeometry g;
   PetscInt         nb = 0, *loc;
+  PetscBool        springs;
 
   PetscFunctionBeginUser;
-  if (SpringsFromCoordinates(sys, op)) {
+  PetscCall(SpringsFromCoordinates(sys, op, &springs));
+  if (springs) {
     op->form = FORM_SPRING;
     op->nw   = 1;
   }
