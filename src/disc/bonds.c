@@ -207,29 +207,10 @@ PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *p, PetscReal delta,
 }
 
 /*@C
-  PeriDiscBondGeometry - the vector X_j - X_i, length and partial-volume factor of stored bond k of
-  owned particle i in d's pair list: read where the list keeps them, else recomputed from the
-  coordinates as PeriBondsRestoreGeometry does (to the bit). Not collective.
+  PeriDiscBondGeometryFromCoordinates - PeriDiscBondGeometry's recomputation, where d's pair list
+  does not store the geometry. Not collective.
 @*/
-void PeriDiscBondGeometry(const PeriDisc *d, PetscInt i, PetscInt k, PetscReal xi[], PetscReal *len, PetscReal *alpha)
+void PeriDiscBondGeometryFromCoordinates(const PeriDisc *d, PetscInt i, PetscInt k, PetscReal xi[], PetscReal *len, PetscReal *alpha)
 {
-  const PeriBonds *b = &d->bonds;
-
-  if (!b->xi) {
-    BondGeometryFromCoordinates(&d->particles, d->delta, d->horizon, d->partial_volume, i, b->j[k], xi, len, alpha);
-    return;
-  }
-  for (PetscInt e = 0; e < 3; e++) xi[e] = b->xi[3 * k + e];
-  *len   = b->length[k];
-  *alpha = b->alpha[k];
-}
-
-/* The length of stored bond k of owned particle i in d's pair list (PeriDiscBondGeometry). */
-PetscReal PeriDiscBondLength(const PeriDisc *d, PetscInt i, PetscInt k)
-{
-  PetscReal xi[3], len, alpha;
-
-  if (d->bonds.length) return d->bonds.length[k];
-  PeriDiscBondGeometry(d, i, k, xi, &len, &alpha);
-  return len;
+  BondGeometryFromCoordinates(&d->particles, d->delta, d->horizon, d->partial_volume, i, d->bonds.j[k], xi, len, alpha);
 }

@@ -20,9 +20,9 @@ PetscErrorCode PeriNeighborhoodVolumes(const PeriDisc *d, PetscReal family[], Pe
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PetscInt  j = b->j[k];
-      PetscReal xi[3], len, alpha;
+      PetscReal alpha;
       if (!b->live[k]) continue;
-      PeriDiscBondGeometry(d, i, k, xi, &len, &alpha);
+      alpha = PeriDiscBondAlpha(d, i, k);
       /* a stored self-image stands for the pair of images +shift and -shift */
       family[i] += alpha * p->volume[j];
       family[j] += alpha * p->volume[i];

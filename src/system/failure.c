@@ -345,8 +345,7 @@ PetscErrorCode PeriDamage(PeriSystem sys, PetscReal **damage)
   for (PetscInt i = b->rstart; i < b->rend; i++)
     for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
       PetscInt  j    = b->j[k];
-      PetscReal left = b->live[k] ? (b->intact ? b->intact[k] : 1) : 0, xi[3], len, alpha;
-      PeriDiscBondGeometry(&sys->disc, i, k, xi, &len, &alpha);
+      PetscReal left = b->live[k] ? (b->intact ? b->intact[k] : 1) : 0, alpha = PeriDiscBondAlpha(&sys->disc, i, k);
       for (PetscInt e = 0; e < 2; e++) {
         PetscReal *a = &acc[w * (e ? j : i)], V = alpha * pt->volume[e ? i : j];
         a[0] += V;

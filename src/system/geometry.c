@@ -14,14 +14,12 @@ PetscErrorCode PeriSystemCreateVec(PeriSystem sys, Vec *v)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The kernel's view of bond k of owned particle i in the list b with the given vector, length and
- * partial-volume factor (bond_mu: per bond, or NULL). */
-static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const PetscReal bond_mu[], PetscInt i, PetscInt k, const PetscReal xi[], PetscReal len, PetscReal alpha, PeriBondGeometry *g)
+/* The kernel's view of bond k of owned particle i in the list b, its vector and length already in
+ * g, with the partial-volume factor alpha (bond_mu: per bond, or NULL). */
+static inline void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const PetscReal bond_mu[], PetscInt i, PetscInt k, PetscReal alpha, PeriBondGeometry *g)
 {
-  g->i = i;
-  g->j = b->j[k];
-  for (PetscInt d = 0; d < 3; d++) g->xi[d] = xi[d];
-  g->length = len;
+  g->i      = i;
+  g->j      = b->j[k];
   g->Vi     = pt->volume[i];
   g->Vj     = pt->volume[g->j];
   g->weight = alpha * (b->lambda ? b->lambda[k] : 1) * (b->intact ? b->intact[k] : 1);
@@ -33,11 +31,11 @@ static void FillGeometry(const PeriParticles *pt, const PeriBonds *b, const Pets
  * PeriDiscBondGeometry). */
 PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, PeriBondGeometry *g)
 {
-  PetscReal xi[3], len, alpha;
+  PetscReal alpha;
 
   PetscFunctionBeginUser;
-  PeriDiscBondGeometry(&sys->disc, i, k, xi, &len, &alpha);
-  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->materials.bond_mu, i, k, xi, len, alpha, g);
+  PeriDiscBondGeometry(&sys->disc, i, k, g->xi, &g->length, &alpha);
+  FillGeometry(&sys->disc.particles, &sys->disc.bonds, sys->materials.bond_mu, i, k, alpha, g);
   g->bond = k + 1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -51,7 +49,12 @@ PetscErrorCode PeriSystemFamilyGeometry(PeriSystem sys, PetscInt i, PetscInt *n,
   PetscFunctionBeginUser;
   *n = 0;
   for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-    if (b->live[k]) FillGeometry(pt, b, NULL, i, k, &b->xi[3 * k], b->length[k], b->alpha[k], &fam[(*n)++]);
+    if (b->live[k]) {
+      PeriBondGeometry *g = &fam[(*n)++];
+      for (PetscInt d = 0; d < 3; d++) g->xi[d] = b->xi[3 * k + d];
+      g->length = b->length[k];
+      FillGeometry(pt, b, NULL, i, k, b->alpha[k], g);
+    }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -192,8 +192,44 @@ typedef struct {
 
 PETSC_EXTERN PetscErrorCode PeriDiscDestroy(PeriDisc *);
 PETSC_EXTERN PetscErrorCode PeriNeighborhoodVolumes(const PeriDisc *, PetscReal[], PetscInt[]);
-PETSC_EXTERN void           PeriDiscBondGeometry(const PeriDisc *, PetscInt, PetscInt, PetscReal[], PetscReal *, PetscReal *);
-PETSC_EXTERN PetscReal      PeriDiscBondLength(const PeriDisc *, PetscInt, PetscInt);
+PETSC_EXTERN void           PeriDiscBondGeometryFromCoordinates(const PeriDisc *, PetscInt, PetscInt, PetscReal[], PetscReal *, PetscReal *);
+
+/* The vector X_j - X_i, length and partial-volume factor of stored bond k of owned particle i in
+ * d's pair list: read where the list keeps them, else recomputed from the coordinates as
+ * PeriBondsRestoreGeometry does (to the bit). Inline: the failure check calls it for every bond
+ * at every step. Not collective. */
+static inline void PeriDiscBondGeometry(const PeriDisc *d, PetscInt i, PetscInt k, PetscReal xi[], PetscReal *len, PetscReal *alpha)
+{
+  const PeriBonds *b = &d->bonds;
+
+  if (!b->xi) {
+    PeriDiscBondGeometryFromCoordinates(d, i, k, xi, len, alpha);
+    return;
+  }
+  for (PetscInt e = 0; e < 3; e++) xi[e] = b->xi[3 * k + e];
+  *len   = b->length[k];
+  *alpha = b->alpha[k];
+}
+
+/* The length of stored bond k of owned particle i (PeriDiscBondGeometry). */
+static inline PetscReal PeriDiscBondLength(const PeriDisc *d, PetscInt i, PetscInt k)
+{
+  PetscReal xi[3], len, alpha;
+
+  if (d->bonds.length) return d->bonds.length[k];
+  PeriDiscBondGeometryFromCoordinates(d, i, k, xi, &len, &alpha);
+  return len;
+}
+
+/* The partial-volume factor of stored bond k of owned particle i (PeriDiscBondGeometry). */
+static inline PetscReal PeriDiscBondAlpha(const PeriDisc *d, PetscInt i, PetscInt k)
+{
+  PetscReal xi[3], len, alpha;
+
+  if (d->bonds.alpha) return d->bonds.alpha[k];
+  PeriDiscBondGeometryFromCoordinates(d, i, k, xi, &len, &alpha);
+  return alpha;
+}
 PETSC_EXTERN PetscErrorCode PeriDiscSetLocalView(MPI_Comm, PeriDisc *, PeriParticles *, PetscReal);
 PETSC_EXTERN PetscMPIInt    PeriDiscOwner(const PeriDisc *, PetscInt);
 PETSC_EXTERN PetscInt       PeriDiscLocal(const PeriDisc *, PetscInt);
