@@ -58,6 +58,7 @@ typedef struct {
   PetscBool          started;
   PetscReal          omega2_max, dt_limit; /* Gershgorin's bound of M^-1 K, and 2/omega_max */
   PetscInt           nsteps, broken, snes_its, ksp_its;
+  PetscInt           damage_broken;                                              /* d->broken when Fronts last computed the damage; -1: never */
   PetscReal          worst;                                                      /* implicit: the largest relative residual a step ended with */
   PetscReal          kinetic, strain, dissipated, work, E0, scale, error, drift; /* drift: the largest |balance - E0| over the largest energy */
   PetscReal          work_bc;                                                    /* this rank's work of the moving boundaries since the last Work */
@@ -281,7 +282,8 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&d));
-  an->data = d;
+  an->data         = d;
+  d->damage_broken = -1;
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
   PetscCall(PeriSceneGetChoice(s, a, "integrator", dyn_integrators, &kind, NULL));
   d->implicit = (PetscBool)(kind == 1);
@@ -1107,7 +1109,12 @@ static PetscErrorCode Fronts(PeriAnalysis an, Vec p)
 
   PetscFunctionBeginUser;
   if (!d->fronts) PetscFunctionReturn(PETSC_SUCCESS);
-  if (sys->bond_state.failure.active) PetscCall(PeriDamage(sys, &sys->bond_state.damage));
+  /* the damage changes only where bonds broke (softening ones change it by any amount): a bond
+     loop every step costs as much as the step's product on the EOI */
+  if (sys->bond_state.failure.active && (sys->disc.bonds.intact || !sys->bond_state.damage || d->broken != d->damage_broken)) {
+    PetscCall(PeriDamage(sys, &sys->bond_state.damage));
+    d->damage_broken = d->broken;
+  }
   PetscCall(VecGetArrayRead(p, &v));
   for (PetscInt i = 0; i < nloc; i++) {
     const PetscReal dx     = sys->disc.particles.x[3 * i + d->front_axis] - d->front_origin;

@@ -12,72 +12,109 @@ static void BondDOFs(PetscInt bs, const PetscScalar *u, PetscInt i, PetscInt j, 
   }
 }
 
+/* Bond k of owned particle i against the criterion at the local DOFs u: its failure index, the
+ * stiffness share softening leaves it and the cause. */
+static PetscErrorCode EvaluateBond(PeriSystem sys, const PetscScalar *u, PetscInt i, PetscInt k, PetscReal *index, PetscReal *soft, PeriFailureCause *cause)
+{
+  PeriModel        m  = sys->model;
+  const PetscInt   bs = m->dofs;
+  PeriBondGeometry g;
+  PetscReal        ue[2 * PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
+
+  PetscFunctionBeginUser;
+  PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+  BondDOFs(bs, u, i, g.j, ue);
+  m->ops.bond_measures(m, &g, ue, ue + bs, meas);
+  *index = PeriBondFailureIndex(sys, &g, meas, cause);
+  *soft  = sys->disc.bonds.intact ? PeriBondSoftening(sys, meas) : 1;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Bond k of owned particle i breaks (breaks) or keeps the share soft of its stiffness: K follows
+ * (its block's energy at u added to *energy with released; state-based models: K is reassembled
+ * from the synchronized families by the caller), then its flags; *mine counts the bonds broken or
+ * softened by more than 1 %. */
+static PetscErrorCode ChangeBond(PeriSystem sys, const PetscScalar *u, PetscInt i, PetscInt k, PetscBool breaks, PetscReal soft, PeriFailureCause cause, PetscBool released, PetscReal *energy, PetscInt *mine)
+{
+  PeriBonds *b = &sys->disc.bonds;
+
+  PetscFunctionBeginUser;
+  if (sys->model->ops.bond_stiffness) {
+    PetscReal        ue[2 * PERI_MAX_DOF], e = 0;
+    PeriBondGeometry g;
+    if (released) {
+      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
+      BondDOFs(sys->model->dofs, u, i, g.j, ue);
+    }
+    PetscCall(PeriStiffnessScaleBond(sys, i, k, breaks ? 0 : soft / b->intact[k], released ? ue : NULL, &e));
+    *energy += e;
+  }
+  if (breaks || soft <= 0) {
+    b->live[k]  = 0;
+    b->cause[k] = (unsigned char)cause;
+    (*mine)++;
+  } else {
+    /* softening: iterate until no bond loses more than 1 % of its stiffness */
+    if (b->intact[k] - soft > 1e-2) (*mine)++;
+    b->intact[k] = soft;
+    b->cause[k]  = (unsigned char)cause;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether a bond with this index and softened share changes: it breaks, or softens further. */
+static inline PetscBool Changes(const PeriBonds *b, PetscInt k, PetscBool breaks, PetscReal soft)
+{
+  return (PetscBool)(breaks || (b->intact && soft < b->intact[k]));
+}
+
 /*@C
   PeriBondsBreak - evaluates every live bond of this rank against the criterion and breaks those past it (all, or
  * those within the top fraction of the worst index), subtracting their blocks from K; softening
  * bonds lose stiffness by eqs. 45-46 (irreversibly). Returns the global number of bonds broken or
- * softened by more than 1 %. With all, every bond past its criterion breaks; else those within
-  the top fraction of [1, worst index]. Collective.
+ * softened by more than 1 %. With all, every bond past its criterion breaks, in one pass (a bond's
+  index does not depend on another's state: the explicit step's every-step check holds no
+  per-bond arrays); else those within the top fraction of [1, worst index]. Collective.
 @*/
 PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fraction, PetscInt *nbroken, PetscReal *released)
 {
-  PeriBonds        *b  = &sys->disc.bonds;
-  PeriModel         m  = sys->model;
-  const PetscInt    bs = m->dofs;
+  PeriBonds        *b = &sys->disc.bonds;
+  PeriModel         m = sys->model;
   PetscScalar      *u;
-  PeriFailureCause *cause;
-  PetscReal        *index, *soft, worst = 0, threshold = 1, energy = 0;
+  PeriFailureCause *cause, c1;
+  PetscReal        *index, *soft, worst = 0, threshold = 1, energy = 0, index1, soft1;
   PetscInt          mine = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PeriFailureCacheBonds(sys));
   PetscCall(PeriSystemLocalDOFs(sys, U, &u));
-  PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PeriBondGeometry g;
-      PetscReal        ue[2 * PERI_MAX_DOF], meas[PERI_MAX_MEASURE];
-      index[k] = 0;
-      if (!b->live[k] || b->j[k] == i) continue;
-      PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
-      BondDOFs(bs, u, i, g.j, ue);
-      m->ops.bond_measures(m, &g, ue, ue + bs, meas);
-      index[k] = PeriBondFailureIndex(sys, &g, meas, &cause[k]);
-      soft[k]  = b->intact ? PeriBondSoftening(sys, meas) : 1;
-      worst    = PetscMax(worst, index[k]);
-    }
-  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, sys->comm));
-  /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
-  if (!all && worst > 1) threshold = worst - fraction * (worst - 1);
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-      PetscBool breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
-      if (!b->live[k] || b->j[k] == i) continue;
-      if (!breaks && !(b->intact && soft[k] < b->intact[k])) continue;
-      /* the bond's stiffness becomes new share / old share of itself (state-based models: K is
-         reassembled from the synchronized families below) */
-      if (m->ops.bond_stiffness) {
-        PetscReal        ue[2 * PERI_MAX_DOF], e = 0;
-        PeriBondGeometry g;
-        if (released) {
-          PetscCall(PeriSystemBondGeometry(sys, i, k, &g));
-          BondDOFs(bs, u, i, g.j, ue);
-        }
-        PetscCall(PeriStiffnessScaleBond(sys, i, k, breaks ? 0 : soft[k] / b->intact[k], released ? ue : NULL, &e));
-        energy += e;
+  if (all) {
+    for (PetscInt i = b->rstart; i < b->rend; i++)
+      for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+        if (!b->live[k] || b->j[k] == i) continue;
+        PetscCall(EvaluateBond(sys, u, i, k, &index1, &soft1, &c1));
+        if (Changes(b, k, (PetscBool)(index1 >= 1), soft1)) PetscCall(ChangeBond(sys, u, i, k, (PetscBool)(index1 >= 1), soft1, c1, (PetscBool) !!released, &energy, &mine));
       }
-      if (breaks || soft[k] <= 0) {
-        b->live[k]  = 0;
-        b->cause[k] = (unsigned char)cause[k];
-        mine++;
-      } else {
-        /* softening: iterate until no bond loses more than 1 % of its stiffness */
-        if (b->intact[k] - soft[k] > 1e-2) mine++;
-        b->intact[k] = soft[k];
-        b->cause[k]  = (unsigned char)cause[k];
+  } else {
+    PetscCall(PetscMalloc3(b->nbonds, &index, b->nbonds, &soft, b->nbonds, &cause));
+    for (PetscInt i = b->rstart; i < b->rend; i++)
+      for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+        index[k] = 0;
+        if (!b->live[k] || b->j[k] == i) continue;
+        PetscCall(EvaluateBond(sys, u, i, k, &index[k], &soft[k], &cause[k]));
+        worst = PetscMax(worst, index[k]);
       }
-    }
-  PetscCall(PetscFree3(index, soft, cause));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &worst, 1, MPIU_REAL, MPI_MAX, sys->comm));
+    /* the fraction policy breaks the bonds whose index is within the top fraction of [1, worst] */
+    if (worst > 1) threshold = worst - fraction * (worst - 1);
+    for (PetscInt i = b->rstart; i < b->rend; i++)
+      for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
+        PetscBool breaks = (PetscBool)(index[k] >= threshold && index[k] >= 1);
+        if (!b->live[k] || b->j[k] == i || !Changes(b, k, breaks, soft[k])) continue;
+        PetscCall(ChangeBond(sys, u, i, k, breaks, soft[k], cause[k], (PetscBool) !!released, &energy, &mine));
+      }
+    PetscCall(PetscFree3(index, soft, cause));
+  }
   PetscCall(PetscFree(u));
   PetscCall(PeriStiffnessScaled(sys));
   PetscCallMPI(MPI_Allreduce(&mine, nbroken, 1, MPIU_INT, MPI_SUM, sys->comm));
