@@ -72,6 +72,10 @@ for f in "$work/runs/modal"/*.vtu "$work/runs/modal_2ranks"/*.pvtu "$work/runs/m
   cp "$f" "$work/seeds/vtu/$(basename "$(dirname "$f")")_$(basename "$f")"
 done
 cp "$work/runs/checkpoint/checkpoint/state.bin" "$work/seeds/checkpoint/state.bin"
+# earlier findings, fixed (tests/fuzz/regressions/HARNESS-*): seeds too, so every run replays them
+for h in "${harnesses[@]}"; do
+  for f in "$repo/tests/fuzz/regressions/$h-"*; do if [ -e "$f" ]; then cp "$f" "$work/seeds/$h/"; fi; done
+done
 echo "fuzz: seeds made in $((SECONDS - t_start)) s"
 
 # One harness: $seconds of fuzzing from its corpus (kept between runs) and the seeds; its report in
