@@ -468,7 +468,7 @@ static PetscErrorCode BondsWithoutGeometry(PeriSystem sys, PetscBool *lean)
  * local view. */
 static PetscErrorCode SearchBonds(PeriSystem sys)
 {
-  PeriDisc *d = &sys->disc;
+  PeriDisc *d    = &sys->disc;
   PetscBool lean = PETSC_FALSE;
 
   PetscFunctionBeginUser;
