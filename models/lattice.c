@@ -357,15 +357,28 @@ PetscErrorCode PeriLatticeCreate(PeriModel m, const PeriCalibrationData *data, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The multipliers of a bond in its two ends' families, scale_i mu_i(e) and scale_j mu_j(e); 1
+ * without a lattice calibration (lat NULL). State-based models weigh each family with its own
+ * (models/lps.c). */
+void PeriLatticeMultipliers(PeriLattice lat, const PeriBondGeometry *b, PetscReal *fi, PetscReal *fj)
+{
+  PetscReal e[3], pw[3][2 * LATTICE_DEGREE + 1];
+  *fi = *fj = 1;
+  if (!lat) return;
+  for (PetscInt d = 0; d < 3; d++) e[d] = d < lat->dim ? b->xi[d] / b->length : 0;
+  Powers(e, lat->degree, pw);
+  *fi = lat->scale[b->i] * Multiplier(lat, b->i, pw);
+  *fj = lat->scale[b->j] * Multiplier(lat, b->j, pw);
+}
+
 /* The factor of a bond's continuum stiffness: the mean of its two ends' multipliers; 1 without a
  * lattice calibration (lat NULL). */
 PetscReal PeriLatticeFactor(PeriLattice lat, const PeriBondGeometry *b)
 {
-  PetscReal e[3], pw[3][2 * LATTICE_DEGREE + 1];
+  PetscReal fi, fj;
   if (!lat) return 1;
-  for (PetscInt d = 0; d < 3; d++) e[d] = d < lat->dim ? b->xi[d] / b->length : 0;
-  Powers(e, lat->degree, pw);
-  return 0.5 * (lat->scale[b->i] * Multiplier(lat, b->i, pw) + lat->scale[b->j] * Multiplier(lat, b->j, pw)) + PeriPatchCorrection(lat->patch, b);
+  PeriLatticeMultipliers(lat, b, &fi, &fj);
+  return 0.5 * (fi + fj) + PeriPatchCorrection(lat->patch, b);
 }
 
 PetscErrorCode PeriLatticeDestroy(PeriLattice *lat)

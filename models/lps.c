@@ -18,8 +18,15 @@
  * every particle, surfaces included (the standard theta is exact only where S_i is isotropic). The
  * energy is then the springs plus two states, the standard one with modulus -V_i b/d^2 and this
  * one with V_i kappa: W_i = (kappa/2) theta_i^2 + (b / 2 m_i) sum_j omega (e - phi_i |xi| / d)^2
- * alpha V_j, phi_i the standard dilatation; >= 0 by the same Cauchy-Schwarz bound. */
+ * alpha V_j, phi_i the standard dilatation; >= 0 by the same Cauchy-Schwarz bound.
+ * model.calibration: lattice weighs every bond in particle i's family by i's lattice multiplier
+ * f_i(e) (models/lattice.c, profile omega |xi|^2), in m_i, theta_i and the springs alike: the
+ * family's moments of degree 0, 2 and 4 are then the continuum's, so theta_i = tr(eps) and the
+ * springs give the isotropic deviatoric energy for every homogeneous strain at every particle,
+ * surfaces and corners included (where the family is not too lopsided, models/lattice.c), and
+ * W_i >= 0 by the same bound, the springs and theta_i having the same weights. */
 #include <perilin/model.h>
+#include <perilin/scene.h>
 
 static const char *const influences[]  = {"constant", "inverse", "gaussian", NULL};
 static const char *const corrections[] = {"none", NULL};
@@ -38,7 +45,8 @@ typedef struct {
   PetscReal *m; /* weighted volume per particle of the local view */
   PetscReal *V; /* the particles' volumes (borrowed from the calibration data) */
   PetscBool  affine;
-  PetscReal *Sinv; /* model.dilatation: affine: the inverse shape tensor per particle, dim x dim */
+  PetscReal  *Sinv; /* model.dilatation: affine: the inverse shape tensor per particle, dim x dim */
+  PeriLattice lat;  /* model.calibration: lattice, else NULL (multipliers 1) */
 } LPS;
 
 static const PeriKey lps_keys[] = {
@@ -59,6 +67,7 @@ static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
   k              = 0;
   PetscCall(PeriSceneGetChoice(scene, node, "dilatation", dilatations, &k, NULL));
   lps->affine           = (PetscBool)(k == 1);
+  PeriInputCheck(!lps->affine || m->calibration == PERI_CALIBRATION_CONTINUUM, scene, node, "dilatation", "affine with model.calibration: lattice: the lattice calibration already makes the standard dilatation exact for every homogeneous strain; use dilatation: standard, or calibration: continuum");
   m->nstates            = lps->affine ? 2 : 1;
   m->states_along_bonds = 1; /* the standard dilatation (state 0 of either); the affine one is off the bond */
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -81,6 +90,13 @@ static PetscReal Omega(PeriModel m, const PeriBondGeometry *b)
   if (lps->influence == INFLUENCE_INVERSE) return d / b->length;
   if (lps->influence == INFLUENCE_GAUSSIAN) return PetscExpReal(-PetscSqr(b->length / d));
   return 1;
+}
+
+/* the lattice calibration's length profile: the weight omega |xi|^2 of m_i */
+static PetscReal Profile(PeriModel m, PetscReal L)
+{
+  PeriBondGeometry g = {.length = L};
+  return Omega(m, &g) * L * L;
 }
 
 /* Inverts the symmetric d x d matrix S in place (d = 2, 3) by its adjugate; false when it is
@@ -147,12 +163,19 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
   lps->n     = data->n;
   PetscCall(PetscFree(lps->m));
   PetscCall(PetscCalloc1(data->n, &lps->m));
+  if (m->calibration != PERI_CALIBRATION_CONTINUUM) {
+    PetscCheck(!m->horizon, data->comm, PETSC_ERR_USER_INPUT, "lps: model.calibration: lattice calibrates on one horizon for the whole body; with per-particle horizons (horizon.spacing: own, horizon.neighbors) use model.calibration: continuum");
+    PetscCall(PeriLatticeCreate(m, data, 4, Profile, &lps->lat));
+  }
   for (PetscInt i = bd->rstart; i < bd->rend; i++)
     for (PetscInt k = bd->offset[i - bd->rstart]; k < bd->offset[i - bd->rstart + 1]; k++) {
       PeriBondGeometry g = {.i = i, .j = bd->j[k], .length = bd->length[k]};
-      const PetscReal  w = Omega(m, &g) * PetscSqr(bd->length[k]) * bd->alpha[k];
-      lps->m[i] += w * lps->V[g.j];
-      lps->m[g.j] += w * lps->V[i];
+      PetscReal        w, fi, fj;
+      for (PetscInt a = 0; a < 3; a++) g.xi[a] = bd->xi[3 * k + a];
+      w = Omega(m, &g) * PetscSqr(bd->length[k]) * bd->alpha[k];
+      PeriLatticeMultipliers(lps->lat, &g, &fi, &fj);
+      lps->m[i] += w * fi * lps->V[g.j];
+      lps->m[g.j] += w * fj * lps->V[i];
     }
   PetscCall(data->combine(data, MPIU_REAL, 1, MPI_SUM, lps->m));
   for (PetscInt i = 0; i < data->nowned; i++) PetscCheck(lps->m[i] > 0, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "lps: particle %" PetscInt_FMT " has no neighbours, its weighted volume is 0 (is the horizon smaller than the spacing?)", i);
@@ -160,11 +183,14 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* the pair springs: b omega alpha V_i V_j (1/m_i + 1/m_j) along the bond */
+/* the pair springs: b omega alpha V_i V_j (f_i/m_i + f_j/m_j) along the bond (f = 1 but with the
+ * lattice calibration) */
 static void BondStiffness(PeriModel m, const PeriBondGeometry *b, PetscReal Ke[])
 {
   const LPS *lps = (const LPS *)m->data;
-  PeriCentralBondBlock(m, b, lps->b * Omega(m, b) * b->weight * b->Vi * b->Vj * (1 / lps->m[b->i] + 1 / lps->m[b->j]), Ke);
+  PetscReal  fi, fj;
+  PeriLatticeMultipliers(lps->lat, b, &fi, &fj);
+  PeriCentralBondBlock(m, b, lps->b * Omega(m, b) * b->weight * b->Vi * b->Vj * (fi / lps->m[b->i] + fj / lps->m[b->j]), Ke);
 }
 
 /* State 0, the standard dilatation: theta_i += (d omega |xi| alpha V_j / m_i) n . (u_j - u_i), and
@@ -174,12 +200,14 @@ static void BondState(PeriModel m, const PeriBondGeometry *b, PetscInt s, PetscR
   const LPS      *lps = (const LPS *)m->data;
   const PetscInt  d = m->dim, dd = d * d;
   const PetscReal w = Omega(m, b) * b->weight, c = d * w * b->length;
+  PetscReal       fi, fj;
+  PeriLatticeMultipliers(lps->lat, b, &fi, &fj);
   for (PetscInt a = 0; a < m->dofs; a++) {
     gi[a] = gj[a] = 0;
     for (PetscInt e = 0; e < d && a < d; e++) {
       if (s == 0 && e == a) {
-        gi[a] = c * b->Vj / lps->m[b->i] * b->xi[a] / b->length;
-        gj[a] = c * b->Vi / lps->m[b->j] * b->xi[a] / b->length;
+        gi[a] = c * fi * b->Vj / lps->m[b->i] * b->xi[a] / b->length;
+        gj[a] = c * fj * b->Vi / lps->m[b->j] * b->xi[a] / b->length;
       }
       if (s == 1) {
         gi[a] += w * b->Vj * lps->Sinv[b->i * dd + a * d + e] * b->xi[e];
@@ -216,6 +244,7 @@ static PetscErrorCode Destroy(PeriModel m)
   PetscFunctionBeginUser;
   PetscCall(PetscFree(((LPS *)m->data)->m));
   PetscCall(PetscFree(((LPS *)m->data)->Sinv));
+  PetscCall(PeriLatticeDestroy(&((LPS *)m->data)->lat));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -237,6 +266,7 @@ static PetscErrorCode PeriModelCreate_LPS(PeriModel m)
   m->ops.destroy         = Destroy;
   m->surface_corrections = corrections; /* m_i from the actual family is the model's own */
   m->takes_own_horizon   = PETSC_TRUE;
+  m->takes_lattice       = PETSC_TRUE;
   m->nstates             = 1;
   m->states_along_bonds  = 1;
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -133,6 +133,7 @@ PETSC_EXTERN PetscBool       PeriModelInPlane(PeriModel);
 PETSC_EXTERN PetscInt        PeriModelMeasureIndex(PeriModel, PeriMeasureKind);
 PETSC_EXTERN PetscErrorCode  PeriLatticeCreate(PeriModel, const PeriCalibrationData *, PetscInt, PetscReal (*)(PeriModel, PetscReal), PeriLattice *);
 PETSC_EXTERN PetscReal       PeriLatticeFactor(PeriLattice, const PeriBondGeometry *);
+PETSC_EXTERN void            PeriLatticeMultipliers(PeriLattice, const PeriBondGeometry *, PetscReal *, PetscReal *);
 PETSC_EXTERN PetscReal       PeriProfileLength(PeriModel, PetscReal);
 PETSC_EXTERN PetscReal       PeriProfileOne(PeriModel, PetscReal);
 PETSC_EXTERN PetscErrorCode  PeriLatticeDestroy(PeriLattice *);

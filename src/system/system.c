@@ -206,8 +206,8 @@ static PetscErrorCode CreateModel(PeriSystem sys)
   {
     PetscInt kind = sys->model->calibration; /* the model's default */
     PetscCall(PeriSceneGetChoice(s, m, "calibration", PeriCalibrationKinds, &kind, NULL));
-    PeriInputCheck(kind == PERI_CALIBRATION_CONTINUUM || sys->model->takes_lattice, s, m, "calibration", "model %s has no lattice calibration (pmb, npmb, cpmb, pds, mppd, gerstle and antiplane have; antiplane_os is exact for every homogeneous strain with corrections.surface: energy): use continuum", type);
-    PeriInputCheck(kind != PERI_CALIBRATION_PATCH || sys->model->central_force, s, m, "calibration", "patch corrects the springs of central-force models (pmb, npmb, cpmb); model %s has more kinds of springs: use lattice", type);
+    PeriInputCheck(kind == PERI_CALIBRATION_CONTINUUM || sys->model->takes_lattice, s, m, "calibration", "model %s has no lattice calibration (pmb, npmb, cpmb, pds, mppd, gerstle, antiplane and lps have; antiplane_os is exact for every homogeneous strain with corrections.surface: energy): use continuum", type);
+    PeriInputCheck(kind != PERI_CALIBRATION_PATCH || (sys->model->central_force && !PeriModelHasFamilies(sys->model)), s, m, "calibration", "patch corrects the springs of bond-based central-force models (pmb, npmb, cpmb); model %s has more kinds of springs or states: use lattice", type);
     sys->model->calibration = (PeriCalibrationKind)kind;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
