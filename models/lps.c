@@ -39,12 +39,12 @@ typedef enum {
 } Influence;
 
 typedef struct {
-  Influence  influence;
-  PetscReal  kappa, b; /* the dimension's bulk modulus; d (d + 2) G */
-  PetscInt   n;
-  PetscReal *m; /* weighted volume per particle of the local view */
-  PetscReal *V; /* the particles' volumes (borrowed from the calibration data) */
-  PetscBool  affine;
+  Influence   influence;
+  PetscReal   kappa, b; /* the dimension's bulk modulus; d (d + 2) G */
+  PetscInt    n;
+  PetscReal  *m; /* weighted volume per particle of the local view */
+  PetscReal  *V; /* the particles' volumes (borrowed from the calibration data) */
+  PetscBool   affine;
   PetscReal  *Sinv; /* model.dilatation: affine: the inverse shape tensor per particle, dim x dim */
   PeriLattice lat;  /* model.calibration: lattice, else NULL (multipliers 1) */
 } LPS;
@@ -66,7 +66,7 @@ static PetscErrorCode SetFromScene(PeriModel m, PeriScene scene, PeriNode node)
   lps->influence = (Influence)k;
   k              = 0;
   PetscCall(PeriSceneGetChoice(scene, node, "dilatation", dilatations, &k, NULL));
-  lps->affine           = (PetscBool)(k == 1);
+  lps->affine = (PetscBool)(k == 1);
   PeriInputCheck(!lps->affine || m->calibration == PERI_CALIBRATION_CONTINUUM, scene, node, "dilatation", "affine with model.calibration: lattice: the lattice calibration already makes the standard dilatation exact for every homogeneous strain; use dilatation: standard, or calibration: continuum");
   m->nstates            = lps->affine ? 2 : 1;
   m->states_along_bonds = 1; /* the standard dilatation (state 0 of either); the affine one is off the bond */
@@ -164,7 +164,7 @@ static PetscErrorCode Calibrate(PeriModel m, const PeriCalibrationData *data)
   PetscCall(PetscFree(lps->m));
   PetscCall(PetscCalloc1(data->n, &lps->m));
   if (m->calibration != PERI_CALIBRATION_CONTINUUM) {
-    PetscCheck(!m->horizon, data->comm, PETSC_ERR_USER_INPUT, "lps: model.calibration: lattice calibrates on one horizon for the whole body; with per-particle horizons (horizon.spacing: own, horizon.neighbors) use model.calibration: continuum");
+    PetscCheck(!m->horizon, data->comm, PETSC_ERR_PLIB, "lps: the lattice calibration with per-particle horizons (the scene check refuses it)");
     PetscCall(PeriLatticeCreate(m, data, 4, Profile, &lps->lat));
   }
   for (PetscInt i = bd->rstart; i < bd->rend; i++)

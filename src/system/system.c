@@ -10,7 +10,7 @@ static const char *const planes[]     = {"stress", "strain", NULL};
 static const PeriKey     model_keys[] = {
         {"type", PERI_KEY_STRING, "required", NULL, NULL, NULL, "the bond model (docs/models/)"},
         {"plane", PERI_KEY_CHOICE, "stress", NULL, NULL, planes, "2D only: plane stress or plane strain"},
-        {"calibration", PERI_KEY_CHOICE, NULL, NULL, NULL, PeriCalibrationKinds, "lattice: each particle's discrete family reproduces the continuum's moments, so every homogeneous strain has the target energy, at surfaces too (docs/models/lattice.md; the default of pds, mppd, gerstle); patch: lattice, then every bond corrected so that on any cloud (graded, stochastic) affine fields are equilibria and dilations have the target energy at every interior particle (central-force models; docs/mesh.md, \"Patch tests\"); continuum: micromoduli from the continuous horizon (the papers'; the default of the others)"},
+        {"calibration", PERI_KEY_CHOICE, NULL, NULL, NULL, PeriCalibrationKinds, "lattice: each particle's discrete family reproduces the continuum's moments, so every homogeneous strain has the target energy, at surfaces too (docs/models/lattice.md; the default of pds, mppd, gerstle; lps weighs each family by its own particle's multipliers, docs/models/lps.md); patch: lattice, then every bond corrected so that on any cloud (graded, stochastic) affine fields are equilibria and dilations have the target energy at every interior particle (bond-based central-force models; docs/mesh.md, \"Patch tests\"); continuum: micromoduli from the continuous horizon (the papers'; the default of the others)"},
         {NULL},
 };
 static const char *const spacings[]     = {"mean", "own", NULL};
@@ -55,6 +55,7 @@ static PetscErrorCode ReadNeighborsHorizon(PeriSystem sys, PeriNode h, PetscReal
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &N, 1, MPIU_INT, MPI_SUM, sys->comm)); /* the ranks' blocks */
   PeriInputCheck(k < N, s, h, "neighbors", "%" PetscInt_FMT " neighbours per horizon need more than %" PetscInt_FMT " particles; the body has %" PetscInt_FMT, k, k, N);
   PeriInputCheck(sys->model->takes_own_horizon, s, h, "neighbors", "model %s calibrates its springs on one horizon for the whole body; per-particle horizons are derived for pmb and npmb (docs/mesh.md, \"Per-particle horizons\"): use one of them or horizon.m", sys->model->type);
+  PeriInputCheck(sys->model->calibration == PERI_CALIBRATION_CONTINUUM || !PeriModelHasFamilies(sys->model), s, h, "neighbors", "model %s with model.calibration: lattice calibrates its families on one horizon for the whole body: use model.calibration: continuum with per-particle horizons", sys->model->type);
   sys->disc.horizon_k = k;
   sys->disc.horizon_m = dim == 3 ? PetscCbrtReal(3.0 * k / (4 * PETSC_PI)) : PetscSqrtReal(k / PETSC_PI);
   sys->disc.delta     = sys->disc.horizon_m * hmax;
@@ -73,6 +74,7 @@ static PetscErrorCode ReadOwnHorizon(PeriSystem sys, PeriNode h, PetscBool hasm,
   if (!own) PetscFunctionReturn(PETSC_SUCCESS);
   PeriInputCheck(hasm, s, h, "spacing", "own needs horizon.m (the multiple of each particle's spacing), not horizon.delta");
   PeriInputCheck(sys->model->takes_own_horizon, s, h, "spacing", "model %s calibrates its springs on one horizon for the whole body; per-particle horizons are derived for pmb and npmb (docs/mesh.md, \"Per-particle horizons\"): use one of them or horizon.spacing: mean", sys->model->type);
+  PeriInputCheck(sys->model->calibration == PERI_CALIBRATION_CONTINUUM || !PeriModelHasFamilies(sys->model), s, h, "spacing", "model %s with model.calibration: lattice calibrates its families on one horizon for the whole body: use model.calibration: continuum with per-particle horizons", sys->model->type);
   sys->disc.horizon_m = m;
   sys->disc.delta     = m * hmax;
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -22,7 +22,8 @@
  *      radii at m = 4 are 9 spacings), energy only.
  *
  * usage: test_model_contract tests/scenes/contract_2d.yaml tests/scenes/contract_3d.yaml
- *        [-contract_types lps -model_dilatation affine]: only the types listed, with a key of theirs */
+ *        [-contract_types lps -model_dilatation affine]: only the types listed, with a key of theirs
+ *        [-contract_lattice false]: not the lattice calibration (a key of theirs refuses it) */
 #include "testing.h"
 #include <slepcds.h>
 
@@ -347,9 +348,10 @@ static PetscErrorCode RunCase(const char scene[], Case *c, const char *const sur
 
 int main(int argc, char **argv)
 {
-  char   list[4096], **types;
-  int    ntypes;
-  size_t len;
+  char      list[4096], **types;
+  int       ntypes;
+  size_t    len;
+  PetscBool with_lattice = PETSC_TRUE;
 
   PetscCall(PeriInitialize(&argc, &argv, NULL));
   PetscCheck(argc >= 3, PETSC_COMM_WORLD, PETSC_ERR_ARG_WRONG, "usage: test_model_contract contract_2d.yaml contract_3d.yaml");
@@ -357,6 +359,7 @@ int main(int argc, char **argv)
   PetscCall(PeriModelListTypes(list, sizeof(list)));
   /* -contract_types a,b: those types only, e.g. with a model key of theirs among the options */
   PetscCall(PetscOptionsGetString(NULL, NULL, "-contract_types", list, sizeof(list), NULL));
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-contract_lattice", &with_lattice, NULL));
   PetscCall(PetscStrlen(list, &len));
   PetscCheck(len + 1 < sizeof(list), PETSC_COMM_WORLD, PETSC_ERR_PLIB, "the list of model types is too long for this test's buffer");
   for (size_t k = 0; k < len; k++)
@@ -388,7 +391,7 @@ int main(int argc, char **argv)
           PetscCall(RunCase(argv[s], &c, surfaces));
           ncases++;
         }
-        if (lattice) {
+        if (lattice && with_lattice) {
           c.surface     = "none";
           c.calibration = "lattice";
           PetscCall(RunCase(argv[s], &c, surfaces));
