@@ -12,7 +12,8 @@
 # within 8 %, every particle through the thickness fitted. The standard dilatation from the
 # bond-force stress only: its far field is 23 % stiff with four particles through the thickness
 # (the LPS surface effect, docs/models/lps.md), which the elastic stress C : eps shows and the
-# bond forces, which balance the load, do not. The affine dilatation on 2 ranks from both stresses.
+# bond forces, which balance the load, do not. The affine dilatation on 2 ranks from both stresses,
+# and model.calibration: lattice from both (measured 2026-11-29: 3.20 and 3.01).
 # Usage: kt.sh PERILIN EXAMPLES_DIR [lps3d]
 set -u
 exe=$1 ex=$2 mode=${3:-mesh}
@@ -30,6 +31,8 @@ if [ "$mode" = lps3d ]; then
   mpiexec --oversubscribe -n 2 "$exe" "$scene" -quiet -model_dilatation affine -output_dir "$tmp/affine" > /dev/null || exit 1
   "$py" "$here/kt.py" --reference 3.14 --bond-stress-only 1 "$tmp/standard" || fail=1
   "$py" "$here/kt.py" --reference 3.14 "$tmp/affine" || fail=1
+  "$exe" "$scene" -quiet -model_calibration lattice -output_dir "$tmp/lattice" > /dev/null || exit 1
+  "$py" "$here/kt.py" --reference 3.14 "$tmp/lattice" || fail=1
   exit $fail
 fi
 for name in plate_hole plate_hole_graded; do
