@@ -145,7 +145,7 @@ PetscErrorCode PeriProblemSetFromScene(PeriProblem p)
   PetscCall(ReadOutput(p, p->scene->file));
   PetscCall(PeriSystemCreate(p->comm, p->scene, &p->sys));
   p->sys->fields.stress_output = p->stress_output;
-  PetscCall(PeriSystemSetNeeds(p->sys, &p->analysis->type->needs));
+  PetscCall(PeriSystemSetNeeds(p->sys, &p->analysis->needs));
   PetscCall(PeriProgressUpdate(p->sys->run.progress, PERI_PROGRESS_PHASE, "setup"));
   PetscCall(PeriSystemSetFromScene(p->sys));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -59,8 +59,9 @@ PetscErrorCode PeriAnalysisCreate(MPI_Comm comm, const PeriAnalysisType *type, P
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&an));
-  an->type = type;
-  an->comm = comm;
+  an->type  = type;
+  an->needs = type->needs;
+  an->comm  = comm;
   PetscCallMPI(MPI_Comm_rank(comm, &an->rank));
   *analysis = an;
   PetscFunctionReturn(PETSC_SUCCESS);

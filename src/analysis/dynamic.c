@@ -287,6 +287,10 @@ static PetscErrorCode SetFromScene_Dynamic(PeriAnalysis an, PeriScene s, PeriNod
   PetscCall(PeriSceneGetMap(s, s->root, "analysis", PETSC_TRUE, &a));
   PetscCall(PeriSceneGetChoice(s, a, "integrator", dyn_integrators, &kind, NULL));
   d->implicit = (PetscBool)(kind == 1);
+  if (!d->implicit) { /* the explicit step applies K only through its product: no matrix, no copy (the memory estimate) */
+    an->needs.operator_only = PETSC_TRUE;
+    an->needs.matrix_copies = 0;
+  }
   PetscCall(PeriSceneGetReal(s, a, "t_end", PETSC_TRUE, &d->t_end, NULL));
   PetscCall(PeriSceneGetReal(s, a, "dt", (PetscBool)d->implicit, &d->dt, NULL));
   PeriInputCheck(d->dt <= d->t_end, s, a, "dt", "must not exceed t_end = %g, got %g", (double)d->t_end, (double)d->dt);

@@ -73,6 +73,10 @@ static PetscErrorCode SetFromScene_Modal(PeriAnalysis an, PeriScene s, PeriNode 
   PetscCall(PeriSceneGetInt(s, a, "nev", PETSC_FALSE, &md->nev, NULL));
   PetscCall(PeriSceneGetReal(s, a, "target_hz", PETSC_FALSE, &md->target_hz, NULL));
   PetscCall(PeriSceneGetChoice(s, a, "eigensolver", eigensolvers, &md->eigensolver, NULL));
+  /* the memory estimate's path: a factorization at any size where the scene asks for it (or for a
+     target, which LOBPCG cannot take), none with lobpcg */
+  if (md->eigensolver == EIGENSOLVER_SHIFT_INVERT || (md->eigensolver == EIGENSOLVER_AUTO && md->target_hz > 0)) an->needs.iterative_dofs = an->needs.iterative_dofs_grid = 0;
+  if (md->eigensolver == EIGENSOLVER_LOBPCG) an->needs.iterative_dofs = an->needs.iterative_dofs_grid = 1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -50,10 +50,12 @@ PetscReal PeriBondsBallCount(PetscInt dim, PetscReal r)
   radius (PeriBondsBallCount), kept here beside the storage they count so that the estimates
   follow its layout: the neighbour search reserves 1.05 ball / 2 bonds (a half list) of j, xi,
   length, alpha and live (PeriBondsReserve), of which the share found (the faces leave fewer)
-  each get their lambda. Not collective.
+  each get their lambda; without stored geometry (lean, PeriBonds.no_geometry) j, live and the
+  lambda of a surface correction. Not collective.
 @*/
-PetscReal PeriBondsBytesPerParticle(PetscReal ball, PetscReal share)
+PetscReal PeriBondsBytesPerParticle(PetscReal ball, PetscReal share, PetscBool lean)
 {
+  if (lean) return ball / 2 * (1.05 * (sizeof(PetscInt) + 1) + share * sizeof(PetscReal));
   return ball / 2 * (1.05 * (sizeof(PetscInt) + 5 * sizeof(PetscReal) + 1) + share * sizeof(PetscReal));
 }
 

@@ -357,7 +357,7 @@ static PetscErrorCode RefinedBytes(PeriScene scene, PetscInt dim, PetscReal *m, 
   ball = PeriBondsBallCount(dim, r);
   /* the particles' arrays and their bonds, every one found (faces not discounted: an upper bound
      of the bonds, but no matrix or solver is counted) */
-  *bytes = PeriParticlesBytesPerParticle(dim) + PeriBondsBytesPerParticle(ball, 1);
+  *bytes = PeriParticlesBytesPerParticle(dim) + PeriBondsBytesPerParticle(ball, 1, PETSC_FALSE);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

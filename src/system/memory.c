@@ -121,7 +121,7 @@ static PetscReal SurfaceShare(PetscInt dim, PetscReal r, const PetscReal cells[]
  * nonzero; BAIJ: 8, and an index per block) and the solver, for n particles of dofs DOFs, a
  * search radius of r spacings and the share of pairs the faces leave. State-based models also list
  * each family in full and couple particles up to 2 delta apart. */
-static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const PeriSystemNeeds *needs, PetscBool mf, PetscBool mg, MemoryEstimate *e)
+static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal share, PetscBool failure, const PeriSystemNeeds *needs, PetscBool mf, PetscBool mg, PetscBool lean, PetscBool periodic, MemoryEstimate *e)
 {
   const PetscReal dofs = m->dofs, ball = PeriBondsBallCount(m->dim, r);
   PetscReal       reserved, per_bond, blocks, nnz, matrix;
@@ -138,7 +138,7 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   e->nbonds = n * ball / 2 * share;
   /* the search's reserve and every bond's lambda (the bond storage's count), and with failure each
      bond's cause and softening share */
-  reserved = n * PeriBondsBytesPerParticle(ball, share);
+  reserved = n * PeriBondsBytesPerParticle(ball, share, lean);
   per_bond = failure ? 1 + sizeof(PetscReal) : 0;
   /* a matrix-free K: its matrix is the short-range one (1.75 spacings, PeriOperatorPreconditioner)
      beside the operator's partner and sqrt(k) e per bond */
@@ -147,12 +147,18 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
   nnz    = n * blocks * dofs * dofs;
   matrix = aij ? nnz * (sizeof(PetscScalar) + sizeof(PetscInt)) : nnz * sizeof(PetscScalar) + n * blocks * sizeof(PetscInt);
   /* the geometric multigrid stores no matrix but the coarsest's: its levels hold a third of the
-     finest's operator and 15 more vectors (docs/performance.md, "Geometric multigrid") */
-  if (mg) matrix = 0;
-  if (mg) reserved += e->nbonds / 3 * (sizeof(PetscInt) + dofs * sizeof(PetscReal)) + 15 * n * dofs * sizeof(PetscScalar);
-  if (mf) reserved += e->nbonds * (sizeof(PetscInt) + (m->central_force ? dofs : dofs == 2 ? 3
-                                                                                           : 7) *
-                                                          sizeof(PetscReal)); /* operator.c's forms */
+     finest's bonds, with their geometry, and operator in the vector form, and 15 more vectors
+     (docs/performance.md, "Geometric multigrid") */
+  if (mg || (mf && needs->operator_only)) matrix = 0; /* the explicit step has no PC */
+  if (mg) reserved += e->nbonds / 3 * (PeriBondsBytesPerParticle(2, share, PETSC_FALSE) + sizeof(PetscInt) + dofs * sizeof(PetscReal)) + 15 * n * dofs * sizeof(PetscScalar);
+  if (mf) { /* operator.c's forms: the spring form's s (central, no states, no periodic image) */
+    PetscBool springs = PETSC_TRUE;
+    PetscReal reals   = m->central_force ? dofs : dofs == 2 ? 3
+                                                            : 7;
+    PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_operator_springs", &springs, NULL));
+    if (springs && m->central_force && !PeriModelHasFamilies(m) && !periodic) reals = 1;
+    reserved += e->nbonds * (sizeof(PetscInt) + reals * sizeof(PetscReal));
+  }
   /* GAMG's scalar graph (matrix / dofs^2), its coarse levels and prolongators and CG's vectors:
      PERI_MEMORY_SOLVER graphs, fitted to the peaks of 2D plates (2 DOFs, 1e4-1e6 particles, where
      the whole run peaks at 2.5x the matrix as in docs/performance.md) and 3D blocks (3 DOFs) */
@@ -165,6 +171,35 @@ static PetscErrorCode Estimate(PeriModel m, PetscReal n, PetscReal r, PetscReal 
      they share out like the rest (docs/distributed.md) */
   e->shared += n * PeriParticlesBytesPerParticle(m->dofs);
   e->per_rank = PERI_MEMORY_RUNTIME;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether the set-up will store the bonds without their geometry (PeriSystemBondsLean), from the
+ * scene: per-particle horizons (horizon.spacing: own, horizon.neighbors), a periodic axis of a
+ * grid (periodic NULL: particles read from a file), fictitious boundary layers. */
+static PetscErrorCode Lean(PeriScene s, PeriModel m, const PetscBool periodic[], PetscBool *lean, PetscBool *per)
+{
+  PeriNode  hz, layers;
+  PetscInt  own = 0;
+  PetscBool k   = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  *per = PETSC_FALSE;
+  for (PetscInt d = 0; periodic && d < m->dim; d++) *per = (PetscBool)(*per || periodic[d]);
+  PetscCall(PeriSceneGetMap(s, s->root, "horizon", PETSC_FALSE, &hz));
+  if (hz) {
+    PeriNode       nb;
+    PetscErrorCode ierr;
+    /* a bad spacing is reported later, by its reader, in the order of the other checks */
+    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+    ierr = PeriSceneGetChoice(s, hz, "spacing", PeriHorizonSpacings, &own, NULL);
+    PetscCall(PetscPopErrorHandler());
+    if (ierr) own = 0;
+    PetscCall(PeriSceneGetNode(hz, "neighbors", &nb));
+    k = (PetscBool)(nb != NULL);
+  }
+  PetscCall(PeriSceneGetNode(s->root, "boundary_layers", &layers));
+  PetscCall(PeriSystemBondsLean(s, m, (PetscBool)(own || k), *per, (PetscBool)(layers != NULL), lean));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -206,13 +241,17 @@ static PetscErrorCode CheckEstimate(MPI_Comm comm, PeriScene s, PeriModel m, con
   MemoryEstimate  e = {0};
   PeriSystemNeeds at;
   PeriNode        node;
-  PetscBool       failure, mf;
+  PetscBool       failure, mf, lean, per;
 
   PetscFunctionBeginUser;
   PetscCall(PeriSceneGetNode(s->root, "failure", &node));
   failure = node ? PETSC_TRUE : PETSC_FALSE;
   at      = *needs;
-  if (periodic && at.iterative_dofs_grid > 0) at.iterative_dofs = at.iterative_dofs_grid; /* a grid */
+  PetscCall(Lean(s, m, periodic, &lean, &per));
+  PetscCall(PeriSceneGetNode(s->root, "bc", &node));
+  /* the sooner iterative default (the modal analysis' auto rule): a held grid body that is not
+     periodic (the geometric multigrid's), or a free body of a state-based model */
+  if (at.iterative_dofs_grid > 0 && ((periodic && !per && node) || (!node && PeriModelHasFamilies(m)))) at.iterative_dofs = at.iterative_dofs_grid;
   if (at.iterative_dofs > 0 && n * m->dofs >= at.iterative_dofs) {
     /* the analysis' iterative default (a modal LOBPCG): no factor, and K matrix-free where the
        operator applies (solver.operator assembled or a forced factorization then need more) */
@@ -221,7 +260,7 @@ static PetscErrorCode CheckEstimate(MPI_Comm comm, PeriScene s, PeriModel m, con
   } else
     PetscCall(MatrixFree(s, m, &at, &mf));
   if (failure && !m->central_force) mf = PETSC_FALSE; /* PeriMatrixFreeWhyNot */
-  PetscCall(Estimate(m, n, r, share, failure, &at, mf, (PetscBool)(periodic && Multigrid(m, &at, mf, failure, n, periodic)), &e));
+  PetscCall(Estimate(m, n, r, share, failure, &at, mf, (PetscBool)(periodic && !at.operator_only && Multigrid(m, &at, mf, failure, n, periodic)), lean, per, &e));
   PetscCall(NodeBalance(comm, &e));
   PeriInputCheck(!(e.have > 0) || e.need <= e.have, s, where, key, "this scene needs about %.3g GB (%.3g particles, %.3g bonds), this machine has %.3g GB available: %s", (double)(e.need / 1e9), (double)e.n, (double)e.nbonds, (double)(e.have / 1e9), what);
   PetscCall(PetscInfo(NULL, "memory estimate: %g bytes on the fullest node, %g available (%g particles, %g bonds)\n", (double)e.need, (double)e.have, (double)e.n, (double)e.nbonds));

@@ -108,6 +108,7 @@ typedef struct {
  * its file and its tests. */
 struct _p_PeriAnalysis {
   const PeriAnalysisType *type;
+  PeriSystemNeeds         needs; /* its type's, refined by its scene (ops.setfromscene): what the system is set up for */
   MPI_Comm                comm;
   PetscMPIInt             rank;
   PeriSystem              sys;

@@ -106,7 +106,7 @@ PETSC_EXTERN PetscErrorCode PeriNeighborSearchLevels(const PeriParticles *, cons
 PETSC_EXTERN PetscErrorCode PeriBondsAdd(const PeriParticles *, PetscInt, PetscInt, const PetscReal[], PetscReal, PeriPartialVolume, PeriBonds *, PetscInt *);
 PETSC_EXTERN PetscErrorCode PeriBondsReserve(PeriBonds *, PetscInt, PetscInt *);
 PETSC_EXTERN PetscReal      PeriBondsBallCount(PetscInt, PetscReal);
-PETSC_EXTERN PetscReal      PeriBondsBytesPerParticle(PetscReal, PetscReal);
+PETSC_EXTERN PetscReal      PeriBondsBytesPerParticle(PetscReal, PetscReal, PetscBool);
 PETSC_EXTERN PetscErrorCode PeriBondsDestroy(PeriBonds *);
 PETSC_EXTERN PetscErrorCode PeriBondsReleaseGeometry(const PeriParticles *, PeriBonds *, PetscBool *);
 PETSC_EXTERN PetscErrorCode PeriBondsRestoreGeometry(const PeriParticles *, PetscReal, const PetscReal[], PeriPartialVolume, PeriBonds *);

@@ -54,6 +54,7 @@ typedef struct {
   PetscBool matrix_free;         /* uses K through MatMult and PeriStiffnessScaleBond only: K may be matrix-free (solver.operator) */
   PetscBool static_solver;       /* solves with the static KSP, K of its default type (PeriStaticDefaultMatType); else K is AIJ */
   PetscReal matrix_copies;       /* copies of K it holds beside K (the quasi-static loop solves on one: 1) */
+  PetscBool operator_only;       /* applies K only through its product (explicit dynamics): no matrix at all where the operator applies the model */
   PetscReal factor_fill;         /* a direct factorization of K, its fill in matrices per log2(particles) (nested dissection measured 0.45), or 0 */
   PetscReal iterative_dofs;      /* from this many DOFs on it solves iteratively by default (no factorization, K matrix-free where the operator applies), or 0 */
   PetscReal iterative_dofs_grid; /* the same for a grid body, where it takes the iterative solver sooner (0: as iterative_dofs) */

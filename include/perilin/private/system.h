@@ -141,10 +141,12 @@ PETSC_EXTERN PetscErrorCode PeriReferenceEvaluate(PeriSystem);
 PETSC_EXTERN void           PeriReferenceDisplacement(PeriSystem, const PetscReal[], PetscReal[]);
 /* failure, cracks, damage, pieces (src/system/failure.c) */
 /* fictitious boundary layers and torsion (src/system/layers.c) */
-PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel, const PeriSystemNeeds *);
-PETSC_EXTERN PetscErrorCode PeriParticlesCheckMemoryRead(MPI_Comm, PeriScene, PeriModel, const PeriSystemNeeds *, PetscInt, PetscReal);
-PETSC_EXTERN PetscErrorCode PeriSystemReleaseBondGeometry(PeriSystem, PetscBool *);
-PETSC_EXTERN PetscErrorCode PeriSystemRestoreBondGeometry(PeriSystem, PetscBool);
+PETSC_EXTERN PetscErrorCode    PeriParticlesCheckMemory(MPI_Comm, PeriScene, PeriModel, const PeriSystemNeeds *);
+PETSC_EXTERN PetscErrorCode    PeriSystemBondsLean(PeriScene, PeriModel, PetscBool, PetscBool, PetscBool, PetscBool *);
+PETSC_EXTERN const char *const PeriHorizonSpacings[];
+PETSC_EXTERN PetscErrorCode    PeriParticlesCheckMemoryRead(MPI_Comm, PeriScene, PeriModel, const PeriSystemNeeds *, PetscInt, PetscReal);
+PETSC_EXTERN PetscErrorCode    PeriSystemReleaseBondGeometry(PeriSystem, PetscBool *);
+PETSC_EXTERN PetscErrorCode    PeriSystemRestoreBondGeometry(PeriSystem, PetscBool);
 
 /* summary.json sections (src/system/system_summary.c) */
 PETSC_EXTERN PetscErrorCode PeriSystemSummaryModel(PeriSystem, PeriJSON);
