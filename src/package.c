@@ -201,6 +201,47 @@ static const char *const own_options[][2] = {
     {"-scene_doc_check FILE", "fail when the key tables of FILE are out of date"},
 };
 
+/* Whether the option name (with its '-') is one of perilin's own <bool> options. */
+static PetscBool OwnBool(const char name[])
+{
+  size_t n = strlen(name);
+  for (size_t k = 0; k < PETSC_STATIC_ARRAY_LENGTH(own_options); k++)
+    if (!strncmp(own_options[k][0], name, n) && !strcmp(own_options[k][0] + n, " <bool>")) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
+/*@C
+  PeriOptionsCheckOwnBools - refuses a value of perilin's own <bool> options (-progress,
+  -peri_memory_check, ...) that is no boolean, naming the option, before anything reads it
+  (PETSc's refusal names the value only). Marks no option as read. Collective: every rank has the
+  same options.
+@*/
+PetscErrorCode PeriOptionsCheckOwnBools(MPI_Comm comm)
+{
+  char *all, *tok, *save = NULL, *name = NULL, msg[256] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetAll(NULL, &all));
+  for (tok = strtok_r(all, " \t\n", &save); tok && !msg[0]; tok = strtok_r(NULL, " \t\n", &save)) {
+    PetscBool      b;
+    PetscErrorCode ierr;
+    if (tok[0] == '-') { /* a boolean value never starts with '-': the next option's name */
+      name = tok;
+      continue;
+    }
+    if (name && OwnBool(name)) {
+      PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+      ierr = PetscOptionsStringToBool(tok, &b);
+      PetscCall(PetscPopErrorHandler());
+      if (ierr) PetscCall(PetscSNPrintf(msg, sizeof(msg), "option %s: '%s' is not a boolean (true or false; also yes, no, on, off, 1, 0)", name, tok));
+    }
+    name = NULL;
+  }
+  PetscCall(PetscFree(all));
+  PetscCheck(!msg[0], comm, PETSC_ERR_USER_INPUT, "%s", msg);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriPrintHelp - perilin's usage, its own options, then every scene key with its meaning (perilin
   -help). PETSc's options are not listed: perilin -help petsc prints them after this. Collective.

@@ -302,7 +302,8 @@ PetscErrorCode PeriProblemCheckOptions(PeriProblem p)
 {
   PetscFunctionBeginUser;
   PetscCall(PeriOptionsCheckScene(p->comm, p->scene));
-  PetscCall(PeriOptionsCheckTypes(p->comm)); /* before PETSc's leaking refusal of an unknown type */
+  PetscCall(PeriOptionsCheckTypes(p->comm));    /* before PETSc's leaking refusal of an unknown type */
+  PetscCall(PeriOptionsCheckOwnBools(p->comm)); /* before a reader refuses a value without naming the option */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

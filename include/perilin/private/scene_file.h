@@ -26,6 +26,7 @@ PETSC_EXTERN PetscErrorCode PeriSceneOptionExplain(PeriScene, const char[], char
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckScene(MPI_Comm, PeriScene);
 /* Solver types named by the options, against the registered lists (src/scene/option_types.c). */
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckTypes(MPI_Comm);
+PETSC_EXTERN PetscErrorCode PeriOptionsCheckOwnBools(MPI_Comm);
 /* What the run's solvers were, so that an unread option can be explained against them. */
 typedef struct {
   MPI_Comm    comm;
