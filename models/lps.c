@@ -26,7 +26,6 @@
  * surfaces and corners included (where the family is not too lopsided, models/lattice.c), and
  * W_i >= 0 by the same bound, the springs and theta_i having the same weights. */
 #include <perilin/model.h>
-#include <perilin/scene.h>
 
 static const char *const influences[]  = {"constant", "inverse", "gaussian", NULL};
 static const char *const corrections[] = {"none", NULL};

@@ -70,6 +70,7 @@ check() {
 
 check static 'strain energy' pmb/plate_traction.yaml -grid_spacing 0.02
 check modal 'modes \(Hz\)' lamina/modal.yaml -grid_spacing 0.05
+check static_lps_lattice 'strain energy' pmb/plate_traction.yaml -grid_spacing 0.02 -model_type lps -material_nu 0.3 -model_calibration lattice -corrections_surface none
 check quasistatic 'strain energy' antiplane/cracked_bar.yaml -grid_spacing 0.05 -analysis_min_step 0.25 -quiet
 check dynamic_explicit 'explicit dynamics' ../tests/scenes/dynamic_crack.yaml -grid_spacing 0.05 -analysis_t_end 0.004
 check dynamic_implicit 'implicit dynamics' ../tests/scenes/dynamic_crack.yaml -grid_spacing 0.05 -analysis_t_end 0.002 -analysis_integrator implicit -analysis_dt 4e-4

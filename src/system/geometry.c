@@ -84,3 +84,27 @@ PetscErrorCode PeriSystemLocalDOFs(PeriSystem sys, Vec u, PetscScalar **ul)
   PetscCall(PeriDiscOwnersToGhosts(&sys->disc, MPIU_SCALAR, bs, *ul));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* horizon.spacing's choices: one horizon for the body (mean), or one per particle (own); read by
+ * the set-up (system.c) and the memory estimate (memory.c) */
+const char *const PeriHorizonSpacings[] = {"mean", "own", NULL};
+
+/*@C
+  PeriSystemBondsLean - whether the bonds are searched without their geometry (PeriBonds.no_geometry),
+  from what a scene and its model say: the set-up applies it (system.c, BondsWithoutGeometry),
+  the memory estimate (memory.c) predicts with it. own: the
+  particles have their own horizons; periodic: the body has a periodic axis; layers: fictitious
+  boundary layers. Not collective.
+@*/
+PetscErrorCode PeriSystemBondsLean(PeriScene s, PeriModel m, PetscBool own, PetscBool periodic, PetscBool layers, PetscBool *lean)
+{
+  PetscBool release = PETSC_TRUE;
+  PeriNode  failure, cracks;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_release_bond_geometry", &release, NULL));
+  PetscCall(PeriSceneGetNode(s->root, "failure", &failure));
+  PetscCall(PeriSceneGetNode(s->root, "cracks", &cracks));
+  *lean = (PetscBool)(release && m->central_force && !PeriModelHasFamilies(m) && m->calibration == PERI_CALIBRATION_CONTINUUM && !own && !periodic && !layers && !failure && !cracks);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

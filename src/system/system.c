@@ -13,13 +13,12 @@ static const PeriKey     model_keys[] = {
         {"calibration", PERI_KEY_CHOICE, NULL, NULL, NULL, PeriCalibrationKinds, "lattice: each particle's discrete family reproduces the continuum's moments, so every homogeneous strain has the target energy, at surfaces too (docs/models/lattice.md; the default of pds, mppd, gerstle; lps weighs each family by its own particle's multipliers, docs/models/lps.md); patch: lattice, then every bond corrected so that on any cloud (graded, stochastic) affine fields are equilibria and dilations have the target energy at every interior particle (bond-based central-force models; docs/mesh.md, \"Patch tests\"); continuum: micromoduli from the continuous horizon (the papers'; the default of the others)"},
         {NULL},
 };
-const char *const    PeriHorizonSpacings[] = {"mean", "own", NULL};
-static const PeriKey horizon_keys[]        = {
-           {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the spacing: delta = m dx (may be fractional); m, delta or neighbors is required"},
-           {"delta", PERI_KEY_REAL, NULL, NULL, "[length]", NULL, "the horizon radius, instead of m"},
-           {"neighbors", PERI_KEY_INT, NULL, "[2, 1000]", NULL, NULL, "instead of m or delta: each particle's horizon holds this many neighbours (the midpoint of its k-th and (k+1)-th nearest distances; Ganzenmüller et al. take 30 on stochastic tetrahedral meshes), a pair bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md"},
-           {"spacing", PERI_KEY_CHOICE, "mean", NULL, NULL, PeriHorizonSpacings, "the spacing m multiplies: mean (one horizon for the body) or own (each particle's own spacing: a horizon per particle, for graded and stochastic meshes; a pair is bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md)"},
-           {NULL},
+static const PeriKey horizon_keys[] = {
+    {"m", PERI_KEY_REAL, NULL, "[1, inf)", NULL, NULL, "the horizon as a multiple of the spacing: delta = m dx (may be fractional); m, delta or neighbors is required"},
+    {"delta", PERI_KEY_REAL, NULL, NULL, "[length]", NULL, "the horizon radius, instead of m"},
+    {"neighbors", PERI_KEY_INT, NULL, "[2, 1000]", NULL, NULL, "instead of m or delta: each particle's horizon holds this many neighbours (the midpoint of its k-th and (k+1)-th nearest distances; Ganzenmüller et al. take 30 on stochastic tetrahedral meshes), a pair bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md"},
+    {"spacing", PERI_KEY_CHOICE, "mean", NULL, NULL, PeriHorizonSpacings, "the spacing m multiplies: mean (one horizon for the body) or own (each particle's own spacing: a horizon per particle, for graded and stochastic meshes; a pair is bonded within the larger of its two horizons; pmb and npmb; docs/mesh.md)"},
+    {NULL},
 };
 static const PeriKey corrections_keys[] = {
     {"partial_volume", PERI_KEY_CHOICE, "linear_continued", NULL, NULL, PeriPartialVolumes, "partial volumes of the particles the horizon cuts: none, linear (alpha ramp cut at delta), linear_continued (the ramp continued to delta + dx/2)"},
@@ -458,25 +457,6 @@ static PetscErrorCode BondsWithoutGeometry(PeriSystem sys, PetscBool *lean)
 
   PetscFunctionBeginUser;
   PetscCall(PeriSystemBondsLean(sys->scene, sys->model, (PetscBool)(d->horizon != NULL), (PetscBool)(d->particles.periodic[0] || d->particles.periodic[1] || d->particles.periodic[2]), (PetscBool)(sys->conditions.layers.nfaces > 0), lean));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/*@C
-  PeriSystemBondsLean - the rule of BondsWithoutGeometry from what a scene and its model say:
-  the set-up applies it, the memory estimate (src/system/memory.c) predicts with it. own: the
-  particles have their own horizons; periodic: the body has a periodic axis; layers: fictitious
-  boundary layers. Not collective.
-@*/
-PetscErrorCode PeriSystemBondsLean(PeriScene s, PeriModel m, PetscBool own, PetscBool periodic, PetscBool layers, PetscBool *lean)
-{
-  PetscBool release = PETSC_TRUE;
-  PeriNode  failure, cracks;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_release_bond_geometry", &release, NULL));
-  PetscCall(PeriSceneGetNode(s->root, "failure", &failure));
-  PetscCall(PeriSceneGetNode(s->root, "cracks", &cracks));
-  *lean = (PetscBool)(release && m->central_force && !PeriModelHasFamilies(m) && m->calibration == PERI_CALIBRATION_CONTINUUM && !own && !periodic && !layers && !failure && !cracks);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
