@@ -210,6 +210,22 @@ static PetscBool OwnBool(const char name[])
   return PETSC_FALSE;
 }
 
+/* PeriOptionsEachValue's check for perilin's own <bool> options */
+static PetscErrorCode CheckOwnBool(const char name[], const char value[], void *ctx, char msg[], size_t len)
+{
+  PetscBool      b;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  (void)ctx;
+  if (!OwnBool(name)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = PetscOptionsStringToBool(value, &b);
+  PetscCall(PetscPopErrorHandler());
+  if (ierr) PetscCall(PetscSNPrintf(msg, len, "option %s: '%s' is not a boolean (true or false; also yes, no, on, off, 1, 0)", name, value));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /*@C
   PeriOptionsCheckOwnBools - refuses a value of perilin's own <bool> options (-progress,
   -peri_memory_check, ...) that is no boolean, naming the option, before anything reads it
@@ -218,25 +234,11 @@ static PetscBool OwnBool(const char name[])
 @*/
 PetscErrorCode PeriOptionsCheckOwnBools(MPI_Comm comm)
 {
-  char *all, *tok, *save = NULL, *name = NULL, msg[256] = "";
+  char *all, msg[256];
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsGetAll(NULL, &all));
-  for (tok = strtok_r(all, " \t\n", &save); tok && !msg[0]; tok = strtok_r(NULL, " \t\n", &save)) {
-    PetscBool      b;
-    PetscErrorCode ierr;
-    if (tok[0] == '-') { /* a boolean value never starts with '-': the next option's name */
-      name = tok;
-      continue;
-    }
-    if (name && OwnBool(name)) {
-      PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-      ierr = PetscOptionsStringToBool(tok, &b);
-      PetscCall(PetscPopErrorHandler());
-      if (ierr) PetscCall(PetscSNPrintf(msg, sizeof(msg), "option %s: '%s' is not a boolean (true or false; also yes, no, on, off, 1, 0)", name, tok));
-    }
-    name = NULL;
-  }
+  PetscCall(PeriOptionsEachValue(all, CheckOwnBool, NULL, msg, sizeof(msg)));
   PetscCall(PetscFree(all));
   PetscCheck(!msg[0], comm, PETSC_ERR_USER_INPUT, "%s", msg);
   PetscFunctionReturn(PETSC_SUCCESS);

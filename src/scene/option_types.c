@@ -61,6 +61,41 @@ static PetscBool EndsWith(const char name[], const char suffix[])
 }
 
 /*@C
+  PeriOptionsEachValue - calls check(name, value, ctx, msg, len) for every option of the option
+  string opts ("-ksp_type cg -pc_type gamg", as PetscOptionsGetAll gives the database) that has a
+  value, in order, until one sets msg (len bytes; "" when none does). A token starting with '-'
+  is an option's name: no value this walk serves (a type, a boolean) starts with one. Not
+  collective.
+@*/
+PetscErrorCode PeriOptionsEachValue(const char opts[], PetscErrorCode (*check)(const char[], const char[], void *, char[], size_t), void *ctx, char msg[], size_t len)
+{
+  char *copy, *tok, *save = NULL, *name = NULL;
+
+  PetscFunctionBeginUser;
+  msg[0] = 0;
+  PetscCall(PetscStrallocpy(opts, &copy));
+  for (tok = strtok_r(copy, " \t\n", &save); tok && !msg[0]; tok = strtok_r(NULL, " \t\n", &save)) {
+    if (tok[0] == '-') {
+      name = tok;
+      continue;
+    }
+    if (name) PetscCall(check(name, tok, ctx, msg, len));
+    name = NULL;
+  }
+  PetscCall(PetscFree(copy));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* PeriOptionsEachValue's check for the solver types (ctx: the TypeOption table, NULL-ended) */
+static PetscErrorCode CheckTypeValue(const char name[], const char value[], void *ctx, char msg[], size_t len)
+{
+  PetscFunctionBeginUser;
+  for (const TypeOption *t = (const TypeOption *)ctx; t->suffix && !msg[0]; t++)
+    if (EndsWith(name, t->suffix)) PetscCall(CheckOne(t, name, value, msg, len));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/*@C
   PeriOptionsCheckTypesString - checks the solver types an option string names ("-ksp_type cg
   -pc_type gamg", as PetscOptionsGetAll gives the database or as a tune configuration is written):
   msg (len bytes) says the first unknown one with the option, the closest names and every
@@ -68,30 +103,18 @@ static PetscBool EndsWith(const char name[], const char suffix[])
 @*/
 PetscErrorCode PeriOptionsCheckTypesString(const char opts[], char msg[], size_t len)
 {
-  const TypeOption types[] = {
+  TypeOption types[] = {
       {"ksp_type", "KSP", &KSPList},
       {"pc_type", "PC", &PCList},
       {"st_type", "ST", &STList},
+      {NULL, NULL, NULL},
   };
-  char *copy, *tok, *save = NULL, *name = NULL;
 
   PetscFunctionBeginUser;
-  msg[0] = 0;
   PetscCall(KSPInitializePackage()); /* the lists are filled when their package starts */
   PetscCall(PCInitializePackage());
   PetscCall(STInitializePackage());
-  PetscCall(PetscStrallocpy(opts, &copy));
-  for (tok = strtok_r(copy, " \t\n", &save); tok && !msg[0]; tok = strtok_r(NULL, " \t\n", &save)) {
-    /* a type name never starts with '-': such a token is the next option's name */
-    if (tok[0] == '-') {
-      name = tok;
-      continue;
-    }
-    for (size_t k = 0; name && k < sizeof(types) / sizeof(types[0]); k++)
-      if (EndsWith(name, types[k].suffix)) PetscCall(CheckOne(&types[k], name, tok, msg, len));
-    name = NULL;
-  }
-  PetscCall(PetscFree(copy));
+  PetscCall(PeriOptionsEachValue(opts, CheckTypeValue, types, msg, len));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -27,6 +27,7 @@ PETSC_EXTERN PetscErrorCode PeriOptionsCheckScene(MPI_Comm, PeriScene);
 /* Solver types named by the options, against the registered lists (src/scene/option_types.c). */
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckTypes(MPI_Comm);
 PETSC_EXTERN PetscErrorCode PeriOptionsCheckOwnBools(MPI_Comm);
+PETSC_EXTERN PetscErrorCode PeriOptionsEachValue(const char[], PetscErrorCode (*)(const char[], const char[], void *, char[], size_t), void *, char[], size_t);
 /* What the run's solvers were, so that an unread option can be explained against them. */
 typedef struct {
   MPI_Comm    comm;
