@@ -46,6 +46,13 @@ static PetscReal Index(const PeriCriterion *c, PeriModel m, const PeriBondGeomet
   return meas[0] > 0 ? meas[0] / crit : 0;
 }
 
+/* the bond's s_c(G) once Critical has computed it; a shear angle is no stretch */
+static PetscReal StretchLimit(const PeriCriterion *c, PeriModel m, PetscInt k)
+{
+  if (m->measure_kinds[0] != PERI_MEASURE_STRETCH || k >= c->ncritical) return -1;
+  return c->critical[k];
+}
+
 static PetscErrorCode View(const PeriCriterion *c, PeriModel m, MPI_Comm comm)
 {
   PetscFunctionBeginUser;
@@ -57,5 +64,5 @@ const PeriCriterionType PeriCriterion_Energy = {
     .name     = "energy",
     .per_bond = PETSC_TRUE,
     .keys     = {{"G", PERI_KEY_REAL, NULL, "(0, inf)", "[energy/length^2]", NULL, "energy release rate: each bond's critical stretch or shear angle from its model"}},
-    .ops      = {.setfromscene = SetFromScene, .index = Index, .view = View},
+    .ops      = {.setfromscene = SetFromScene, .index = Index, .stretch_limit = StretchLimit, .view = View},
 };

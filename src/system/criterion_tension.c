@@ -29,6 +29,13 @@ static PetscReal Index(const PeriCriterion *c, PeriModel m, const PeriBondGeomet
   return s > 0 ? s / sc : 0;
 }
 
+/* s_c itself; a softening bond is not a bound on s alone (its stiffness falls before it breaks) */
+static PetscReal StretchLimit(const PeriCriterion *c, PeriModel m, PetscInt k)
+{
+  (void)m, (void)k;
+  return c->softens || c->measure[0] != 0 ? -1 : c->value[CRITICAL];
+}
+
 static PetscReal Softening(const PeriCriterion *c, const PetscReal meas[])
 {
   const PetscReal s = meas[c->measure[0]], s0 = c->value[CRITICAL], su = c->value[ULTIMATE];
@@ -50,5 +57,5 @@ const PeriCriterionType PeriCriterion_Tension = {
     .softening_keys = {{"ultimate_stretch", PERI_KEY_REAL, NULL, "(critical_stretch, inf)", NULL, NULL, "softening (eq. 45): the stiffness falls linearly from critical_stretch to 0 here"}},
     .measures       = {PERI_MEASURE_STRETCH},
     .nmeasures      = 1,
-    .ops            = {.setfromscene = SetFromScene, .index = Index, .softening = Softening, .view = View},
+    .ops            = {.setfromscene = SetFromScene, .index = Index, .stretch_limit = StretchLimit, .softening = Softening, .view = View},
 };

@@ -277,6 +277,42 @@ PetscReal PeriBondFailureIndex(PeriSystem sys, const PeriBondGeometry *g, const 
   return idx;
 }
 
+/*@C
+  PeriFailureScreens - whether a bond's failure index is a bound on its linearized stretch alone:
+  the model's measure is PeriBondStretch's and every active criterion has ops.stretch_limit, no
+  bond softens. Then PeriBondStretchLimit bounds the stretch below which no criterion breaks it.
+  Not collective.
+@*/
+PetscBool PeriFailureScreens(PeriSystem sys)
+{
+  const PeriFailure *F = &sys->bond_state.failure;
+
+  if (sys->model->ops.bond_measures != PeriBondStretch || sys->disc.bonds.intact) return PETSC_FALSE;
+  for (PetscInt i = 0; i < F->ncriteria; i++)
+    if (F->criterion[i].active && !F->criterion[i].type->ops.stretch_limit) return PETSC_FALSE;
+  return PETSC_TRUE;
+}
+
+/*@C
+  PeriBondStretchLimit - with PeriFailureScreens, the smallest of the active criteria's stretch
+  limits of listed bond k: below it the bond's index is below 1. Negative when a criterion does not
+  know it (yet). Not collective.
+@*/
+PetscReal PeriBondStretchLimit(PeriSystem sys, PetscInt k)
+{
+  const PeriFailure *F     = &sys->bond_state.failure;
+  PetscReal          limit = PETSC_MAX_REAL;
+
+  for (PetscInt i = 0; i < F->ncriteria; i++) {
+    const PeriCriterion *c = &F->criterion[i];
+    if (!c->active) continue;
+    PetscReal v = c->type->ops.stretch_limit(c, sys->model, k);
+    if (v < 0) return -1;
+    limit = PetscMin(limit, v);
+  }
+  return limit;
+}
+
 /* The bond's failure index when its measures at unit load, meas1, are scaled by lam. */
 static PetscReal IndexAt(PeriSystem sys, const PeriBondGeometry *g, const PetscReal meas1[], PetscInt nmeas, PetscReal lam)
 {

@@ -68,6 +68,10 @@ struct _PeriCriterionType {
     /* The bond's failure index (it breaks at 1), 0 when the criterion does not apply; *cause its
        PeriFailureCause. meas[] are the model's measures of the bond. */
     PetscReal (*index)(const PeriCriterion *c, PeriModel m, const PeriBondGeometry *g, const PetscReal meas[], PeriFailureCause *cause);
+    /* Where the index is s/limit for a stretch s > 0 and 0 otherwise (a bound on tension): bond
+       k's limit, for the every-step check's screen (PeriBondsBreak); < 0 when unknown yet or when
+       the bond is not bounded so (softening). NULL: the criterion is not of that form. */
+    PetscReal (*stretch_limit)(const PeriCriterion *c, PeriModel m, PetscInt k);
     /* The share of its stiffness the bond keeps (1: untouched); NULL: brittle. */
     PetscReal (*softening)(const PeriCriterion *c, const PetscReal meas[]);
     /* Its part of the run log's "failure:" line, starting with a blank. */
@@ -115,6 +119,8 @@ PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriCracksRead(PeriSystem, PeriNode, struct _PeriCrackSet *);
 PETSC_EXTERN PetscInt       PeriCracksCut(const PeriParticles *, PeriBonds *, const struct _PeriCrackSet *, PetscInt[]);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
+PETSC_EXTERN PetscBool      PeriFailureScreens(PeriSystem);
+PETSC_EXTERN PetscReal      PeriBondStretchLimit(PeriSystem, PetscInt);
 PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriSystem, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriFailureView(const PeriFailure *, PeriModel, MPI_Comm);
