@@ -195,6 +195,7 @@ static const char *const own_options[][2] = {
     {"-peri_memory_check <bool>", "refuse a scene that does not fit in the node's available memory; default true"},
     {"-peri_release_bond_geometry <bool>", "free the bonds' geometry while a static solve runs, and search without it where nothing needs it stored; default true"},
     {"-peri_operator_springs <bool>", "the matrix-free operator keeps one number per central spring and forms its vector from the coordinates (12 bytes a bond); false: the vector itself (28 bytes, a product up to 1.2x faster on thin bodies); default true"},
+    {"-peri_failure_screen <bool>", "a time loop's every-step failure check skips, by its stretch alone, each bond well below a tension or G limit (the same bonds break); false: every live bond in full; default true"},
     {"-peri_read_chunk N", "particles per chunk rank 0 deals out from particles.file or .mesh; default 65536"},
     {"-peri_malloc_mmap_threshold N", "arrays of N bytes and more (N <= 32 MiB) are mapped on their own; default 32 MiB, 0: off"},
     {"-scene_doc_update FILE", "rewrite the key tables of FILE (docs/scene.md) from the declared keys"},

@@ -104,6 +104,8 @@ PetscErrorCode PeriFailureSetUp(PeriSystem sys)
     PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &sys->disc.bonds.intact));
     for (PetscInt k = 0; k < sys->disc.bonds.nbonds; k++) sys->disc.bonds.intact[k] = 1;
   }
+  F->screen = PETSC_TRUE;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_failure_screen", &F->screen, NULL));
   F->active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -280,14 +282,14 @@ PetscReal PeriBondFailureIndex(PeriSystem sys, const PeriBondGeometry *g, const 
 /*@C
   PeriFailureScreens - whether a bond's failure index is a bound on its linearized stretch alone:
   the model's measure is PeriBondStretch's and every active criterion has ops.stretch_limit, no
-  bond softens. Then PeriBondStretchLimit bounds the stretch below which no criterion breaks it.
+  bond softens, and -peri_failure_screen is not false. Then PeriBondStretchLimit bounds the stretch below which no criterion breaks it.
   Not collective.
 @*/
 PetscBool PeriFailureScreens(PeriSystem sys)
 {
   const PeriFailure *F = &sys->bond_state.failure;
 
-  if (sys->model->ops.bond_measures != PeriBondStretch || sys->disc.bonds.intact) return PETSC_FALSE;
+  if (!F->screen || sys->model->ops.bond_measures != PeriBondStretch || sys->disc.bonds.intact) return PETSC_FALSE;
   for (PetscInt i = 0; i < F->ncriteria; i++)
     if (F->criterion[i].active && !F->criterion[i].type->ops.stretch_limit) return PETSC_FALSE;
   return PETSC_TRUE;

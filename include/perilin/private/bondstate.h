@@ -89,6 +89,7 @@ PETSC_EXTERN PetscErrorCode PeriCriterionMagnitudeView(const PeriCriterion *, Pe
 typedef struct {
   PetscBool     active;    /* the scene has failure: */
   PetscBool     softening; /* a criterion softens bonds: bonds.intact is kept */
+  PetscBool     screen;    /* -peri_failure_screen: PeriFailureScreens may say yes */
   PetscInt      ncriteria;
   PeriCriterion criterion[PERI_MAX_CRITERIA]; /* in the order of src/system/criterion_list.h */
   PetscInt      precracked_bonds;             /* bonds the scene's cracks removed */
