@@ -30,20 +30,48 @@ static PetscErrorCode EvaluateBond(PeriSystem sys, const PetscScalar *u, PetscIn
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether every bond vector of this rank is x_j - x_i to the bit (the search's arithmetic,
+ * bonds.c: always so where the geometry is not stored), so that the screen may read the
+ * coordinates, which stay in cache, instead of 24 bytes of stored vector a bond; not so across a
+ * periodic axis. Checked once. */
+static PetscBool ScreenFromCoordinates(PeriSystem sys)
+{
+  PeriFailure     *F = &sys->bond_state.failure;
+  const PeriBonds *b = &sys->disc.bonds;
+  const PetscReal *x = sys->disc.particles.x;
+
+  if (F->screen_xi >= 0) return (PetscBool)F->screen_xi;
+  F->screen_xi = 1;
+  for (PetscInt i = b->rstart; i < b->rend && b->xi && F->screen_xi; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      for (PetscInt d = 0; d < 3; d++)
+        if (b->xi[3 * k + d] != x[3 * b->j[k] + d] + 0.0 - x[3 * i + d]) F->screen_xi = 0;
+  return (PetscBool)F->screen_xi;
+}
+
 /* With PeriFailureScreens: whether bond k of owned particle i is surely below its criteria at the
  * local DOFs u, from its linearized stretch against its limit, without the full evaluation (the
  * every-step check of a time loop: the geometry, the model's measures and each criterion's index
- * cost four times the force). The margin keeps every bond that the full evaluation could break. */
-static inline PetscBool SurelyHolds(PeriSystem sys, const PetscScalar *u, PetscInt i, PetscInt k)
+ * cost four times the force). The margin keeps every bond that the full evaluation could break.
+ * No array for the bond's vector: a vector load of scalars just stored stalls the loop. */
+static inline PetscBool SurelyHolds(PeriSystem sys, PetscInt nact, const PeriCriterion *act[], PetscBool coords, const PetscScalar *u, PetscInt i, PetscInt k)
 {
-  const PetscInt  dim = sys->model->dim, bs = sys->model->dofs, j = sys->disc.bonds.j[k];
-  const PetscReal limit = PeriBondStretchLimit(sys, k);
-  PetscReal       xi[3], len, alpha, t = 0;
+  const PeriBonds *b   = &sys->disc.bonds;
+  const PetscInt   dim = sys->model->dim, bs = sys->model->dofs, j = b->j[k];
+  const PetscReal *x     = sys->disc.particles.x;
+  PetscReal        limit = PETSC_MAX_REAL, len2 = 0, t = 0;
 
-  if (limit < 0) return PETSC_FALSE;
-  PeriDiscBondGeometry(&sys->disc, i, k, xi, &len, &alpha);
-  for (PetscInt d = 0; d < dim; d++) t += xi[d] * (PetscRealPart(u[j * bs + d]) - PetscRealPart(u[i * bs + d]));
-  return (PetscBool)(t < (1 - 1e-9) * limit * len * len);
+  for (PetscInt c = 0; c < nact; c++) {
+    const PetscReal v = act[c]->type->ops.stretch_limit(act[c], sys->model, k);
+    if (v < 0) return PETSC_FALSE; /* not known yet: the full evaluation finds it */
+    limit = PetscMin(limit, v);
+  }
+  for (PetscInt d = 0; d < dim; d++) {
+    const PetscReal e = coords ? x[3 * j + d] + 0.0 - x[3 * i + d] : b->xi[3 * k + d];
+    t += e * (PetscRealPart(u[j * bs + d]) - PetscRealPart(u[i * bs + d]));
+    len2 += e * e;
+  }
+  return (PetscBool)(t < (1 - 1e-9) * limit * len2);
 }
 
 /* Bond k of owned particle i breaks (breaks) or keeps the share soft of its stiffness: K follows
@@ -105,10 +133,12 @@ PetscErrorCode PeriBondsBreak(PeriSystem sys, Vec U, PetscBool all, PetscReal fr
   PetscCall(PeriFailureCacheBonds(sys));
   PetscCall(PeriSystemLocalDOFs(sys, U, &u));
   if (all) {
-    const PetscBool screen = PeriFailureScreens(sys);
+    const PeriCriterion *act[PERI_MAX_CRITERIA];
+    PetscInt             nact;
+    const PetscBool      screen = PeriFailureScreens(sys, &nact, act), coords = (PetscBool)(screen && ScreenFromCoordinates(sys));
     for (PetscInt i = b->rstart; i < b->rend; i++)
       for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++) {
-        if (!b->live[k] || b->j[k] == i || (screen && SurelyHolds(sys, u, i, k))) continue;
+        if (!b->live[k] || b->j[k] == i || (screen && SurelyHolds(sys, nact, act, coords, u, i, k))) continue;
         PetscCall(EvaluateBond(sys, u, i, k, &index1, &soft1, &c1));
         if (Changes(b, k, (PetscBool)(index1 >= 1), soft1)) PetscCall(ChangeBond(sys, u, i, k, (PetscBool)(index1 >= 1), soft1, c1, (PetscBool) !!released, &energy, &mine));
       }

@@ -104,7 +104,8 @@ PetscErrorCode PeriFailureSetUp(PeriSystem sys)
     PetscCall(PetscMalloc1(sys->disc.bonds.nbonds, &sys->disc.bonds.intact));
     for (PetscInt k = 0; k < sys->disc.bonds.nbonds; k++) sys->disc.bonds.intact[k] = 1;
   }
-  F->screen = PETSC_TRUE;
+  F->screen    = PETSC_TRUE;
+  F->screen_xi = -1;
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_failure_screen", &F->screen, NULL));
   F->active = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -282,37 +283,22 @@ PetscReal PeriBondFailureIndex(PeriSystem sys, const PeriBondGeometry *g, const 
 /*@C
   PeriFailureScreens - whether a bond's failure index is a bound on its linearized stretch alone:
   the model's measure is PeriBondStretch's and every active criterion has ops.stretch_limit, no
-  bond softens, and -peri_failure_screen is not false. Then PeriBondStretchLimit bounds the stretch below which no criterion breaks it.
-  Not collective.
+  bond softens, and -peri_failure_screen is not false. Then the smallest of the active criteria's
+  stretch limits of a bond (act[], n of them; PERI_MAX_CRITERIA room) is the stretch below which
+  none breaks it. Not collective.
 @*/
-PetscBool PeriFailureScreens(PeriSystem sys)
+PetscBool PeriFailureScreens(PeriSystem sys, PetscInt *n, const PeriCriterion *act[])
 {
   const PeriFailure *F = &sys->bond_state.failure;
 
+  *n = 0;
   if (!F->screen || sys->model->ops.bond_measures != PeriBondStretch || sys->disc.bonds.intact) return PETSC_FALSE;
-  for (PetscInt i = 0; i < F->ncriteria; i++)
-    if (F->criterion[i].active && !F->criterion[i].type->ops.stretch_limit) return PETSC_FALSE;
-  return PETSC_TRUE;
-}
-
-/*@C
-  PeriBondStretchLimit - with PeriFailureScreens, the smallest of the active criteria's stretch
-  limits of listed bond k: below it the bond's index is below 1. Negative when a criterion does not
-  know it (yet). Not collective.
-@*/
-PetscReal PeriBondStretchLimit(PeriSystem sys, PetscInt k)
-{
-  const PeriFailure *F     = &sys->bond_state.failure;
-  PetscReal          limit = PETSC_MAX_REAL;
-
   for (PetscInt i = 0; i < F->ncriteria; i++) {
-    const PeriCriterion *c = &F->criterion[i];
-    if (!c->active) continue;
-    PetscReal v = c->type->ops.stretch_limit(c, sys->model, k);
-    if (v < 0) return -1;
-    limit = PetscMin(limit, v);
+    if (!F->criterion[i].active) continue;
+    if (!F->criterion[i].type->ops.stretch_limit) return PETSC_FALSE;
+    act[(*n)++] = &F->criterion[i];
   }
-  return limit;
+  return PETSC_TRUE;
 }
 
 /* The bond's failure index when its measures at unit load, meas1, are scaled by lam. */

@@ -90,6 +90,7 @@ typedef struct {
   PetscBool     active;    /* the scene has failure: */
   PetscBool     softening; /* a criterion softens bonds: bonds.intact is kept */
   PetscBool     screen;    /* -peri_failure_screen: PeriFailureScreens may say yes */
+  PetscInt      screen_xi; /* the screen's bond vectors: -1 not yet known, 0 stored, 1 from the coordinates (every stored one equals x_j - x_i) */
   PetscInt      ncriteria;
   PeriCriterion criterion[PERI_MAX_CRITERIA]; /* in the order of src/system/criterion_list.h */
   PetscInt      precracked_bonds;             /* bonds the scene's cracks removed */
@@ -120,8 +121,7 @@ PETSC_EXTERN PetscErrorCode PeriCracksApply(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriCracksRead(PeriSystem, PeriNode, struct _PeriCrackSet *);
 PETSC_EXTERN PetscInt       PeriCracksCut(const PeriParticles *, PeriBonds *, const struct _PeriCrackSet *, PetscInt[]);
 PETSC_EXTERN PetscReal      PeriBondFailureIndex(PeriSystem, const PeriBondGeometry *, const PetscReal[], PeriFailureCause *);
-PETSC_EXTERN PetscBool      PeriFailureScreens(PeriSystem);
-PETSC_EXTERN PetscReal      PeriBondStretchLimit(PeriSystem, PetscInt);
+PETSC_EXTERN PetscBool      PeriFailureScreens(PeriSystem, PetscInt *, const PeriCriterion *[]);
 PETSC_EXTERN PetscReal      PeriBondCriticalLoad(PeriSystem, const PeriBondGeometry *, const PetscReal[], PetscInt);
 PETSC_EXTERN PetscReal      PeriBondSoftening(PeriSystem, const PetscReal[]);
 PETSC_EXTERN PetscErrorCode PeriFailureView(const PeriFailure *, PeriModel, MPI_Comm);
