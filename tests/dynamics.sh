@@ -44,6 +44,9 @@
 #     under a CSV table on a free plate): the rigid translation u(t) integrated exactly by hand,
 #     reached at second order in dt by both integrators (error ratio 4 +- 0.2 per halving, below
 #     2e-5 at dt 1e-4), and the kinetic energy equal to the loads' work (1e-10).
+# 14. The every-step failure check's screen on the periodic pulse with a critical stretch (its
+#     bonds across the periodic faces are not x_j - x_i, so the screen reads the stored vectors):
+#     bonds break, and with -peri_failure_screen false history.csv is the same bytes.
 # Usage: dynamics.sh PERILIN REPO
 set -u
 exe=${1:?usage: dynamics.sh PERILIN REPO}
@@ -84,6 +87,8 @@ eoi=$repo/examples/dynamics/eoi.yaml
 run eoi1 "$exe" "$eoi"
 run eoi2 mpiexec --oversubscribe -n 2 "$exe" "$eoi"
 run eoi_pmb "$exe" "$eoi" -model_type pmb
+run pscreen "$exe" "$pulse" -failure_critical_stretch 3e-4 -analysis_t_end 40
+run pnoscreen "$exe" "$pulse" -failure_critical_stretch 3e-4 -analysis_t_end 40 -peri_failure_screen false
 for dt in 2e-4 1e-4; do
   run tl_e$dt "$exe" "$repo/tests/scenes/timed_loads.yaml" -analysis_dt $dt
   run tl_i$dt "$exe" "$repo/tests/scenes/timed_loads.yaml" -analysis_dt $dt -analysis_integrator implicit
@@ -249,6 +254,9 @@ def timed_error(name):
 for kind in ("e", "i"):
     (e2, w2), (e1, w1) = timed_error(f"tl_{kind}2e-4"), timed_error(f"tl_{kind}1e-4")
     check(3.8 < e2 / e1 < 4.2 and abs(e1) < 2e-5 and max(w1, w2) < 1e-10, f"timed loads ({'explicit' if kind == 'e' else 'implicit'}): u off the exact by {e2:.3g}, {e1:.3g} at dt 2e-4, 1e-4 (ratio {e2/e1:.3f}: second order); kinetic = work to {max(w1, w2):.1g}")
+ps = dyn("pscreen")
+same = open(f"{tmp}/pscreen/history.csv", "rb").read() == open(f"{tmp}/pnoscreen/history.csv", "rb").read()
+check(ps["broken_bonds"] > 0 and same, f"the failure screen across a periodic axis (bond vectors stored, not x_j - x_i): {ps['broken_bonds']} bonds broken, history.csv the same bytes with -peri_failure_screen false")
 e1, e2 = dyn("eoi1"), dyn("eoi2")
 check(e1["broken_bonds"] == e2["broken_bonds"] and abs(e1["dissipated_energy"] / e2["dissipated_energy"] - 1) < 1e-10, f"EOI on 2 ranks = 1 rank: {e2['broken_bonds']} bonds, dissipated {e2['dissipated_energy']:.12g} vs {e1['dissipated_energy']:.12g}")
 sys.exit(bad)
