@@ -3,7 +3,7 @@
 # (-peri_stop_after_step K) and continued with -restart ends as the uninterrupted run: summary.json's
 # steps, broken bonds, energies and impactor state equal to 1e-12 (relative), history.csv the same
 # bytes, particles.pvd the same frames. Kalthoff-Winkler (bonds breaking, contact, an impactor) on 1
-# and 2 ranks (there without contact between particles); the pulse with the implicit integrator.
+# and 2 ranks (there with and without contact between particles); the pulse with the implicit integrator.
 # usage: dynamic_restart.sh PERILIN REPO [MPIRUN...]
 set -u
 exe=$1 repo=$2
@@ -53,9 +53,11 @@ case_run() { # name K launcher... -- perilin arguments
 }
 kw=("$repo/examples/dynamics/kalthoff_winkler.yaml" -grid_spacing 2e-3)
 case_run kw 100 env -- "${kw[@]}"
-# contact between particles on 2 ranks stops once the struck zone has moved farther than the
-# ghosts reach (docs/contact.md): the 2-rank case keeps the impactor and the breaking bonds
+# 2 ranks: the impactor and the breaking bonds without contact between particles, and with it
+# (its candidate pairs rebuilt from the restored positions; the default ghost layer reaches far
+# enough for the whole run: docs/contact.md)
 grep -v '^contact:' "$repo/examples/dynamics/kalthoff_winkler.yaml" > "$tmp/kw_no_contact.yaml"
 [ ${#mpirun[@]} -gt 0 ] && case_run kw_2ranks 60 "${mpirun[@]}" -- "$tmp/kw_no_contact.yaml" -grid_spacing 2.5e-3
+[ ${#mpirun[@]} -gt 0 ] && case_run kw_contact_2ranks 60 "${mpirun[@]}" -- "$repo/examples/dynamics/kalthoff_winkler.yaml" -grid_spacing 2.5e-3
 case_run pulse_implicit 8 env -- "$repo/examples/dynamics/pulse.yaml" -analysis_integrator implicit -analysis_dt 0.4 -analysis_t_end 6 -output_vtk true
 exit $fail
