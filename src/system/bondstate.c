@@ -30,22 +30,14 @@ static PetscErrorCode EvaluateBond(PeriSystem sys, const PetscScalar *u, PetscIn
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether every bond vector of this rank is x_j - x_i to the bit (the search's arithmetic,
- * bonds.c: always so where the geometry is not stored), so that the screen may read the
- * coordinates, which stay in cache, instead of 24 bytes of stored vector a bond; not so across a
- * periodic axis. Checked once. */
+/* Whether the screen may form the bond vectors from the coordinates, which stay in cache, instead
+ * of reading 24 bytes a bond (PeriSystemBondVectorsFromCoordinates; not across a periodic axis).
+ * Asked once: bonds that break later only shrink the set it holds for. */
 static PetscBool ScreenFromCoordinates(PeriSystem sys)
 {
-  PeriFailure     *F = &sys->bond_state.failure;
-  const PeriBonds *b = &sys->disc.bonds;
-  const PetscReal *x = sys->disc.particles.x;
+  PeriFailure *F = &sys->bond_state.failure;
 
-  if (F->screen_xi >= 0) return (PetscBool)F->screen_xi;
-  F->screen_xi = 1;
-  for (PetscInt i = b->rstart; i < b->rend && b->xi && F->screen_xi; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-      for (PetscInt d = 0; d < 3; d++)
-        if (b->xi[3 * k + d] != x[3 * b->j[k] + d] + 0.0 - x[3 * i + d]) F->screen_xi = 0;
+  if (F->screen_xi < 0) F->screen_xi = PeriSystemBondVectorsFromCoordinates(sys);
   return (PetscBool)F->screen_xi;
 }
 
@@ -67,7 +59,7 @@ static inline PetscBool SurelyHolds(PeriSystem sys, PetscInt nact, const PeriCri
     limit = PetscMin(limit, v);
   }
   for (PetscInt d = 0; d < dim; d++) {
-    const PetscReal e = coords ? x[3 * j + d] + 0.0 - x[3 * i + d] : b->xi[3 * k + d];
+    const PetscReal e = coords ? x[3 * j + d] - x[3 * i + d] : b->xi[3 * k + d];
     t += e * (PetscRealPart(u[j * bs + d]) - PetscRealPart(u[i * bs + d]));
     len2 += e * e;
   }

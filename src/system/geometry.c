@@ -40,6 +40,25 @@ PetscErrorCode PeriSystemBondGeometry(PeriSystem sys, PetscInt i, PetscInt k, Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/*@C
+  PeriSystemBondVectorsFromCoordinates - whether every live bond of this rank to another particle
+  has the vector X_j - X_i to the bit, so that a loop over the bonds may form it from the
+  coordinates instead of reading it (the operator's spring form, the failure screen). A periodic
+  image's is not; a list without stored vectors has them so. Not collective.
+@*/
+PetscBool PeriSystemBondVectorsFromCoordinates(PeriSystem sys)
+{
+  const PeriBonds *b = &sys->disc.bonds;
+  const PetscReal *x = sys->disc.particles.x;
+
+  if (!b->xi) return PETSC_TRUE;
+  for (PetscInt i = b->rstart; i < b->rend; i++)
+    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
+      for (PetscInt d = 0; d < 3 && b->live[k] && b->j[k] != i; d++)
+        if (b->xi[3 * k + d] != x[3 * b->j[k] + d] - x[3 * i + d]) return PETSC_FALSE;
+  return PETSC_TRUE;
+}
+
 /* Gathers the family of owned particle i from sys->disc.family (state-based models). */
 PetscErrorCode PeriSystemFamilyGeometry(PeriSystem sys, PetscInt i, PetscInt *n, PeriBondGeometry fam[])
 {

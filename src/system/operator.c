@@ -694,9 +694,6 @@ static inline PetscBool OperatorBond(const PeriBonds *b, PetscInt i, PetscInt k)
  * vector is X_j - X_i to the bit (a periodic image's is not; a list without vectors has them so). */
 static PetscErrorCode SpringsFromCoordinates(PeriSystem sys, const PeriOperator op, PetscBool *springs)
 {
-  const PeriBonds *b = &sys->disc.bonds;
-  const PetscReal *x = sys->disc.particles.x;
-
   PetscFunctionBeginUser;
   *springs = PETSC_TRUE;
   /* the product gathers X_j beside u_j: 1.20x the vector form's time on the thin 102,400-site
@@ -704,11 +701,7 @@ static PetscErrorCode SpringsFromCoordinates(PeriSystem sys, const PeriOperator 
      caches), 1.1x on a cube, for 16 bytes less a bond (docs/performance.md) */
   PetscCall(PetscOptionsGetBool(NULL, NULL, "-peri_operator_springs", springs, NULL));
   if (op->form != FORM_CENTRAL || sys->model->ops.bond_state) *springs = PETSC_FALSE;
-  if (!*springs || !b->xi) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt i = b->rstart; i < b->rend; i++)
-    for (PetscInt k = b->offset[i - b->rstart]; k < b->offset[i - b->rstart + 1]; k++)
-      for (PetscInt d = 0; d < 3 && OperatorBond(b, i, k); d++)
-        if (b->xi[3 * k + d] != x[3 * b->j[k] + d] - x[3 * i + d]) *springs = PETSC_FALSE;
+  if (*springs) *springs = PeriSystemBondVectorsFromCoordinates(sys);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -98,6 +98,7 @@ PETSC_EXTERN const char    *PeriMultigridWhyNotBody(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemDestroy(PeriSystem *);
 PETSC_EXTERN PetscErrorCode PeriSystemCreateVec(PeriSystem, Vec *);
 PETSC_EXTERN PetscErrorCode PeriSystemBondGeometry(PeriSystem, PetscInt, PetscInt, PeriBondGeometry *);
+PETSC_EXTERN PetscBool      PeriSystemBondVectorsFromCoordinates(PeriSystem);
 PETSC_EXTERN PetscErrorCode PeriSystemFamilyGeometry(PeriSystem, PetscInt, PetscInt *, PeriBondGeometry[]);
 PETSC_EXTERN PetscInt       PeriSystemMaxFamily(PeriSystem);
 
